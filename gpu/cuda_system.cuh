@@ -1,0 +1,90 @@
+// The CUDA backend's execution system: stream-ordered allocation (cudaMallocAsync from the device's
+// memory pool, also for Thrust's temporaries), Thrust's par_nosync policy on one stream, and every
+// CUDA call checked. Only compiled by nvcc.
+#pragma once
+
+#include <cuda_runtime.h>
+
+#include <string>
+
+#include <thrust/system/cuda/execution_policy.h>
+
+#include "gpu/delaunay_backend.hpp"
+
+namespace galpha::detail {
+
+/// Turns a failed CUDA call into an EngineError and clears the sticky error state where CUDA allows.
+inline void CheckCuda(cudaError_t result, const char* what) {
+  if (result == cudaSuccess) return;
+  cudaGetLastError();  // clear a non-sticky error so the next build starts clean
+  const auto kind = result == cudaErrorMemoryAllocation ? EngineError::Kind::kResourceExhausted
+                                                        : EngineError::Kind::kInternal;
+  throw EngineError(kind, std::string(what) + ": " + cudaGetErrorString(result));
+}
+
+/// Thrust temporary storage taken from the stream-ordered pool instead of cudaMalloc.
+class StreamOrderedAllocator {
+ public:
+  using value_type = char;
+  explicit StreamOrderedAllocator(cudaStream_t stream) : stream_(stream) {}
+  char* allocate(std::ptrdiff_t bytes) {
+    void* p = nullptr;
+    CheckCuda(cudaMallocAsync(&p, static_cast<size_t>(bytes), stream_), "cudaMallocAsync (thrust temp)");
+    return static_cast<char*>(p);
+  }
+  void deallocate(char* p, size_t) { cudaFreeAsync(p, stream_); }
+
+ private:
+  cudaStream_t stream_;
+};
+
+/// The CUDA backend on one stream.
+class CudaSystem {
+ public:
+  static constexpr const char* kName = "cuda";
+
+  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream) {}
+
+  auto policy() { return thrust::cuda::par_nosync(temp_).on(stream_); }
+
+  template <class T>
+  T* Allocate(size_t count) {
+    if (count == 0) return nullptr;
+    void* p = nullptr;
+    CheckCuda(cudaMallocAsync(&p, count * sizeof(T), stream_), "cudaMallocAsync");
+    return static_cast<T*>(p);
+  }
+  void Free(void* p) { cudaFreeAsync(p, stream_); }
+
+  template <class T>
+  void ToHost(T* host, const T* device, size_t count) {
+    if (count == 0) return;
+    CheckCuda(cudaMemcpyAsync(host, device, count * sizeof(T), cudaMemcpyDeviceToHost, stream_),
+              "cudaMemcpyAsync to host");
+    CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+  }
+  template <class T>
+  void FromHost(T* device, const T* host, size_t count) {
+    if (count == 0) return;
+    CheckCuda(cudaMemcpyAsync(device, host, count * sizeof(T), cudaMemcpyHostToDevice, stream_),
+              "cudaMemcpyAsync to device");
+    // The host buffer may be pageable and short-lived: wait until the copy has consumed it.
+    CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+  }
+  template <class T>
+  T Read(const T* device) {
+    T value;
+    ToHost(&value, device, 1);
+    return value;
+  }
+  void Synchronize() {
+    CheckCuda(cudaGetLastError(), "kernel launch");
+    CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+  }
+
+ private:
+  cudaStream_t stream_;
+  StreamOrderedAllocator temp_;
+};
+
+}  // namespace galpha::detail

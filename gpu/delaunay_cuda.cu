@@ -1,0 +1,47 @@
+// The CUDA instantiation of the triangulation pipeline: one stream, stream-ordered memory.
+#include <cuda_runtime.h>
+
+#include "gpu/cuda_system.cuh"
+#include "gpu/delaunay_backend.hpp"
+#include "gpu/delaunay_impl.cuh"
+
+namespace galpha::detail {
+
+bool CudaDeviceVisible() {
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess) {
+    cudaGetLastError();
+    return false;
+  }
+  return count > 0;
+}
+
+namespace {
+
+/// A stream owned for the duration of one call when the caller brings none.
+class OwnedStream {
+ public:
+  OwnedStream() { CheckCuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate"); }
+  ~OwnedStream() { cudaStreamDestroy(stream_); }
+  OwnedStream(const OwnedStream&) = delete;
+  OwnedStream& operator=(const OwnedStream&) = delete;
+  cudaStream_t get() const { return stream_; }
+
+ private:
+  cudaStream_t stream_ = nullptr;
+};
+
+}  // namespace
+
+void TriangulateOnCuda(const Point2* points, uint32_t n, void* stream, DelaunayOutput* out) {
+  if (stream != nullptr) {
+    CudaSystem system(static_cast<cudaStream_t>(stream));
+    RunTriangulation(system, points, n, out);
+    return;
+  }
+  OwnedStream owned;
+  CudaSystem system(owned.get());
+  RunTriangulation(system, points, n, out);
+}
+
+}  // namespace galpha::detail

@@ -1,0 +1,225 @@
+// Parallel Lawson flips (gDel2D): every active triangle proposes to flip its first non-Delaunay
+// edge; a proposal wins when it holds the minimum vote on both triangles it touches, so no
+// triangle takes part in two flips at once. Also the serial repair of hull triangles that are flat
+// only in the symbolic perturbation.
+#pragma once
+
+#include <cstdint>
+
+#include <cuda/atomic>
+
+#include "core/hd.hpp"
+#include "core/predicates.hpp"
+#include "gpu/mesh.cuh"
+
+namespace galpha::detail {
+
+constexpr uint32_t kNoFlipVote = ~0u;
+constexpr int32_t kNoPartner = -1;
+
+/// The two triangles of a flip before it happens: t = (r, p, q) with the flipped edge p-q opposite
+/// position k, and nb = (s, q, p) with s at position j. After it: t = (r, p, s), nb = (s, q, r).
+/// Edges (r,p) and (s,q) stay in their slots; edge (p,s) moves from nb to t and (q,r) from t to nb.
+struct FlipPlan {
+  int32_t t, nb;
+  int k, j;
+};
+
+/// Writes the flipped pair; outside neighbours are the old ones (the caller re-links).
+GALPHA_HD inline void WriteFlip(const MeshView& mesh, const FlipPlan& f) {
+  const Tri x = mesh.tri[f.t], y = mesh.tri[f.nb];
+  const TriNbr nx = mesh.nbr[f.t], ny = mesh.nbr[f.nb];
+  const int32_t r = x.v[f.k], p = x.v[Next(f.k)];
+  const int32_t s = y.v[f.j], q = y.v[Next(f.j)];
+  const int32_t across_rp = nx.n[Prev(f.k)], across_qr = nx.n[Next(f.k)];
+  const int32_t across_ps = ny.n[Next(f.j)], across_sq = ny.n[Prev(f.j)];
+  mesh.tri[f.t] = Tri{{r, p, s}};
+  mesh.nbr[f.t] = TriNbr{{across_ps, f.nb, across_rp}};
+  mesh.tri[f.nb] = Tri{{s, q, r}};
+  mesh.nbr[f.nb] = TriNbr{{across_qr, f.t, across_sq}};
+}
+
+/// Each active triangle proposes its first edge that must flip and votes on both triangles.
+struct ProposeFlips {
+  MeshView mesh;
+  const int32_t* active;
+  int8_t* proposal_edge;     // per active entry: k, or -1
+  int32_t* proposal_nb;      // per active entry: the neighbour across that edge
+  uint32_t* flip_vote;       // per triangle, kNoFlipVote when untouched
+  bool hull_may_change;
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = active[i];
+    proposal_edge[i] = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (mesh.ShouldFlip(t, k, hull_may_change)) {
+        const int32_t nb = mesh.nbr[t].n[k];
+        proposal_edge[i] = static_cast<int8_t>(k);
+        proposal_nb[i] = nb;
+        cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[t]).fetch_min(static_cast<uint32_t>(t));
+        cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[nb]).fetch_min(static_cast<uint32_t>(t));
+        return;
+      }
+    }
+  }
+};
+
+/// Performs the proposals that won both votes, and records each triangle's flip partner.
+struct ExecuteFlips {
+  MeshView mesh;
+  const int32_t* active;
+  int8_t* proposal_edge;     // set to 3 for a winner (re-linked next), kept for losers
+  const int32_t* proposal_nb;
+  const uint32_t* flip_vote;
+  int32_t* partner;
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    if (proposal_edge[i] < 0) return;
+    const int32_t t = active[i], nb = proposal_nb[i];
+    if (flip_vote[t] != static_cast<uint32_t>(t) || flip_vote[nb] != static_cast<uint32_t>(t)) return;
+    const int k = proposal_edge[i];
+    const Tri x = mesh.tri[t];
+    const int j = mesh.EdgePos(nb, x.v[Prev(k)], x.v[Next(k)]);
+    WriteFlip(mesh, FlipPlan{t, nb, k, j});
+    partner[t] = nb;
+    partner[nb] = t;
+    proposal_edge[i] = 3;
+  }
+};
+
+/// After ExecuteFlips: points each flipped triangle's outside edges at their current owners, and
+/// untouched neighbours of a moved edge back at the flipped triangle. One writer per slot.
+struct LinkFlips {
+  MeshView mesh;
+  const int32_t* active;
+  const int8_t* proposal_edge;
+  const int32_t* proposal_nb;
+  const int32_t* partner;
+
+  GALPHA_HD void Relink(int32_t y, int pos, bool moved) const {
+    const int32_t x = mesh.nbr[y].n[pos];
+    const int32_t a = mesh.tri[y].v[Next(pos)], b = mesh.tri[y].v[Prev(pos)];
+    const int32_t px = partner[x];
+    if (px != kNoPartner) {
+      mesh.nbr[y].n[pos] = mesh.EdgePos(x, b, a) >= 0 ? x : px;
+    } else if (moved) {
+      mesh.nbr[x].n[mesh.EdgePos(x, b, a)] = y;
+    }
+  }
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    if (proposal_edge[i] != 3) return;
+    const int32_t t = active[i], nb = proposal_nb[i];
+    Relink(t, 0, true);
+    Relink(t, 2, false);
+    Relink(nb, 0, true);
+    Relink(nb, 2, false);
+  }
+};
+
+/// Clears the votes and partners one iteration used, and lists the triangles to check next: both
+/// triangles of a flip, and the proposer of a flip that lost. `stamp` de-duplicates the list.
+struct CollectNextActive {
+  const int32_t* active;
+  const int8_t* proposal_edge;
+  const int32_t* proposal_nb;
+  uint32_t* flip_vote;
+  int32_t* partner;
+  uint32_t* stamp;
+  uint32_t generation;
+  int32_t* candidates;  // two per active entry, -1 when unused
+
+  GALPHA_HD bool Claim(int32_t t) const {
+    return cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(stamp[t]).exchange(generation) != generation;
+  }
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    candidates[2 * i] = -1;
+    candidates[2 * i + 1] = -1;
+    if (proposal_edge[i] < 0) return;
+    const int32_t t = active[i], nb = proposal_nb[i];
+    flip_vote[t] = kNoFlipVote;
+    flip_vote[nb] = kNoFlipVote;
+    if (Claim(t)) candidates[2 * i] = t;
+    if (proposal_edge[i] == 3) {
+      partner[t] = kNoPartner;
+      partner[nb] = kNoPartner;
+      if (Claim(nb)) candidates[2 * i + 1] = nb;
+    }
+  }
+};
+
+/// Removes triangles that are flat in reality (three collinear vertices on a hull line, produced
+/// by the symbolic perturbation) so that hull points on a hull edge become hull vertices, as in
+/// CGAL. A flat triangle (m between p and q) is flipped across its long edge p-q when the triangle
+/// there is infinite (m joins the hull) or properly shaped (m joins that triangle's apex). Runs as
+/// one thread: the flat triangles lie on the hull, O(sqrt n) of them on a grid.
+struct RepairFlatHullTriangles {
+  MeshView mesh;
+  int32_t* flat;        // candidate triangle ids; -1 once repaired
+  uint32_t num_flat;
+  int32_t* failed;      // set when no progress can be made (reported as an internal error)
+  int32_t* flips_done;
+
+  GALPHA_HD bool IsFlat(int32_t t) const {
+    if (mesh.IsInfinite(t)) return false;
+    const Tri& x = mesh.tri[t];
+    return Orient2dSign(mesh.pts[x.v[0]], mesh.pts[x.v[1]], mesh.pts[x.v[2]]) == 0;
+  }
+
+  /// Position of the vertex lying between the other two (collinear vertices).
+  GALPHA_HD int MiddlePos(int32_t t) const {
+    const Tri& x = mesh.tri[t];
+    for (int k = 0; k < 3; ++k) {
+      const Point2 m = mesh.pts[x.v[k]], a = mesh.pts[x.v[Next(k)]], b = mesh.pts[x.v[Prev(k)]];
+      if ((LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a))) return k;
+    }
+    return -1;
+  }
+
+  GALPHA_HD void SerialFlip(int32_t t, int k) const {
+    const Tri x = mesh.tri[t];
+    const int32_t nb = mesh.nbr[t].n[k];
+    const int j = mesh.EdgePos(nb, x.v[Prev(k)], x.v[Next(k)]);
+    WriteFlip(mesh, FlipPlan{t, nb, k, j});
+    // The two moved edges: re-point their outside neighbours.
+    for (int32_t y : {t, nb}) {
+      const int32_t o = mesh.nbr[y].n[0];
+      const int32_t a = mesh.tri[y].v[1], b = mesh.tri[y].v[2];
+      mesh.nbr[o].n[mesh.EdgePos(o, b, a)] = y;
+    }
+  }
+
+  GALPHA_HD void operator()(uint32_t) const {
+    uint32_t remaining = num_flat;
+    int32_t flips = 0;
+    while (remaining > 0) {
+      bool progress = false;
+      for (uint32_t i = 0; i < num_flat; ++i) {
+        const int32_t t = flat[i];
+        if (t < 0) continue;
+        if (!IsFlat(t)) {
+          flat[i] = -1;
+          --remaining;
+          progress = true;
+          continue;
+        }
+        const int k = MiddlePos(t);
+        const int32_t nb = mesh.nbr[t].n[k];
+        if (k < 0 || (!mesh.IsInfinite(nb) && IsFlat(nb))) continue;
+        SerialFlip(t, k);
+        ++flips;
+        flat[i] = -1;
+        --remaining;
+        progress = true;
+      }
+      if (!progress) {
+        *failed = 1;
+        break;
+      }
+    }
+    *flips_done = flips;
+  }
+};
+
+}  // namespace galpha::detail

@@ -1,0 +1,365 @@
+// The triangulation pipeline, written once over an execution system (CpuSystem or CudaSystem):
+// dedupe -> Hilbert order -> insertion rounds with Lawson flips -> hull repair -> output.
+// Instantiated by delaunay_cpu.cpp (OpenMP) and delaunay_cuda.cu (CUDA).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <thrust/copy.h>
+#include <thrust/count.h>
+#include <thrust/fill.h>
+#include <thrust/find.h>
+#include <thrust/for_each.h>
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/zip_iterator.h>
+#include <thrust/remove.h>
+#include <thrust/scan.h>
+#include <thrust/sequence.h>
+#include <thrust/sort.h>
+#include <thrust/transform.h>
+#include <thrust/transform_reduce.h>
+#include <thrust/transform_scan.h>
+
+#include "core/predicates.hpp"
+#include "gpu/delaunay_backend.hpp"
+#include "gpu/delaunay_flip.cuh"
+#include "gpu/delaunay_insert.cuh"
+#include "gpu/delaunay_output.cuh"
+#include "gpu/engine_system.cuh"
+#include "gpu/mesh.cuh"
+#include "gpu/point_order.cuh"
+
+namespace galpha::detail {
+
+struct NotCollinearWith {
+  const Point2* pts;
+  Point2 a, b;
+  GALPHA_HD bool operator()(uint32_t input_index) const {
+    return Orient2dSign(a, b, pts[input_index]) != 0;
+  }
+};
+
+struct NotCollinearWithVertices {
+  const Point2* vp;
+  GALPHA_HD bool operator()(int32_t v) const { return Orient2dSign(vp[0], vp[1], vp[v]) != 0; }
+};
+
+struct NotInitialVertex {
+  int32_t a, b, c;
+  GALPHA_HD bool operator()(int32_t v) const { return v != a && v != b && v != c; }
+};
+
+struct IsNonNegative {
+  GALPHA_HD bool operator()(int32_t x) const { return x >= 0; }
+  GALPHA_HD bool operator()(int8_t x) const { return x >= 0; }
+};
+
+struct IsFlatFiniteTriangle {
+  MeshView mesh;
+  GALPHA_HD bool operator()(int32_t t) const {
+    if (mesh.IsInfinite(t)) return false;
+    const Tri& x = mesh.tri[t];
+    return Orient2dSign(mesh.pts[x.v[0]], mesh.pts[x.v[1]], mesh.pts[x.v[2]]) == 0;
+  }
+};
+
+struct IsFiniteTri {
+  MeshView mesh;
+  GALPHA_HD bool operator()(int32_t t) const { return !mesh.IsInfinite(t); }
+};
+
+/// The working state of one triangulation and the steps that change it.
+template <class System>
+class DelaunayBuilder {
+ public:
+  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m)
+      : sys_(sys),
+        m_(m),
+        capacity_(2 * m),
+        tri_(sys, capacity_),
+        nbr_(sys, capacity_),
+        tri_vote_(sys, capacity_),
+        split_offset_(sys, capacity_),
+        flip_vote_(sys, capacity_),
+        partner_(sys, capacity_),
+        stamp_(sys, capacity_),
+        active_(sys, capacity_),
+        candidates_(sys, 2 * capacity_),
+        proposal_edge_(sys, capacity_),
+        proposal_nb_(sys, capacity_),
+        flags_(sys, 4) {
+    mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m)};
+    thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
+    thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
+    thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
+    thrust::fill(sys_.policy(), flags_.begin(), flags_.end(), 0);
+  }
+
+  int32_t num_triangles() const { return num_tri_; }
+  const MeshView& mesh() const { return mesh_; }
+  int rounds() const { return rounds_; }
+
+  /// Starts from the triangle (a, b, c), counter-clockwise, and its three infinite neighbours.
+  void Start(int32_t a, int32_t b, int32_t c) {
+    const int32_t inf = mesh_.inf;
+    const Tri init[4] = {{{a, b, c}}, {{b, a, inf}}, {{c, b, inf}}, {{a, c, inf}}};
+    TriNbr links[4];
+    for (int t = 0; t < 4; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const int32_t p = init[t].v[Next(k)], q = init[t].v[Prev(k)];
+        for (int u = 0; u < 4; ++u) {
+          for (int j = 0; j < 3; ++j) {
+            if (u != t && init[u].v[Next(j)] == q && init[u].v[Prev(j)] == p) links[t].n[k] = u;
+          }
+        }
+      }
+    }
+    sys_.FromHost(tri_.data(), init, 4);
+    sys_.FromHost(nbr_.data(), links, 4);
+    num_tri_ = 4;
+  }
+
+  /// Inserts every pending vertex in rounds; `location` starts at a triangle of the mesh.
+  void InsertAll(int32_t* pending, int32_t* location, uint8_t* inserted, uint32_t num_pending) {
+    auto pol = sys_.policy();
+    const thrust::counting_iterator<uint32_t> first(0);
+    Relocate(pending, location, inserted, num_pending);
+    while (num_pending > 0) {
+      ++rounds_;
+      thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
+      thrust::for_each(pol, first, first + num_pending,
+                       VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
+      thrust::transform_exclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
+                                       split_offset_.data(), HasWinner(), 0, thrust::plus<int32_t>());
+      const int32_t num_split = sys_.Read(split_offset_.data() + num_tri_ - 1) +
+                                (sys_.Read(tri_vote_.data() + num_tri_ - 1) != kNoVote ? 1 : 0);
+      if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
+      const thrust::counting_iterator<int32_t> tfirst(0);
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       SplitTriangles{mesh_, tri_vote_.data(), split_offset_.data(), pending, inserted, num_tri_});
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       LinkSplitChildren{mesh_, tri_vote_.data(), split_offset_.data(), num_tri_});
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       ListSplitChildren{tri_vote_.data(), split_offset_.data(), active_.data(), num_tri_});
+      num_tri_ += 2 * num_split;
+      RestoreDelaunay(static_cast<uint32_t>(3 * num_split), /*hull_may_change=*/true);
+
+      Relocate(pending, location, inserted, num_pending);
+      auto zipped = thrust::make_zip_iterator(thrust::make_tuple(pending, location));
+      auto zipped_end = thrust::remove_if(pol, zipped, zipped + num_pending, inserted, thrust::identity<uint8_t>());
+      num_pending = static_cast<uint32_t>(zipped_end - zipped);
+      thrust::fill(pol, inserted, inserted + num_pending, uint8_t{0});
+    }
+  }
+
+  /// Removes symbolically flat hull triangles, then re-flips the finite triangles to Delaunay
+  /// with the hull fixed. Returns the number of repair flips.
+  int32_t RepairHull() {
+    auto pol = sys_.policy();
+    const thrust::counting_iterator<int32_t> tfirst(0);
+    int32_t* flat = candidates_.data();
+    const uint32_t num_flat = static_cast<uint32_t>(
+        thrust::copy_if(pol, tfirst, tfirst + num_tri_, flat, IsFlatFiniteTriangle{mesh_}) - flat);
+    if (num_flat == 0) return 0;
+    thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(1),
+                     RepairFlatHullTriangles{mesh_, flat, num_flat, flags_.data() + 1, flags_.data() + 2});
+    if (sys_.Read(flags_.data() + 1) != 0) {
+      throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+    }
+    const int32_t flips = sys_.Read(flags_.data() + 2);
+    const uint32_t num_active = static_cast<uint32_t>(
+        thrust::copy_if(pol, tfirst, tfirst + num_tri_, active_.data(), IsFiniteTri{mesh_}) - active_.data());
+    RestoreDelaunay(num_active, /*hull_may_change=*/false);
+    return flips;
+  }
+
+ private:
+  void Relocate(const int32_t* pending, int32_t* location, const uint8_t* inserted, uint32_t num_pending) {
+    const thrust::counting_iterator<uint32_t> first(0);
+    thrust::for_each(sys_.policy(), first, first + num_pending,
+                     RelocatePoint{mesh_, pending, inserted, location, flags_.data(), m_ + 16u});
+    if (sys_.Read(flags_.data()) != 0) {
+      throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
+    }
+  }
+
+  /// Parallel Lawson flips from the `count` triangles in active_ until no edge needs a flip.
+  void RestoreDelaunay(uint32_t count, bool hull_may_change) {
+    auto pol = sys_.policy();
+    const thrust::counting_iterator<uint32_t> first(0);
+    for (int iteration = 0; count > 0; ++iteration) {
+      if (iteration > (1 << 20)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
+      thrust::for_each(pol, first, first + count,
+                       ProposeFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(),
+                                    flip_vote_.data(), hull_may_change});
+      const auto proposals = thrust::count_if(pol, proposal_edge_.data(), proposal_edge_.data() + count, IsNonNegative());
+      if (proposals == 0) break;
+      thrust::for_each(pol, first, first + count,
+                       ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(),
+                                    flip_vote_.data(), partner_.data()});
+      thrust::for_each(pol, first, first + count,
+                       LinkFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(), partner_.data()});
+      ++generation_;
+      thrust::for_each(pol, first, first + count,
+                       CollectNextActive{active_.data(), proposal_edge_.data(), proposal_nb_.data(),
+                                         flip_vote_.data(), partner_.data(), stamp_.data(), generation_,
+                                         candidates_.data()});
+      count = static_cast<uint32_t>(thrust::copy_if(pol, candidates_.data(), candidates_.data() + 2 * count,
+                                                    active_.data(), IsNonNegative()) -
+                                    active_.data());
+    }
+  }
+
+  System& sys_;
+  uint32_t m_;
+  uint32_t capacity_;
+  Buffer<Tri, System> tri_;
+  Buffer<TriNbr, System> nbr_;
+  Buffer<unsigned long long, System> tri_vote_;
+  Buffer<int32_t, System> split_offset_;
+  Buffer<uint32_t, System> flip_vote_;
+  Buffer<int32_t, System> partner_;
+  Buffer<uint32_t, System> stamp_;
+  Buffer<int32_t, System> active_;
+  Buffer<int32_t, System> candidates_;
+  Buffer<int8_t, System> proposal_edge_;
+  Buffer<int32_t, System> proposal_nb_;
+  Buffer<int32_t, System> flags_;  // [0] walk failed, [1] repair failed, [2] repair flips
+  MeshView mesh_{};
+  int32_t num_tri_ = 0;
+  int rounds_ = 0;
+  uint32_t generation_ = 0;
+};
+
+template <class T, class System>
+void CopyOut(System& sys, const Buffer<T, System>& buffer, size_t count, void* host) {
+  sys.ToHost(static_cast<T*>(host), buffer.data(), count);
+}
+
+/// Runs the whole triangulation of `n` host points on `sys`, filling `out`.
+template <class System>
+void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, DelaunayOutput* out) {
+  static_assert(sizeof(std::array<uint32_t, 3>) == sizeof(Tri), "triangle layout");
+  static_assert(sizeof(std::array<int32_t, 3>) == sizeof(TriNbr), "neighbour layout");
+  static_assert(sizeof(std::array<uint32_t, 2>) == sizeof(EdgePair), "edge layout");
+  StageTimer<System> timer(sys, &out->stage_times);
+  auto pol = sys.policy();
+  const thrust::counting_iterator<uint32_t> first(0);
+
+  Buffer<Point2, System> input(sys, n);
+  sys.FromHost(input.data(), host_points, n);
+  timer.EndStage("upload");
+
+  // Exact duplicates: sort by (point, index); each run's head is the first occurrence.
+  Buffer<uint32_t, System> unique(sys, n);
+  uint32_t m = 0;
+  {
+    Buffer<uint32_t, System> sorted(sys, n);
+    Buffer<uint32_t, System> head(sys, n);
+    Buffer<uint32_t, System> representative(sys, n);
+    thrust::sequence(pol, sorted.begin(), sorted.end());
+    thrust::sort(pol, sorted.begin(), sorted.end(), PointThenIndexLess{input.data()});
+    thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data()});
+    thrust::inclusive_scan(pol, head.begin(), head.end(), head.begin(), thrust::maximum<uint32_t>());
+    thrust::for_each(pol, first, first + n, WriteRepresentative{sorted.data(), head.data(), representative.data()});
+    m = static_cast<uint32_t>(
+        thrust::copy_if(pol, sorted.begin(), sorted.end(), first, unique.begin(), IsRunHead{head.data()}) -
+        unique.begin());
+    out->representative = representative.ToHostVector(n);
+  }
+  out->num_unique = m;
+  timer.EndStage("dedupe");
+
+  // Fewer than three distinct points, or all on one line: no triangles, the sorted chain of edges.
+  bool collinear = m < 3;
+  if (!collinear) {
+    const Point2 a = sys.Read(input.data() + sys.Read(unique.data()));
+    const Point2 b = sys.Read(input.data() + sys.Read(unique.data() + m - 1));
+    collinear = thrust::find_if(pol, unique.begin(), unique.begin() + m, NotCollinearWith{input.data(), a, b}) ==
+                unique.begin() + m;
+  }
+  if (collinear) {
+    const uint32_t num_edges = m > 1 ? m - 1 : 0;
+    Buffer<EdgePair, System> edges(sys, num_edges);
+    thrust::for_each(pol, first, first + num_edges, WriteChainEdge{unique.data(), edges.data()});
+    out->edges.resize(num_edges);
+    CopyOut(sys, edges, num_edges, out->edges.data());
+    timer.EndStage("collinear_chain");
+    return;
+  }
+
+  // Hilbert order of the distinct points: neighbours in the order are neighbours in the plane.
+  Buffer<Point2, System> vertex_points(sys, m);
+  {
+    const BoundingBox box = thrust::transform_reduce(pol, input.begin(), input.end(), PointToBox(),
+                                                     PointToBox()(sys.Read(input.data())), MergeBoxes());
+    Buffer<uint64_t, System> keys(sys, m);
+    thrust::transform(pol, first, first + m, keys.begin(), HilbertKey{input.data(), unique.data(), box});
+    thrust::sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
+    thrust::for_each(pol, first, first + m, GatherVertex{input.data(), unique.data(), vertex_points.data()});
+  }
+  timer.EndStage("hilbert_sort");
+
+  // The first triangle: vertices 0, 1 and the first vertex off their line.
+  const thrust::counting_iterator<int32_t> vfirst(0);
+  const int32_t c = *thrust::find_if(pol, vfirst + 2, vfirst + m, NotCollinearWithVertices{vertex_points.data()});
+  int32_t a = 0, b = 1;
+  if (Orient2dSign(sys.Read(vertex_points.data()), sys.Read(vertex_points.data() + 1),
+                   sys.Read(vertex_points.data() + c)) < 0) {
+    a = 1;
+    b = 0;
+  }
+  DelaunayBuilder<System> builder(sys, vertex_points.data(), unique.data(), m);
+  builder.Start(a, b, c);
+  {
+    const uint32_t num_pending = m - 3;
+    Buffer<int32_t, System> pending(sys, num_pending);
+    Buffer<int32_t, System> location(sys, num_pending);
+    Buffer<uint8_t, System> inserted(sys, num_pending);
+    thrust::copy_if(pol, vfirst, vfirst + m, pending.begin(), NotInitialVertex{a, b, c});
+    thrust::fill(pol, location.begin(), location.end(), 0);
+    thrust::fill(pol, inserted.begin(), inserted.end(), uint8_t{0});
+    builder.InsertAll(pending.data(), location.data(), inserted.data(), num_pending);
+  }
+  timer.EndStage("insert_and_flip");
+  builder.RepairHull();
+  timer.EndStage("hull_repair");
+
+  // Output: finite triangles by input index, neighbours, owned edges.
+  const MeshView mesh = builder.mesh();
+  const int32_t num_tri = builder.num_triangles();
+  const thrust::counting_iterator<int32_t> tfirst(0);
+  Buffer<int32_t, System> finite_id(sys, num_tri);
+  thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_tri, finite_id.begin(), IsFiniteTriangle{mesh}, 0,
+                                   thrust::plus<int32_t>());
+  const int32_t num_finite =
+      static_cast<int32_t>(thrust::count_if(pol, tfirst, tfirst + num_tri, IsFiniteTri{mesh}));
+  Buffer<Tri, System> out_tri(sys, num_finite);
+  Buffer<TriNbr, System> out_nbr(sys, num_finite);
+  thrust::for_each(pol, tfirst, tfirst + num_tri, WriteFiniteTriangle{mesh, finite_id.data(), out_tri.data(), out_nbr.data()});
+  Buffer<uint32_t, System> edge_begin(sys, num_finite);
+  thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_finite, edge_begin.begin(),
+                                   CountOwnedEdges{out_tri.data(), out_nbr.data()}, 0u, thrust::plus<uint32_t>());
+  const uint32_t num_edges = sys.Read(edge_begin.data() + num_finite - 1) +
+                             thrust::transform_reduce(pol, tfirst + num_finite - 1, tfirst + num_finite,
+                                                      CountOwnedEdges{out_tri.data(), out_nbr.data()}, 0u,
+                                                      thrust::plus<uint32_t>());
+  Buffer<EdgePair, System> edges(sys, num_edges);
+  thrust::for_each(pol, tfirst, tfirst + num_finite,
+                   WriteOwnedEdges{out_tri.data(), out_nbr.data(), edge_begin.data(), edges.data()});
+  timer.EndStage("output");
+
+  out->triangles.resize(num_finite);
+  out->neighbors.resize(num_finite);
+  out->tri_edge_begin.resize(num_finite);
+  out->edges.resize(num_edges);
+  CopyOut(sys, out_tri, num_finite, out->triangles.data());
+  CopyOut(sys, out_nbr, num_finite, out->neighbors.data());
+  CopyOut(sys, edge_begin, num_finite, out->tri_edge_begin.data());
+  CopyOut(sys, edges, num_edges, out->edges.data());
+  timer.EndStage("download");
+}
+
+}  // namespace galpha::detail

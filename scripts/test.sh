@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# The README's second command, and what CI runs: installs what is needed, builds every target
+# (the CUDA backend too when nvcc is present, for one architecture) and runs the whole test suite.
+# Tests that need a GPU skip themselves on machines without one.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+preset=cpu
+if [ -x /usr/local/cuda/bin/nvcc ] || command -v nvcc >/dev/null; then preset=cuda; fi
+cmake --preset "$preset"
+cmake --build --preset "$preset" -j"$(nproc)"
+ctest --preset "$preset"
