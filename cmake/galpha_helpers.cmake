@@ -12,6 +12,9 @@ endfunction()
 # Thrust/libcu++ headers for code that runs the engine's algorithms.
 function(galpha_use_cccl target)
   target_include_directories(${target} SYSTEM PUBLIC ${GALPHA_CCCL_INCLUDE_DIR})
+  # Plain C++ files see Thrust with OpenMP as the "device" system; .cu files keep CUDA's.
+  target_compile_definitions(${target} PUBLIC
+    $<$<COMPILE_LANGUAGE:CXX>:THRUST_DEVICE_SYSTEM=THRUST_DEVICE_SYSTEM_OMP>)
 endfunction()
 
 # galpha_add_test(NAME name SOURCES ... LIBS ...): a GoogleTest executable registered with CTest.

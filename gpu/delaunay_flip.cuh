@@ -205,8 +205,9 @@ struct RepairFlatHullTriangles {
           continue;
         }
         const int k = MiddlePos(t);
+        if (k < 0) continue;
         const int32_t nb = mesh.nbr[t].n[k];
-        if (k < 0 || (!mesh.IsInfinite(nb) && IsFlat(nb))) continue;
+        if (!mesh.IsInfinite(nb) && IsFlat(nb)) continue;
         SerialFlip(t, k);
         ++flips;
         flat[i] = -1;

@@ -51,6 +51,10 @@ struct NotInitialVertex {
   GALPHA_HD bool operator()(int32_t v) const { return v != a && v != b && v != c; }
 };
 
+struct IsSet {
+  GALPHA_HD bool operator()(uint8_t x) const { return x != 0; }
+};
+
 struct IsNonNegative {
   GALPHA_HD bool operator()(int32_t x) const { return x >= 0; }
   GALPHA_HD bool operator()(int8_t x) const { return x >= 0; }
@@ -148,7 +152,7 @@ class DelaunayBuilder {
 
       Relocate(pending, location, inserted, num_pending);
       auto zipped = thrust::make_zip_iterator(thrust::make_tuple(pending, location));
-      auto zipped_end = thrust::remove_if(pol, zipped, zipped + num_pending, inserted, thrust::identity<uint8_t>());
+      auto zipped_end = thrust::remove_if(pol, zipped, zipped + num_pending, inserted, IsSet());
       num_pending = static_cast<uint32_t>(zipped_end - zipped);
       thrust::fill(pol, inserted, inserted + num_pending, uint8_t{0});
     }
