@@ -39,10 +39,18 @@ GALPHA_HD inline void WriteFlip(const MeshView& mesh, const FlipPlan& f) {
   mesh.nbr[f.nb] = TriNbr{{across_qr, f.t, across_sq}};
 }
 
+/// Edge masks of active triangles: which positions may have stopped being locally Delaunay. After a
+/// 1-to-3 split only a child's outside edge (position 2) can be; after a flip only the four outer
+/// edges of the quadrilateral (positions 0 and 2 of both triangles), never the new diagonal.
+constexpr uint8_t kCheckOutsideEdge = 0b100;
+constexpr uint8_t kCheckFlipOuterEdges = 0b101;
+constexpr uint8_t kCheckAllEdges = 0b111;
+
 /// Each active triangle proposes its first edge that must flip and votes on both triangles.
 struct ProposeFlips {
   MeshView mesh;
   const int32_t* active;
+  const uint8_t* active_mask;
   int8_t* proposal_edge;     // per active entry: k, or -1
   int32_t* proposal_nb;      // per active entry: the neighbour across that edge
   uint32_t* flip_vote;       // per triangle, kNoFlipVote when untouched
@@ -51,8 +59,9 @@ struct ProposeFlips {
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t t = active[i];
     proposal_edge[i] = -1;
+    const uint8_t mask = active_mask[i];
     for (int k = 0; k < 3; ++k) {
-      if (mesh.ShouldFlip(t, k, hull_may_change)) {
+      if (((mask >> k) & 1u) && mesh.ShouldFlip(t, k, hull_may_change)) {
         const int32_t nb = mesh.nbr[t].n[k];
         proposal_edge[i] = static_cast<int8_t>(k);
         proposal_nb[i] = nb;
@@ -121,6 +130,7 @@ struct LinkFlips {
 /// triangles of a flip, and the proposer of a flip that lost. `stamp` de-duplicates the list.
 struct CollectNextActive {
   const int32_t* active;
+  const uint8_t* active_mask;
   const int8_t* proposal_edge;
   const int32_t* proposal_nb;
   uint32_t* flip_vote;
@@ -128,6 +138,7 @@ struct CollectNextActive {
   uint32_t* stamp;
   uint32_t generation;
   int32_t* candidates;  // two per active entry, -1 when unused
+  uint8_t* candidate_mask;
 
   GALPHA_HD bool Claim(int32_t t) const {
     return cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(stamp[t]).exchange(generation) != generation;
@@ -140,11 +151,18 @@ struct CollectNextActive {
     const int32_t t = active[i], nb = proposal_nb[i];
     flip_vote[t] = kNoFlipVote;
     flip_vote[nb] = kNoFlipVote;
-    if (Claim(t)) candidates[2 * i] = t;
-    if (proposal_edge[i] == 3) {
+    const bool flipped = proposal_edge[i] == 3;
+    if (Claim(t)) {
+      candidates[2 * i] = t;
+      candidate_mask[2 * i] = flipped ? kCheckFlipOuterEdges : active_mask[i];
+    }
+    if (flipped) {
       partner[t] = kNoPartner;
       partner[nb] = kNoPartner;
-      if (Claim(nb)) candidates[2 * i + 1] = nb;
+      if (Claim(nb)) {
+        candidates[2 * i + 1] = nb;
+        candidate_mask[2 * i + 1] = kCheckFlipOuterEdges;
+      }
     }
   }
 };

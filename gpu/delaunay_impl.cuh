@@ -90,7 +90,9 @@ class DelaunayBuilder {
         partner_(sys, capacity_),
         stamp_(sys, capacity_),
         active_(sys, capacity_),
+        active_mask_(sys, capacity_),
         candidates_(sys, 2 * capacity_),
+        candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
         proposal_nb_(sys, capacity_),
         flags_(sys, 4) {
@@ -148,6 +150,7 @@ class DelaunayBuilder {
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
                        ListSplitChildren{tri_vote_.data(), split_offset_.data(), active_.data(), num_tri_});
       num_tri_ += 2 * num_split;
+      thrust::fill(pol, active_mask_.data(), active_mask_.data() + 3 * num_split, kCheckOutsideEdge);
       RestoreDelaunay(static_cast<uint32_t>(3 * num_split), /*hull_may_change=*/true);
 
       Relocate(pending, location, inserted, num_pending);
@@ -175,6 +178,7 @@ class DelaunayBuilder {
     const int32_t flips = sys_.Read(flags_.data() + 2);
     const uint32_t num_active = static_cast<uint32_t>(
         thrust::copy_if(pol, tfirst, tfirst + num_tri_, active_.data(), IsFiniteTri{mesh_}) - active_.data());
+    thrust::fill(pol, active_mask_.data(), active_mask_.data() + num_active, kCheckAllEdges);
     RestoreDelaunay(num_active, /*hull_may_change=*/false);
     return flips;
   }
@@ -196,7 +200,7 @@ class DelaunayBuilder {
     for (int iteration = 0; count > 0; ++iteration) {
       if (iteration > (1 << 20)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
       thrust::for_each(pol, first, first + count,
-                       ProposeFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(),
+                       ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), proposal_nb_.data(),
                                     flip_vote_.data(), hull_may_change});
       const auto proposals = thrust::count_if(pol, proposal_edge_.data(), proposal_edge_.data() + count, IsNonNegative());
       if (proposals == 0) break;
@@ -207,12 +211,13 @@ class DelaunayBuilder {
                        LinkFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(), partner_.data()});
       ++generation_;
       thrust::for_each(pol, first, first + count,
-                       CollectNextActive{active_.data(), proposal_edge_.data(), proposal_nb_.data(),
-                                         flip_vote_.data(), partner_.data(), stamp_.data(), generation_,
-                                         candidates_.data()});
-      count = static_cast<uint32_t>(thrust::copy_if(pol, candidates_.data(), candidates_.data() + 2 * count,
-                                                    active_.data(), IsNonNegative()) -
-                                    active_.data());
+                       CollectNextActive{active_.data(), active_mask_.data(), proposal_edge_.data(),
+                                         proposal_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
+                                         generation_, candidates_.data(), candidate_mask_.data()});
+      auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates_.data(), candidate_mask_.data()));
+      auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
+      count = static_cast<uint32_t>(
+          thrust::copy_if(pol, from, from + 2 * count, candidates_.data(), to, IsNonNegative()) - to);
     }
   }
 
@@ -227,7 +232,9 @@ class DelaunayBuilder {
   Buffer<int32_t, System> partner_;
   Buffer<uint32_t, System> stamp_;
   Buffer<int32_t, System> active_;
+  Buffer<uint8_t, System> active_mask_;
   Buffer<int32_t, System> candidates_;
+  Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
   Buffer<int32_t, System> proposal_nb_;
   Buffer<int32_t, System> flags_;  // [0] walk failed, [1] repair failed, [2] repair flips
