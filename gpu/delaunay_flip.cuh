@@ -178,6 +178,7 @@ struct RepairFlatHullTriangles {
   uint32_t num_flat;
   int32_t* failed;      // set when no progress can be made (reported as an internal error)
   int32_t* flips_done;
+  int32_t* touched;     // the two triangles of every repair flip, for the Lawson pass after
 
   GALPHA_HD bool IsFlat(int32_t t) const {
     if (mesh.IsInfinite(t)) return false;
@@ -227,6 +228,8 @@ struct RepairFlatHullTriangles {
         const int32_t nb = mesh.nbr[t].n[k];
         if (!mesh.IsInfinite(nb) && IsFlat(nb)) continue;
         SerialFlip(t, k);
+        touched[2 * flips] = t;
+        touched[2 * flips + 1] = nb;
         ++flips;
         flat[i] = -1;
         --remaining;

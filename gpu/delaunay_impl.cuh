@@ -21,6 +21,7 @@
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 #include <thrust/transform_scan.h>
+#include <thrust/unique.h>
 
 #include "core/predicates.hpp"
 #include "gpu/delaunay_backend.hpp"
@@ -170,14 +171,20 @@ class DelaunayBuilder {
     const uint32_t num_flat = static_cast<uint32_t>(
         thrust::copy_if(pol, tfirst, tfirst + num_tri_, flat, IsFlatFiniteTriangle{mesh_}) - flat);
     if (num_flat == 0) return 0;
+    // Each flat triangle is repaired by one flip of two triangles.
+    Buffer<int32_t, System> touched_buffer(sys_, 2 * static_cast<size_t>(num_flat));
+    int32_t* touched = touched_buffer.data();
     thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(1),
-                     RepairFlatHullTriangles{mesh_, flat, num_flat, flags_.data() + 1, flags_.data() + 2});
+                     RepairFlatHullTriangles{mesh_, flat, num_flat, flags_.data() + 1, flags_.data() + 2, touched});
     if (sys_.Read(flags_.data() + 1) != 0) {
       throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
     }
     const int32_t flips = sys_.Read(flags_.data() + 2);
+    // Only triangles a repair flip changed can hold an edge that is no longer locally Delaunay.
+    // A triangle may appear twice (two repair flips): de-duplicate before flipping in parallel.
+    thrust::sort(pol, touched, touched + 2 * flips);
     const uint32_t num_active = static_cast<uint32_t>(
-        thrust::copy_if(pol, tfirst, tfirst + num_tri_, active_.data(), IsFiniteTri{mesh_}) - active_.data());
+        thrust::unique_copy(pol, touched, touched + 2 * flips, active_.data()) - active_.data());
     thrust::fill(pol, active_mask_.data(), active_mask_.data() + num_active, kCheckAllEdges);
     RestoreDelaunay(num_active, /*hull_may_change=*/false);
     return flips;

@@ -42,8 +42,17 @@ struct VoteForInsertion {
       if (x.v[k] == mesh.inf) inf_pos = k;
     }
     if (inf_pos >= 0) {
+      // Farthest outside first (the hull grows as in quickhull). Points on the hull edge's line
+      // (grids, collinear data) all score 0 that way: among them prefer the one nearest the
+      // edge's midpoint, so a line of n such points is split in halves, O(log n) rounds, not n.
       const Point2 u = mesh.pts[x.v[Next(inf_pos)]], w = mesh.pts[x.v[Prev(inf_pos)]];
-      score = -static_cast<float>(Orient2dApprox(u, w, p));
+      const double outside = Orient2dApprox(u, w, p);
+      if (outside > 0.0) {
+        score = -static_cast<float>(outside);
+      } else {
+        const double dx = p.x - 0.5 * (u.x + w.x), dy = p.y - 0.5 * (u.y + w.y);
+        score = static_cast<float>(dx * dx + dy * dy);
+      }
     } else {
       const Point2 a = mesh.pts[x.v[0]], b = mesh.pts[x.v[1]], c = mesh.pts[x.v[2]];
       const double bx = b.x - a.x, by = b.y - a.y, cx = c.x - a.x, cy = c.y - a.y;
