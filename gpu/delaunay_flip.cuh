@@ -154,7 +154,9 @@ struct CollectNextActive {
     const bool flipped = proposal_edge[i] == 3;
     if (Claim(t)) {
       candidates[2 * i] = t;
-      candidate_mask[2 * i] = flipped ? kCheckFlipOuterEdges : active_mask[i];
+      // A losing proposer may also have been flipped as another flip's neighbour, and only one
+      // of its two claims lands: check every edge so that neither reason is lost.
+      candidate_mask[2 * i] = flipped ? kCheckFlipOuterEdges : kCheckAllEdges;
     }
     if (flipped) {
       partner[t] = kNoPartner;

@@ -1,0 +1,245 @@
+// delaunay_bench: galpha::Triangulate against CGAL's Delaunay_triangulation_2 in the same run, over
+// distributions x sizes (and real .bin files), printed as markdown tables with the ratio and
+// galpha's per-stage times. A plain harness, kept out of ctest.
+//
+//   delaunay_bench [--backend=auto|cpu|cuda] [--repeat=3] [--sizes=100000,1000000]
+//                  [--dists=uniform,gaussian,clustered,grid] [--seed=1] [--data FILE.bin]...
+//
+// With --data and no --dists/--sizes, only the files run. Times are the best of --repeat runs;
+// point generation and conversion are not timed.
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "core/point_io.hpp"
+#include "gpu/delaunay.hpp"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CgalDelaunay = CGAL::Delaunay_triangulation_2<Kernel>;
+
+struct BenchOptions {
+  Backend backend = Backend::kAuto;
+  int repeat = 3;
+  std::vector<size_t> sizes = {100000, 1000000};
+  std::vector<std::string> distributions = {"uniform", "gaussian", "clustered", "grid"};
+  uint64_t seed = 1;
+  std::vector<std::string> data_files;
+};
+
+// One input to time: a generated distribution at a size, or a file.
+struct BenchInput {
+  std::string name;
+  std::vector<Point2> points;
+};
+
+struct BenchResult {
+  std::string name;
+  size_t n = 0;
+  Backend backend = Backend::kCpu;
+  double galpha_ms = 0;
+  double cgal_ms = 0;
+  size_t galpha_triangles = 0;
+  size_t cgal_triangles = 0;
+  std::vector<StageTime> stages;  // of galpha's best run
+  std::string error;              // galpha's failure, if any: the row says so, the run goes on
+};
+
+constexpr char kUsage[] =
+    "usage: delaunay_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...]\n"
+    "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]...\n";
+
+absl::StatusOr<BenchOptions> ParseArgs(int argc, char** argv) {
+  BenchOptions options;
+  bool explicit_generated = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value_of = [&](const std::string& flag) -> const char* {
+      return arg.rfind(flag + "=", 0) == 0 ? argv[i] + flag.size() + 1 : nullptr;
+    };
+    if (const char* v = value_of("--backend")) {
+      const std::string name = v;
+      if (name == "auto") {
+        options.backend = Backend::kAuto;
+      } else if (name == "cpu") {
+        options.backend = Backend::kCpu;
+      } else if (name == "cuda") {
+        options.backend = Backend::kCuda;
+      } else {
+        return absl::InvalidArgumentError(absl::StrCat("unknown backend '", name, "'"));
+      }
+    } else if (const char* v = value_of("--repeat")) {
+      if (!absl::SimpleAtoi(v, &options.repeat) || options.repeat < 1) {
+        return absl::InvalidArgumentError(absl::StrCat("bad --repeat '", v, "'"));
+      }
+    } else if (const char* v = value_of("--seed")) {
+      if (!absl::SimpleAtoi(v, &options.seed)) {
+        return absl::InvalidArgumentError(absl::StrCat("bad --seed '", v, "'"));
+      }
+    } else if (const char* v = value_of("--sizes")) {
+      options.sizes.clear();
+      for (absl::string_view part : absl::StrSplit(v, ',', absl::SkipEmpty())) {
+        size_t n;
+        if (!absl::SimpleAtoi(part, &n)) {
+          return absl::InvalidArgumentError(absl::StrCat("bad size '", part, "'"));
+        }
+        options.sizes.push_back(n);
+      }
+      explicit_generated = true;
+    } else if (const char* v = value_of("--dists")) {
+      options.distributions = absl::StrSplit(v, ',', absl::SkipEmpty());
+      for (const std::string& name : options.distributions) {
+        if (gen::FindDistribution(name) == nullptr) {
+          return absl::InvalidArgumentError(absl::StrCat("unknown distribution '", name, "'"));
+        }
+      }
+      explicit_generated = true;
+    } else if (arg == "--data" && i + 1 < argc) {
+      options.data_files.push_back(argv[++i]);
+    } else if (const char* v = value_of("--data")) {
+      options.data_files.push_back(v);
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
+    }
+  }
+  if (!options.data_files.empty() && !explicit_generated) {
+    options.distributions.clear();
+  }
+  return options;
+}
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
+  BenchResult result;
+  result.name = input.name;
+  result.n = input.points.size();
+  result.galpha_ms = std::numeric_limits<double>::infinity();
+  result.cgal_ms = std::numeric_limits<double>::infinity();
+  TriangulateOptions triangulate_options;
+  triangulate_options.backend = options.backend;
+  for (int r = 0; r < options.repeat; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<Triangulation> t = Triangulate(input.points, triangulate_options);
+    const double ms = MillisecondsSince(start);
+    if (!t.ok()) {
+      result.error = t.status().ToString();
+      return result;
+    }
+    if (ms < result.galpha_ms) {
+      result.galpha_ms = ms;
+      result.backend = t->backend;
+      result.galpha_triangles = t->triangles.size();
+      result.stages = t->stage_times;
+    }
+  }
+
+  std::vector<Kernel::Point_2> cgal_points;
+  cgal_points.reserve(input.points.size());
+  for (const Point2& p : input.points) cgal_points.emplace_back(p.x, p.y);
+  for (int r = 0; r < options.repeat; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    // Range insertion spatially sorts first: CGAL's fast path.
+    const CgalDelaunay dt(cgal_points.begin(), cgal_points.end());
+    result.cgal_ms = std::min(result.cgal_ms, MillisecondsSince(start));
+    result.cgal_triangles = dt.dimension() == 2 ? dt.number_of_faces() : 0;
+  }
+  return result;
+}
+
+std::string StageSummary(const std::vector<StageTime>& stages) {
+  std::string out;
+  for (const StageTime& stage : stages) {
+    absl::StrAppend(&out, out.empty() ? "" : ", ", stage.stage, " ");
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%.2f", stage.seconds * 1e3);
+    absl::StrAppend(&out, ms);
+  }
+  return out;
+}
+
+void PrintTables(const std::vector<BenchResult>& results) {
+  std::printf(
+      "| distribution | n | galpha backend | galpha ms | CGAL ms | CGAL/galpha | triangles |\n"
+      "|---|---:|---|---:|---:|---:|---:|\n");
+  for (const BenchResult& r : results) {
+    if (!r.error.empty()) {
+      std::printf("| %s | %zu | - | error: %s | | | |\n", r.name.c_str(), r.n, r.error.c_str());
+      continue;
+    }
+    const std::string triangles =
+        r.galpha_triangles == r.cgal_triangles
+            ? absl::StrCat(r.galpha_triangles)
+            : absl::StrCat(r.galpha_triangles, " (CGAL ", r.cgal_triangles, ": MISMATCH)");
+    std::printf("| %s | %zu | %s | %.2f | %.2f | %.2f | %s |\n", r.name.c_str(), r.n,
+                BackendName(r.backend), r.galpha_ms, r.cgal_ms, r.cgal_ms / r.galpha_ms,
+                triangles.c_str());
+  }
+  std::printf("\n| distribution | n | galpha stages, best run (ms) |\n|---|---:|---|\n");
+  for (const BenchResult& r : results) {
+    if (!r.error.empty()) continue;
+    std::printf("| %s | %zu | %s |\n", r.name.c_str(), r.n, StageSummary(r.stages).c_str());
+  }
+}
+
+int Main(int argc, char** argv) {
+  const absl::StatusOr<BenchOptions> options = ParseArgs(argc, argv);
+  if (!options.ok()) {
+    std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
+    return 2;
+  }
+  std::printf("delaunay_bench: backend %s requested (CUDA %s), best of %d, %u host threads\n\n",
+              BackendName(options->backend),
+              CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
+              std::thread::hardware_concurrency());
+
+  std::vector<BenchResult> results;
+  bool failed = false;
+  auto run = [&](const BenchInput& input) {
+    std::fprintf(stderr, "running %s n=%zu\n", input.name.c_str(), input.points.size());
+    BenchResult result = RunOne(input, *options);
+    failed |= !result.error.empty() || result.galpha_triangles != result.cgal_triangles;
+    results.push_back(std::move(result));
+  };
+  for (const std::string& name : options->distributions) {
+    for (size_t n : options->sizes) {
+      run({name, gen::FindDistribution(name)->generate(n, options->seed)});
+    }
+  }
+  for (const std::string& file : options->data_files) {
+    absl::StatusOr<std::vector<Point2>> points = ReadPointsBin(file);
+    if (!points.ok()) {
+      std::fprintf(stderr, "%s\n", points.status().ToString().c_str());
+      return 1;
+    }
+    const size_t slash = file.find_last_of('/');
+    run({slash == std::string::npos ? file : file.substr(slash + 1), *std::move(points)});
+  }
+  PrintTables(results);
+  // An engine error, or a triangle count unlike CGAL's for the same point set, fails the run.
+  return failed ? 1 : 0;
+}
+
+}  // namespace
+}  // namespace galpha
+
+int main(int argc, char** argv) { return galpha::Main(argc, argv); }

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Run HERE (the build machine): builds the CUDA configuration and gathers what the GPU machine
+# needs into .carry/ (git-ignored): the test and benchmark binaries, the shared libraries they
+# use that a bare Ubuntu 24.04 + CUDA machine lacks (Abseil, GMP, MPFR), and the data sets.
+# Then call the device tool with carry=[".carry"] and command "bench/gpu_run.sh".
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake --preset cuda >/dev/null
+cmake --build --preset cuda -j"$(nproc)"
+rm -rf .carry && mkdir -p .carry/bin .carry/lib
+bins=()
+for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
+         bench/delaunay_bench client/alphactl; do
+  if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
+done
+for b in "${bins[@]}"; do
+  ldd "$b" | awk '/=> \//{print $3}' | grep -E 'libabsl|libgmp|libmpfr|libgtest|libbenchmark' || true
+done | sort -u | while read -r lib; do cp -L "$lib" .carry/lib/; done
+du -sh .carry
