@@ -79,7 +79,7 @@ struct IsFiniteTri {
 template <class System>
 class DelaunayBuilder {
  public:
-  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m)
+  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m, int32_t a, int32_t b, int32_t c)
       : sys_(sys),
         m_(m),
         capacity_(2 * m),
@@ -97,7 +97,7 @@ class DelaunayBuilder {
         proposal_edge_(sys, capacity_),
         proposal_nb_(sys, capacity_),
         flags_(sys, 4) {
-    mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m)};
+    mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
     thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
     thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
@@ -329,7 +329,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     a = 1;
     b = 0;
   }
-  DelaunayBuilder<System> builder(sys, vertex_points.data(), unique.data(), m);
+  DelaunayBuilder<System> builder(sys, vertex_points.data(), unique.data(), m, a, b, c);
   builder.Start(a, b, c);
   {
     const uint32_t num_pending = m - 3;

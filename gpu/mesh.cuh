@@ -32,6 +32,20 @@ struct MeshView {
   Tri* tri;
   TriNbr* nbr;
   int32_t inf;           // id of the vertex at infinity (= number of finite vertices)
+  // The vertices of the first triangle. Their symbolic interior point c = a + e1 (b - a) +
+  // e2 (c - a) (0 < e2 << e1 << 1) lies inside every later hull; rays from it through the hull
+  // vertices split the outside into disjoint sectors, one per infinite triangle, so points
+  // inserted outside the hull in the same round never overlap.
+  int32_t center_a, center_b, center_c;
+
+  /// Sign of orient(center, w, p): orient is affine in its first point, so it is the first
+  /// nonzero of the exact signs with a, b, c in its place (never zero: a, b, c are not collinear).
+  GALPHA_HD int CenterOrient(int32_t w, int32_t p) const {
+    int s = Orient2dSign(pts[center_a], pts[w], pts[p]);
+    if (s == 0) s = Orient2dSign(pts[center_b], pts[w], pts[p]);
+    if (s == 0) s = Orient2dSign(pts[center_c], pts[w], pts[p]);
+    return s;
+  }
 
   GALPHA_HD bool IsInfinite(int32_t t) const {
     const Tri& x = tri[t];
@@ -76,8 +90,18 @@ struct MeshView {
         if (x.v[k] == inf) inf_pos = k;
       }
       if (inf_pos >= 0) {
-        if (Orient(x.v[Next(inf_pos)], x.v[Prev(inf_pos)], p) > 0) return t;
-        t = nbr[t].n[inf_pos];
+        // Hull edge u->w with the outside on its left; its sector is the wedge from ray
+        // center->w counter-clockwise to ray center->u.
+        const int32_t u = x.v[Next(inf_pos)], w = x.v[Prev(inf_pos)];
+        if (CenterOrient(w, p) < 0) {
+          t = nbr[t].n[Next(inf_pos)];  // across the edge (w, inf): the sector clockwise of w
+        } else if (CenterOrient(u, p) > 0) {
+          t = nbr[t].n[Prev(inf_pos)];  // across the edge (inf, u): the sector beyond u
+        } else if (Orient(u, w, p) > 0) {
+          return t;
+        } else {
+          t = nbr[t].n[inf_pos];
+        }
         continue;
       }
       // Start at a rotating edge so that walks through long chains spread over the three choices.
