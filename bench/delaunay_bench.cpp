@@ -53,7 +53,9 @@ struct BenchResult {
   std::string name;
   size_t n = 0;
   Backend backend = Backend::kCpu;
-  double galpha_ms = 0;
+  double galpha_ms = 0;           // the whole call, transfers included
+  double galpha_compute_ms = 0;   // the same run without the upload and download stages
+  size_t galpha_peak_bytes = 0;   // working memory peak on the backend
   double cgal_ms = 0;
   size_t galpha_triangles = 0;
   size_t cgal_triangles = 0;
@@ -129,6 +131,9 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+// Host-device copies: on the CUDA backend these are PCIe transfers, reported apart from compute.
+bool IsTransferStage(const std::string& stage) { return stage == "upload" || stage == "download"; }
+
 BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
   BenchResult result;
   result.name = input.name;
@@ -150,6 +155,11 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
       result.backend = t->backend;
       result.galpha_triangles = t->triangles.size();
       result.stages = t->stage_times;
+      result.galpha_peak_bytes = t->peak_memory_bytes;
+      result.galpha_compute_ms = 0;
+      for (const StageTime& stage : t->stage_times) {
+        if (!IsTransferStage(stage.stage)) result.galpha_compute_ms += stage.seconds * 1e3;
+      }
     }
   }
 
@@ -179,19 +189,22 @@ std::string StageSummary(const std::vector<StageTime>& stages) {
 
 void PrintTables(const std::vector<BenchResult>& results) {
   std::printf(
-      "| distribution | n | galpha backend | galpha ms | CGAL ms | CGAL/galpha | triangles |\n"
-      "|---|---:|---|---:|---:|---:|---:|\n");
+      "| distribution | n | galpha backend | galpha ms (no transfers) | transfers+host copies ms | CGAL ms | "
+      "CGAL/galpha (no transfers) | CGAL/galpha (whole call) | peak bytes/point | triangles |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const BenchResult& r : results) {
     if (!r.error.empty()) {
-      std::printf("| %s | %zu | - | error: %s | | | |\n", r.name.c_str(), r.n, r.error.c_str());
+      std::printf("| %s | %zu | - | error: %s | | | | | | |\n", r.name.c_str(), r.n, r.error.c_str());
       continue;
     }
     const std::string triangles =
         r.galpha_triangles == r.cgal_triangles
             ? absl::StrCat(r.galpha_triangles)
             : absl::StrCat(r.galpha_triangles, " (CGAL ", r.cgal_triangles, ": MISMATCH)");
-    std::printf("| %s | %zu | %s | %.2f | %.2f | %.2f | %s |\n", r.name.c_str(), r.n,
-                BackendName(r.backend), r.galpha_ms, r.cgal_ms, r.cgal_ms / r.galpha_ms,
+    std::printf("| %s | %zu | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %s |\n", r.name.c_str(), r.n,
+                BackendName(r.backend), r.galpha_compute_ms, r.galpha_ms - r.galpha_compute_ms, r.cgal_ms,
+                r.cgal_ms / r.galpha_compute_ms, r.cgal_ms / r.galpha_ms,
+                static_cast<double>(r.galpha_peak_bytes) / static_cast<double>(std::max<size_t>(r.n, 1)),
                 triangles.c_str());
   }
   std::printf("\n| distribution | n | galpha stages, best run (ms) |\n|---|---:|---|\n");

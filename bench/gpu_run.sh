@@ -1,24 +1,79 @@
 #!/usr/bin/env bash
 # Run ON THE GPU MACHINE (H100/H200, CUDA 13, no Abseil/CGAL there) from the repository root,
-# with .carry/ made by bench/gpu_bundle.sh: runs the tests on the CUDA backend, then the
-# benchmark (galpha CUDA vs CGAL on the same machine). Logs go to $OUT when set.
+# with .carry/ made by bench/gpu_bundle.sh. Phases, in the order given (default: smoke test bench):
+#   smoke   alphactl triangulate on every data set, CUDA then CPU backend, each under a timeout
+#   sanitize  compute-sanitizer memcheck and racecheck of one small CUDA triangulation
+#   test    the test binaries (CUDA backend included), each test under GALPHA_TEST_TIMEOUT seconds
+#           (default 240), one process per test so that a hang names its test
+#   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides its args
+# Full logs go to $OUT (8 files at most, so that all of them come back) (or /tmp/galpha-gpu); a short summary goes to standard output.
 set -uo pipefail
 out="${OUT:-/tmp/galpha-gpu}"
 mkdir -p "$out"
 export LD_LIBRARY_PATH="$PWD/.carry/lib:${LD_LIBRARY_PATH:-}"
 export GALPHA_DATA_DIR="$PWD/data"
-nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader | tee "$out/machine.txt"
-nproc | sed 's/^/cores: /' | tee -a "$out/machine.txt"
+phases=("$@")
+[ ${#phases[@]} -gt 0 ] || phases=(smoke test bench)
 status=0
-for t in predicates_test predicates_device_test delaunay_test; do
-  if [ -x ".carry/bin/$t" ]; then
-    echo "== $t"
-    ".carry/bin/$t" --gtest_brief=1 2>&1 | tee "$out/$t.log" | tail -n 30
-    [ "${PIPESTATUS[0]}" -eq 0 ] || status=1
-  fi
+
+nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader | tee "$out/machine.txt"
+echo "cores: $(nproc)" | tee -a "$out/machine.txt"
+
+# run_step NAME SECONDS CMD...: runs CMD under a timeout, logs to $out/NAME.log, reports the outcome.
+run_step() {
+  local name=$1 seconds=$2
+  shift 2
+  local start=$SECONDS
+  timeout -k 5 "$seconds" "$@" >>"$out/$name.log" 2>&1
+  local rc=$?
+  local verdict=ok
+  [ $rc -eq 0 ] || verdict="FAILED rc=$rc"
+  [ $rc -eq 124 ] && verdict="TIMED OUT after ${seconds}s"
+  echo "$name: $* -> $verdict ($((SECONDS - start)) s)"
+  [ $rc -eq 0 ] || status=1
+  return $rc
+}
+
+for phase in "${phases[@]}"; do
+  case "$phase" in
+    smoke)
+      for backend in cuda cpu; do
+        for f in data/*.bin; do
+          run_step smoke 60 .carry/bin/alphactl triangulate "$f" --backend=$backend
+        done
+      done
+      grep -E '"backend"' "$out/smoke.log" | sed -E 's/"stage_ms".*//' 
+      ;;
+    sanitize)
+      small=data/ourairports_medium_large.bin
+      for tool in memcheck racecheck synccheck; do
+        run_step sanitize 240 compute-sanitizer --tool "$tool" --error-exitcode 9 \
+          .carry/bin/alphactl triangulate "$small" --backend=cuda
+      done
+      grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race" "$out/sanitize.log" | sort | uniq -c | head -n 20
+      ;;
+    test)
+      for t in predicates_test predicates_device_test delaunay_test; do
+        [ -x ".carry/bin/$t" ] || continue
+        # One process per test, so that a hang names its test and the rest still run.
+        for name in $(".carry/bin/$t" --gtest_list_tests | awk '/^[^ ]/{suite=$1} /^  /{print suite $1}'); do
+          run_step "$t" "${GALPHA_TEST_TIMEOUT:-240}" ".carry/bin/$t" --gtest_filter="$name" >>"$out/steps.txt"
+        done
+        grep -v -- '-> ok' "$out/steps.txt" | grep -F "$t" || true
+        grep -cE '^\[       OK \]' "$out/$t.log" | sed "s/^/$t: tests passed: /"
+        grep -E '^\[  FAILED  \]|Failure' "$out/$t.log" | sort -u | head -n 20
+      done
+      ;;
+    bench)
+      [ -x .carry/bin/delaunay_bench ] || { echo "no delaunay_bench in .carry"; status=1; continue; }
+      # shellcheck disable=SC2086
+      run_step bench 560 .carry/bin/delaunay_bench ${GALPHA_BENCH_ARGS:---backend=cuda --sizes=100000,1000000,10000000}
+      grep -E '^\|' "$out/bench.log"
+      ;;
+    *)
+      echo "unknown phase '$phase'"
+      status=1
+      ;;
+  esac
 done
-if [ -x .carry/bin/delaunay_bench ]; then
-  echo "== delaunay_bench"
-  .carry/bin/delaunay_bench ${GALPHA_BENCH_ARGS:---backend=cuda --sizes=100000,1000000,10000000} 2>&1 | tee "$out/bench.md"
-fi
 exit $status

@@ -69,9 +69,10 @@ int Triangulate(const std::vector<std::string>& args) {
   std::printf(
       "{\"file\": \"%s\", \"points\": %zu, \"distinct_points\": %u, \"duplicates\": %zu, "
       "\"triangles\": %zu, \"edges\": %zu, \"hull_edges\": %zu, \"backend\": \"%s\", "
-      "\"total_ms\": %.3f, \"stage_ms\": {%s}}\n",
+      "\"peak_memory_bytes\": %zu, \"total_ms\": %.3f, \"stage_ms\": {%s}}\n",
       file.c_str(), points->size(), tri->num_unique, points->size() - tri->num_unique, tri->triangles.size(),
-      tri->edges.size(), hull_edges, galpha::BackendName(tri->backend), total * 1e3, stages.c_str());
+      tri->edges.size(), hull_edges, galpha::BackendName(tri->backend), tri->peak_memory_bytes, total * 1e3,
+      stages.c_str());
   return 0;
 }
 

@@ -10,6 +10,7 @@
 #include <thrust/system/cuda/execution_policy.h>
 
 #include "gpu/delaunay_backend.hpp"
+#include "gpu/engine_system.cuh"
 
 namespace galpha::detail {
 
@@ -26,16 +27,21 @@ inline void CheckCuda(cudaError_t result, const char* what) {
 class StreamOrderedAllocator {
  public:
   using value_type = char;
-  explicit StreamOrderedAllocator(cudaStream_t stream) : stream_(stream) {}
+  StreamOrderedAllocator(cudaStream_t stream, MemoryLedger* ledger) : stream_(stream), ledger_(ledger) {}
   char* allocate(std::ptrdiff_t bytes) {
     void* p = nullptr;
     CheckCuda(cudaMallocAsync(&p, static_cast<size_t>(bytes), stream_), "cudaMallocAsync (thrust temp)");
+    ledger_->Add(static_cast<size_t>(bytes));
     return static_cast<char*>(p);
   }
-  void deallocate(char* p, size_t) { cudaFreeAsync(p, stream_); }
+  void deallocate(char* p, size_t bytes) {
+    cudaFreeAsync(p, stream_);
+    ledger_->Remove(bytes);
+  }
 
  private:
   cudaStream_t stream_;
+  MemoryLedger* ledger_;
 };
 
 /// The CUDA backend on one stream.
@@ -43,7 +49,9 @@ class CudaSystem {
  public:
   static constexpr const char* kName = "cuda";
 
-  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream) {}
+  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) {}
+  CudaSystem(const CudaSystem&) = delete;
+  CudaSystem& operator=(const CudaSystem&) = delete;
 
   auto policy() { return thrust::cuda::par_nosync(temp_).on(stream_); }
 
@@ -52,9 +60,15 @@ class CudaSystem {
     if (count == 0) return nullptr;
     void* p = nullptr;
     CheckCuda(cudaMallocAsync(&p, count * sizeof(T), stream_), "cudaMallocAsync");
+    ledger_.Add(count * sizeof(T));
     return static_cast<T*>(p);
   }
-  void Free(void* p) { cudaFreeAsync(p, stream_); }
+  void Free(void* p, size_t bytes) {
+    cudaFreeAsync(p, stream_);
+    ledger_.Remove(bytes);
+  }
+  /// Peak bytes of device memory this build has held: its buffers and Thrust's temporaries.
+  size_t peak_bytes() const { return ledger_.peak(); }
 
   template <class T>
   void ToHost(T* host, const T* device, size_t count) {
@@ -84,6 +98,7 @@ class CudaSystem {
 
  private:
   cudaStream_t stream_;
+  MemoryLedger ledger_;  // declared before temp_, which points at it
   StreamOrderedAllocator temp_;
 };
 

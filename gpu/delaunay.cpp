@@ -85,6 +85,7 @@ absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points, const
   result.edges = std::move(raw.edges);
   result.backend = backend;
   result.stage_times = std::move(raw.stage_times);
+  result.peak_memory_bytes = raw.peak_memory_bytes;
   return result;
 }
 

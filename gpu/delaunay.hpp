@@ -67,6 +67,10 @@ struct Triangulation {
   /// Backend that ran, and the stage times (transfers are their own stages).
   Backend backend = Backend::kCpu;
   std::vector<StageTime> stage_times;
+  /// Peak working memory of the build on its backend (device memory on CUDA, host memory on the
+  /// CPU backend), in bytes: the engine's buffers and its algorithms' temporaries, input included,
+  /// the returned host vectors excluded.
+  size_t peak_memory_bytes = 0;
 
   static constexpr int32_t kNoNeighbor = -1;
 };

@@ -23,6 +23,7 @@ struct DelaunayOutput {
   std::vector<uint32_t> tri_edge_begin;
   std::vector<std::array<uint32_t, 2>> edges;
   std::vector<StageTime> stage_times;
+  size_t peak_memory_bytes = 0;
 };
 
 /// Failure inside a backend. Thrown inside the engine (Thrust reports errors by exception too) and

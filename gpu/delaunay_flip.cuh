@@ -172,13 +172,18 @@ struct CollectNextActive {
 /// Removes triangles that are flat in reality (three collinear vertices on a hull line, produced
 /// by the symbolic perturbation) so that hull points on a hull edge become hull vertices, as in
 /// CGAL. A flat triangle (m between p and q) is flipped across its long edge p-q when the triangle
-/// there is infinite (m joins the hull) or properly shaped (m joins that triangle's apex). Runs as
-/// one thread: the flat triangles lie on the hull, O(sqrt n) of them on a grid.
+/// there is infinite (m joins the hull) or properly shaped (m joins that triangle's apex). Such a
+/// flip never makes a new flat triangle. When the triangle across is flat too, it is repaired
+/// first, depth-first with an explicit stack, so that each flat triangle is visited O(1) times
+/// (on two parallel lines of points every point is on the hull, and the flat triangles stack up).
+/// Runs as one thread: the flat triangles lie on the hull, O(sqrt n) of them on a grid.
 struct RepairFlatHullTriangles {
   MeshView mesh;
-  int32_t* flat;        // candidate triangle ids; -1 once repaired
+  const int32_t* flat;  // the flat triangles found before the repair
   uint32_t num_flat;
-  int32_t* failed;      // set when no progress can be made (reported as an internal error)
+  int32_t* stack;       // num_flat entries
+  uint8_t* on_stack;    // per triangle, zero on entry and on exit
+  int32_t* failed;      // set when flat triangles remain (reported as an internal error)
   int32_t* flips_done;
   int32_t* touched;     // the two triangles of every repair flip, for the Lawson pass after
 
@@ -211,33 +216,48 @@ struct RepairFlatHullTriangles {
     }
   }
 
-  GALPHA_HD void operator()(uint32_t) const {
-    uint32_t remaining = num_flat;
-    int32_t flips = 0;
-    while (remaining > 0) {
-      bool progress = false;
-      for (uint32_t i = 0; i < num_flat; ++i) {
-        const int32_t t = flat[i];
-        if (t < 0) continue;
-        if (!IsFlat(t)) {
-          flat[i] = -1;
-          --remaining;
-          progress = true;
-          continue;
-        }
-        const int k = MiddlePos(t);
-        if (k < 0) continue;
+  /// Repairs flat triangle `first` and, before it, the flat triangles it waits for. Returns false
+  /// when `first` is left flat (two flat triangles sharing their long edge wait for each other).
+  GALPHA_HD bool RepairFrom(int32_t first, int32_t* flips) const {
+    uint32_t top = 0;
+    stack[top++] = first;
+    on_stack[first] = 1;
+    while (top > 0) {
+      const int32_t t = stack[top - 1];
+      const int k = IsFlat(t) ? MiddlePos(t) : -1;
+      if (k >= 0) {
         const int32_t nb = mesh.nbr[t].n[k];
-        if (!mesh.IsInfinite(nb) && IsFlat(nb)) continue;
-        SerialFlip(t, k);
-        touched[2 * flips] = t;
-        touched[2 * flips + 1] = nb;
-        ++flips;
-        flat[i] = -1;
-        --remaining;
-        progress = true;
+        if (!mesh.IsInfinite(nb) && IsFlat(nb)) {
+          if (!on_stack[nb] && top < num_flat) {
+            stack[top++] = nb;
+            on_stack[nb] = 1;
+            continue;
+          }
+          // A cycle: t stays flat for now, and a later pass tries again.
+        } else {
+          SerialFlip(t, k);
+          touched[2 * *flips] = t;
+          touched[2 * *flips + 1] = nb;
+          ++*flips;
+        }
       }
-      if (!progress) {
+      on_stack[t] = 0;
+      --top;
+    }
+    return !IsFlat(first);
+  }
+
+  GALPHA_HD void operator()(uint32_t) const {
+    int32_t flips = 0;
+    // Passes until every flat triangle is repaired; a pass that repairs none is a failure.
+    bool remaining = true;
+    while (remaining) {
+      remaining = false;
+      const int32_t before = flips;
+      for (uint32_t i = 0; i < num_flat; ++i) {
+        if (IsFlat(flat[i]) && !RepairFrom(flat[i], &flips)) remaining = true;
+      }
+      if (remaining && flips == before) {
         *failed = 1;
         break;
       }

@@ -173,9 +173,13 @@ class DelaunayBuilder {
     if (num_flat == 0) return 0;
     // Each flat triangle is repaired by one flip of two triangles.
     Buffer<int32_t, System> touched_buffer(sys_, 2 * static_cast<size_t>(num_flat));
+    Buffer<int32_t, System> stack(sys_, num_flat);
+    Buffer<uint8_t, System> on_stack(sys_, static_cast<size_t>(num_tri_));
+    thrust::fill(pol, on_stack.begin(), on_stack.end(), uint8_t{0});
     int32_t* touched = touched_buffer.data();
     thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(1),
-                     RepairFlatHullTriangles{mesh_, flat, num_flat, flags_.data() + 1, flags_.data() + 2, touched});
+                     RepairFlatHullTriangles{mesh_, flat, num_flat, stack.data(), on_stack.data(), flags_.data() + 1,
+                                             flags_.data() + 2, touched});
     if (sys_.Read(flags_.data() + 1) != 0) {
       throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
     }
@@ -305,6 +309,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     out->edges.resize(num_edges);
     CopyOut(sys, edges, num_edges, out->edges.data());
     timer.EndStage("collinear_chain");
+    out->peak_memory_bytes = sys.peak_bytes();
     return;
   }
 
@@ -378,6 +383,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
   CopyOut(sys, edge_begin, num_finite, out->tri_edge_begin.data());
   CopyOut(sys, edges, num_edges, out->edges.data());
   timer.EndStage("download");
+  out->peak_memory_bytes = sys.peak_bytes();
 }
 
 }  // namespace galpha::detail

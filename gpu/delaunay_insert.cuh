@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cmath>
 #include <cstring>
 
 #include <cuda/atomic>
@@ -22,10 +23,19 @@ GALPHA_HD inline uint32_t OrderedFloatKey(float f) {
   return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
 }
 
+/// Binary exponent of the largest magnitude among the given differences (0 when all are zero).
+/// Scores are computed on coordinates divided by 2^exponent (exact: a power of two), so that
+/// subnormal or huge inputs neither underflow to ties nor overflow.
+GALPHA_HD inline int ScoreExponent(double a, double b, double c, double d) {
+  const double m = fmax(fmax(fabs(a), fabs(b)), fmax(fabs(c), fabs(d)));
+  return m > 0.0 ? ilogb(m) : 0;
+}
+
 /// Each uninserted point votes for itself in the triangle that contains it; the smallest key wins.
 /// Finite triangles prefer the point nearest the circumcentre (gDel2D's choice: it keeps triangles
 /// well shaped); infinite ones the point farthest outside their hull edge. The choice is a
-/// heuristic only, so approximate doubles are fine here.
+/// heuristic only, so approximate doubles are fine here; but ties must be rare, or the smallest
+/// index (an end of a run of points along a line, in Hilbert order) wins every round.
 struct VoteForInsertion {
   MeshView mesh;
   const int32_t* pending;        // vertex of each uninserted point
@@ -46,22 +56,32 @@ struct VoteForInsertion {
       // (grids, collinear data) all score 0 that way: among them prefer the one nearest the
       // edge's midpoint, so a line of n such points is split in halves, O(log n) rounds, not n.
       const Point2 u = mesh.pts[x.v[Next(inf_pos)]], w = mesh.pts[x.v[Prev(inf_pos)]];
-      const double outside = Orient2dApprox(u, w, p);
+      const int e = ScoreExponent(w.x - u.x, w.y - u.y, 0.0, 0.0);
+      const double wx = ldexp(w.x - u.x, -e), wy = ldexp(w.y - u.y, -e);
+      const double px = ldexp(p.x - u.x, -e), py = ldexp(p.y - u.y, -e);
+      const double outside = wx * py - wy * px;
       if (outside > 0.0) {
         score = -static_cast<float>(outside);
       } else {
-        const double dx = p.x - 0.5 * (u.x + w.x), dy = p.y - 0.5 * (u.y + w.y);
+        const double dx = px - 0.5 * wx, dy = py - 0.5 * wy;
         score = static_cast<float>(dx * dx + dy * dy);
       }
     } else {
+      // Nearest the circumcentre o means the smallest power |p - o|^2 - R^2 (same order), but the
+      // power is computed from coordinates relative to a vertex, without R^2: for a sliver, whose
+      // circumcentre is far away, |p - o|^2 rounds to the same float for every point, and the
+      // index would then pick an end of the sliver (linear rounds on collinear data) instead of
+      // its middle (a point on a chord has power -|p - a| |p - b|, lowest at the midpoint).
       const Point2 a = mesh.pts[x.v[0]], b = mesh.pts[x.v[1]], c = mesh.pts[x.v[2]];
-      const double bx = b.x - a.x, by = b.y - a.y, cx = c.x - a.x, cy = c.y - a.y;
-      const double d = 2.0 * (bx * cy - by * cx);
+      const int e = ScoreExponent(b.x - a.x, b.y - a.y, c.x - a.x, c.y - a.y);
+      const double bx = ldexp(b.x - a.x, -e), by = ldexp(b.y - a.y, -e);
+      const double cx = ldexp(c.x - a.x, -e), cy = ldexp(c.y - a.y, -e);
+      const double px = ldexp(p.x - a.x, -e), py = ldexp(p.y - a.y, -e);
+      const double d = bx * cy - by * cx;
       const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-      const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-      const double dx = p.x - a.x - ux, dy = p.y - a.y - uy;
-      const double dist2 = dx * dx + dy * dy;
-      score = (dist2 == dist2 && dist2 < 3.0e38) ? static_cast<float>(dist2) : 3.0e38f;
+      const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
+      score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
+                                                                     : (power < 0 ? -3.0e38f : 3.0e38f);
     }
     const unsigned long long key =
         (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;

@@ -18,12 +18,53 @@
 
 namespace galpha::detail {
 
+/// Bytes a build holds in its system's memory now and at its peak: the engine's buffers and the
+/// temporaries of Thrust's algorithms. Stream-ordered frees count when they are queued, which is
+/// when the memory becomes reusable by the build's later work on the same stream.
+class MemoryLedger {
+ public:
+  void Add(size_t bytes) {
+    live_ += bytes;
+    if (live_ > peak_) peak_ = live_;
+  }
+  void Remove(size_t bytes) { live_ -= bytes; }
+  size_t peak() const { return peak_; }
+
+ private:
+  size_t live_ = 0;
+  size_t peak_ = 0;
+};
+
+/// Thrust's temporary storage on the host, counted in the build's ledger.
+class HostTempAllocator {
+ public:
+  using value_type = char;
+  explicit HostTempAllocator(MemoryLedger* ledger) : ledger_(ledger) {}
+  char* allocate(std::ptrdiff_t bytes) {
+    void* p = std::malloc(static_cast<size_t>(bytes));
+    if (p == nullptr) throw std::bad_alloc();
+    ledger_->Add(static_cast<size_t>(bytes));
+    return static_cast<char*>(p);
+  }
+  void deallocate(char* p, size_t bytes) {
+    std::free(p);
+    ledger_->Remove(bytes);
+  }
+
+ private:
+  MemoryLedger* ledger_;
+};
+
 /// The OpenMP backend: host memory, thrust::omp::par.
 class CpuSystem {
  public:
   static constexpr const char* kName = "cpu";
 
-  auto policy() const { return thrust::omp::par; }
+  CpuSystem() : temp_(&ledger_) {}
+  CpuSystem(const CpuSystem&) = delete;
+  CpuSystem& operator=(const CpuSystem&) = delete;
+
+  auto policy() { return thrust::omp::par(temp_); }
 
   template <class T>
   T* Allocate(size_t count) {
@@ -33,9 +74,15 @@ class CpuSystem {
       throw EngineError(EngineError::Kind::kResourceExhausted,
                         "host allocation of " + std::to_string(count * sizeof(T)) + " bytes failed");
     }
+    ledger_.Add(count * sizeof(T));
     return static_cast<T*>(p);
   }
-  void Free(void* p) { std::free(p); }
+  void Free(void* p, size_t bytes) {
+    std::free(p);
+    ledger_.Remove(bytes);
+  }
+  /// Peak bytes of working memory held so far: the engine's buffers and Thrust's temporaries.
+  size_t peak_bytes() const { return ledger_.peak(); }
 
   template <class T>
   void ToHost(T* host, const T* system, size_t count) {
@@ -51,6 +98,10 @@ class CpuSystem {
   }
   /// Waits for queued work; the CPU backend runs synchronously.
   void Synchronize() {}
+
+ private:
+  MemoryLedger ledger_;  // declared before temp_, which points at it
+  HostTempAllocator temp_;
 };
 
 /// An owning array in a system's memory. Move-only.
@@ -64,7 +115,7 @@ class Buffer {
   Buffer(Buffer&& other) noexcept
       : system_(other.system_), data_(std::exchange(other.data_, nullptr)), size_(other.size_) {}
   ~Buffer() {
-    if (data_ != nullptr) system_->Free(data_);
+    if (data_ != nullptr) system_->Free(data_, size_ * sizeof(T));
   }
 
   T* data() { return data_; }

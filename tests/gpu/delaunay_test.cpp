@@ -150,6 +150,19 @@ TEST_P(DelaunayTest, RealDataSets) {
   }();
 }
 
+// The ledger counts every buffer: the build holds at least the input and the mesh of 2n triangles
+// (3 vertices, 3 neighbours each), and a linear-memory engine stays within a few hundred bytes
+// a point.
+TEST_P(DelaunayTest, PeakMemoryIsCountedAndLinear) {
+  for (size_t n : {20000, 200000}) {
+    SCOPED_TRACE(absl::StrCat("n=", n));
+    Triangulation t;
+    ASSERT_NO_FATAL_FAILURE(RunAndCheck(gen::Uniform(n, 5), &t));
+    EXPECT_GE(t.peak_memory_bytes, n * (sizeof(Point2) + 2 * 6 * sizeof(int32_t)));
+    EXPECT_LE(t.peak_memory_bytes, n * 400);
+  }
+}
+
 TEST_P(DelaunayTest, Empty) {
   Triangulation t;
   ASSERT_NO_FATAL_FAILURE(RunAndCheck({}, &t));
