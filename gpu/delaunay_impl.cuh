@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <thrust/copy.h>
@@ -86,7 +87,7 @@ class DelaunayBuilder {
         tri_(sys, capacity_),
         nbr_(sys, capacity_),
         tri_vote_(sys, capacity_),
-        split_offset_(sys, capacity_),
+        split_offset_or_nb_(sys, capacity_),
         flip_vote_(sys, capacity_),
         partner_(sys, capacity_),
         stamp_(sys, capacity_),
@@ -95,13 +96,26 @@ class DelaunayBuilder {
         candidates_(sys, 2 * capacity_),
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
-        proposal_nb_(sys, capacity_),
         flags_(sys, 4) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
     thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
     thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
     thrust::fill(sys_.policy(), flags_.begin(), flags_.end(), 0);
+  }
+
+  /// Frees everything but the mesh once it is final (before the output stage).
+  void ReleaseWorkspace() {
+    tri_vote_.Reset();
+    split_offset_or_nb_.Reset();
+    flip_vote_.Reset();
+    partner_.Reset();
+    stamp_.Reset();
+    active_.Reset();
+    active_mask_.Reset();
+    candidates_.Reset();
+    candidate_mask_.Reset();
+    proposal_edge_.Reset();
   }
 
   int32_t num_triangles() const { return num_tri_; }
@@ -139,17 +153,17 @@ class DelaunayBuilder {
       thrust::for_each(pol, first, first + num_pending,
                        VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
       thrust::transform_exclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
-                                       split_offset_.data(), HasWinner(), 0, thrust::plus<int32_t>());
-      const int32_t num_split = sys_.Read(split_offset_.data() + num_tri_ - 1) +
+                                       split_offset_or_nb_.data(), HasWinner(), 0, thrust::plus<int32_t>());
+      const int32_t num_split = sys_.Read(split_offset_or_nb_.data() + num_tri_ - 1) +
                                 (sys_.Read(tri_vote_.data() + num_tri_ - 1) != kNoVote ? 1 : 0);
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       SplitTriangles{mesh_, tri_vote_.data(), split_offset_.data(), pending, inserted, num_tri_});
+                       SplitTriangles{mesh_, tri_vote_.data(), split_offset_or_nb_.data(), pending, inserted, num_tri_});
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       LinkSplitChildren{mesh_, tri_vote_.data(), split_offset_.data(), num_tri_});
+                       LinkSplitChildren{mesh_, tri_vote_.data(), split_offset_or_nb_.data(), num_tri_});
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       ListSplitChildren{tri_vote_.data(), split_offset_.data(), active_.data(), num_tri_});
+                       ListSplitChildren{tri_vote_.data(), split_offset_or_nb_.data(), active_.data(), num_tri_});
       num_tri_ += 2 * num_split;
       thrust::fill(pol, active_mask_.data(), active_mask_.data() + 3 * num_split, kCheckOutsideEdge);
       RestoreDelaunay(static_cast<uint32_t>(3 * num_split), /*hull_may_change=*/true);
@@ -211,19 +225,19 @@ class DelaunayBuilder {
     for (int iteration = 0; count > 0; ++iteration) {
       if (iteration > (1 << 20)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
       thrust::for_each(pol, first, first + count,
-                       ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), proposal_nb_.data(),
+                       ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_offset_or_nb_.data(),
                                     flip_vote_.data(), hull_may_change});
       const auto proposals = thrust::count_if(pol, proposal_edge_.data(), proposal_edge_.data() + count, IsNonNegative());
       if (proposals == 0) break;
       thrust::for_each(pol, first, first + count,
-                       ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(),
+                       ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_offset_or_nb_.data(),
                                     flip_vote_.data(), partner_.data()});
       thrust::for_each(pol, first, first + count,
-                       LinkFlips{mesh_, active_.data(), proposal_edge_.data(), proposal_nb_.data(), partner_.data()});
+                       LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_offset_or_nb_.data(), partner_.data()});
       ++generation_;
       thrust::for_each(pol, first, first + count,
                        CollectNextActive{active_.data(), active_mask_.data(), proposal_edge_.data(),
-                                         proposal_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
+                                         split_offset_or_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
                                          generation_, candidates_.data(), candidate_mask_.data()});
       auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates_.data(), candidate_mask_.data()));
       auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
@@ -238,7 +252,9 @@ class DelaunayBuilder {
   Buffer<Tri, System> tri_;
   Buffer<TriNbr, System> nbr_;
   Buffer<unsigned long long, System> tri_vote_;
-  Buffer<int32_t, System> split_offset_;
+  // Split offsets while splitting, the neighbour of each flip proposal while flipping: never both
+  // at once, so one buffer serves both.
+  Buffer<int32_t, System> split_offset_or_nb_;
   Buffer<uint32_t, System> flip_vote_;
   Buffer<int32_t, System> partner_;
   Buffer<uint32_t, System> stamp_;
@@ -247,7 +263,6 @@ class DelaunayBuilder {
   Buffer<int32_t, System> candidates_;
   Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
-  Buffer<int32_t, System> proposal_nb_;
   Buffer<int32_t, System> flags_;  // [0] walk failed, [1] repair failed, [2] repair flips
   MeshView mesh_{};
   int32_t num_tri_ = 0;
@@ -270,6 +285,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
 
+  // The input as given; freed once the distinct points are gathered in Hilbert order.
   Buffer<Point2, System> input(sys, n);
   sys.FromHost(input.data(), host_points, n);
   timer.EndStage("upload");
@@ -323,6 +339,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     thrust::sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
     thrust::for_each(pol, first, first + m, GatherVertex{input.data(), unique.data(), vertex_points.data()});
   }
+  input.Reset();
   timer.EndStage("hilbert_sort");
 
   // The first triangle: vertices 0, 1 and the first vertex off their line.
@@ -334,8 +351,10 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     a = 1;
     b = 0;
   }
-  DelaunayBuilder<System> builder(sys, vertex_points.data(), unique.data(), m, a, b, c);
-  builder.Start(a, b, c);
+  // Held in an optional so that the mesh is freed as soon as the output holds its triangles.
+  std::optional<DelaunayBuilder<System>> builder;
+  builder.emplace(sys, vertex_points.data(), unique.data(), m, a, b, c);
+  builder->Start(a, b, c);
   {
     const uint32_t num_pending = m - 3;
     Buffer<int32_t, System> pending(sys, num_pending);
@@ -344,15 +363,16 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     thrust::copy_if(pol, vfirst, vfirst + m, pending.begin(), NotInitialVertex{a, b, c});
     thrust::fill(pol, location.begin(), location.end(), 0);
     thrust::fill(pol, inserted.begin(), inserted.end(), uint8_t{0});
-    builder.InsertAll(pending.data(), location.data(), inserted.data(), num_pending);
+    builder->InsertAll(pending.data(), location.data(), inserted.data(), num_pending);
   }
   timer.EndStage("insert_and_flip");
-  builder.RepairHull();
+  builder->RepairHull();
+  builder->ReleaseWorkspace();
   timer.EndStage("hull_repair");
 
   // Output: finite triangles by input index, neighbours, owned edges.
-  const MeshView mesh = builder.mesh();
-  const int32_t num_tri = builder.num_triangles();
+  const MeshView mesh = builder->mesh();
+  const int32_t num_tri = builder->num_triangles();
   const thrust::counting_iterator<int32_t> tfirst(0);
   Buffer<int32_t, System> finite_id(sys, num_tri);
   thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_tri, finite_id.begin(), IsFiniteTriangle{mesh}, 0,
@@ -362,6 +382,8 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
   Buffer<Tri, System> out_tri(sys, num_finite);
   Buffer<TriNbr, System> out_nbr(sys, num_finite);
   thrust::for_each(pol, tfirst, tfirst + num_tri, WriteFiniteTriangle{mesh, finite_id.data(), out_tri.data(), out_nbr.data()});
+  finite_id.Reset();
+  builder.reset();  // `mesh` dangles from here on
   Buffer<uint32_t, System> edge_begin(sys, num_finite);
   thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_finite, edge_begin.begin(),
                                    CountOwnedEdges{out_tri.data(), out_nbr.data()}, 0u, thrust::plus<uint32_t>());
