@@ -93,7 +93,6 @@ class DelaunayBuilder {
         stamp_(sys, capacity_),
         active_(sys, capacity_),
         active_mask_(sys, capacity_),
-        candidates_(sys, 2 * capacity_),
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
         flags_(sys, 4) {
@@ -113,7 +112,6 @@ class DelaunayBuilder {
     stamp_.Reset();
     active_.Reset();
     active_mask_.Reset();
-    candidates_.Reset();
     candidate_mask_.Reset();
     proposal_edge_.Reset();
   }
@@ -152,10 +150,10 @@ class DelaunayBuilder {
       thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
       thrust::for_each(pol, first, first + num_pending,
                        VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
-      thrust::transform_exclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
-                                       split_offset_or_nb_.data(), HasWinner(), 0, thrust::plus<int32_t>());
-      const int32_t num_split = sys_.Read(split_offset_or_nb_.data() + num_tri_ - 1) +
-                                (sys_.Read(tri_vote_.data() + num_tri_ - 1) != kNoVote ? 1 : 0);
+      // Inclusive, so that its last entry is the number of splits: one read, one host sync.
+      thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
+                                       split_offset_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
+      const int32_t num_split = sys_.Read(split_offset_or_nb_.data() + num_tri_ - 1);
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
@@ -181,7 +179,7 @@ class DelaunayBuilder {
   int32_t RepairHull() {
     auto pol = sys_.policy();
     const thrust::counting_iterator<int32_t> tfirst(0);
-    int32_t* flat = candidates_.data();
+    int32_t* flat = candidates();
     const uint32_t num_flat = static_cast<uint32_t>(
         thrust::copy_if(pol, tfirst, tfirst + num_tri_, flat, IsFlatFiniteTriangle{mesh_}) - flat);
     if (num_flat == 0) return 0;
@@ -209,6 +207,11 @@ class DelaunayBuilder {
   }
 
  private:
+  int32_t* candidates() {
+    static_assert(sizeof(unsigned long long) == 2 * sizeof(int32_t), "candidates share the vote buffer");
+    return reinterpret_cast<int32_t*>(tri_vote_.data());
+  }
+
   void Relocate(const int32_t* pending, int32_t* location, const uint8_t* inserted, uint32_t num_pending) {
     const thrust::counting_iterator<uint32_t> first(0);
     thrust::for_each(sys_.policy(), first, first + num_pending,
@@ -227,8 +230,8 @@ class DelaunayBuilder {
       thrust::for_each(pol, first, first + count,
                        ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_offset_or_nb_.data(),
                                     flip_vote_.data(), hull_may_change});
-      const auto proposals = thrust::count_if(pol, proposal_edge_.data(), proposal_edge_.data() + count, IsNonNegative());
-      if (proposals == 0) break;
+      // No count of the proposals here (one host sync less per iteration): without any, the
+      // passes below change nothing and leave no candidates, which ends the loop.
       thrust::for_each(pol, first, first + count,
                        ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_offset_or_nb_.data(),
                                     flip_vote_.data(), partner_.data()});
@@ -238,11 +241,11 @@ class DelaunayBuilder {
       thrust::for_each(pol, first, first + count,
                        CollectNextActive{active_.data(), active_mask_.data(), proposal_edge_.data(),
                                          split_offset_or_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
-                                         generation_, candidates_.data(), candidate_mask_.data()});
-      auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates_.data(), candidate_mask_.data()));
+                                         generation_, candidates(), candidate_mask_.data()});
+      auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates(), candidate_mask_.data()));
       auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
       count = static_cast<uint32_t>(
-          thrust::copy_if(pol, from, from + 2 * count, candidates_.data(), to, IsNonNegative()) - to);
+          thrust::copy_if(pol, from, from + 2 * count, candidates(), to, IsNonNegative()) - to);
     }
   }
 
@@ -251,8 +254,10 @@ class DelaunayBuilder {
   uint32_t capacity_;
   Buffer<Tri, System> tri_;
   Buffer<TriNbr, System> nbr_;
+  // Insertion votes while splitting; while flipping, the same bytes hold 2 * capacity_ flip
+  // candidates (int32): the two are never live at once, and sharing them saves 8 bytes a point.
   Buffer<unsigned long long, System> tri_vote_;
-  // Split offsets while splitting, the neighbour of each flip proposal while flipping: never both
+  // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while flipping: never both
   // at once, so one buffer serves both.
   Buffer<int32_t, System> split_offset_or_nb_;
   Buffer<uint32_t, System> flip_vote_;
@@ -260,7 +265,6 @@ class DelaunayBuilder {
   Buffer<uint32_t, System> stamp_;
   Buffer<int32_t, System> active_;
   Buffer<uint8_t, System> active_mask_;
-  Buffer<int32_t, System> candidates_;
   Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
   Buffer<int32_t, System> flags_;  // [0] walk failed, [1] repair failed, [2] repair flips

@@ -96,9 +96,10 @@ struct HasWinner {
 };
 
 /// Where the three children of a split triangle live: child 2 reuses the parent's slot, children
-/// 0 and 1 take two fresh slots after the current triangles.
-GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_offset, int32_t num_tri) {
-  return k == 2 ? parent : num_tri + 2 * split_offset + k;
+/// 0 and 1 take two fresh slots after the current triangles. `split_count` is the inclusive scan of
+/// HasWinner, so a split parent is the (split_count - 1)-th split of the round.
+GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_count, int32_t num_tri) {
+  return k == 2 ? parent : num_tri + 2 * (split_count - 1) + k;
 }
 
 /// Splits every elected triangle (a, b, c) around its point w into (b, c, w), (c, a, w), (a, b, w):
@@ -107,7 +108,7 @@ GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_offset, 
 struct SplitTriangles {
   MeshView mesh;
   const unsigned long long* tri_vote;
-  const int32_t* split_offset;  // exclusive scan of HasWinner
+  const int32_t* split_offset;  // inclusive scan of HasWinner
   const int32_t* pending;
   uint8_t* inserted;            // per uninserted point
   int32_t num_tri;
@@ -135,7 +136,7 @@ struct SplitTriangles {
 struct LinkSplitChildren {
   MeshView mesh;
   const unsigned long long* tri_vote;
-  const int32_t* split_offset;
+  const int32_t* split_offset;  // inclusive scan of HasWinner
   int32_t num_tri;
 
   GALPHA_HD void operator()(int32_t t) const {
@@ -159,13 +160,13 @@ struct LinkSplitChildren {
 /// Lists the three children of every split triangle: the first triangles to check for flips.
 struct ListSplitChildren {
   const unsigned long long* tri_vote;
-  const int32_t* split_offset;
+  const int32_t* split_offset;  // inclusive scan of HasWinner
   int32_t* active;
   int32_t num_tri;
 
   GALPHA_HD void operator()(int32_t t) const {
     if (tri_vote[t] == kNoVote) return;
-    for (int k = 0; k < 3; ++k) active[3 * split_offset[t] + k] = ChildSlot(t, k, split_offset[t], num_tri);
+    for (int k = 0; k < 3; ++k) active[3 * (split_offset[t] - 1) + k] = ChildSlot(t, k, split_offset[t], num_tri);
   }
 };
 
