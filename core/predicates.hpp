@@ -271,6 +271,62 @@ GALPHA_HD GALPHA_FORCEINLINE int Orient2dSign(Point2 a, Point2 b, Point2 c) {
 
 /// Exact in-circle test: +1 if d lies strictly inside the circle through a, b, c (given
 /// counter-clockwise; the sign flips for clockwise a, b, c), -1 outside, 0 on it.
+namespace pred_detail {
+
+/// Accumulates whether every operation of a computation was exact: each result is formed with an
+/// error-free transformation, and the computation is exact iff every tail is zero.
+struct ExactnessWitness {
+  bool exact = true;
+  GALPHA_HD GALPHA_FORCEINLINE double Diff(double a, double b) {
+    double x, y;
+    exact::TwoDiff(a, b, x, y);
+    exact = exact && y == 0.0;
+    return x;
+  }
+  GALPHA_HD GALPHA_FORCEINLINE double Sum(double a, double b) {
+    double x, y;
+    exact::TwoSum(a, b, x, y);
+    exact = exact && y == 0.0;
+    return x;
+  }
+  GALPHA_HD GALPHA_FORCEINLINE double Product(double a, double b) {
+    double x, y;
+    exact::TwoProduct(a, b, x, y);
+    exact = exact && y == 0.0;
+    return x;
+  }
+};
+
+/// The in-circle determinant in plain doubles when every operation in it happens to be exact, as
+/// for small integer coordinates (grids): then its sign is exact, zero included, and the costly
+/// expansion stage is skipped. Returns false when some operation rounded, or when a nonzero
+/// coordinate difference lies outside [2^-240, 2^241), where Two-Product's tail could underflow or
+/// its split overflow and a zero tail would prove nothing.
+GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Point2 b, Point2 c, Point2 d,
+                                                                   int* sign) {
+  ExactnessWitness w;
+  const double adx = w.Diff(a.x, d.x), ady = w.Diff(a.y, d.y);
+  const double bdx = w.Diff(b.x, d.x), bdy = w.Diff(b.y, d.y);
+  const double cdx = w.Diff(c.x, d.x), cdy = w.Diff(c.y, d.y);
+  if (!w.exact) return false;
+  const double differences[6] = {adx, ady, bdx, bdy, cdx, cdy};
+  for (double v : differences) {
+    if (v != 0.0 && (exact::ExponentOf(v) < -240 || exact::ExponentOf(v) > 240)) return false;
+  }
+  const double ma = w.Diff(w.Product(bdx, cdy), w.Product(cdx, bdy));
+  const double mb = w.Diff(w.Product(cdx, ady), w.Product(adx, cdy));
+  const double mc = w.Diff(w.Product(adx, bdy), w.Product(bdx, ady));
+  const double alift = w.Sum(w.Product(adx, adx), w.Product(ady, ady));
+  const double blift = w.Sum(w.Product(bdx, bdx), w.Product(bdy, bdy));
+  const double clift = w.Sum(w.Product(cdx, cdx), w.Product(cdy, cdy));
+  const double det = w.Sum(w.Sum(w.Product(alift, ma), w.Product(blift, mb)), w.Product(clift, mc));
+  if (!w.exact) return false;
+  *sign = det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
+  return true;
+}
+
+}  // namespace pred_detail
+
 GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Point2 d) {
   using namespace exact;
   const double adx = Sub(a.x, d.x), ady = Sub(a.y, d.y);
@@ -294,6 +350,8 @@ GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Poin
   const double gate = Mul(pred_detail::kUnderflowGate,
                           Add(Add(Add(Add(alift, blift), Add(clift, pa)), Add(pb, pc)), 1.0));
   if (errbound >= gate && (det > errbound || -det > errbound)) return det > 0.0 ? 1 : -1;
+  int sign;
+  if (pred_detail::InCircleSignIfExactInDoubles(a, b, c, d, &sign)) return sign;
   double e[kInCircleExpansionCapacity];
   return ExpansionSign(InCircleExpansion(a, b, c, d, e), e);
 }
@@ -353,12 +411,13 @@ GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSoSDegenerate(Point2 a, uint32_t i
 /// whenever they are reached (r2 == r3), and we skip them. Terms 14-18 are kept so that the
 /// function stays total and deterministic if a caller breaks the distinct-points promise.
 GALPHA_HD inline int Det4SoSSign(const Point2* p) {
+  int t = -Orient2dSign(p[1], p[2], p[3]);  // 2: decides unless r1, r2, r3 are collinear
+  if (t != 0) return t;
   double x[4] = {0.0, 0.0, 0.0, 0.0}, y[4] = {0.0, 0.0, 0.0, 0.0}, z[4][4];
   int zl[4];
   ScaleForInCircle<4>(p, x, y);  // leaves the zeros when every coordinate is 0
   for (int i = 0; i < 4; ++i) zl[i] = Lift(x[i], y[i], z[i]);
-  int t = -Orient2dSign(p[1], p[2], p[3]);          // 2
-  if (t == 0) t = MinorUZSign(x, z, zl, 1, 2, 3);   // 3
+  t = MinorUZSign(x, z, zl, 1, 2, 3);               // 3
   if (t == 0) t = -MinorUZSign(y, z, zl, 1, 2, 3);  // 4
   if (t == 0) t = Orient2dSign(p[0], p[2], p[3]);   // 5
   if (t == 0) t = CompareSign(p[3].x, p[2].x);      // 6

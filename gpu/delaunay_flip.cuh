@@ -1,7 +1,7 @@
 // Parallel Lawson flips (gDel2D): every active triangle proposes to flip its first non-Delaunay
 // edge; a proposal wins when it holds the minimum vote on both triangles it touches, so no
-// triangle takes part in two flips at once. Also the serial repair of hull triangles that are flat
-// only in the symbolic perturbation.
+// triangle takes part in two flips at once. Also the repair of hull triangles that are flat
+// in reality but not in the symbolic perturbation.
 #pragma once
 
 #include <cstdint>
@@ -169,39 +169,93 @@ struct CollectNextActive {
   }
 };
 
-/// Removes triangles that are flat in reality (three collinear vertices on a hull line, produced
-/// by the symbolic perturbation) so that hull points on a hull edge become hull vertices, as in
-/// CGAL. A flat triangle (m between p and q) is flipped across its long edge p-q when the triangle
-/// there is infinite (m joins the hull) or properly shaped (m joins that triangle's apex). Such a
-/// flip never makes a new flat triangle. When the triangle across is flat too, it is repaired
-/// first, depth-first with an explicit stack, so that each flat triangle is visited O(1) times
-/// (on two parallel lines of points every point is on the hull, and the flat triangles stack up).
-/// Runs as one thread: the flat triangles lie on the hull, O(sqrt n) of them on a grid.
-struct RepairFlatHullTriangles {
+/// Whether finite triangle t is flat in reality: three collinear vertices on a hull line, made by
+/// the symbolic perturbation.
+GALPHA_HD inline bool IsFlatTriangle(const MeshView& mesh, int32_t t) {
+  if (mesh.IsInfinite(t)) return false;
+  const Tri& x = mesh.tri[t];
+  return Orient2dSign(mesh.pts[x.v[0]], mesh.pts[x.v[1]], mesh.pts[x.v[2]]) == 0;
+}
+
+/// Position of the vertex of a flat triangle that lies between the other two.
+GALPHA_HD inline int MiddlePosition(const MeshView& mesh, int32_t t) {
+  const Tri& x = mesh.tri[t];
+  for (int k = 0; k < 3; ++k) {
+    const Point2 m = mesh.pts[x.v[k]], a = mesh.pts[x.v[Next(k)]], b = mesh.pts[x.v[Prev(k)]];
+    if ((LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a))) return k;
+  }
+  return -1;
+}
+
+/// The hull repair: flat triangles are removed so that points on a hull edge become hull vertices,
+/// as in CGAL. A flat triangle (m between p and q) flips across its long edge p-q when the triangle
+/// there is infinite (m joins the hull) or properly shaped (m joins that triangle's apex); such a
+/// flip never makes a new flat triangle. When the triangle across is flat too, it waits for that
+/// one's repair. Proposals are voted on and executed like Lawson flips (ExecuteFlips, LinkFlips),
+/// in parallel rounds; a round's depth is the longest chain of flat triangles waiting on each other.
+struct ProposeFlatRepairs {
   MeshView mesh;
-  const int32_t* flat;  // the flat triangles found before the repair
-  uint32_t num_flat;
-  int32_t* stack;       // num_flat entries
-  uint8_t* on_stack;    // per triangle, zero on entry and on exit
-  int32_t* failed;      // set when flat triangles remain (reported as an internal error)
-  int32_t* flips_done;
-  int32_t* touched;     // the two triangles of every repair flip, for the Lawson pass after
+  const int32_t* flat;    // flat triangles still to repair
+  int8_t* proposal_edge;  // per entry: the long edge's position, or -1 while waiting
+  int32_t* proposal_nb;
+  uint32_t* flip_vote;
 
-  GALPHA_HD bool IsFlat(int32_t t) const {
-    if (mesh.IsInfinite(t)) return false;
-    const Tri& x = mesh.tri[t];
-    return Orient2dSign(mesh.pts[x.v[0]], mesh.pts[x.v[1]], mesh.pts[x.v[2]]) == 0;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = flat[i];
+    proposal_edge[i] = -1;
+    const int k = MiddlePosition(mesh, t);
+    if (k < 0) return;
+    const int32_t nb = mesh.nbr[t].n[k];
+    if (IsFlatTriangle(mesh, nb)) return;
+    proposal_edge[i] = static_cast<int8_t>(k);
+    proposal_nb[i] = nb;
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[t]).fetch_min(static_cast<uint32_t>(t));
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[nb]).fetch_min(static_cast<uint32_t>(t));
   }
+};
 
-  /// Position of the vertex lying between the other two (collinear vertices).
-  GALPHA_HD int MiddlePos(int32_t t) const {
-    const Tri& x = mesh.tri[t];
-    for (int k = 0; k < 3; ++k) {
-      const Point2 m = mesh.pts[x.v[k]], a = mesh.pts[x.v[Next(k)]], b = mesh.pts[x.v[Prev(k)]];
-      if ((LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a))) return k;
+/// After a repair round: clears votes and partners, lists both triangles of every executed repair
+/// (for the Lawson pass after), and marks the flat triangles that remain.
+struct CollectFlatRepairs {
+  const int32_t* flat;
+  const int8_t* proposal_edge;  // 3 where ExecuteFlips flipped
+  const int32_t* proposal_nb;
+  uint32_t* flip_vote;
+  int32_t* partner;
+  int32_t* flipped_pairs;       // two per entry, -1 when unused
+  uint8_t* still_flat;          // per entry
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = flat[i];
+    flipped_pairs[2 * i] = -1;
+    flipped_pairs[2 * i + 1] = -1;
+    still_flat[i] = proposal_edge[i] != 3;
+    if (proposal_edge[i] < 0) return;
+    const int32_t nb = proposal_nb[i];
+    flip_vote[t] = kNoFlipVote;
+    flip_vote[nb] = kNoFlipVote;
+    if (proposal_edge[i] == 3) {
+      partner[t] = kNoPartner;
+      partner[nb] = kNoPartner;
+      flipped_pairs[2 * i] = t;
+      flipped_pairs[2 * i + 1] = nb;
     }
-    return -1;
   }
+};
+
+/// The repair of what the parallel rounds leave when flat triangles wait on each other in long
+/// chains (on two parallel lines of points every point is on the hull, and the chains are O(n)
+/// long, so parallel rounds would take O(n) rounds): one thread, depth-first with an explicit
+/// stack, so that each flat triangle is visited O(1) times.
+struct RepairFlatChainsSerially {
+  MeshView mesh;
+  const int32_t* flat;   // the flat triangles left
+  uint32_t num_flat;
+  int32_t* stack;        // num_flat entries
+  uint32_t* on_stack;    // per triangle, kNoFlipVote (the idle flip votes) when not on the stack
+  int32_t* failed;       // set when flat triangles remain (reported as an internal error)
+  int32_t* flips_done;
+  int32_t* touched;      // the two triangles of every repair flip, for the Lawson pass after
 
   GALPHA_HD void SerialFlip(int32_t t, int k) const {
     const Tri x = mesh.tri[t];
@@ -216,21 +270,20 @@ struct RepairFlatHullTriangles {
     }
   }
 
-  /// Repairs flat triangle `first` and, before it, the flat triangles it waits for. Returns false
-  /// when `first` is left flat (two flat triangles sharing their long edge wait for each other).
-  GALPHA_HD bool RepairFrom(int32_t first, int32_t* flips) const {
+  /// Repairs flat triangle `first` and, before it, the flat triangles it waits for.
+  GALPHA_HD void RepairFrom(int32_t first, int32_t* flips) const {
     uint32_t top = 0;
     stack[top++] = first;
-    on_stack[first] = 1;
+    on_stack[first] = 0;
     while (top > 0) {
       const int32_t t = stack[top - 1];
-      const int k = IsFlat(t) ? MiddlePos(t) : -1;
+      const int k = IsFlatTriangle(mesh, t) ? MiddlePosition(mesh, t) : -1;
       if (k >= 0) {
         const int32_t nb = mesh.nbr[t].n[k];
-        if (!mesh.IsInfinite(nb) && IsFlat(nb)) {
-          if (!on_stack[nb] && top < num_flat) {
+        if (IsFlatTriangle(mesh, nb)) {
+          if (on_stack[nb] == kNoFlipVote && top < num_flat) {
             stack[top++] = nb;
-            on_stack[nb] = 1;
+            on_stack[nb] = 0;
             continue;
           }
           // A cycle: t stays flat for now, and a later pass tries again.
@@ -241,21 +294,20 @@ struct RepairFlatHullTriangles {
           ++*flips;
         }
       }
-      on_stack[t] = 0;
+      on_stack[t] = kNoFlipVote;
       --top;
     }
-    return !IsFlat(first);
   }
 
   GALPHA_HD void operator()(uint32_t) const {
     int32_t flips = 0;
     // Passes until every flat triangle is repaired; a pass that repairs none is a failure.
-    bool remaining = true;
-    while (remaining) {
+    for (bool remaining = true; remaining;) {
       remaining = false;
       const int32_t before = flips;
       for (uint32_t i = 0; i < num_flat; ++i) {
-        if (IsFlat(flat[i]) && !RepairFrom(flat[i], &flips)) remaining = true;
+        if (IsFlatTriangle(mesh, flat[i])) RepairFrom(flat[i], &flips);
+        remaining |= IsFlatTriangle(mesh, flat[i]);
       }
       if (remaining && flips == before) {
         *failed = 1;

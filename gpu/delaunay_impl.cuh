@@ -3,8 +3,10 @@
 // Instantiated by delaunay_cpu.cpp (OpenMP) and delaunay_cuda.cu (CUDA).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <string>
 
 #include <thrust/copy.h>
@@ -64,11 +66,7 @@ struct IsNonNegative {
 
 struct IsFlatFiniteTriangle {
   MeshView mesh;
-  GALPHA_HD bool operator()(int32_t t) const {
-    if (mesh.IsInfinite(t)) return false;
-    const Tri& x = mesh.tri[t];
-    return Orient2dSign(mesh.pts[x.v[0]], mesh.pts[x.v[1]], mesh.pts[x.v[2]]) == 0;
-  }
+  GALPHA_HD bool operator()(int32_t t) const { return IsFlatTriangle(mesh, t); }
 };
 
 struct IsFiniteTri {
@@ -95,7 +93,7 @@ class DelaunayBuilder {
         active_mask_(sys, capacity_),
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
-        flags_(sys, 4) {
+        flags_(sys, 2) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
     thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
@@ -177,33 +175,69 @@ class DelaunayBuilder {
   /// Removes symbolically flat hull triangles, then re-flips the finite triangles to Delaunay
   /// with the hull fixed. Returns the number of repair flips.
   int32_t RepairHull() {
+    // Below this many repairs in a round, the rest is repaired by one thread.
+    constexpr uint32_t kMinParallelRepairs = 64;
     auto pol = sys_.policy();
     const thrust::counting_iterator<int32_t> tfirst(0);
-    int32_t* flat = candidates();
-    const uint32_t num_flat = static_cast<uint32_t>(
-        thrust::copy_if(pol, tfirst, tfirst + num_tri_, flat, IsFlatFiniteTriangle{mesh_}) - flat);
+    const thrust::counting_iterator<uint32_t> first(0);
+    // Found in the (larger, idle) candidate buffer, then moved to one of their own size.
+    uint32_t num_flat = static_cast<uint32_t>(
+        thrust::copy_if(pol, tfirst, tfirst + num_tri_, candidates(), IsFlatFiniteTriangle{mesh_}) - candidates());
     if (num_flat == 0) return 0;
+    Buffer<int32_t, System> flat_now(sys_, num_flat);
+    thrust::copy(pol, candidates(), candidates() + num_flat, flat_now.begin());
     // Each flat triangle is repaired by one flip of two triangles.
-    Buffer<int32_t, System> touched_buffer(sys_, 2 * static_cast<size_t>(num_flat));
-    Buffer<int32_t, System> stack(sys_, num_flat);
-    Buffer<uint8_t, System> on_stack(sys_, static_cast<size_t>(num_tri_));
-    thrust::fill(pol, on_stack.begin(), on_stack.end(), uint8_t{0});
-    int32_t* touched = touched_buffer.data();
-    thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(1),
-                     RepairFlatHullTriangles{mesh_, flat, num_flat, stack.data(), on_stack.data(), flags_.data() + 1,
-                                             flags_.data() + 2, touched});
-    if (sys_.Read(flags_.data() + 1) != 0) {
-      throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+    Buffer<int32_t, System> flat_next(sys_, num_flat);
+    Buffer<uint8_t, System> still_flat(sys_, num_flat);
+    Buffer<int32_t, System> touched(sys_, 2 * static_cast<size_t>(num_flat));
+    int32_t* flat = flat_now.data();
+    int32_t* next = flat_next.data();
+    uint32_t num_touched = 0;
+    while (num_flat > 0) {
+      thrust::for_each(pol, first, first + num_flat,
+                       ProposeFlatRepairs{mesh_, flat, proposal_edge_.data(), split_offset_or_nb_.data(),
+                                          flip_vote_.data()});
+      thrust::for_each(pol, first, first + num_flat,
+                       ExecuteFlips{mesh_, flat, proposal_edge_.data(), split_offset_or_nb_.data(), flip_vote_.data(),
+                                    partner_.data()});
+      thrust::for_each(pol, first, first + num_flat,
+                       LinkFlips{mesh_, flat, proposal_edge_.data(), split_offset_or_nb_.data(), partner_.data()});
+      thrust::for_each(pol, first, first + num_flat,
+                       CollectFlatRepairs{flat, proposal_edge_.data(), split_offset_or_nb_.data(), flip_vote_.data(),
+                                          partner_.data(), candidates(), still_flat.data()});
+      num_touched = static_cast<uint32_t>(thrust::copy_if(pol, candidates(), candidates() + 2 * num_flat,
+                                                          touched.data() + num_touched, IsNonNegative()) -
+                                          touched.data());
+      const uint32_t remaining = static_cast<uint32_t>(
+          thrust::copy_if(pol, flat, flat + num_flat, still_flat.data(), next, IsSet()) - next);
+      std::swap(flat, next);
+      // The smallest proposer always wins both of its votes, so every round repairs at least
+      // one. A round that repairs few means long chains of flat triangles waiting on each other:
+      // one thread walks them depth-first in time linear in what is left.
+      const bool chains = num_flat - remaining < std::max<uint32_t>(kMinParallelRepairs, remaining / 4);
+      num_flat = remaining;
+      if (num_flat > 0 && chains) {
+        thrust::fill(pol, flags_.begin(), flags_.end(), 0);
+        thrust::for_each(pol, first, first + 1,
+                         RepairFlatChainsSerially{mesh_, flat, num_flat, next, flip_vote_.data(), flags_.data(),
+                                                  flags_.data() + 1, touched.data() + num_touched});
+        if (sys_.Read(flags_.data()) != 0) {
+          throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+        }
+        num_touched += 2 * static_cast<uint32_t>(sys_.Read(flags_.data() + 1));
+        num_flat = 0;
+      }
     }
-    const int32_t flips = sys_.Read(flags_.data() + 2);
+    flat_now.Reset();
+    flat_next.Reset();
     // Only triangles a repair flip changed can hold an edge that is no longer locally Delaunay.
     // A triangle may appear twice (two repair flips): de-duplicate before flipping in parallel.
-    thrust::sort(pol, touched, touched + 2 * flips);
+    thrust::sort(pol, touched.begin(), touched.begin() + num_touched);
     const uint32_t num_active = static_cast<uint32_t>(
-        thrust::unique_copy(pol, touched, touched + 2 * flips, active_.data()) - active_.data());
+        thrust::unique_copy(pol, touched.begin(), touched.begin() + num_touched, active_.data()) - active_.data());
     thrust::fill(pol, active_mask_.data(), active_mask_.data() + num_active, kCheckAllEdges);
     RestoreDelaunay(num_active, /*hull_may_change=*/false);
-    return flips;
+    return static_cast<int32_t>(num_touched / 2);
   }
 
  private:
@@ -267,7 +301,7 @@ class DelaunayBuilder {
   Buffer<uint8_t, System> active_mask_;
   Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
-  Buffer<int32_t, System> flags_;  // [0] walk failed, [1] repair failed, [2] repair flips
+  Buffer<int32_t, System> flags_;  // [0] walk or repair failed, [1] serial repair flips
   MeshView mesh_{};
   int32_t num_tri_ = 0;
   int rounds_ = 0;
