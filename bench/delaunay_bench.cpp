@@ -187,16 +187,18 @@ std::string StageSummary(const std::vector<StageTime>& stages) {
   return out;
 }
 
-void PrintTables(const std::vector<BenchResult>& results) {
+void PrintHeader() {
   std::printf(
       "| distribution | n | galpha backend | galpha ms (no transfers) | transfers+host copies ms | CGAL ms | "
       "CGAL/galpha (no transfers) | CGAL/galpha (whole call) | peak bytes/point | triangles |\n"
       "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
-  for (const BenchResult& r : results) {
-    if (!r.error.empty()) {
-      std::printf("| %s | %zu | - | error: %s | | | | | | |\n", r.name.c_str(), r.n, r.error.c_str());
-      continue;
-    }
+}
+
+// One row as soon as its input is measured (flushed), so that a run cut short keeps its rows.
+void PrintRow(const BenchResult& r) {
+  if (!r.error.empty()) {
+    std::printf("| %s | %zu | - | error: %s | | | | | | |\n", r.name.c_str(), r.n, r.error.c_str());
+  } else {
     const std::string triangles =
         r.galpha_triangles == r.cgal_triangles
             ? absl::StrCat(r.galpha_triangles)
@@ -207,6 +209,10 @@ void PrintTables(const std::vector<BenchResult>& results) {
                 static_cast<double>(r.galpha_peak_bytes) / static_cast<double>(std::max<size_t>(r.n, 1)),
                 triangles.c_str());
   }
+  std::fflush(stdout);
+}
+
+void PrintStageTable(const std::vector<BenchResult>& results) {
   std::printf("\n| distribution | n | galpha stages, best run (ms) |\n|---|---:|---|\n");
   for (const BenchResult& r : results) {
     if (!r.error.empty()) continue;
@@ -225,12 +231,14 @@ int Main(int argc, char** argv) {
               CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
               std::thread::hardware_concurrency());
 
+  PrintHeader();
   std::vector<BenchResult> results;
   bool failed = false;
   auto run = [&](const BenchInput& input) {
     std::fprintf(stderr, "running %s n=%zu\n", input.name.c_str(), input.points.size());
     BenchResult result = RunOne(input, *options);
     failed |= !result.error.empty() || result.galpha_triangles != result.cgal_triangles;
+    PrintRow(result);
     results.push_back(std::move(result));
   };
   for (const std::string& name : options->distributions) {
@@ -247,7 +255,7 @@ int Main(int argc, char** argv) {
     const size_t slash = file.find_last_of('/');
     run({slash == std::string::npos ? file : file.substr(slash + 1), *std::move(points)});
   }
-  PrintTables(results);
+  PrintStageTable(results);
   // An engine error, or a triangle count unlike CGAL's for the same point set, fails the run.
   return failed ? 1 : 0;
 }

@@ -5,7 +5,8 @@
 #   sanitize  compute-sanitizer memcheck and racecheck of one small CUDA triangulation
 #   test    the test binaries (CUDA backend included), each test under GALPHA_TEST_TIMEOUT seconds
 #           (default 240), one process per test so that a hang names its test
-#   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides its args
+#   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
+#           its first run (the benchmark distributions)
 # Full logs go to $OUT (8 files at most, so that all of them come back) (or /tmp/galpha-gpu); a short summary goes to standard output.
 set -uo pipefail
 out="${OUT:-/tmp/galpha-gpu}"
@@ -66,8 +67,13 @@ for phase in "${phases[@]}"; do
       ;;
     bench)
       [ -x .carry/bin/delaunay_bench ] || { echo "no delaunay_bench in .carry"; status=1; continue; }
+      # The benchmark distributions at three sizes, then the degenerate test distributions, whose
+      # rows only show that they are not pathologically slow.
       # shellcheck disable=SC2086
-      run_step bench 560 .carry/bin/delaunay_bench ${GALPHA_BENCH_ARGS:---backend=cuda --sizes=100000,1000000,10000000}
+      run_step bench 420 .carry/bin/delaunay_bench \
+        ${GALPHA_BENCH_ARGS:---backend=cuda --sizes=100000,1000000,10000000 --repeat=3}
+      run_step bench 120 .carry/bin/delaunay_bench --backend=cuda --sizes=100000,1000000 --repeat=1 \
+        --dists=parallel_lines,two_lines,circle,tiny,huge_offset_1e15
       grep -E '^\|' "$out/bench.log"
       ;;
     *)

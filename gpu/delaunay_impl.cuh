@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <utility>
 #include <string>
@@ -335,8 +336,15 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     Buffer<uint32_t, System> sorted(sys, n);
     Buffer<uint32_t, System> head(sys, n);
     Buffer<uint32_t, System> representative(sys, n);
+    // Sorted by (x, y, index): stable radix sorts by y, then by x, of the identity permutation.
     thrust::sequence(pol, sorted.begin(), sorted.end());
-    thrust::sort(pol, sorted.begin(), sorted.end(), PointThenIndexLess{input.data()});
+    {
+      Buffer<uint64_t, System> keys(sys, n);
+      for (const CoordinateKey::Axis axis : {CoordinateKey::kY, CoordinateKey::kX}) {
+        thrust::transform(pol, first, first + n, keys.begin(), CoordinateKey{input.data(), sorted.data(), axis});
+        thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
+      }
+    }
     thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data()});
     thrust::inclusive_scan(pol, head.begin(), head.end(), head.begin(), thrust::maximum<uint32_t>());
     thrust::for_each(pol, first, first + n, WriteRepresentative{sorted.data(), head.data(), representative.data()});

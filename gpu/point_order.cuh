@@ -3,20 +3,32 @@
 #pragma once
 
 #include <cstdint>
+#include <cstring>
 
 #include "core/hd.hpp"
 #include "core/point.hpp"
 
 namespace galpha::detail {
 
-/// Orders input indices by point (x, then y), ties by index so a run's head is its first occurrence.
-struct PointThenIndexLess {
+/// A 64-bit key with the order of the double (-0.0 and +0.0 get the same key): radix-sortable.
+GALPHA_HD inline uint64_t OrderedDoubleKey(double v) {
+  const double normalized = v + 0.0;  // -0.0 + 0.0 == +0.0
+  uint64_t bits;
+  memcpy(&bits, &normalized, sizeof bits);
+  return (bits >> 63) ? ~bits : (bits | 0x8000000000000000ull);
+}
+
+/// The sort key of coordinate y (kY) or x (kX) of the input point a permutation entry names. Sorting
+/// stably by y, then by x, orders by (x, y) with ties in index order (exact
+/// duplicates adjacent, first occurrence first), with two radix sorts instead of a comparison sort.
+struct CoordinateKey {
+  enum Axis { kX, kY };
   const Point2* pts;
-  GALPHA_HD bool operator()(uint32_t a, uint32_t b) const {
-    const Point2 pa = pts[a], pb = pts[b];
-    if (LexLess(pa, pb)) return true;
-    if (LexLess(pb, pa)) return false;
-    return a < b;
+  const uint32_t* order;
+  Axis axis;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const Point2 p = pts[order[k]];
+    return OrderedDoubleKey(axis == kX ? p.x : p.y);
   }
 };
 
