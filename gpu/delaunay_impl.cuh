@@ -331,11 +331,12 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
 
   // Exact duplicates: sort by (point, index); each run's head is the first occurrence.
   Buffer<uint32_t, System> unique(sys, n);
+  // Stays on the device until the download stage: a transfer, not part of the dedupe's time.
+  Buffer<uint32_t, System> representative(sys, n);
   uint32_t m = 0;
   {
     Buffer<uint32_t, System> sorted(sys, n);
     Buffer<uint32_t, System> head(sys, n);
-    Buffer<uint32_t, System> representative(sys, n);
     // Sorted by (x, y, index): stable radix sorts by y, then by x, of the identity permutation.
     thrust::sequence(pol, sorted.begin(), sorted.end());
     {
@@ -351,7 +352,6 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     m = static_cast<uint32_t>(
         thrust::copy_if(pol, sorted.begin(), sorted.end(), first, unique.begin(), IsRunHead{head.data()}) -
         unique.begin());
-    out->representative = representative.ToHostVector(n);
   }
   out->num_unique = m;
   timer.EndStage("dedupe");
@@ -370,6 +370,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     thrust::for_each(pol, first, first + num_edges, WriteChainEdge{unique.data(), edges.data()});
     out->edges.resize(num_edges);
     CopyOut(sys, edges, num_edges, out->edges.data());
+    out->representative = representative.ToHostVector(n);
     timer.EndStage("collinear_chain");
     out->peak_memory_bytes = sys.peak_bytes();
     return;
@@ -450,6 +451,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
   CopyOut(sys, out_nbr, num_finite, out->neighbors.data());
   CopyOut(sys, edge_begin, num_finite, out->tri_edge_begin.data());
   CopyOut(sys, edges, num_edges, out->edges.data());
+  out->representative = representative.ToHostVector(n);
   timer.EndStage("download");
   out->peak_memory_bytes = sys.peak_bytes();
 }
