@@ -10,6 +10,7 @@ cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
 for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
+         tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test \
          bench/delaunay_bench client/alphactl; do
   if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
 done

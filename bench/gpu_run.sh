@@ -54,7 +54,7 @@ for phase in "${phases[@]}"; do
       grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race" "$out/sanitize.log" | sort | uniq -c | head -n 20
       ;;
     test)
-      for t in predicates_test predicates_device_test delaunay_test; do
+      for t in predicates_test predicates_device_test triangulation_checks_test delaunay_test delaunay_cgal_test; do
         [ -x ".carry/bin/$t" ] || continue
         # One process per test, so that a hang names its test and the rest still run.
         for name in $(".carry/bin/$t" --gtest_list_tests | awk '/^[^ ]/{suite=$1} /^  /{print suite $1}'); do
