@@ -48,6 +48,7 @@ class StreamOrderedAllocator {
 class CudaSystem {
  public:
   static constexpr const char* kName = "cuda";
+  static constexpr bool kHostMemory = false;
 
   explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) {}
   CudaSystem(const CudaSystem&) = delete;

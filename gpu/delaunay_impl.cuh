@@ -7,8 +7,9 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <thrust/copy.h>
 #include <thrust/count.h>
@@ -176,8 +177,10 @@ class DelaunayBuilder {
   /// Removes symbolically flat hull triangles, then re-flips the finite triangles to Delaunay
   /// with the hull fixed. Returns the number of repair flips.
   int32_t RepairHull() {
-    // Below this many repairs in a round, the rest is repaired by one thread.
-    constexpr uint32_t kMinParallelRepairs = 64;
+    // Flat triangles wait on each other in chains, and a round repairs one per chain: when the
+    // rounds left would exceed this (remaining / repaired in the last round), one thread walks
+    // the chains instead, in time linear in what is left.
+    constexpr uint32_t kMaxParallelRepairRounds = 256;
     auto pol = sys_.policy();
     const thrust::counting_iterator<int32_t> tfirst(0);
     const thrust::counting_iterator<uint32_t> first(0);
@@ -215,17 +218,10 @@ class DelaunayBuilder {
       // The smallest proposer always wins both of its votes, so every round repairs at least
       // one. A round that repairs few means long chains of flat triangles waiting on each other:
       // one thread walks them depth-first in time linear in what is left.
-      const bool chains = num_flat - remaining < std::max<uint32_t>(kMinParallelRepairs, remaining / 4);
+      const bool chains = remaining > kMaxParallelRepairRounds * (num_flat - remaining);
       num_flat = remaining;
       if (num_flat > 0 && chains) {
-        thrust::fill(pol, flags_.begin(), flags_.end(), 0);
-        thrust::for_each(pol, first, first + 1,
-                         RepairFlatChainsSerially{mesh_, flat, num_flat, next, flip_vote_.data(), flags_.data(),
-                                                  flags_.data() + 1, touched.data() + num_touched});
-        if (sys_.Read(flags_.data()) != 0) {
-          throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
-        }
-        num_touched += 2 * static_cast<uint32_t>(sys_.Read(flags_.data() + 1));
+        num_touched += RepairChainsSerially(flat, num_flat, next, touched.data() + num_touched);
         num_flat = 0;
       }
     }
@@ -242,6 +238,52 @@ class DelaunayBuilder {
   }
 
  private:
+  /// Runs RepairFlatChainsSerially over the `num_flat` flat triangles left; returns the number of
+  /// entries it wrote to `touched`. One device thread walks at global-memory latency (~4 us a
+  /// triangle on an H100), so when the chains are long compared with the mesh (every point on the
+  /// hull: parallel lines), the mesh goes to the host, is repaired there by the same functor, and
+  /// comes back (~100 bytes a point each way, ~20 ns a point).
+  uint32_t RepairChainsSerially(const int32_t* flat, uint32_t num_flat, int32_t* stack, int32_t* touched) {
+    constexpr uint32_t kPointsPerDeviceWalkStep = 200;
+    int32_t flips = 0;
+    if constexpr (!System::kHostMemory) {
+      if (num_flat > m_ / kPointsPerDeviceWalkStep) {
+        std::vector<Tri> tri(num_tri_);
+        std::vector<TriNbr> nbr(num_tri_);
+        std::vector<Point2> pts(m_);
+        std::vector<int32_t> host_flat(num_flat), host_stack(num_flat), host_touched(2 * size_t{num_flat});
+        std::vector<uint32_t> on_stack(num_tri_, kNoFlipVote);
+        sys_.ToHost(tri.data(), tri_.data(), tri.size());
+        sys_.ToHost(nbr.data(), nbr_.data(), nbr.size());
+        sys_.ToHost(pts.data(), mesh_.pts, pts.size());
+        sys_.ToHost(host_flat.data(), flat, num_flat);
+        MeshView host_mesh = mesh_;
+        host_mesh.pts = pts.data();
+        host_mesh.sos = nullptr;  // the repair decides by exact orientation only, never by SoS
+        host_mesh.tri = tri.data();
+        host_mesh.nbr = nbr.data();
+        int32_t failed = 0;
+        RepairFlatChainsSerially{host_mesh,        host_flat.data(), num_flat, host_stack.data(), on_stack.data(),
+                                 &failed,          &flips,           host_touched.data()}(0);
+        if (failed != 0) throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+        sys_.FromHost(tri_.data(), tri.data(), tri.size());
+        sys_.FromHost(nbr_.data(), nbr.data(), nbr.size());
+        sys_.FromHost(touched, host_touched.data(), 2 * static_cast<size_t>(flips));
+        return 2 * static_cast<uint32_t>(flips);
+      }
+    }
+    auto pol = sys_.policy();
+    thrust::fill(pol, flags_.begin(), flags_.end(), 0);
+    thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(1),
+                     RepairFlatChainsSerially{mesh_, flat, num_flat, stack, flip_vote_.data(), flags_.data(),
+                                              flags_.data() + 1, touched});
+    if (sys_.Read(flags_.data()) != 0) {
+      throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+    }
+    flips = sys_.Read(flags_.data() + 1);
+    return 2 * static_cast<uint32_t>(flips);
+  }
+
   int32_t* candidates() {
     static_assert(sizeof(unsigned long long) == 2 * sizeof(int32_t), "candidates share the vote buffer");
     return reinterpret_cast<int32_t*>(tri_vote_.data());

@@ -59,6 +59,8 @@ class HostTempAllocator {
 class CpuSystem {
  public:
   static constexpr const char* kName = "cpu";
+  /// Whether the system's memory is the host's (no copies needed to run host code on it).
+  static constexpr bool kHostMemory = true;
 
   CpuSystem() : temp_(&ledger_) {}
   CpuSystem(const CpuSystem&) = delete;
