@@ -177,10 +177,6 @@ class DelaunayBuilder {
   /// Removes symbolically flat hull triangles, then re-flips the finite triangles to Delaunay
   /// with the hull fixed. Returns the number of repair flips.
   int32_t RepairHull() {
-    // Flat triangles wait on each other in chains, and a round repairs one per chain: when the
-    // rounds left would exceed this (remaining / repaired in the last round), one thread walks
-    // the chains instead, in time linear in what is left.
-    constexpr uint32_t kMaxParallelRepairRounds = 256;
     auto pol = sys_.policy();
     const thrust::counting_iterator<int32_t> tfirst(0);
     const thrust::counting_iterator<uint32_t> first(0);
@@ -216,9 +212,10 @@ class DelaunayBuilder {
           thrust::copy_if(pol, flat, flat + num_flat, still_flat.data(), next, IsSet()) - next);
       std::swap(flat, next);
       // The smallest proposer always wins both of its votes, so every round repairs at least
-      // one. A round that repairs few means long chains of flat triangles waiting on each other:
-      // one thread walks them depth-first in time linear in what is left.
-      const bool chains = remaining > kMaxParallelRepairRounds * (num_flat - remaining);
+      // one. Flat triangles wait on each other in chains and a round repairs one per chain: when a
+      // round repairs fewer than one round costs in steps of the one-thread walk, that thread
+      // walks the chains instead, depth-first, in time linear in what is left.
+      const bool chains = num_flat - remaining < System::kRepairStepsPerRound;
       num_flat = remaining;
       if (num_flat > 0 && chains) {
         num_touched += RepairChainsSerially(flat, num_flat, next, touched.data() + num_touched);

@@ -61,6 +61,9 @@ class CpuSystem {
   static constexpr const char* kName = "cpu";
   /// Whether the system's memory is the host's (no copies needed to run host code on it).
   static constexpr bool kHostMemory = true;
+  /// A parallel round of hull repair (a few parallel regions) costs about this many steps of the
+  /// one-thread chain walk (~0.7 us a step here; measured on 2 cores, 2026-11-22).
+  static constexpr uint32_t kRepairStepsPerRound = 64;
 
   CpuSystem() : temp_(&ledger_) {}
   CpuSystem(const CpuSystem&) = delete;
