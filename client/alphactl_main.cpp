@@ -11,14 +11,15 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
-#include "core/point_io.hpp"
+#include "core/point_formats.hpp"
 #include "gpu/delaunay.hpp"
 
 namespace {
 
 constexpr char kUsage[] =
-    "usage: alphactl triangulate FILE.bin [--backend=auto|cpu|cuda]\n"
-    "  FILE.bin: little-endian uint64 N, then N pairs of float64 (x, y)\n";
+    "usage: alphactl triangulate FILE [--backend=auto|cpu|cuda]\n"
+    "  FILE: .bin (little-endian uint64 N, then N pairs of float64 x, y), .npy (float64, N x 2),\n"
+    "        or delimited text (CSV, TSV, whitespace: x and y first, optional header line)\n";
 
 absl::StatusOr<galpha::Backend> ParseBackend(const std::string& name) {
   if (name == "auto") return galpha::Backend::kAuto;
@@ -50,7 +51,7 @@ int Triangulate(const std::vector<std::string>& args) {
   }
   if (file.empty()) return Fail(absl::StrCat("missing FILE\n", kUsage));
 
-  auto points = galpha::ReadPointsBin(file);
+  auto points = galpha::ReadPointsFile(file);
   if (!points.ok()) return Fail(std::string(points.status().message()));
   auto tri = galpha::Triangulate(*points, options);
   if (!tri.ok()) return Fail(std::string(tri.status().message()));
