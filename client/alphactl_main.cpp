@@ -19,7 +19,8 @@ namespace {
 constexpr char kUsage[] =
     "usage: alphactl triangulate FILE [--backend=auto|cpu|cuda]\n"
     "  FILE: .bin (little-endian uint64 N, then N pairs of float64 x, y), .npy (float64, N x 2),\n"
-    "        or delimited text (CSV, TSV, whitespace: x and y first, optional header line)\n";
+    "        .geojson/.json (Point, MultiPoint), or delimited text (CSV, TSV, whitespace:\n"
+    "        x and y first, optional header line)\n";
 
 absl::StatusOr<galpha::Backend> ParseBackend(const std::string& name) {
   if (name == "auto") return galpha::Backend::kAuto;

@@ -15,6 +15,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "core/point_io.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha {
 namespace {
@@ -72,7 +73,71 @@ double DoubleAt(absl::string_view bytes, size_t offset, bool little_endian) {
   return v;
 }
 
+// Appends the points of one GeoJSON object (geometry, feature or collection) at `where`.
+absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string& where, const std::string& source,
+                                 std::vector<Point2>* points) {
+  auto error = [&](const std::string& what) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": ", where.empty() ? "the document" : where, ": ", what));
+  };
+  auto position = [&](const nlohmann::json& p, const std::string& at) -> absl::Status {
+    if (!p.is_array() || p.size() < 2 || p.size() > 3 || !p[0].is_number() || !p[1].is_number()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(source, ": ", at, ": a position must be an array of two or three numbers"));
+    }
+    points->push_back({p[0].get<double>(), p[1].get<double>()});
+    return absl::OkStatus();
+  };
+  if (!object.is_object() || !object.contains("type") || !object["type"].is_string()) {
+    return error("expected a GeoJSON object with a \"type\"");
+  }
+  const std::string type = object["type"].get<std::string>();
+  const std::string prefix = where.empty() ? "" : absl::StrCat(where, ".");
+  if (type == "FeatureCollection" || type == "GeometryCollection") {
+    const char* member = type == "FeatureCollection" ? "features" : "geometries";
+    if (!object.contains(member) || !object[member].is_array()) {
+      return error(absl::StrCat(type, " without a \"", member, "\" array"));
+    }
+    const nlohmann::json& items = object[member];
+    for (size_t i = 0; i < items.size(); ++i) {
+      const absl::Status status =
+          AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points);
+      if (!status.ok()) return status;
+    }
+    return absl::OkStatus();
+  }
+  if (type == "Feature") {
+    if (!object.contains("geometry")) return error("Feature without a \"geometry\"");
+    if (object["geometry"].is_null()) return absl::OkStatus();  // an unlocated feature: no point
+    return AppendGeoJsonPoints(object["geometry"], absl::StrCat(prefix, "geometry"), source, points);
+  }
+  if (type == "Point" || type == "MultiPoint") {
+    if (!object.contains("coordinates")) return error(absl::StrCat(type, " without \"coordinates\""));
+    const nlohmann::json& coordinates = object["coordinates"];
+    if (type == "Point") return position(coordinates, absl::StrCat(prefix, "coordinates"));
+    if (!coordinates.is_array()) return error("MultiPoint coordinates must be an array of positions");
+    for (size_t i = 0; i < coordinates.size(); ++i) {
+      const absl::Status status = position(coordinates[i], absl::StrCat(prefix, "coordinates[", i, "]"));
+      if (!status.ok()) return status;
+    }
+    return absl::OkStatus();
+  }
+  return error(absl::StrCat("a ", type, " is not a point geometry (Point or MultiPoint)"));
+}
+
 }  // namespace
+
+absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source) {
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(text.begin(), text.end());
+  } catch (const nlohmann::json::parse_error& e) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": not valid JSON at byte ", e.byte));
+  }
+  std::vector<Point2> points;
+  const absl::Status status = AppendGeoJsonPoints(document, "", source, &points);
+  if (!status.ok()) return status;
+  return points;
+}
 
 absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source) {
   std::vector<Point2> points;
@@ -179,6 +244,7 @@ absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) return absl::DataLossError(absl::StrCat("cannot read points file '", path, "'"));
   if (extension == ".npy") return ParsePointsNpy(bytes, path);
+  if (extension == ".geojson" || extension == ".json") return ParsePointsGeoJson(bytes, path);
   return ParsePointsText(bytes, path);
 }
 

@@ -29,8 +29,18 @@ absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, cons
 /// dtype or shape; DataLoss when the data is shorter or longer than the header says.
 absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, const std::string& source);
 
+/// Parses GeoJSON (RFC 7946): a FeatureCollection, Feature, GeometryCollection, Point or
+/// MultiPoint; points are taken in document order, the third coordinate (altitude) ignored, features
+/// with a null geometry (unlocated) skipped. O(size).
+///
+/// Errors: InvalidArgument naming `source` and, for content, the place in the document (as
+/// `features[3].geometry`): invalid JSON (with its byte offset), a geometry that is not a Point or
+/// MultiPoint (other geometries are refused rather than skipped, so that no data is lost
+/// silently), a position that is not an array of two or three numbers.
+absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source);
+
 /// Reads a point file, choosing the format by extension: `.bin` (raw, point_io.hpp), `.npy`,
-/// anything else as delimited text. Errors name the file: NotFound when it does not exist, the
+/// `.geojson` or `.json`, anything else as delimited text. Errors name the file: NotFound when it does not exist, the
 /// errno-derived code when it cannot be read, and the parsers' errors above.
 absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path);
 

@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   libgmp-dev             # exact rational oracle in tests
+  nlohmann-json3-dev     # GeoJSON point files
   libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
 )
 

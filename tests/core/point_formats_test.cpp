@@ -120,6 +120,48 @@ TEST(ParsePointsNpyTest, WrongDtypeShapeMagicAndSizeAreErrors) {
   EXPECT_NE(short_data.status().message().find("t.npy"), absl::string_view::npos);
 }
 
+TEST(ParsePointsGeoJsonTest, FeatureCollectionOfPointsAndMultiPoints) {
+  const std::string text = R"({"type": "FeatureCollection", "features": [
+      {"type": "Feature", "properties": {"name": "a"}, "geometry": {"type": "Point", "coordinates": [1.5, -2]}},
+      {"type": "Feature", "properties": {}, "geometry": {"type": "MultiPoint", "coordinates": [[3, 4, 100], [5e-3, 6]]}}
+  ]})";
+  ExpectPoints(ParsePointsGeoJson(text, "f.geojson"), Points({{1.5, -2}, {3, 4}, {5e-3, 6}}));
+}
+
+TEST(ParsePointsGeoJsonTest, BareGeometriesAndGeometryCollection) {
+  ExpectPoints(ParsePointsGeoJson(R"({"type": "Point", "coordinates": [0.1, 0.2]})", "p.json"), Points({{0.1, 0.2}}));
+  ExpectPoints(ParsePointsGeoJson(R"({"type": "GeometryCollection", "geometries": [
+                                       {"type": "Point", "coordinates": [1, 2]},
+                                       {"type": "MultiPoint", "coordinates": []}]})",
+                                  "g.json"),
+               Points({{1, 2}}));
+  // RFC 7946 3.2: an unlocated feature has a null geometry; it holds no point.
+  ExpectPoints(ParsePointsGeoJson(R"({"type": "FeatureCollection", "features": [
+                                       {"type": "Feature", "geometry": null, "properties": {}},
+                                       {"type": "Feature", "geometry": {"type": "Point", "coordinates": [3, 4]}}]})",
+                                  "u.json"),
+               Points({{3, 4}}));
+}
+
+TEST(ParsePointsGeoJsonTest, ErrorsNameThePlace) {
+  const auto line = ParsePointsGeoJson(R"({"type": "FeatureCollection", "features": [
+      {"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 2]}},
+      {"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[1, 2], [3, 4]]}}]})",
+                                       "l.geojson");
+  ASSERT_EQ(line.status().code(), absl::StatusCode::kInvalidArgument) << line.status();
+  EXPECT_NE(line.status().message().find("features[1].geometry"), absl::string_view::npos) << line.status();
+  EXPECT_NE(line.status().message().find("LineString"), absl::string_view::npos) << line.status();
+  const auto text = ParsePointsGeoJson(R"({"type": "MultiPoint", "coordinates": [[1, 2], ["3", 4]]})", "s.json");
+  ASSERT_EQ(text.status().code(), absl::StatusCode::kInvalidArgument) << text.status();
+  EXPECT_NE(text.status().message().find("coordinates[1]"), absl::string_view::npos) << text.status();
+  const auto broken = ParsePointsGeoJson(R"({"type": "Point", "coordinates": [1, 2)", "b.json");
+  ASSERT_EQ(broken.status().code(), absl::StatusCode::kInvalidArgument) << broken.status();
+  EXPECT_NE(broken.status().message().find("not valid JSON"), absl::string_view::npos) << broken.status();
+  EXPECT_EQ(ParsePointsGeoJson(R"({"type": "Feature"})", "n.json").status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(ParsePointsGeoJson(R"([1, 2])", "a.json").status().code(), absl::StatusCode::kInvalidArgument);
+}
+
 class ReadPointsFileTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -139,6 +181,7 @@ class ReadPointsFileTest : public ::testing::Test {
 TEST_F(ReadPointsFileTest, ChoosesTheFormatByExtension) {
   ExpectPoints(ReadPointsFile(Write("p.csv", "x,y\n1,2\n")), Points({{1, 2}}));
   ExpectPoints(ReadPointsFile(Write("p.XYZ", "1 2 3\n")), Points({{1, 2}}));
+  ExpectPoints(ReadPointsFile(Write("p.geojson", R"({"type": "Point", "coordinates": [9, 10]})")), Points({{9, 10}}));
   ExpectPoints(ReadPointsFile(Write("p.npy", Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 2), }",
                                                  {3, 4}))),
                Points({{3, 4}}));
