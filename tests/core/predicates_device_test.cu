@@ -13,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "core/attachment.hpp"
 #include "core/predicates.hpp"
 
 namespace galpha {
@@ -25,17 +26,18 @@ struct Case {
 
 struct Result {
   int orient, incircle, orient_sos, incircle_sos;
-  int orient_len, incircle_len, pad0, pad1;
+  int orient_len, incircle_len, diametral, diametral_len;
   double orient_approx, incircle_approx;
   double orient_exp[exact::kOrient2dExpansionCapacity];
   double incircle_exp[exact::kInCircleExpansionCapacity];
+  double diametral_exp[exact::kDiametralExpansionCapacity];
 };
 
 struct Evaluate {
   GALPHA_HD Result operator()(const Case& c) const {
     Result r;
-    r.pad0 = r.pad1 = 0;
     for (int i = 0; i < exact::kOrient2dExpansionCapacity; ++i) r.orient_exp[i] = 0.0;
+    for (int i = 0; i < exact::kDiametralExpansionCapacity; ++i) r.diametral_exp[i] = 0.0;
     for (int i = 0; i < exact::kInCircleExpansionCapacity; ++i) r.incircle_exp[i] = 0.0;
     const Point2 a = c.p[0], b = c.p[1], cc = c.p[2], d = c.p[3];
     r.orient = Orient2dSign(a, b, cc);
@@ -46,6 +48,8 @@ struct Evaluate {
     r.incircle_approx = InCircleApprox(a, b, cc, d);
     r.orient_len = exact::Orient2dExpansion(a, b, cc, r.orient_exp);
     r.incircle_len = exact::InCircleExpansion(a, b, cc, d, r.incircle_exp);
+    r.diametral = InDiametralCircleSign(a, b, cc);
+    r.diametral_len = exact::DiametralDotExpansion(a, b, cc, r.diametral_exp);
     return r;
   }
 };
@@ -152,6 +156,9 @@ TEST(PredicatesDevice, BitIdenticalToHost) {
     ASSERT_EQ(g.incircle_len, h.incircle_len);
     ASSERT_EQ(std::memcmp(g.orient_exp, h.orient_exp, sizeof h.orient_exp), 0);
     ASSERT_EQ(std::memcmp(g.incircle_exp, h.incircle_exp, sizeof h.incircle_exp), 0);
+    ASSERT_EQ(g.diametral, h.diametral);
+    ASSERT_EQ(g.diametral_len, h.diametral_len);
+    ASSERT_EQ(std::memcmp(g.diametral_exp, h.diametral_exp, sizeof h.diametral_exp), 0);
     degenerate += h.incircle == 0;
   }
   EXPECT_GT(degenerate, 500);  // the SoS paths ran on the device too
