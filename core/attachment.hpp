@@ -22,18 +22,10 @@ constexpr int kDiametralExpansionCapacity = 16;
 /// nonoverlapping expansion of at most kDiametralExpansionCapacity components; returns its length.
 /// Exact over the range of Orient2dSign (core/predicates.hpp): the computation has the same shape.
 GALPHA_HD inline int DiametralDotExpansion(Point2 p, Point2 q, Point2 r, double* out) {
-  double hi[4], lo[4];
-  TwoDiff(p.x, r.x, hi[0], lo[0]);
-  TwoDiff(p.y, r.y, hi[1], lo[1]);
-  TwoDiff(q.x, r.x, hi[2], lo[2]);
-  TwoDiff(q.y, r.y, hi[3], lo[3]);
-  double maxabs = 0.0;
-  for (int i = 0; i < 4; ++i) maxabs = Abs(hi[i]) > maxabs ? Abs(hi[i]) : maxabs;
-  if (maxabs == 0.0) return 0;
-  const int s = kOrientScaleTarget - ExponentOf(maxabs);
+  // p - r and q - r, by coordinate
   double d[4][2];
   int dl[4];
-  for (int i = 0; i < 4; ++i) dl[i] = TwoToExpansion(ScaleByPow2(hi[i], s), ScaleByPow2(lo[i], s), d[i]);
+  if (!ScaledDifferences({p.x, p.y, q.x, q.y}, {r.x, r.y, r.x, r.y}, d, dl)) return 0;
   double xx[8], yy[8];
   const int xl = ExpansionProduct<2, 2>(dl[0], d[0], dl[2], d[2], xx);  // (px - rx)(qx - rx)
   const int yl = ExpansionProduct<2, 2>(dl[1], d[1], dl[3], d[3], yy);  // (py - ry)(qy - ry)

@@ -175,25 +175,30 @@ GALPHA_HD GALPHA_FORCEINLINE int CompareSign(double u, double v) { return (u > v
 
 namespace exact {
 
+/// The four exact differences u[i] - v[i] (Two-Diff, never rounded), all scaled by one power of two
+/// 2^s that brings the largest to 2^kOrientScaleTarget, as expansions d[i] of dl[i] <= 2
+/// components. Products of two of them, and sums of such products, are then exact (no underflow,
+/// no overflow) over Orient2dSign's range. Returns false when every difference is zero.
+GALPHA_HD inline bool ScaledDifferences(const double (&u)[4], const double (&v)[4], double (&d)[4][2], int (&dl)[4]) {
+  double hi[4], lo[4];
+  for (int i = 0; i < 4; ++i) TwoDiff(u[i], v[i], hi[i], lo[i]);
+  double maxabs = 0.0;
+  for (int i = 0; i < 4; ++i) maxabs = Abs(hi[i]) > maxabs ? Abs(hi[i]) : maxabs;
+  if (maxabs == 0.0) return false;  // hi == 0 means the difference was exact, so lo == 0 too
+  const int s = kOrientScaleTarget - ExponentOf(maxabs);
+  for (int i = 0; i < 4; ++i) dl[i] = TwoToExpansion(ScaleByPow2(hi[i], s), ScaleByPow2(lo[i], s), d[i]);
+  return true;
+}
+
 /// The exact determinant of Orient2dSign, times 2^(2s) for an internal s (so with the same sign),
 /// as a nonoverlapping expansion of at most kOrient2dExpansionCapacity components; returns its
 /// length (0 for zero). Built on the exact differences b-a and c-a (Two-Diff), never on rounded
 /// ones.
 GALPHA_HD GALPHA_PRED_COLD inline int Orient2dExpansion(Point2 a, Point2 b, Point2 c, double* out) {
-  double hi[4], lo[4];
-  TwoDiff(b.x, a.x, hi[0], lo[0]);  // bax
-  TwoDiff(b.y, a.y, hi[1], lo[1]);  // bay
-  TwoDiff(c.x, a.x, hi[2], lo[2]);  // cax
-  TwoDiff(c.y, a.y, hi[3], lo[3]);  // cay
-  double maxabs = 0.0;
-  for (int i = 0; i < 4; ++i) maxabs = Abs(hi[i]) > maxabs ? Abs(hi[i]) : maxabs;
-  if (maxabs == 0.0) return 0;  // hi == 0 means the difference was exact, so lo == 0 too
-  const int s = kOrientScaleTarget - ExponentOf(maxabs);
+  // bax, bay, cax, cay
   double d[4][2];
   int dl[4];
-  for (int i = 0; i < 4; ++i) {
-    dl[i] = TwoToExpansion(ScaleByPow2(hi[i], s), ScaleByPow2(lo[i], s), d[i]);
-  }
+  if (!ScaledDifferences({b.x, b.y, c.x, c.y}, {a.x, a.y, a.x, a.y}, d, dl)) return 0;
   double left[8], right[8];
   const int ll = ExpansionProduct<2, 2>(dl[0], d[0], dl[3], d[3], left);   // bax * cay
   const int rl = ExpansionProduct<2, 2>(dl[2], d[2], dl[1], d[1], right);  // cax * bay
