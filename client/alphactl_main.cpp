@@ -22,6 +22,24 @@ constexpr char kUsage[] =
     "        .geojson/.json (Point, MultiPoint), or delimited text (CSV, TSV, whitespace:\n"
     "        x and y first, optional header line)\n";
 
+// A JSON string literal for `text` (quotes, backslashes and control characters escaped).
+std::string JsonString(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
 absl::StatusOr<galpha::Backend> ParseBackend(const std::string& name) {
   if (name == "auto") return galpha::Backend::kAuto;
   if (name == "cpu") return galpha::Backend::kCpu;
@@ -69,10 +87,10 @@ int Triangulate(const std::vector<std::string>& args) {
     total += s.seconds;
   }
   std::printf(
-      "{\"file\": \"%s\", \"points\": %zu, \"distinct_points\": %u, \"duplicates\": %zu, "
+      "{\"file\": %s, \"points\": %zu, \"distinct_points\": %u, \"duplicates\": %zu, "
       "\"triangles\": %zu, \"edges\": %zu, \"hull_edges\": %zu, \"backend\": \"%s\", "
       "\"peak_memory_bytes\": %zu, \"total_ms\": %.3f, \"stage_ms\": {%s}}\n",
-      file.c_str(), points->size(), tri->num_unique, points->size() - tri->num_unique, tri->triangles.size(),
+      JsonString(file).c_str(), points->size(), tri->num_unique, points->size() - tri->num_unique, tri->triangles.size(),
       tri->edges.size(), hull_edges, galpha::BackendName(tri->backend), tri->peak_memory_bytes, total * 1e3,
       stages.c_str());
   return 0;
