@@ -7,7 +7,8 @@
 #           (default 240), one process per test so that a hang names its test
 #   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
 #           its first run (the benchmark distributions)
-# Full logs go to $OUT (8 files at most, so that all of them come back) (or /tmp/galpha-gpu); a short summary goes to standard output.
+# Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
+# short summary goes to standard output.
 set -uo pipefail
 out="${OUT:-/tmp/galpha-gpu}"
 mkdir -p "$out"

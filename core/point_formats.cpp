@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <system_error>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/strings/ascii.h"
@@ -20,13 +21,20 @@
 namespace galpha {
 namespace {
 
-// Up to the first two fields of a line; returns how many it found (0, 1 or 2).
+// Up to the first two fields of a line; returns how many it found (0, 1 or 2). A line with a
+// comma, semicolon or tab is split on that delimiter and keeps its empty fields ("1,,2" has an
+// empty y, not y = 2); otherwise runs of spaces separate the fields.
 int FirstTwoFields(absl::string_view line, absl::string_view* x, absl::string_view* y) {
-  int found = 0;
-  for (absl::string_view field : absl::StrSplit(line, absl::ByAnyChar(",;\t "), absl::SkipWhitespace())) {
-    (found == 0 ? *x : *y) = absl::StripAsciiWhitespace(field);
-    if (++found == 2) break;
+  const size_t delimiter_at = line.find_first_of(",;\t");
+  std::vector<absl::string_view> fields;
+  if (delimiter_at != absl::string_view::npos) {
+    fields = absl::StrSplit(line, line[delimiter_at]);
+  } else {
+    fields = absl::StrSplit(line, ' ', absl::SkipWhitespace());
   }
+  const int found = fields.size() >= 2 ? 2 : static_cast<int>(fields.size());
+  if (found >= 1) *x = absl::StripAsciiWhitespace(fields[0]);
+  if (found >= 2) *y = absl::StripAsciiWhitespace(fields[1]);
   return found;
 }
 

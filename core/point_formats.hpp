@@ -14,9 +14,9 @@
 namespace galpha {
 
 /// Parses delimited text: one point per line, x and y the first two fields, fields separated by
-/// commas, semicolons, tabs or spaces (runs of spaces count as one separator). Empty lines and
-/// lines starting with '#' are skipped. The first non-skipped line is a header when one of its first
-/// two fields is not a number. Further fields are ignored. O(size).
+/// the line's first comma, semicolon or tab (empty fields count), or else by runs of spaces. Empty
+/// lines and lines starting with '#' are skipped. The first non-skipped line is a header when one
+/// of its first two fields is not a number. Further fields are ignored. O(size).
 ///
 /// Errors: InvalidArgument naming `source` and the 1-based line number of a line that has fewer
 /// than two fields or whose x or y is not a number.

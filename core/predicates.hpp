@@ -274,8 +274,6 @@ GALPHA_HD GALPHA_FORCEINLINE int Orient2dSign(Point2 a, Point2 b, Point2 c) {
   return ExpansionSign(Orient2dExpansion(a, b, c, e), e);
 }
 
-/// Exact in-circle test: +1 if d lies strictly inside the circle through a, b, c (given
-/// counter-clockwise; the sign flips for clockwise a, b, c), -1 outside, 0 on it.
 namespace pred_detail {
 
 /// Accumulates whether every operation of a computation was exact: each result is formed with an
@@ -332,6 +330,8 @@ GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Po
 
 }  // namespace pred_detail
 
+/// Exact in-circle test: +1 if d lies strictly inside the circle through a, b, c (given
+/// counter-clockwise; the sign flips for clockwise a, b, c), -1 outside, 0 on it.
 GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Point2 d) {
   using namespace exact;
   const double adx = Sub(a.x, d.x), ady = Sub(a.y, d.y);

@@ -87,7 +87,7 @@ class DelaunayBuilder {
         tri_(sys, capacity_),
         nbr_(sys, capacity_),
         tri_vote_(sys, capacity_),
-        split_offset_or_nb_(sys, capacity_),
+        split_count_or_nb_(sys, capacity_),
         flip_vote_(sys, capacity_),
         partner_(sys, capacity_),
         stamp_(sys, capacity_),
@@ -106,7 +106,7 @@ class DelaunayBuilder {
   /// Frees everything but the mesh once it is final (before the output stage).
   void ReleaseWorkspace() {
     tri_vote_.Reset();
-    split_offset_or_nb_.Reset();
+    split_count_or_nb_.Reset();
     flip_vote_.Reset();
     partner_.Reset();
     stamp_.Reset();
@@ -152,16 +152,16 @@ class DelaunayBuilder {
                        VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
       // Inclusive, so that its last entry is the number of splits: one read, one host sync.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
-                                       split_offset_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
-      const int32_t num_split = sys_.Read(split_offset_or_nb_.data() + num_tri_ - 1);
+                                       split_count_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
+      const int32_t num_split = sys_.Read(split_count_or_nb_.data() + num_tri_ - 1);
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       SplitTriangles{mesh_, tri_vote_.data(), split_offset_or_nb_.data(), pending, inserted, num_tri_});
+                       SplitTriangles{mesh_, tri_vote_.data(), split_count_or_nb_.data(), pending, inserted, num_tri_});
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       LinkSplitChildren{mesh_, tri_vote_.data(), split_offset_or_nb_.data(), num_tri_});
+                       LinkSplitChildren{mesh_, tri_vote_.data(), split_count_or_nb_.data(), num_tri_});
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       ListSplitChildren{tri_vote_.data(), split_offset_or_nb_.data(), active_.data(), num_tri_});
+                       ListSplitChildren{tri_vote_.data(), split_count_or_nb_.data(), active_.data(), num_tri_});
       num_tri_ += 2 * num_split;
       thrust::fill(pol, active_mask_.data(), active_mask_.data() + 3 * num_split, kCheckOutsideEdge);
       RestoreDelaunay(static_cast<uint32_t>(3 * num_split), /*hull_may_change=*/true);
@@ -195,15 +195,15 @@ class DelaunayBuilder {
     uint32_t num_touched = 0;
     while (num_flat > 0) {
       thrust::for_each(pol, first, first + num_flat,
-                       ProposeFlatRepairs{mesh_, flat, proposal_edge_.data(), split_offset_or_nb_.data(),
+                       ProposeFlatRepairs{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(),
                                           flip_vote_.data()});
       thrust::for_each(pol, first, first + num_flat,
-                       ExecuteFlips{mesh_, flat, proposal_edge_.data(), split_offset_or_nb_.data(), flip_vote_.data(),
+                       ExecuteFlips{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
                                     partner_.data()});
       thrust::for_each(pol, first, first + num_flat,
-                       LinkFlips{mesh_, flat, proposal_edge_.data(), split_offset_or_nb_.data(), partner_.data()});
+                       LinkFlips{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
       thrust::for_each(pol, first, first + num_flat,
-                       CollectFlatRepairs{flat, proposal_edge_.data(), split_offset_or_nb_.data(), flip_vote_.data(),
+                       CollectFlatRepairs{flat, proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
                                           partner_.data(), candidates(), still_flat.data()});
       num_touched = static_cast<uint32_t>(thrust::copy_if(pol, candidates(), candidates() + 2 * num_flat,
                                                           touched.data() + num_touched, IsNonNegative()) -
@@ -302,19 +302,19 @@ class DelaunayBuilder {
     for (int iteration = 0; count > 0; ++iteration) {
       if (iteration > (1 << 20)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
       thrust::for_each(pol, first, first + count,
-                       ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_offset_or_nb_.data(),
+                       ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
                                     flip_vote_.data(), hull_may_change});
       // No count of the proposals here (one host sync less per iteration): without any, the
       // passes below change nothing and leave no candidates, which ends the loop.
       thrust::for_each(pol, first, first + count,
-                       ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_offset_or_nb_.data(),
+                       ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
                                     flip_vote_.data(), partner_.data()});
       thrust::for_each(pol, first, first + count,
-                       LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_offset_or_nb_.data(), partner_.data()});
+                       LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
       ++generation_;
       thrust::for_each(pol, first, first + count,
                        CollectNextActive{active_.data(), active_mask_.data(), proposal_edge_.data(),
-                                         split_offset_or_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
+                                         split_count_or_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
                                          generation_, candidates(), candidate_mask_.data()});
       auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates(), candidate_mask_.data()));
       auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
@@ -331,9 +331,9 @@ class DelaunayBuilder {
   // Insertion votes while splitting; while flipping, the same bytes hold 2 * capacity_ flip
   // candidates (int32): the two are never live at once, and sharing them saves 8 bytes a point.
   Buffer<unsigned long long, System> tri_vote_;
-  // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while flipping: never both
-  // at once, so one buffer serves both.
-  Buffer<int32_t, System> split_offset_or_nb_;
+  // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while
+  // flipping: never both at once, so one buffer serves both.
+  Buffer<int32_t, System> split_count_or_nb_;
   Buffer<uint32_t, System> flip_vote_;
   Buffer<int32_t, System> partner_;
   Buffer<uint32_t, System> stamp_;

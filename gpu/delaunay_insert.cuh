@@ -3,8 +3,8 @@
 // the split triangles' outside neighbours are re-linked.
 #pragma once
 
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 #include <cuda/atomic>
@@ -108,7 +108,7 @@ GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_count, i
 struct SplitTriangles {
   MeshView mesh;
   const unsigned long long* tri_vote;
-  const int32_t* split_offset;  // inclusive scan of HasWinner
+  const int32_t* split_count;  // inclusive scan of HasWinner
   const int32_t* pending;
   uint8_t* inserted;            // per uninserted point
   int32_t num_tri;
@@ -122,7 +122,7 @@ struct SplitTriangles {
     const Tri x = mesh.tri[t];
     const TriNbr nx = mesh.nbr[t];
     int32_t child[3];
-    for (int k = 0; k < 3; ++k) child[k] = ChildSlot(t, k, split_offset[t], num_tri);
+    for (int k = 0; k < 3; ++k) child[k] = ChildSlot(t, k, split_count[t], num_tri);
     for (int k = 0; k < 3; ++k) {
       mesh.tri[child[k]] = Tri{{x.v[Next(k)], x.v[Prev(k)], w}};
       mesh.nbr[child[k]] = TriNbr{{child[Next(k)], child[Prev(k)], nx.n[k]}};
@@ -136,18 +136,18 @@ struct SplitTriangles {
 struct LinkSplitChildren {
   MeshView mesh;
   const unsigned long long* tri_vote;
-  const int32_t* split_offset;  // inclusive scan of HasWinner
+  const int32_t* split_count;  // inclusive scan of HasWinner
   int32_t num_tri;
 
   GALPHA_HD void operator()(int32_t t) const {
     if (tri_vote[t] == kNoVote) return;
     for (int k = 0; k < 3; ++k) {
-      const int32_t c = ChildSlot(t, k, split_offset[t], num_tri);
+      const int32_t c = ChildSlot(t, k, split_count[t], num_tri);
       const int32_t p = mesh.tri[c].v[0], q = mesh.tri[c].v[1];
       const int32_t x = mesh.nbr[c].n[2];
       if (tri_vote[x] != kNoVote) {
         for (int j = 0; j < 3; ++j) {
-          const int32_t cx = ChildSlot(x, j, split_offset[x], num_tri);
+          const int32_t cx = ChildSlot(x, j, split_count[x], num_tri);
           if (mesh.tri[cx].v[0] == q && mesh.tri[cx].v[1] == p) mesh.nbr[c].n[2] = cx;
         }
       } else {
@@ -160,13 +160,13 @@ struct LinkSplitChildren {
 /// Lists the three children of every split triangle: the first triangles to check for flips.
 struct ListSplitChildren {
   const unsigned long long* tri_vote;
-  const int32_t* split_offset;  // inclusive scan of HasWinner
+  const int32_t* split_count;  // inclusive scan of HasWinner
   int32_t* active;
   int32_t num_tri;
 
   GALPHA_HD void operator()(int32_t t) const {
     if (tri_vote[t] == kNoVote) return;
-    for (int k = 0; k < 3; ++k) active[3 * (split_offset[t] - 1) + k] = ChildSlot(t, k, split_offset[t], num_tri);
+    for (int k = 0; k < 3; ++k) active[3 * (split_count[t] - 1) + k] = ChildSlot(t, k, split_count[t], num_tri);
   }
 };
 

@@ -56,6 +56,10 @@ TEST(ParsePointsTextTest, BadLineIsNamedByNumber) {
   const auto got = ParsePointsText("x,y\n1,2\n3\n", "bad.csv");
   ASSERT_EQ(got.status().code(), absl::StatusCode::kInvalidArgument) << got.status();
   EXPECT_NE(got.status().message().find("bad.csv:3"), absl::string_view::npos) << got.status();
+  // An empty field is a missing coordinate, not a reason to take the next column.
+  const auto empty = ParsePointsText("1,2\n3,,4\n", "e.csv");
+  ASSERT_EQ(empty.status().code(), absl::StatusCode::kInvalidArgument) << empty.status();
+  EXPECT_NE(empty.status().message().find("e.csv:2"), absl::string_view::npos) << empty.status();
   // A first line of one number is a bad data line, not a header.
   const auto lone = ParsePointsText("1\n2,3\n", "l.csv");
   ASSERT_EQ(lone.status().code(), absl::StatusCode::kInvalidArgument) << lone.status();
