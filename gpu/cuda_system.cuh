@@ -107,4 +107,17 @@ class CudaSystem {
   StreamOrderedAllocator temp_;
 };
 
+/// A stream owned for the duration of one call when the caller brings none.
+class OwnedStream {
+ public:
+  OwnedStream() { CheckCuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate"); }
+  ~OwnedStream() { cudaStreamDestroy(stream_); }
+  OwnedStream(const OwnedStream&) = delete;
+  OwnedStream& operator=(const OwnedStream&) = delete;
+  cudaStream_t get() const { return stream_; }
+
+ private:
+  cudaStream_t stream_ = nullptr;
+};
+
 }  // namespace galpha::detail

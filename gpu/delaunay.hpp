@@ -16,7 +16,7 @@
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/point.hpp"
-#include "gpu/stage_time.hpp"
+#include "core/stage_time.hpp"
 
 namespace galpha {
 

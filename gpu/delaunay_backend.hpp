@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/point.hpp"
-#include "gpu/stage_time.hpp"
+#include "core/stage_time.hpp"
 
 namespace galpha::detail {
 

@@ -16,22 +16,6 @@ bool CudaDeviceVisible() {
   return count > 0;
 }
 
-namespace {
-
-/// A stream owned for the duration of one call when the caller brings none.
-class OwnedStream {
- public:
-  OwnedStream() { CheckCuda(cudaStreamCreateWithFlags(&stream_, cudaStreamNonBlocking), "cudaStreamCreate"); }
-  ~OwnedStream() { cudaStreamDestroy(stream_); }
-  OwnedStream(const OwnedStream&) = delete;
-  OwnedStream& operator=(const OwnedStream&) = delete;
-  cudaStream_t get() const { return stream_; }
-
- private:
-  cudaStream_t stream_ = nullptr;
-};
-
-}  // namespace
 
 void TriangulateOnCuda(const Point2* points, uint32_t n, void* stream, DelaunayOutput* out) {
   if (stream != nullptr) {

@@ -1,4 +1,5 @@
 // Builds without nvcc have no CUDA backend: these are its answers there.
+#include "gpu/alpha_backend.hpp"
 #include "gpu/delaunay_backend.hpp"
 
 namespace galpha::detail {
@@ -6,6 +7,10 @@ namespace galpha::detail {
 bool CudaDeviceVisible() { return false; }
 
 void TriangulateOnCuda(const Point2*, uint32_t, void*, DelaunayOutput*) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
+void BuildAlphaOnCuda(const AlphaInput&, void*, AlphaRanks*, std::vector<StageTime>*, size_t*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 

@@ -119,6 +119,15 @@ class Buffer {
   Buffer& operator=(const Buffer&) = delete;
   Buffer(Buffer&& other) noexcept
       : system_(other.system_), data_(std::exchange(other.data_, nullptr)), size_(other.size_) {}
+  Buffer& operator=(Buffer&& other) noexcept {
+    if (this != &other) {
+      Reset();
+      system_ = other.system_;
+      data_ = std::exchange(other.data_, nullptr);
+      size_ = std::exchange(other.size_, 0);
+    }
+    return *this;
+  }
   ~Buffer() { Reset(); }
 
   /// Frees the memory now, before the end of the scope: lowers a build's peak.

@@ -12,6 +12,7 @@ packages=(
   libgmp-dev             # exact rational oracle in tests
   nlohmann-json3-dev     # GeoJSON point files
   libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
+  libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
 )
 
 missing=()

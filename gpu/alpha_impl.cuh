@@ -1,0 +1,253 @@
+// The alpha pipeline after the triangulation, written once over an execution system (CpuSystem or
+// CudaSystem): edge topology, radii and attachment, the exact spectrum (sort by certified keys,
+// exact repair of the runs whose keys may tie, merge of exact ties), ranks, intervals and the
+// master list (report chapters 3-4; DESIGN.md sections 2-3).
+#pragma once
+
+#include <thrust/copy.h>
+#include <thrust/count.h>
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/gather.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
+#include <thrust/reduce.h>
+#include <thrust/scan.h>
+#include <thrust/sequence.h>
+#include <thrust/sort.h>
+#include <thrust/transform.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "core/alpha_ranks.hpp"
+#include "gpu/alpha_backend.hpp"
+#include "gpu/alpha_functors.cuh"
+#include "gpu/alpha_host_repair.hpp"
+#include "gpu/engine_system.cuh"
+
+namespace galpha::detail {
+
+template <class System>
+void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::vector<StageTime>* stage_times,
+                      size_t* peak_bytes) {
+  static_assert(sizeof(TriIdx) == sizeof(std::array<uint32_t, 3>), "layout of the host triangles");
+  static_assert(sizeof(TriNb) == sizeof(std::array<int32_t, 3>), "layout of the host neighbours");
+  static_assert(sizeof(EdgeIdx) == sizeof(std::array<uint32_t, 2>), "layout of the host edges");
+  static_assert(sizeof(EdgeTris) == sizeof(std::array<int32_t, 2>), "layout of the edge triangles");
+  StageTimer<System> timer(sys, stage_times);
+  auto policy = sys.policy();
+  const uint32_t n = in.num_points, num_tri = in.num_triangles, num_edges = in.num_edges;
+  const uint32_t num_simplices = num_tri + num_edges;
+  thrust::counting_iterator<uint32_t> zero(0);
+
+  Buffer<Point2, System> points(sys, n);
+  Buffer<uint32_t, System> representative(sys, n);
+  Buffer<TriIdx, System> tri(sys, num_tri);
+  Buffer<TriNb, System> nbr(sys, num_tri);
+  Buffer<uint32_t, System> edge_begin(sys, num_tri);
+  Buffer<EdgeIdx, System> edges(sys, num_edges);
+  sys.FromHost(points.data(), in.points, n);
+  sys.FromHost(representative.data(), in.representative, n);
+  sys.FromHost(tri.data(), reinterpret_cast<const TriIdx*>(in.triangles), num_tri);
+  sys.FromHost(nbr.data(), reinterpret_cast<const TriNb*>(in.neighbors), num_tri);
+  sys.FromHost(edge_begin.data(), in.tri_edge_begin, num_tri);
+  sys.FromHost(edges.data(), reinterpret_cast<const EdgeIdx*>(in.edges), num_edges);
+  timer.EndStage("alpha_upload");
+
+  // Edge topology: the incident triangles of every edge (none for a collinear chain).
+  Buffer<EdgeTris, System> edge_tris(sys, num_edges);
+  thrust::fill_n(policy, edge_tris.data(), num_edges, EdgeTris{{-1, -1}});
+  thrust::for_each_n(policy, zero, num_tri, WriteEdgeTriangles{tri.data(), nbr.data(), edge_begin.data(), edge_tris.data()});
+  nbr.Reset();
+  edge_begin.Reset();
+  timer.EndStage("edge_topology");
+
+  // Radii and attachment: one certified key per simplex.
+  const SimplexPoints simplex{points.data(), tri.data(), edges.data(), num_tri};
+  Buffer<uint64_t, System> keys(sys, num_simplices);
+  Buffer<uint8_t, System> uncertified(sys, num_simplices);
+  thrust::for_each_n(policy, zero, num_simplices,
+                     ComputeRadiusKeys{simplex, edge_tris.data(), keys.data(), uncertified.data()});
+  timer.EndStage("radii_attachment");
+
+  // The spectrum's entries: triangles and unattached edges with certified keys, sorted by key;
+  // the few uncertified ones are placed by the host with exact comparisons.
+  Buffer<uint32_t, System> ids(sys, num_simplices);
+  const uint32_t num_entries = static_cast<uint32_t>(
+      thrust::copy_if(policy, zero, zero + num_simplices, ids.data(), IsSpectrumEntry{keys.data(), uncertified.data(), false}) -
+      ids.data());
+  Buffer<uint32_t, System> odd_ids(sys, num_simplices - num_entries);
+  const uint32_t num_odd = static_cast<uint32_t>(
+      thrust::copy_if(policy, zero, zero + num_simplices, odd_ids.data(), IsSpectrumEntry{keys.data(), uncertified.data(), true}) -
+      odd_ids.data());
+  uncertified.Reset();
+  Buffer<uint64_t, System> sorted_keys(sys, num_entries);
+  thrust::gather(policy, ids.data(), ids.data() + num_entries, keys.data(), sorted_keys.data());
+  thrust::sort_by_key(policy, sorted_keys.data(), sorted_keys.data() + num_entries, ids.data());
+  timer.EndStage("spectrum_sort");
+
+  // Runs of entries whose keys may tie: sorted exactly; short runs in parallel on the system,
+  // long or undecided runs on the host.
+  Buffer<uint8_t, System> new_value(sys, num_entries);
+  thrust::fill_n(policy, new_value.data(), num_entries, uint8_t{1});
+  uint64_t num_links = 0;
+  if (num_entries > 1) {
+    Buffer<uint8_t, System> link(sys, num_entries - 1);
+    thrust::transform(policy, zero, zero + (num_entries - 1), link.data(), MayTieWithNext{sorted_keys.data()});
+    num_links = thrust::count(policy, link.data(), link.data() + (num_entries - 1), uint8_t{1});
+    Buffer<uint32_t, System> run_begin(sys, num_entries + 1);
+    const uint32_t num_runs = static_cast<uint32_t>(
+        thrust::copy_if(policy, zero, zero + num_entries, run_begin.data(), IsRunStart{link.data()}) - run_begin.data());
+    link.Reset();
+    sys.FromHost(run_begin.data() + num_runs, &num_entries, 1);
+    const uint32_t* run_end = run_begin.data() + 1;
+    Buffer<uint8_t, System> needs_host(sys, num_runs);
+    Buffer<uint32_t, System> run_comparisons(sys, num_runs);
+    thrust::for_each_n(policy, zero, num_runs,
+                       RepairRun{simplex, run_begin.data(), run_end, ids.data(), new_value.data(), needs_host.data(),
+                                 run_comparisons.data()});
+    out->comparisons.bounded_exact +=
+        thrust::reduce(policy, run_comparisons.data(), run_comparisons.data() + num_runs, uint64_t{0});
+    const uint32_t host_runs = static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
+    if (host_runs > 0) {
+      // Bring the whole order to the host once (rare: long runs of near or exact ties, such as a
+      // grid's congruent triangles) and repair there.
+      std::vector<uint32_t> host_ids = ids.ToHostVector(num_entries);
+      std::vector<uint8_t> host_new = new_value.ToHostVector(num_entries);
+      std::vector<uint32_t> host_begin = run_begin.ToHostVector(num_runs + 1);
+      std::vector<uint8_t> host_needs = needs_host.ToHostVector(num_runs);
+      std::vector<std::array<uint32_t, 2>> runs;
+      for (uint32_t r = 0; r < num_runs; ++r) {
+        if (host_needs[r]) runs.push_back({host_begin[r], host_begin[r + 1]});
+      }
+      RepairRunsOnHost(in, runs, host_ids.data(), host_new.data(), &out->comparisons);
+      sys.FromHost(ids.data(), host_ids.data(), num_entries);
+      sys.FromHost(new_value.data(), host_new.data(), num_entries);
+    }
+  }
+  out->comparisons.filter += num_entries > 0 ? (num_entries - 1) - num_links : 0;
+  sorted_keys.Reset();
+
+  // Entries whose keys are not certified (extreme exponent ranges inside one simplex): merged
+  // into the exact order on the host.
+  uint32_t total_entries = num_entries;
+  if (num_odd > 0) {
+    std::vector<uint32_t> host_ids = ids.ToHostVector(num_entries);
+    std::vector<uint8_t> host_new = new_value.ToHostVector(num_entries);
+    std::vector<uint32_t> odd = odd_ids.ToHostVector(num_odd);
+    MergeUncertifiedOnHost(in, odd, &host_ids, &host_new, &out->comparisons);
+    total_entries = static_cast<uint32_t>(host_ids.size());
+    ids = Buffer<uint32_t, System>(sys, total_entries);
+    new_value = Buffer<uint8_t, System>(sys, total_entries);
+    sys.FromHost(ids.data(), host_ids.data(), total_entries);
+    sys.FromHost(new_value.data(), host_new.data(), total_entries);
+  }
+  odd_ids.Reset();
+  timer.EndStage("spectrum_repair");
+
+  // Ranks: an inclusive scan of the value starts numbers the distinct exact values 1..K.
+  Buffer<uint32_t, System> rank(sys, total_entries);
+  // (Scanned as uint32: Thrust may accumulate in the input's type, and uint8 would wrap.)
+  const auto as_u32 = thrust::make_transform_iterator(new_value.data(), ToU32{});
+  thrust::inclusive_scan(policy, as_u32, as_u32 + total_entries, rank.data());
+  const uint32_t num_ranks = total_entries > 0 ? sys.Read(rank.data() + (total_entries - 1)) : 0;
+  Buffer<uint32_t, System> tri_rank(sys, num_tri);
+  Buffer<uint32_t, System> edge_rho_rank(sys, num_edges);
+  thrust::fill_n(policy, tri_rank.data(), num_tri, kNeverRank);  // collinear triangles: never born
+  thrust::fill_n(policy, edge_rho_rank.data(), num_edges, uint32_t{0});
+  Buffer<uint32_t, System> spectrum_simplex(sys, num_ranks);
+  thrust::for_each_n(policy, zero, total_entries,
+                     ScatterRanks{ids.data(), rank.data(), new_value.data(), num_tri, tri_rank.data(),
+                                  edge_rho_rank.data(), spectrum_simplex.data()});
+  rank.Reset();
+  ids.Reset();
+  new_value.Reset();
+  timer.EndStage("ranks");
+
+  // Published spectrum values: the nearest doubles.
+  Buffer<double, System> spectrum(sys, num_ranks);
+  {
+    Buffer<uint8_t, System> needs_host(sys, num_ranks);
+    thrust::for_each_n(policy, zero, num_ranks,
+                       NearestSpectrumValue{simplex, spectrum_simplex.data(), spectrum.data(), needs_host.data()});
+    out->spectrum = spectrum.ToHostVector(num_ranks);
+    out->spectrum_simplex = spectrum_simplex.ToHostVector(num_ranks);
+    if (thrust::count(policy, needs_host.data(), needs_host.data() + num_ranks, uint8_t{1}) > 0) {
+      const std::vector<uint8_t> host_needs = needs_host.ToHostVector(num_ranks);
+      NearestValuesOnHost(in, host_needs, out);
+    }
+  }
+  timer.EndStage("spectrum_values");
+
+  // Intervals (report Table 2.1) for edges and vertices.
+  Buffer<uint32_t, System> edge_mu_low(sys, num_edges), edge_mu_high(sys, num_edges);
+  Buffer<uint32_t, System> vertex_mu_low(sys, n), vertex_mu_high(sys, n), vertex_tri_low(sys, n);
+  thrust::fill_n(policy, vertex_mu_low.data(), n, kNeverRank);
+  thrust::fill_n(policy, vertex_mu_high.data(), n, uint32_t{0});
+  thrust::fill_n(policy, vertex_tri_low.data(), n, kNeverRank);
+  thrust::for_each_n(policy, zero, num_edges,
+                     EdgeIntervals{edges.data(), edge_tris.data(), tri_rank.data(), edge_rho_rank.data(),
+                                   edge_mu_low.data(), edge_mu_high.data(), keys.data(), num_tri,
+                                   vertex_mu_low.data(), vertex_mu_high.data(), vertex_tri_low.data()});
+  // Representatives first (their own values), then duplicates copy them.
+  thrust::for_each_n(policy, zero, n,
+                     FinishVertexIntervals{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
+                                           vertex_tri_low.data()});
+  keys.Reset();
+  timer.EndStage("intervals");
+
+  // Master list: every real end point keyed by (rank, dimension), stably sorted so that ids and
+  // end points stay in order within a key.
+  Buffer<uint32_t, System> vertex_offset(sys, n), edge_offset(sys, num_edges);
+  thrust::transform(policy, zero, zero + n, vertex_offset.data(),
+                    CountVertexEntries{representative.data(), vertex_mu_low.data(), vertex_mu_high.data()});
+  thrust::transform(policy, zero, zero + num_edges, edge_offset.data(),
+                    CountEdgeEntries{edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data()});
+  const uint32_t vertex_entries = thrust::reduce(policy, vertex_offset.data(), vertex_offset.data() + n, uint32_t{0});
+  const uint32_t edge_entries =
+      thrust::reduce(policy, edge_offset.data(), edge_offset.data() + num_edges, uint32_t{0});
+  thrust::exclusive_scan(policy, vertex_offset.data(), vertex_offset.data() + n, vertex_offset.data());
+  thrust::exclusive_scan(policy, edge_offset.data(), edge_offset.data() + num_edges, edge_offset.data());
+  // Collinear triangles cannot occur in a triangulation (its triangles have positive area), so
+  // every triangle has a rank.
+  const uint32_t num_master = vertex_entries + edge_entries + num_tri;
+  Buffer<uint64_t, System> master_keys(sys, num_master), master_values(sys, num_master);
+  thrust::for_each_n(policy, zero, n,
+                     WriteVertexEntries{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
+                                        vertex_offset.data(), master_keys.data(), master_values.data()});
+  thrust::for_each_n(policy, zero, num_edges,
+                     WriteEdgeEntries{edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(), edge_offset.data(),
+                                      vertex_entries, master_keys.data(), master_values.data()});
+  thrust::for_each_n(policy, zero, num_tri,
+                     WriteTriangleEntry{tri_rank.data(), vertex_entries + edge_entries, master_keys.data(),
+                                        master_values.data()});
+  vertex_offset.Reset();
+  edge_offset.Reset();
+  thrust::stable_sort_by_key(policy, master_keys.data(), master_keys.data() + num_master, master_values.data());
+  Buffer<uint32_t, System> master_begin(sys, static_cast<size_t>(num_ranks) + 2);
+  thrust::transform(policy, zero, zero + (num_ranks + 2), master_begin.data(), MasterBegin{master_keys.data(), num_master});
+  timer.EndStage("master_list");
+
+  out->tri_rank = tri_rank.ToHostVector(num_tri);
+  out->edge_rho_rank = edge_rho_rank.ToHostVector(num_edges);
+  out->edge_mu_low = edge_mu_low.ToHostVector(num_edges);
+  out->edge_mu_high = edge_mu_high.ToHostVector(num_edges);
+  out->edge_triangles.resize(num_edges);
+  sys.ToHost(reinterpret_cast<EdgeTris*>(out->edge_triangles.data()), edge_tris.data(), num_edges);
+  out->vertex_mu_low = vertex_mu_low.ToHostVector(n);
+  out->vertex_mu_high = vertex_mu_high.ToHostVector(n);
+  out->vertex_tri_low = vertex_tri_low.ToHostVector(n);
+  out->master_begin = master_begin.ToHostVector(static_cast<size_t>(num_ranks) + 2);
+  const std::vector<uint64_t> values = master_values.ToHostVector(num_master);
+  const std::vector<uint64_t> mkeys = master_keys.ToHostVector(num_master);
+  out->master.resize(num_master);
+  for (uint32_t i = 0; i < num_master; ++i) {
+    out->master[i] = MasterEntry{static_cast<uint32_t>(values[i] >> 2), static_cast<SimplexKind>(mkeys[i] & 3),
+                                 static_cast<Endpoint>(values[i] & 3)};
+  }
+  timer.EndStage("alpha_download");
+  *peak_bytes = sys.peak_bytes();
+}
+
+}  // namespace galpha::detail
