@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Run HERE (the build machine): builds the CUDA configuration and gathers what the GPU machine
 # needs into .carry/ (git-ignored): the test and benchmark binaries, the shared libraries they
-# use that a bare Ubuntu 24.04 + CUDA machine lacks (Abseil, GMP, MPFR), and the data sets.
+# use that a bare Ubuntu 24.04 + CUDA machine lacks (Abseil, GMP, MPFR, GEOS), and the data sets.
 # Then call the device tool with carry=[".carry"] and command "bench/gpu_run.sh".
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -10,11 +10,12 @@ cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
 for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
-         tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test \
-         bench/delaunay_bench client/alphactl; do
+         tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test tests/core/radius_test \
+         tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/core/shape_test \
+         bench/delaunay_bench bench/alpha_bench client/alphactl; do
   if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
 done
 for b in "${bins[@]}"; do
-  ldd "$b" | awk '/=> \//{print $3}' | grep -E 'libabsl|libgmp|libmpfr|libgtest|libbenchmark' || true
+  ldd "$b" | awk '/=> \//{print $3}' | grep -E 'libabsl|libgmp|libmpfr|libgtest|libbenchmark|libgeos' || true
 done | sort -u | while read -r lib; do cp -L "$lib" .carry/lib/; done
 du -sh .carry

@@ -7,6 +7,7 @@
 #           (default 240), one process per test so that a hang names its test
 #   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
 #           its first run (the benchmark distributions)
+#   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
 # short summary goes to standard output.
 set -uo pipefail
@@ -55,7 +56,8 @@ for phase in "${phases[@]}"; do
       grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race" "$out/sanitize.log" | sort | uniq -c | head -n 20
       ;;
     test)
-      for t in predicates_test predicates_device_test triangulation_checks_test delaunay_test delaunay_cgal_test; do
+      for t in predicates_test predicates_device_test radius_test triangulation_checks_test delaunay_test \
+               delaunay_cgal_test shape_test alpha_family_test alpha_family_cgal_test; do
         [ -x ".carry/bin/$t" ] || continue
         # One process per test, so that a hang names its test and the rest still run.
         for name in $(".carry/bin/$t" --gtest_list_tests | awk '/^[^ ]/{suite=$1} /^  /{print suite $1}'); do
@@ -65,6 +67,8 @@ for phase in "${phases[@]}"; do
         grep -cE '^\[       OK \]' "$out/$t.log" | sed "s/^/$t: tests passed: /"
         grep -E '^\[  FAILED  \]|Failure' "$out/$t.log" | sort -u | head -n 20
       done
+      # One file for all test logs: at most 8 files come back from the machine.
+      for f in "$out"/*_test.log; do { echo "=== $(basename "$f")"; cat "$f"; } >>"$out/tests.log"; rm -f "$f"; done
       ;;
     bench)
       [ -x .carry/bin/delaunay_bench ] || { echo "no delaunay_bench in .carry"; status=1; continue; }
@@ -76,6 +80,15 @@ for phase in "${phases[@]}"; do
       run_step bench 120 .carry/bin/delaunay_bench --backend=cuda --sizes=100000,1000000 --repeat=1 \
         --dists=parallel_lines,two_lines,circle,tiny,huge_offset_1e15
       grep -E '^\|' "$out/bench.log"
+      ;;
+    alpha)
+      [ -x .carry/bin/alpha_bench ] || { echo "no alpha_bench in .carry"; status=1; continue; }
+      # The whole family on the GPU against CGAL's Alpha_shape_2 (exact constructions, one thread)
+      # at 100K and 1M, then the GPU alone at 10M; then the CPU backend on this machine's cores.
+      run_step alpha 300 .carry/bin/alpha_bench --backend=cuda --sizes=100000,1000000 --repeat=3
+      run_step alpha 120 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --repeat=2 --cgal-max=0
+      run_step alpha 150 .carry/bin/alpha_bench --backend=cpu --sizes=1000000 --repeat=1 --cgal-max=0
+      grep -E '^\|' "$out/alpha.log"
       ;;
     *)
       echo "unknown phase '$phase'"

@@ -21,6 +21,7 @@
 #include "core/expansion.hpp"
 #include "core/hd.hpp"
 #include "core/point.hpp"
+#include "core/predicates.hpp"
 
 namespace galpha {
 
@@ -367,10 +368,48 @@ GALPHA_HD GALPHA_FORCEINLINE bool RadiusKeysMayTie(uint64_t lo, uint64_t hi) {
   return hi - lo <= kRadiusKeyGap + 1;
 }
 
+/// rho^2 of p[0..n) when every operation computing it in plain doubles is exact and the result is
+/// a double, as for small integer coordinates (grids): then equal values are proven equal by one
+/// double comparison. False otherwise (nothing is claimed). Differences are kept inside
+/// [2^-100, 2^100] so that no Two-Product tail can underflow or overflow in degree 6.
+GALPHA_HD inline bool ExactDoubleRadiusSq(const Point2* p, int n, double* out) {
+  using namespace exact;
+  pred_detail::ExactnessWitness w;
+  const int from[3] = {0, 0, 1}, to[3] = {1, 2, 2};
+  const int m = n == 2 ? 1 : 3;
+  double dx[3], dy[3], len[3];
+  for (int k = 0; k < m; ++k) {
+    dx[k] = w.Diff(p[to[k]].x, p[from[k]].x);
+    dy[k] = w.Diff(p[to[k]].y, p[from[k]].y);
+    const double c[2] = {Abs(dx[k]), Abs(dy[k])};
+    for (double v : c) {
+      if (v != 0.0 && !(v >= 0x1p-100 && v <= 0x1p100)) return false;
+    }
+    len[k] = w.Sum(w.Product(dx[k], dx[k]), w.Product(dy[k], dy[k]));
+  }
+  if (!w.exact) return false;
+  if (n == 2) {
+    *out = Mul(len[0], 0.25);  // exact: len >= 2^-200
+    return true;
+  }
+  const double num = w.Product(w.Product(len[0], len[1]), len[2]);
+  const double area = w.Diff(w.Product(dx[0], dy[1]), w.Product(dy[0], dx[1]));
+  if (!w.exact || area == 0.0) return false;
+  const double den = Mul(w.Product(area, area), 4.0);
+  const double q = num / den;
+  double hi, lo;
+  TwoProduct(q, den, hi, lo);
+  if (!w.exact || hi != num || lo != 0.0) return false;
+  *out = q;
+  return true;
+}
+
 /// Exact sign of rho^2(a) - rho^2(b) for simplices a (na = 2 or 3 points) and b, or
 /// kRadiusUndecided when the bounded buffers or the exponent range do not suffice.
 GALPHA_HD inline int CompareRadiusSqBounded(const Point2* a, int na, const Point2* b, int nb) {
   using namespace radius_detail;
+  double va, vb;
+  if (ExactDoubleRadiusSq(a, na, &va) && ExactDoubleRadiusSq(b, nb, &vb)) return (va > vb) - (va < vb);
   double dmax = 0.0;
   int lowest = 1 << 20;
   if (!DifferenceRange(a, na, &dmax, &lowest) || !DifferenceRange(b, nb, &dmax, &lowest)) {
@@ -460,6 +499,103 @@ GALPHA_HD inline bool NearestRadiusSqBounded(const Point2* p, int n, double* out
     }
   }
   return false;
+}
+
+namespace radius_detail {
+
+/// Double-double value h + l (|l| <= half an ulp of h after TwoSum).
+struct DoubleDouble {
+  double h, l;
+};
+
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble Normalize(double h, double l) {
+  DoubleDouble r;
+  TwoSum(h, l, r.h, r.l);
+  return r;
+}
+/// Relative error below 2^-102 (the dropped l*l term and three roundings of the tail).
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDMul(DoubleDouble a, DoubleDouble b) {
+  double p, e;
+  TwoProduct(a.h, b.h, p, e);
+  return Normalize(p, Add(e, Add(Mul(a.h, b.l), Mul(a.l, b.h))));
+}
+/// Absolute error below 2^-102 (|a| + |b|).
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDAdd(DoubleDouble a, DoubleDouble b) {
+  double s, e;
+  TwoSum(a.h, b.h, s, e);
+  return Normalize(s, Add(e, Add(a.l, b.l)));
+}
+/// Relative error below 2^-100 for positive operands.
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDDiv(DoubleDouble a, DoubleDouble b) {
+  const double q1 = a.h / b.h;
+  const DoubleDouble qb = DDMul(b, DoubleDouble{q1, 0.0});
+  const DoubleDouble r = DDAdd(a, DoubleDouble{-qb.h, -qb.l});
+  return Normalize(q1, r.h / b.h);
+}
+/// Exact scaled difference as a double-double.
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDDiff(double u, double v, int s) {
+  double hi, lo;
+  TwoDiff(u, v, hi, lo);
+  return DoubleDouble{ScaleByPow2(hi, s), ScaleByPow2(lo, s)};
+}
+
+}  // namespace radius_detail
+
+/// The double nearest to rho^2 of p[0..n) by double-double arithmetic with a certified error
+/// bound (about 2^-95 relative): decides the rounding unless the value lies within that bound of a
+/// midpoint between two doubles or outside the normal range, where it returns false and the
+/// exact NearestRadiusSqBounded decides. The fast path of the published spectrum.
+GALPHA_HD inline bool NearestRadiusSqFast(const Point2* p, int n, double* out) {
+  using namespace radius_detail;
+  const int from[3] = {0, 0, 1}, to[3] = {1, 2, 2};
+  const int m = n == 2 ? 1 : 3;
+  double maxabs = 0.0;
+  for (int k = 0; k < m; ++k) {
+    const double dx = Abs(Sub(p[to[k]].x, p[from[k]].x)), dy = Abs(Sub(p[to[k]].y, p[from[k]].y));
+    if (!Finite(dx) || !Finite(dy)) return false;
+    maxabs = dx > maxabs ? dx : maxabs;
+    maxabs = dy > maxabs ? dy : maxabs;
+  }
+  if (maxabs == 0.0) return false;
+  const int s = -ExactExponentOf(maxabs);
+  DoubleDouble d[3][2];
+  for (int k = 0; k < m; ++k) {
+    d[k][0] = DDDiff(p[to[k]].x, p[from[k]].x, s);
+    d[k][1] = DDDiff(p[to[k]].y, p[from[k]].y, s);
+    for (int c = 0; c < 2; ++c) {
+      // Tiny differences beside large ones could underflow in products: the exact path takes them.
+      if (d[k][c].h != 0.0 && Abs(d[k][c].h) < 0x1p-300) return false;
+    }
+  }
+  DoubleDouble len[3];
+  for (int k = 0; k < m; ++k) len[k] = DDAdd(DDMul(d[k][0], d[k][0]), DDMul(d[k][1], d[k][1]));
+  DoubleDouble value;
+  double bound = 0x1p-95;
+  if (n == 2) {
+    value = DoubleDouble{Mul(len[0].h, 0.25), Mul(len[0].l, 0.25)};
+  } else {
+    const DoubleDouble left = DDMul(d[0][0], d[1][1]), right = DDMul(d[0][1], d[1][0]);
+    const DoubleDouble area = DDAdd(left, DoubleDouble{-right.h, -right.l});
+    const double sum = Add(Abs(left.h), Abs(right.h));
+    if (Abs(area.h) < 0x1p-500 || Abs(area.h) < Mul(sum, 0x1p-31)) return false;
+    // D's relative error: 2^-101 (|left| + |right|) / |D| <= 2^-70; rho^2 gets four times that.
+    bound = Add(bound, Mul(Mul(sum / Abs(area.h), 0x1p-101), 4.0));
+    const DoubleDouble num = DDMul(DDMul(len[0], len[1]), len[2]);
+    const DoubleDouble den = DDMul(area, area);
+    value = DDDiv(num, DoubleDouble{Mul(den.h, 4.0), Mul(den.l, 4.0)});
+  }
+  // Unscale (exact while normal), then decide the rounding: the exact value lies within
+  // bound * value of h + l; h is its nearest double if that interval stays strictly inside
+  // h's rounding interval.
+  const double h = ldexp(value.h, -2 * s);
+  const double l = ldexp(value.l, -2 * s);
+  if (!(h >= 0x1p-900 && h <= 0x1p1000)) return false;  // l and the bound stay normal
+  const double err = Mul(Mul(h, bound), 1.0 + 0x1p-20);
+  const double up = Mul(Sub(NextUp(h), h), 0.5);
+  const double down = Mul(Sub(h, NextDown(h)), 0.5);
+  if (!(Add(l, err) < up && Sub(l, err) > -down)) return false;
+  *out = h;
+  return true;
 }
 
 }  // namespace galpha

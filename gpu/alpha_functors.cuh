@@ -243,7 +243,7 @@ struct NearestSpectrumValue {
   GALPHA_HD void operator()(uint32_t r) const {
     Point2 p[3];
     const int n = simplex(spectrum_simplex[r], p);
-    needs_host[r] = NearestRadiusSqBounded(p, n, &spectrum[r]) ? 0 : 1;
+    needs_host[r] = NearestRadiusSqFast(p, n, &spectrum[r]) || NearestRadiusSqBounded(p, n, &spectrum[r]) ? 0 : 1;
   }
 };
 
@@ -301,106 +301,100 @@ struct FinishVertexIntervals {
   }
 };
 
-/// Master-list entries: a sort key (rank, dimension) and the entry (id, kind, end point) packed.
-struct MasterKey {
-  GALPHA_HD static uint64_t Key(uint32_t rank, SimplexKind kind) {
-    return (static_cast<uint64_t>(rank) << 2) | static_cast<uint64_t>(kind);
-  }
-  GALPHA_HD static uint64_t Value(uint32_t id, Endpoint endpoint) {
-    return (static_cast<uint64_t>(id) << 2) | static_cast<uint64_t>(endpoint);
-  }
-};
+GALPHA_HD inline uint32_t AtomicAddU32(uint32_t* p, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return atomicAdd(p, v);
+#else
+  return __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
 
-/// Number of master-list entries of each simplex (its interval end points that are real ranks).
-struct CountVertexEntries {
-  const uint32_t* representative;
-  const uint32_t* mu_low;
-  const uint32_t* mu_high;
-  GALPHA_HD uint32_t operator()(uint32_t v) const {
-    if (representative[v] != v) return 0;
-    return (mu_low[v] != kNeverRank ? 1u : 0u) + (mu_high[v] != kNeverRank ? 1u : 0u);
-  }
-};
-struct CountEdgeEntries {
-  const uint32_t* rho;
-  const uint32_t* mu_low;
-  const uint32_t* mu_high;
-  GALPHA_HD uint32_t operator()(uint32_t e) const {
-    return (rho[e] != 0 ? 1u : 0u) + (mu_low[e] != kNeverRank ? 1u : 0u) + (mu_high[e] != kNeverRank ? 1u : 0u);
-  }
-};
+/// A master-list entry packed so that its natural order is the order within a rank: vertex < edge
+/// < triangle, then id, then end point.
+GALPHA_HD inline uint64_t PackMasterEntry(SimplexKind kind, uint32_t id, Endpoint endpoint) {
+  return (static_cast<uint64_t>(kind) << 34) | (static_cast<uint64_t>(id) << 2) | static_cast<uint64_t>(endpoint);
+}
 
-struct WriteVertexEntries {
+/// Visits every master-list end point of every simplex (ranks 1..K; 0 and kNeverRank are not end
+/// points in the list): Visitor(rank, packed entry). Items 0..n-1 are vertices, then edges, then
+/// triangles.
+struct MasterEndpoints {
   const uint32_t* representative;
-  const uint32_t* mu_low;
-  const uint32_t* mu_high;
-  const uint32_t* offset;
-  uint64_t* keys;
-  uint64_t* values;
-  GALPHA_HD void operator()(uint32_t v) const {
-    if (representative[v] != v) return;
-    uint32_t o = offset[v];
-    if (mu_low[v] != kNeverRank) {
-      keys[o] = MasterKey::Key(mu_low[v], SimplexKind::kVertex);
-      values[o++] = MasterKey::Value(v, Endpoint::kMuLow);
-    }
-    if (mu_high[v] != kNeverRank) {
-      keys[o] = MasterKey::Key(mu_high[v], SimplexKind::kVertex);
-      values[o] = MasterKey::Value(v, Endpoint::kMuHigh);
-    }
-  }
-};
-struct WriteEdgeEntries {
-  const uint32_t* rho;
-  const uint32_t* mu_low;
-  const uint32_t* mu_high;
-  const uint32_t* offset;
-  uint32_t base;
-  uint64_t* keys;
-  uint64_t* values;
-  GALPHA_HD void operator()(uint32_t e) const {
-    uint32_t o = base + offset[e];
-    if (rho[e] != 0) {
-      keys[o] = MasterKey::Key(rho[e], SimplexKind::kEdge);
-      values[o++] = MasterKey::Value(e, Endpoint::kRho);
-    }
-    if (mu_low[e] != kNeverRank) {
-      keys[o] = MasterKey::Key(mu_low[e], SimplexKind::kEdge);
-      values[o++] = MasterKey::Value(e, Endpoint::kMuLow);
-    }
-    if (mu_high[e] != kNeverRank) {
-      keys[o] = MasterKey::Key(mu_high[e], SimplexKind::kEdge);
-      values[o] = MasterKey::Value(e, Endpoint::kMuHigh);
-    }
-  }
-};
-struct WriteTriangleEntry {
+  const uint32_t* vertex_mu_low;
+  const uint32_t* vertex_mu_high;
+  const uint32_t* edge_rho;
+  const uint32_t* edge_mu_low;
+  const uint32_t* edge_mu_high;
   const uint32_t* tri_rank;
-  uint32_t base;
-  uint64_t* keys;
-  uint64_t* values;
-  GALPHA_HD void operator()(uint32_t t) const {
-    keys[base + t] = MasterKey::Key(tri_rank[t], SimplexKind::kTriangle);
-    values[base + t] = MasterKey::Value(t, Endpoint::kRho);
+  uint32_t num_points;
+  uint32_t num_edges;
+
+  template <class Visitor>
+  GALPHA_HD void Visit(uint32_t item, Visitor& visit) const {
+    auto real = [](uint32_t r) { return r != 0 && r != kNeverRank; };
+    if (item < num_points) {
+      const uint32_t v = item;
+      if (representative[v] != v) return;
+      if (real(vertex_mu_low[v])) visit(vertex_mu_low[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuLow));
+      if (real(vertex_mu_high[v])) visit(vertex_mu_high[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuHigh));
+      return;
+    }
+    item -= num_points;
+    if (item < num_edges) {
+      const uint32_t e = item;
+      if (real(edge_rho[e])) visit(edge_rho[e], PackMasterEntry(SimplexKind::kEdge, e, Endpoint::kRho));
+      if (real(edge_mu_low[e])) visit(edge_mu_low[e], PackMasterEntry(SimplexKind::kEdge, e, Endpoint::kMuLow));
+      if (real(edge_mu_high[e])) visit(edge_mu_high[e], PackMasterEntry(SimplexKind::kEdge, e, Endpoint::kMuHigh));
+      return;
+    }
+    const uint32_t t = item - num_edges;
+    if (real(tri_rank[t])) visit(tri_rank[t], PackMasterEntry(SimplexKind::kTriangle, t, Endpoint::kRho));
   }
 };
 
-/// master_begin[r] = first entry of rank >= r (binary search in the sorted keys).
-struct MasterBegin {
-  const uint64_t* keys;
-  uint32_t count;
-  GALPHA_HD uint32_t operator()(uint32_t r) const {
-    const uint64_t target = static_cast<uint64_t>(r) << 2;
-    uint32_t lo = 0, hi = count;
-    while (lo < hi) {
-      const uint32_t mid = lo + (hi - lo) / 2;
-      if (keys[mid] < target) {
-        lo = mid + 1;
-      } else {
-        hi = mid;
+/// Pass 1: entries per rank.
+struct CountMasterEntries {
+  MasterEndpoints endpoints;
+  uint32_t* count;
+  GALPHA_HD void operator()(uint32_t item) const {
+    auto visit = [this](uint32_t rank, uint64_t) { AtomicAddU32(&count[rank], 1); };
+    endpoints.Visit(item, visit);
+  }
+};
+
+/// Pass 2: each entry into a free slot of its rank's segment (order fixed by pass 3).
+struct FillMasterEntries {
+  MasterEndpoints endpoints;
+  uint32_t* cursor;
+  uint64_t* entries;
+  GALPHA_HD void operator()(uint32_t item) const {
+    auto visit = [this](uint32_t rank, uint64_t packed) { entries[AtomicAddU32(&cursor[rank], 1)] = packed; };
+    endpoints.Visit(item, visit);
+  }
+};
+
+/// Largest rank segment sorted by one thread; longer ones (exact ties: a grid's congruent
+/// triangles) are sorted by a Thrust call each.
+constexpr uint32_t kMaxThreadSegment = 64;
+
+/// Pass 3: sorts every short rank segment (insertion sort); flags the long ones.
+struct SortMasterSegment {
+  const uint32_t* begin;
+  uint64_t* entries;
+  uint8_t* long_segment;
+  GALPHA_HD void operator()(uint32_t rank) const {
+    const uint32_t b = begin[rank], e = begin[rank + 1];
+    long_segment[rank] = e - b > kMaxThreadSegment ? 1 : 0;
+    if (e - b > kMaxThreadSegment) return;
+    for (uint32_t i = b + 1; i < e; ++i) {
+      const uint64_t x = entries[i];
+      uint32_t j = i;
+      while (j > b && entries[j - 1] > x) {
+        entries[j] = entries[j - 1];
+        --j;
       }
+      entries[j] = x;
     }
-    return lo;
   }
 };
 

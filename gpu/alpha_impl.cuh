@@ -197,36 +197,35 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   keys.Reset();
   timer.EndStage("intervals");
 
-  // Master list: every real end point keyed by (rank, dimension), stably sorted so that ids and
-  // end points stay in order within a key.
-  Buffer<uint32_t, System> vertex_offset(sys, n), edge_offset(sys, num_edges);
-  thrust::transform(policy, zero, zero + n, vertex_offset.data(),
-                    CountVertexEntries{representative.data(), vertex_mu_low.data(), vertex_mu_high.data()});
-  thrust::transform(policy, zero, zero + num_edges, edge_offset.data(),
-                    CountEdgeEntries{edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data()});
-  const uint32_t vertex_entries = thrust::reduce(policy, vertex_offset.data(), vertex_offset.data() + n, uint32_t{0});
-  const uint32_t edge_entries =
-      thrust::reduce(policy, edge_offset.data(), edge_offset.data() + num_edges, uint32_t{0});
-  thrust::exclusive_scan(policy, vertex_offset.data(), vertex_offset.data() + n, vertex_offset.data());
-  thrust::exclusive_scan(policy, edge_offset.data(), edge_offset.data() + num_edges, edge_offset.data());
-  // Collinear triangles cannot occur in a triangulation (its triangles have positive area), so
-  // every triangle has a rank.
-  const uint32_t num_master = vertex_entries + edge_entries + num_tri;
-  Buffer<uint64_t, System> master_keys(sys, num_master), master_values(sys, num_master);
-  thrust::for_each_n(policy, zero, n,
-                     WriteVertexEntries{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
-                                        vertex_offset.data(), master_keys.data(), master_values.data()});
-  thrust::for_each_n(policy, zero, num_edges,
-                     WriteEdgeEntries{edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(), edge_offset.data(),
-                                      vertex_entries, master_keys.data(), master_values.data()});
-  thrust::for_each_n(policy, zero, num_tri,
-                     WriteTriangleEntry{tri_rank.data(), vertex_entries + edge_entries, master_keys.data(),
-                                        master_values.data()});
-  vertex_offset.Reset();
-  edge_offset.Reset();
-  thrust::stable_sort_by_key(policy, master_keys.data(), master_keys.data() + num_master, master_values.data());
+  // Master list in CSR form: count the end points per rank, scan, place each entry in its rank's
+  // segment, then sort every segment (O(entries): no global sort).
+  const MasterEndpoints endpoints{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
+                                  edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(),
+                                  tri_rank.data(), n, num_edges};
+  const uint32_t num_items = n + num_edges + num_tri;
   Buffer<uint32_t, System> master_begin(sys, static_cast<size_t>(num_ranks) + 2);
-  thrust::transform(policy, zero, zero + (num_ranks + 2), master_begin.data(), MasterBegin{master_keys.data(), num_master});
+  thrust::fill_n(policy, master_begin.data(), num_ranks + 2, uint32_t{0});
+  thrust::for_each_n(policy, zero, num_items, CountMasterEntries{endpoints, master_begin.data()});
+  thrust::exclusive_scan(policy, master_begin.data(), master_begin.data() + (num_ranks + 2), master_begin.data());
+  const uint32_t num_master = sys.Read(master_begin.data() + (num_ranks + 1));
+  Buffer<uint64_t, System> master_entries(sys, num_master);
+  {
+    Buffer<uint32_t, System> cursor(sys, static_cast<size_t>(num_ranks) + 2);
+    thrust::copy_n(policy, master_begin.data(), num_ranks + 2, cursor.data());
+    thrust::for_each_n(policy, zero, num_items, FillMasterEntries{endpoints, cursor.data(), master_entries.data()});
+  }
+  {
+    Buffer<uint8_t, System> long_segment(sys, static_cast<size_t>(num_ranks) + 1);
+    thrust::for_each_n(policy, zero, num_ranks + 1,
+                       SortMasterSegment{master_begin.data(), master_entries.data(), long_segment.data()});
+    if (thrust::count(policy, long_segment.data(), long_segment.data() + (num_ranks + 1), uint8_t{1}) > 0) {
+      const std::vector<uint8_t> host_long = long_segment.ToHostVector(num_ranks + 1);
+      const std::vector<uint32_t> host_begin = master_begin.ToHostVector(num_ranks + 2);
+      for (uint32_t r = 0; r <= num_ranks; ++r) {
+        if (host_long[r]) thrust::sort(policy, master_entries.data() + host_begin[r], master_entries.data() + host_begin[r + 1]);
+      }
+    }
+  }
   timer.EndStage("master_list");
 
   out->tri_rank = tri_rank.ToHostVector(num_tri);
@@ -239,12 +238,13 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   out->vertex_mu_high = vertex_mu_high.ToHostVector(n);
   out->vertex_tri_low = vertex_tri_low.ToHostVector(n);
   out->master_begin = master_begin.ToHostVector(static_cast<size_t>(num_ranks) + 2);
-  const std::vector<uint64_t> values = master_values.ToHostVector(num_master);
-  const std::vector<uint64_t> mkeys = master_keys.ToHostVector(num_master);
-  out->master.resize(num_master);
-  for (uint32_t i = 0; i < num_master; ++i) {
-    out->master[i] = MasterEntry{static_cast<uint32_t>(values[i] >> 2), static_cast<SimplexKind>(mkeys[i] & 3),
-                                 static_cast<Endpoint>(values[i] & 3)};
+  {
+    const std::vector<uint64_t> packed = master_entries.ToHostVector(num_master);
+    out->master.resize(num_master);
+    for (uint32_t i = 0; i < num_master; ++i) {
+      out->master[i] = MasterEntry{static_cast<uint32_t>(packed[i] >> 2), static_cast<SimplexKind>(packed[i] >> 34),
+                                   static_cast<Endpoint>(packed[i] & 3)};
+    }
   }
   timer.EndStage("alpha_download");
   *peak_bytes = sys.peak_bytes();

@@ -162,6 +162,23 @@ TEST_P(RadiusTest, NearestDoubleMatchesGmp) {
   }
 }
 
+TEST_P(RadiusTest, FastNearestDoubleIsExactWhenItAnswers) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 400, 17);
+  int answered = 0;
+  for (const Simplex& s : simplices) {
+    double got = 0.0;
+    if (!NearestRadiusSqFast(s.p, s.n, &got)) continue;
+    ++answered;
+    const std::optional<mpq_class> exact = RadiusSqRational(s.p, s.n);
+    ASSERT_TRUE(exact.has_value()) << Show(s);
+    ASSERT_EQ(got, NearestDouble(*exact)) << Show(s);
+  }
+  // The fast path answers nearly everything in ordinary ranges.
+  if (GetParam() == "uniform" || GetParam() == "grid" || GetParam() == "offset1e9") {
+    EXPECT_GT(answered, static_cast<int>(simplices.size()) * 9 / 10);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Families, RadiusTest,
                          ::testing::Values("uniform", "grid", "nudged", "offset1e9", "offset1e15", "tiny",
                                            "subnormal", "mixed", "flat"));

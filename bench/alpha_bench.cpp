@@ -1,0 +1,305 @@
+// alpha_bench: the whole alpha-shape family (galpha::BuildAlphaFamily) against CGAL's Alpha_shape_2
+// with exact constructions (Exact_predicates_exact_constructions_kernel, GENERAL mode) in the same
+// run, over distributions x sizes (and real .bin files). Prints a markdown table with both times,
+// the ratio, both memory peaks per point, the time of one classification of every simplex and
+// galpha's stage times. A plain harness, kept out of ctest.
+//
+//   alpha_bench [--backend=auto|cpu|cuda] [--repeat=3] [--sizes=100000,1000000]
+//               [--dists=uniform,gaussian,clustered,grid] [--seed=1] [--cgal-max=1000000]
+//               [--data FILE.bin]...
+//
+// Memory: the peak resident set of the process during the call minus the resident set before it
+// (Linux: VmHWM reset through /proc/self/clear_refs), so it counts everything the call allocates on
+// the host: working memory, the returned family, CGAL's triangulation and intervals. On the CUDA
+// backend the engine's device peak is printed too.
+#include <CGAL/Alpha_shape_2.h>
+#include <CGAL/Alpha_shape_face_base_2.h>
+#include <CGAL/Alpha_shape_vertex_base_2.h>
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+
+#include <malloc.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "core/alpha_family.hpp"
+#include "core/point_formats.hpp"
+#include "gpu/alpha_engine.hpp"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
+using Vb = CGAL::Alpha_shape_vertex_base_2<Kernel>;
+using Fb = CGAL::Alpha_shape_face_base_2<Kernel>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using CgalAlphaShape = CGAL::Alpha_shape_2<CGAL::Delaunay_triangulation_2<Kernel, Tds>>;
+
+struct BenchOptions {
+  Backend backend = Backend::kAuto;
+  int repeat = 3;
+  std::vector<size_t> sizes = {100000, 1000000};
+  std::vector<std::string> distributions = {"uniform", "gaussian", "clustered", "grid"};
+  uint64_t seed = 1;
+  size_t cgal_max = 1000000;
+  std::vector<std::string> data_files;
+};
+
+constexpr char kUsage[] =
+    "usage: alpha_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...] [--dists=NAME,...]\n"
+    "                   [--seed=N] [--cgal-max=N] [--data FILE.bin]...\n";
+
+absl::StatusOr<BenchOptions> ParseArgs(int argc, char** argv) {
+  BenchOptions options;
+  bool explicit_generated = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value_of = [&](const std::string& flag) -> const char* {
+      return arg.rfind(flag + "=", 0) == 0 ? argv[i] + flag.size() + 1 : nullptr;
+    };
+    if (const char* v = value_of("--backend")) {
+      const std::string name = v;
+      if (name == "auto") {
+        options.backend = Backend::kAuto;
+      } else if (name == "cpu") {
+        options.backend = Backend::kCpu;
+      } else if (name == "cuda") {
+        options.backend = Backend::kCuda;
+      } else {
+        return absl::InvalidArgumentError(absl::StrCat("unknown backend '", name, "'"));
+      }
+    } else if (const char* v = value_of("--repeat")) {
+      if (!absl::SimpleAtoi(v, &options.repeat) || options.repeat < 1) {
+        return absl::InvalidArgumentError(absl::StrCat("bad --repeat '", v, "'"));
+      }
+    } else if (const char* v = value_of("--seed")) {
+      if (!absl::SimpleAtoi(v, &options.seed)) return absl::InvalidArgumentError(absl::StrCat("bad --seed '", v, "'"));
+    } else if (const char* v = value_of("--cgal-max")) {
+      if (!absl::SimpleAtoi(v, &options.cgal_max)) {
+        return absl::InvalidArgumentError(absl::StrCat("bad --cgal-max '", v, "'"));
+      }
+    } else if (const char* v = value_of("--sizes")) {
+      options.sizes.clear();
+      for (absl::string_view part : absl::StrSplit(v, ',', absl::SkipEmpty())) {
+        size_t n;
+        if (!absl::SimpleAtoi(part, &n)) return absl::InvalidArgumentError(absl::StrCat("bad size '", part, "'"));
+        options.sizes.push_back(n);
+      }
+      explicit_generated = true;
+    } else if (const char* v = value_of("--dists")) {
+      options.distributions = absl::StrSplit(v, ',', absl::SkipEmpty());
+      for (const std::string& name : options.distributions) {
+        if (gen::FindDistribution(name) == nullptr) {
+          return absl::InvalidArgumentError(absl::StrCat("unknown distribution '", name, "'"));
+        }
+      }
+      explicit_generated = true;
+    } else if (arg == "--data" && i + 1 < argc) {
+      options.data_files.push_back(argv[++i]);
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
+    }
+  }
+  if (!options.data_files.empty() && !explicit_generated) options.distributions.clear();
+  return options;
+}
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+/// A field of /proc/self/status in bytes (VmRSS, VmHWM).
+size_t StatusBytes(const char* field) {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind(field, 0) == 0) return std::strtoull(line.c_str() + std::string(field).size() + 1, nullptr, 10) * 1024;
+  }
+  return 0;
+}
+
+/// Peak resident growth of `fn`, in bytes (0 where the kernel cannot reset the peak).
+template <class Fn>
+size_t PeakGrowth(Fn&& fn) {
+  {
+    std::ofstream reset("/proc/self/clear_refs");
+    reset << "5";
+  }
+  malloc_trim(0);  // return memory freed by earlier runs, so that reuse of it counts again
+  const size_t before = StatusBytes("VmRSS:");
+  fn();
+  const size_t peak = StatusBytes("VmHWM:");
+  return peak > before ? peak - before : 0;
+}
+
+struct BenchResult {
+  std::string name;
+  size_t n = 0;
+  std::string backend;
+  double galpha_ms = std::numeric_limits<double>::infinity();
+  double transfer_ms = 0;
+  size_t galpha_rss = 0;
+  size_t galpha_engine_peak = 0;
+  double classify_ms = 0;
+  size_t spectrum = 0;
+  ComparisonCounts counts;
+  std::vector<StageTime> stages;
+  double cgal_ms = -1;  // not run above --cgal-max
+  size_t cgal_rss = 0;
+  size_t cgal_spectrum = 0;
+  std::string error;
+};
+
+bool IsTransferStage(const std::string& stage) {
+  return stage == "upload" || stage == "download" || stage == "alpha_upload" || stage == "alpha_download";
+}
+
+BenchResult RunOne(const std::string& name, const std::vector<Point2>& points, const BenchOptions& options) {
+  BenchResult result;
+  result.name = name;
+  result.n = points.size();
+  BuildOptions build;
+  build.backend = options.backend;
+  for (int r = 0; r < options.repeat; ++r) {
+    absl::StatusOr<AlphaFamily> family = absl::InternalError("not run");
+    double ms = 0;
+    const size_t rss = PeakGrowth([&] {
+      const auto start = std::chrono::steady_clock::now();
+      family = BuildAlphaFamily(points, build);
+      ms = MillisecondsSince(start);
+    });
+    if (!family.ok()) {
+      result.error = family.status().ToString();
+      return result;
+    }
+    result.galpha_rss = std::max(result.galpha_rss, rss);
+    if (ms < result.galpha_ms) {
+      result.galpha_ms = ms;
+      result.backend = family->report().backend;
+      result.stages = family->report().stage_times;
+      result.counts = family->report().comparisons;
+      result.galpha_engine_peak = family->report().peak_memory_bytes;
+      result.spectrum = family->spectrum().size();
+      result.transfer_ms = 0;
+      for (const StageTime& s : result.stages) {
+        if (IsTransferStage(s.stage)) result.transfer_ms += s.seconds * 1e3;
+      }
+      const auto start = std::chrono::steady_clock::now();
+      const Classification c = family->ClassifyAll(family->max_level() / 2, ClassifyMode::kGeneral, VertexRule::kReport);
+      result.classify_ms = MillisecondsSince(start);
+      if (c.edges.size() != family->edges().size()) result.error = "classification size mismatch";
+    }
+  }
+  if (points.size() > options.cgal_max) return result;
+  std::vector<Kernel::Point_2> cgal_points;
+  cgal_points.reserve(points.size());
+  for (const Point2& p : points) cgal_points.emplace_back(p.x, p.y);
+  // CGAL takes tens of seconds at 1M points: one run is enough.
+  const auto start = std::chrono::steady_clock::now();
+  result.cgal_rss = PeakGrowth([&] {
+    const CgalAlphaShape shape(cgal_points.begin(), cgal_points.end(), Kernel::FT(0), CgalAlphaShape::GENERAL);
+    result.cgal_ms = MillisecondsSince(start);
+    result.cgal_spectrum = static_cast<size_t>(std::distance(shape.alpha_begin(), shape.alpha_end()));
+  });
+  return result;
+}
+
+void PrintHeader() {
+  std::printf(
+      "| input | n | galpha backend | galpha ms (whole family) | of which transfers ms | CGAL EPEC ms | "
+      "CGAL/galpha | galpha peak RSS B/pt | engine peak B/pt | CGAL peak RSS B/pt | classify all ms | "
+      "spectrum | exact cmp (filter / bounded / CPU fallback) |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+}
+
+void PrintRow(const BenchResult& r) {
+  if (!r.error.empty()) {
+    std::printf("| %s | %zu | - | error: %s |||||||||\n", r.name.c_str(), r.n, r.error.c_str());
+    std::fflush(stdout);
+    return;
+  }
+  const double n = static_cast<double>(std::max<size_t>(r.n, 1));
+  std::string cgal = "-", ratio = "-", cgal_mem = "-";
+  if (r.cgal_ms >= 0) {
+    cgal = absl::StrCat(static_cast<int64_t>(r.cgal_ms));
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", r.cgal_ms / r.galpha_ms);
+    ratio = text;
+    cgal_mem = absl::StrCat(static_cast<int64_t>(static_cast<double>(r.cgal_rss) / n));
+  }
+  std::string spectrum = absl::StrCat(r.spectrum);
+  if (r.cgal_ms >= 0 && r.cgal_spectrum != r.spectrum) absl::StrAppend(&spectrum, " (CGAL ", r.cgal_spectrum, ": MISMATCH)");
+  std::printf("| %s | %zu | %s | %.1f | %.1f | %s | %s | %.0f | %.0f | %s | %.1f | %s | %llu / %llu / %llu |\n",
+              r.name.c_str(), r.n, r.backend.c_str(), r.galpha_ms, r.transfer_ms, cgal.c_str(), ratio.c_str(),
+              static_cast<double>(r.galpha_rss) / n, static_cast<double>(r.galpha_engine_peak) / n,
+              cgal_mem.c_str(), r.classify_ms, spectrum.c_str(), static_cast<unsigned long long>(r.counts.filter),
+              static_cast<unsigned long long>(r.counts.bounded_exact),
+              static_cast<unsigned long long>(r.counts.cpu_fallback));
+  std::fflush(stdout);
+}
+
+void PrintStages(const std::vector<BenchResult>& results) {
+  std::printf("\n| input | n | galpha stages of the best run (ms) |\n|---|---:|---|\n");
+  for (const BenchResult& r : results) {
+    if (!r.error.empty()) continue;
+    std::string stages;
+    for (const StageTime& s : r.stages) {
+      char ms[48];
+      std::snprintf(ms, sizeof ms, "%s%s %.1f", stages.empty() ? "" : ", ", s.stage.c_str(), s.seconds * 1e3);
+      stages += ms;
+    }
+    std::printf("| %s | %zu | %s |\n", r.name.c_str(), r.n, stages.c_str());
+  }
+}
+
+int Main(int argc, char** argv) {
+  const absl::StatusOr<BenchOptions> options = ParseArgs(argc, argv);
+  if (!options.ok()) {
+    std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
+    return 2;
+  }
+  std::printf("alpha_bench: backend %s requested (CUDA %s), galpha best of %d, CGAL once, %u host threads\n\n",
+              BackendName(options->backend), CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
+              std::thread::hardware_concurrency());
+  PrintHeader();
+  std::vector<BenchResult> results;
+  bool failed = false;
+  auto run = [&](const std::string& name, const std::vector<Point2>& points) {
+    std::fprintf(stderr, "running %s n=%zu\n", name.c_str(), points.size());
+    BenchResult r = RunOne(name, points, *options);
+    failed |= !r.error.empty() || (r.cgal_ms >= 0 && r.cgal_spectrum != r.spectrum);
+    PrintRow(r);
+    results.push_back(std::move(r));
+  };
+  for (const std::string& name : options->distributions) {
+    for (size_t n : options->sizes) run(name, gen::FindDistribution(name)->generate(n, options->seed));
+  }
+  for (const std::string& file : options->data_files) {
+    absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
+    if (!points.ok()) {
+      std::fprintf(stderr, "%s\n", points.status().ToString().c_str());
+      return 1;
+    }
+    run(file.substr(file.find_last_of('/') + 1), *points);
+  }
+  PrintStages(results);
+  return failed ? 1 : 0;
+}
+
+}  // namespace
+}  // namespace galpha
+
+int main(int argc, char** argv) { return galpha::Main(argc, argv); }
