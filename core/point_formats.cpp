@@ -242,11 +242,15 @@ absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, cons
 
 absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
   const std::string extension = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
-  if (extension == ".bin") return ReadPointsBin(path);
   std::error_code error;
   if (!std::filesystem::exists(path, error)) {
     return absl::NotFoundError(absl::StrCat("points file '", path, "' does not exist"));
   }
+  // A directory opens as a stream on Linux and fails only when read (by exception).
+  if (std::filesystem::is_directory(path, error)) {
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' is a directory"));
+  }
+  if (extension == ".bin") return ReadPointsBin(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open points file '", path, "'"));
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -1,19 +1,27 @@
-// alphactl triangulate, run as a child process: one JSON object on standard output with counts that
-// agree with Euler's formula, and on failure one line on standard error and a non-zero exit code.
+// alphactl as users run it: the real binary in a child process, on small inputs whose families are
+// derived by hand (a square, a triangle, an obtuse triangle, collinear points, duplicates) and on a
+// real data set, checking the exact output formats, the JSON, the exit codes and one-line errors.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <iterator>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "nlohmann/json.hpp"
+#include "tests/support/data_files.hpp"
 
 namespace {
 
@@ -53,6 +61,63 @@ std::string WriteFile(const std::string& name, const std::string& text) {
   return path;
 }
 
+/// The raw format: little-endian uint64 N, then N pairs of float64 (this test runs on
+/// little-endian hosts only, as the engine does).
+std::string WriteBin(const std::string& name, const std::vector<std::array<double, 2>>& points) {
+  const std::string path = std::filesystem::temp_directory_path() / name;
+  std::ofstream out(path, std::ios::binary);
+  const uint64_t n = points.size();
+  out.write(reinterpret_cast<const char*>(&n), sizeof n);
+  for (const auto& p : points) out.write(reinterpret_cast<const char*>(p.data()), sizeof(double) * 2);
+  return path;
+}
+
+std::string Lines(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const std::string& line : lines) text += line + "\n";
+  return text;
+}
+
+std::vector<std::string> SplitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::string Printed(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+/// Runs `args` on `file` and expects success; returns standard output.
+std::string Succeeds(const std::string& command, const std::string& file, const std::string& options) {
+  const CommandResult run = Alphactl(command + " " + Quote(file) + " " + options);
+  EXPECT_EQ(run.exit_code, 0) << command << " " << options << ": " << run.err;
+  EXPECT_TRUE(run.err.empty()) << run.err;
+  return run.out;
+}
+
+/// A failure: the exit code, nothing on stdout, one line on stderr starting "alphactl: " that
+/// contains `needle`.
+void ExpectError(const CommandResult& run, int exit_code, const std::string& needle) {
+  EXPECT_EQ(run.exit_code, exit_code) << run.err;
+  EXPECT_TRUE(run.out.empty()) << run.out;
+  EXPECT_EQ(run.err.rfind("alphactl: ", 0), 0u) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  EXPECT_NE(run.err.find(needle), std::string::npos) << "expected '" << needle << "' in: " << run.err;
+}
+
+// The unit square 0 (0,0), 1 (1,0), 2 (1,1), 3 (0,1): Delaunay triangles 013 and 123 (the
+// diagonal 1-3: on a co-circular square the tie is broken by index). Sides: rho^2 = 1/4,
+// unattached (the opposite vertices lie on their diametral circles, not inside). Triangles and the
+// diagonal (their common hypotenuse, unattached): 1/2. Spectrum {1/4, 1/2}.
+const std::string& SquareCsv() {
+  static const std::string path = WriteFile("alphactl_unit_square.csv", "x,y\n0,0\n1,0\n1,1\n0,1\n");
+  return path;
+}
+
 TEST(AlphactlTest, TriangulatesACsvAndPrintsOneJsonObject) {
   // A unit square with its centre: 4 triangles, 8 edges, 4 hull edges; one duplicate.
   const std::string path = WriteFile("alphactl_square.csv", "x,y\n0,0\n1,0\n0,1\n1,1\n0.5,0.5\n1,1\n");
@@ -77,32 +142,434 @@ TEST(AlphactlTest, FileNamesAreEscapedInTheJson) {
   const CommandResult run = Alphactl("triangulate " + Quote(path) + " --backend=cpu");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out)["file"], path);
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", path, "--rank 0"))["file"], path);
   std::filesystem::remove(path);
+}
+
+TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
+  const CommandResult help = Alphactl("--help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_TRUE(help.err.empty());
+  for (const char* word : {"triangulate", "spectrum", "classify", "summary", "shape", "masterlist", "optimal",
+                           "bench", "--alpha-sq", "--alpha ", "--rank", "--mode", "--vertex-rule", "--format",
+                           "--components", "--repeat", "--backend", "geojson|wkt|svg", "general|regularized",
+                           "report|cgal"}) {
+    EXPECT_NE(help.out.find(word), std::string::npos) << word;
+  }
+  const CommandResult none = Alphactl("");
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_EQ(none.out, help.out);
+  const CommandResult command_help = Alphactl("classify --help");
+  EXPECT_EQ(command_help.exit_code, 0);
+  EXPECT_EQ(command_help.out, help.out);
+}
+
+TEST(AlphactlTest, SpectrumsArePrintedExactly) {
+  EXPECT_EQ(Succeeds("spectrum", SquareCsv(), ""), "0.25\n0.5\n");
+  // (0,0), (4,0), (2,3): sides 16/4 and 13/4 (twice, one value), all unattached; circumradius^2
+  // 169/36.
+  const std::string triangle = WriteFile("alphactl_triangle.txt", "0 0\n4 0\n2 3\n");
+  EXPECT_EQ(Succeeds("spectrum", triangle, "--backend=cpu"), Lines({"3.25", "4", Printed(169.0 / 36.0)}));
+  // Obtuse (0,0), (4,0), (2,1): the long edge is attached ((2,1) is inside its diametral circle),
+  // so its 4 is not in the spectrum; the short edges 5/4, circumradius^2 (centre (2,-1.5)) 25/4.
+  const std::string obtuse = WriteFile("alphactl_obtuse.txt", "0 0\n4 0\n2 1\n");
+  EXPECT_EQ(Succeeds("spectrum", obtuse, ""), "1.25\n6.25\n");
+  EXPECT_EQ(Succeeds("classify", obtuse, "--rank 1"),
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 1 EXTERIOR", "e 0 2 SINGULAR",
+                   "e 1 2 SINGULAR", "t 0 1 2 EXTERIOR"}));
+  // The attached edge is born with its triangle; hull edges stay REGULAR.
+  EXPECT_EQ(Succeeds("classify", obtuse, "--rank 2"),
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 1 REGULAR", "e 0 2 REGULAR",
+                   "e 1 2 REGULAR", "t 0 1 2 INTERIOR"}));
+  std::filesystem::remove(triangle);
+  std::filesystem::remove(obtuse);
+}
+
+TEST(AlphactlTest, ClassifiesTheSquareAtEveryRank) {
+  const std::string& square = SquareCsv();
+  EXPECT_EQ(Succeeds("classify", square, "--rank 0"),
+            Lines({"v 0 SINGULAR", "v 1 SINGULAR", "v 2 SINGULAR", "v 3 SINGULAR", "e 0 1 EXTERIOR",
+                   "e 0 3 EXTERIOR", "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR",
+                   "t 1 2 3 EXTERIOR"}));
+  // alpha_sq = 1/4: the sides are in with no triangle; vertices are REGULAR by the report's rule
+  // (an incident edge is in), SINGULAR by CGAL's (no incident triangle).
+  const std::string rank1_edges =
+      Lines({"e 0 1 SINGULAR", "e 0 3 SINGULAR", "e 1 2 SINGULAR", "e 1 3 EXTERIOR", "e 2 3 SINGULAR",
+             "t 0 1 3 EXTERIOR", "t 1 2 3 EXTERIOR"});
+  EXPECT_EQ(Succeeds("classify", square, "--rank 1 --backend=cpu"),
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "v 3 REGULAR"}) + rank1_edges);
+  EXPECT_EQ(Succeeds("classify", square, "--rank 1 --vertex-rule cgal"),
+            Lines({"v 0 SINGULAR", "v 1 SINGULAR", "v 2 SINGULAR", "v 3 SINGULAR"}) + rank1_edges);
+  // Regularized: nothing bounds a triangle yet.
+  EXPECT_EQ(Succeeds("classify", square, "--rank 1 --mode regularized"),
+            Lines({"v 0 EXTERIOR", "v 1 EXTERIOR", "v 2 EXTERIOR", "v 3 EXTERIOR", "e 0 1 EXTERIOR",
+                   "e 0 3 EXTERIOR", "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR",
+                   "t 1 2 3 EXTERIOR"}));
+  const std::string all_in =
+      Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "v 3 REGULAR", "e 0 1 REGULAR", "e 0 3 REGULAR",
+             "e 1 2 REGULAR", "e 1 3 INTERIOR", "e 2 3 REGULAR", "t 0 1 3 INTERIOR", "t 1 2 3 INTERIOR"});
+  EXPECT_EQ(Succeeds("classify", square, "--rank 2"), all_in);
+  EXPECT_EQ(Succeeds("classify", square, "--rank 2 --mode regularized --vertex-rule cgal"), all_in);
+
+  // The raw binary format gives the same answers.
+  const std::string bin = WriteBin("alphactl_unit_square.bin", {{{0, 0}}, {{1, 0}}, {{1, 1}}, {{0, 1}}});
+  EXPECT_EQ(Succeeds("classify", bin, "--rank 2"), all_in);
+  EXPECT_EQ(Succeeds("spectrum", bin, ""), "0.25\n0.5\n");
+  std::filesystem::remove(bin);
+}
+
+TEST(AlphactlTest, ThresholdUnitsAgreeAndCompareExactly) {
+  const std::string& square = SquareCsv();
+  const std::string rank0 = Succeeds("classify", square, "--rank 0");
+  const std::string rank1 = Succeeds("classify", square, "--rank 1");
+  EXPECT_EQ(Succeeds("classify", square, "--alpha 0.5"), rank1);
+  EXPECT_EQ(Succeeds("classify", square, "--alpha-sq 0.25"), rank1);
+  EXPECT_EQ(Succeeds("classify", square, "--alpha-sq=0.3"), rank1);
+  EXPECT_EQ(Succeeds("classify", square, "--alpha-sq 0.24999999999999997"), rank0);
+  EXPECT_EQ(Succeeds("classify", square, "--alpha 0"), rank0);
+  EXPECT_EQ(Succeeds("classify", square, "--alpha-sq 1e300"), Succeeds("classify", square, "--rank 2"));
+
+  const nlohmann::json by_alpha = nlohmann::json::parse(Succeeds("summary", square, "--alpha 0.5"));
+  EXPECT_EQ(by_alpha["level"], 1);
+  EXPECT_EQ(by_alpha["alpha_sq"], 0.25);
+  const nlohmann::json by_value = nlohmann::json::parse(Succeeds("summary", square, "--alpha-sq 0.3"));
+  EXPECT_EQ(by_value["level"], 1);
+  EXPECT_EQ(by_value["alpha_sq"], 0.3);
+  const nlohmann::json negative = nlohmann::json::parse(Succeeds("summary", square, "--alpha-sq -1"));
+  EXPECT_EQ(negative["level"], -1);
+  EXPECT_EQ(negative["vertices"]["EXTERIOR"], 4);
+
+  // (0,0), (4,0), (2,6): sides 4 and 10 (twice), circumradius^2 100/9, whose nearest double lies
+  // below it: as --alpha-sq that double is compared exactly and the triangle is not yet in.
+  const std::string tall = WriteFile("alphactl_tall.txt", "0 0\n4 0\n2 6\n");
+  EXPECT_EQ(Succeeds("spectrum", tall, ""), Lines({"4", "10", Printed(100.0 / 9.0)}));
+  const nlohmann::json rank3 = nlohmann::json::parse(Succeeds("summary", tall, "--rank 3"));
+  EXPECT_EQ(rank3["level"], 3);
+  EXPECT_EQ(rank3["alpha_sq"], 100.0 / 9.0);
+  EXPECT_EQ(rank3["triangles"]["INTERIOR"], 1);
+  const nlohmann::json below = nlohmann::json::parse(Succeeds("summary", tall, "--alpha-sq " + Printed(100.0 / 9.0)));
+  EXPECT_EQ(below["level"], 2);
+  EXPECT_EQ(below["triangles"]["INTERIOR"], 0);
+  std::filesystem::remove(tall);
+}
+
+TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
+  const CommandResult run = Alphactl("summary " + Quote(SquareCsv()) + " --rank 1 --backend=cpu");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(std::count(run.out.begin(), run.out.end(), '\n'), 1);
+  const nlohmann::ordered_json j = nlohmann::ordered_json::parse(run.out);
+  std::vector<std::string> keys;
+  for (const auto& item : j.items()) keys.push_back(item.key());
+  EXPECT_EQ(keys, (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size",
+                                             "level", "alpha_sq", "mode", "vertex_rule", "vertices", "edges",
+                                             "triangles", "components", "solid_components", "interior_area",
+                                             "backend"}));
+  const nlohmann::json expected = {
+      {"file", SquareCsv()},
+      {"points", 4},
+      {"distinct_points", 4},
+      {"duplicates", 0},
+      {"spectrum_size", 2},
+      {"level", 1},
+      {"alpha_sq", 0.25},
+      {"mode", "general"},
+      {"vertex_rule", "report"},
+      {"vertices", {{"EXTERIOR", 0}, {"SINGULAR", 0}, {"REGULAR", 4}, {"INTERIOR", 0}}},
+      {"edges", {{"EXTERIOR", 1}, {"SINGULAR", 4}, {"REGULAR", 0}, {"INTERIOR", 0}}},
+      {"triangles", {{"EXTERIOR", 2}, {"SINGULAR", 0}, {"REGULAR", 0}, {"INTERIOR", 0}}},
+      {"components", 1},
+      {"solid_components", 0},
+      {"interior_area", 0.0},
+      {"backend", "cpu"}};
+  EXPECT_EQ(nlohmann::json::parse(run.out), expected);
+
+  const nlohmann::json full =
+      nlohmann::json::parse(Succeeds("summary", SquareCsv(), "--rank 2 --mode regularized --vertex-rule cgal"));
+  EXPECT_EQ(full["mode"], "regularized");
+  EXPECT_EQ(full["vertex_rule"], "cgal");
+  EXPECT_EQ(full["alpha_sq"], 0.5);
+  EXPECT_EQ(full["edges"]["INTERIOR"], 1);
+  EXPECT_EQ(full["triangles"]["INTERIOR"], 2);
+  EXPECT_EQ(full["solid_components"], 1);
+  EXPECT_EQ(full["interior_area"], 1.0);
+}
+
+TEST(AlphactlTest, ShapesInEveryFormat) {
+  const std::string& square = SquareCsv();
+  EXPECT_EQ(Succeeds("shape", square, "--rank 2 --format wkt"),
+            "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 1, 0 0))))\n");
+  EXPECT_EQ(Succeeds("shape", square, "--rank 1 --format=wkt"),
+            "GEOMETRYCOLLECTION (MULTILINESTRING ((0 0, 1 0), (0 0, 0 1), (1 0, 1 1), (1 1, 0 1)))\n");
+  EXPECT_EQ(Succeeds("shape", square, "--rank 0 --format wkt"),
+            "GEOMETRYCOLLECTION (MULTIPOINT ((0 0), (1 0), (1 1), (0 1)))\n");
+  EXPECT_EQ(Succeeds("shape", square, "--rank 1 --format wkt --mode regularized"), "GEOMETRYCOLLECTION EMPTY\n");
+
+  const nlohmann::json geojson = nlohmann::json::parse(Succeeds("shape", square, "--alpha 1 --format geojson"));
+  EXPECT_EQ(geojson["type"], "FeatureCollection");
+  ASSERT_EQ(geojson["features"].size(), 1u);
+  EXPECT_EQ(geojson["features"][0]["geometry"]["type"], "MultiPolygon");
+  EXPECT_EQ(geojson["features"][0]["properties"]["area"], 1.0);
+  EXPECT_EQ(geojson["features"][0]["geometry"]["coordinates"],
+            nlohmann::json::parse("[[[[0,0],[1,0],[1,1],[0,1],[0,0]]]]"));
+
+  const std::string svg = Succeeds("shape", square, "--rank 2 --format svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u) << svg;
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+}
+
+TEST(AlphactlTest, MasterListOfTheSquare) {
+  // Ranks 1 and 2, grouped vertex < edge < triangle; within a group the family's (id) order.
+  auto check = [](const std::string& out, std::vector<std::string> expected) {
+    std::vector<std::string> lines = SplitLines(out);
+    std::string kinds;
+    for (const std::string& line : lines) kinds += line.substr(0, 1);
+    EXPECT_TRUE(std::is_sorted(kinds.begin(), kinds.end(), [](char a, char b) {
+      return std::string("vet").find(a) < std::string("vet").find(b);
+    })) << out;
+    std::sort(lines.begin(), lines.end());
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(lines, expected);
+  };
+  check(Succeeds("masterlist", SquareCsv(), "--rank 1"),
+        {"v 0 MU_LOW", "v 1 MU_LOW", "v 2 MU_LOW", "v 3 MU_LOW", "e 0 1 RHO", "e 0 3 RHO", "e 1 2 RHO", "e 2 3 RHO"});
+  check(Succeeds("masterlist", SquareCsv(), "--rank 2"),
+        {"e 0 1 MU_LOW", "e 0 3 MU_LOW", "e 1 2 MU_LOW", "e 2 3 MU_LOW", "e 1 3 RHO", "e 1 3 MU_LOW",
+         "e 1 3 MU_HIGH", "t 0 1 3 RHO", "t 1 2 3 RHO"});
+  ExpectError(Alphactl("masterlist " + Quote(SquareCsv()) + " --rank 0"), 2, "--rank 0 is outside 1..2");
+  ExpectError(Alphactl("masterlist " + Quote(SquareCsv()) + " --rank 3"), 2, "--rank 3 is outside 1..2");
+  ExpectError(Alphactl("masterlist " + Quote(SquareCsv())), 2, "missing --rank");
+}
+
+TEST(AlphactlTest, OptimalRanks) {
+  EXPECT_EQ(Succeeds("optimal", SquareCsv(), "--components 1"),
+            "{\"components\":1,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1},"
+            "\"general\":{\"rank\":1,\"alpha_sq\":0.25,\"components\":1}}\n");
+  EXPECT_EQ(Succeeds("optimal", SquareCsv(), "--components 4"),
+            "{\"components\":4,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1},"
+            "\"general\":{\"rank\":0,\"alpha_sq\":0,\"components\":4}}\n");
+  // Two unit squares 9 apart: each square is connected at 1/4 and solid at 1/2.
+  const std::string two = WriteFile("alphactl_two_squares.txt", "0 0\n1 0\n1 1\n0 1\n10 0\n11 0\n11 1\n10 1\n");
+  const nlohmann::json j = nlohmann::json::parse(Succeeds("optimal", two, "--components 2"));
+  EXPECT_EQ(j, nlohmann::json::parse("{\"components\":2,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,"
+                                     "\"solid_components\":2},\"general\":{\"rank\":1,\"alpha_sq\":0.25,"
+                                     "\"components\":2}}"));
+  const nlohmann::json one = nlohmann::json::parse(Succeeds("optimal", two, "--components 1"));
+  EXPECT_GT(one["general"]["rank"].get<int>(), 2);
+  EXPECT_EQ(one["general"]["components"], 1);
+  // Collinear points never have a triangle: no regularized answer.
+  const std::string line = WriteFile("alphactl_line.txt", "0 0\n1 0\n3 0\n");
+  EXPECT_EQ(Succeeds("optimal", line, "--components 1"),
+            "{\"components\":1,\"regularized\":null,\"general\":{\"rank\":2,\"alpha_sq\":1,\"components\":1}}\n");
+  ExpectError(Alphactl("optimal " + Quote(line) + " --components 0"), 2, "--components '0'");
+  ExpectError(Alphactl("optimal " + Quote(line) + " --components x"), 2, "--components 'x'");
+  ExpectError(Alphactl("optimal " + Quote(line)), 2, "missing --components");
+  std::filesystem::remove(two);
+  std::filesystem::remove(line);
+}
+
+TEST(AlphactlTest, BenchPrintsEveryStageAndTheCounts) {
+  const CommandResult triangulate = Alphactl("triangulate " + Quote(SquareCsv()) + " --backend=cpu");
+  ASSERT_EQ(triangulate.exit_code, 0) << triangulate.err;
+  const CommandResult run = Alphactl("bench " + Quote(SquareCsv()) + " --repeat 2 --backend=cpu");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::map<std::string, std::string> rows;
+  for (const std::string& line : SplitLines(run.out)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    std::string name, value, extra;
+    fields >> name >> value;
+    EXPECT_FALSE(fields >> extra) << line;
+    rows[name] = value;
+  }
+  EXPECT_NE(run.out.find("best of 2 builds"), std::string::npos) << run.out;
+  for (const auto& stage : nlohmann::json::parse(triangulate.out)["stage_ms"].items()) {
+    EXPECT_TRUE(rows.count(stage.key())) << stage.key() << " in\n" << run.out;
+  }
+  for (const char* name : {"spectrum_sort", "master_list", "components", "total", "peak_memory_bytes",
+                           "bytes_per_point", "comparisons_filter", "comparisons_bounded_exact",
+                           "comparisons_cpu_fallback"}) {
+    ASSERT_TRUE(rows.count(name)) << name << " in\n" << run.out;
+    EXPECT_GE(std::stod(rows[name]), 0.0) << name;
+  }
+  EXPECT_GT(std::stod(rows["total"]), 0.0);
+  EXPECT_GT(std::stoll(rows["peak_memory_bytes"]), 0);
+  EXPECT_NEAR(std::stod(rows["bytes_per_point"]), std::stoll(rows["peak_memory_bytes"]) / 4.0, 0.051);
+  // Six births in two exact ties: the spectrum sort compared at least one pair.
+  EXPECT_GT(std::stoll(rows["comparisons_filter"]) + std::stoll(rows["comparisons_bounded_exact"]) +
+                std::stoll(rows["comparisons_cpu_fallback"]),
+            0);
+  EXPECT_EQ(rows["spectrum_size"], "2");
+  EXPECT_EQ(rows["backend"], "cpu");
+  ExpectError(Alphactl("bench " + Quote(SquareCsv()) + " --repeat 0"), 2, "--repeat '0'");
+}
+
+TEST(AlphactlTest, DuplicatesAreNamedByTheirFirstOccurrence) {
+  // The square with (0,0) again at 2 and (1,0) again at 4: points 0, 1, 3 (1,1), 5 (0,1).
+  const std::string path = WriteFile("alphactl_duplicates.csv", "0,0\n1,0\n0,0\n1,1\n1,0\n0,1\n");
+  EXPECT_EQ(Succeeds("classify", path, "--rank 2"),
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 3 REGULAR", "v 5 REGULAR", "e 0 1 REGULAR", "e 0 5 REGULAR",
+                   "e 1 3 REGULAR", "e 1 5 INTERIOR", "e 3 5 REGULAR", "t 0 1 5 INTERIOR", "t 1 3 5 INTERIOR"}));
+  const nlohmann::json j = nlohmann::json::parse(Succeeds("summary", path, "--rank 1"));
+  EXPECT_EQ(j["points"], 6);
+  EXPECT_EQ(j["distinct_points"], 4);
+  EXPECT_EQ(j["duplicates"], 2);
+  EXPECT_EQ(j["vertices"]["REGULAR"], 4);
+  EXPECT_EQ(j["components"], 1);
+  std::filesystem::remove(path);
+}
+
+TEST(AlphactlTest, CollinearAndTinyInputs) {
+  // 0 (3,0), 1 (0,0), 2 (1,0) on a line: edges 1-2 (rho^2 1/4) and 0-2 (1); no triangles.
+  const std::string line = WriteFile("alphactl_collinear.txt", "3 0\n0 0\n1 0\n");
+  EXPECT_EQ(Succeeds("spectrum", line, ""), "0.25\n1\n");
+  EXPECT_EQ(Succeeds("classify", line, "--rank 1"),
+            Lines({"v 0 SINGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 2 EXTERIOR", "e 1 2 SINGULAR"}));
+  EXPECT_EQ(Succeeds("classify", line, "--alpha-sq 1e9"),
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 2 SINGULAR", "e 1 2 SINGULAR"}));
+  EXPECT_EQ(Succeeds("shape", line, "--rank 2 --format wkt"),
+            "GEOMETRYCOLLECTION (MULTILINESTRING ((3 0, 1 0), (0 0, 1 0)))\n");
+
+  const std::string one = WriteFile("alphactl_one.txt", "5 5\n");
+  EXPECT_EQ(Succeeds("spectrum", one, ""), "");
+  EXPECT_EQ(Succeeds("classify", one, "--rank 0"), "v 0 SINGULAR\n");
+  EXPECT_EQ(Succeeds("shape", one, "--alpha-sq 7 --format wkt"), "GEOMETRYCOLLECTION (MULTIPOINT ((5 5)))\n");
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", one, "--rank 0"))["components"], 1);
+  ExpectError(Alphactl("classify " + Quote(one) + " --rank 1"), 2, "--rank 1 is outside 0..0");
+  ExpectError(Alphactl("masterlist " + Quote(one) + " --rank 1"), 2, "the spectrum is empty");
+
+  const std::string two = WriteBin("alphactl_two.bin", {{{0, 0}}, {{2, 0}}});
+  EXPECT_EQ(Succeeds("spectrum", two, ""), "1\n");
+  EXPECT_EQ(Succeeds("classify", two, "--rank 0"), "v 0 SINGULAR\nv 1 SINGULAR\ne 0 1 EXTERIOR\n");
+  EXPECT_EQ(Succeeds("classify", two, "--alpha 1"), "v 0 REGULAR\nv 1 REGULAR\ne 0 1 SINGULAR\n");
+  EXPECT_EQ(Succeeds("masterlist", two, "--rank 1"), "v 0 MU_LOW\nv 1 MU_LOW\ne 0 1 RHO\n");
+
+  const std::string empty = WriteBin("alphactl_empty.bin", {});
+  EXPECT_EQ(Succeeds("spectrum", empty, ""), "");
+  EXPECT_EQ(Succeeds("classify", empty, "--rank 0"), "");
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", empty, "--rank 0"))["points"], 0);
+  for (const std::string& path : {line, one, two, empty}) std::filesystem::remove(path);
 }
 
 TEST(AlphactlTest, ErrorsAreOneLineAndANonZeroExit) {
   const CommandResult missing = Alphactl("triangulate /nonexistent/points.csv");
-  EXPECT_NE(missing.exit_code, 0);
-  EXPECT_TRUE(missing.out.empty());
-  EXPECT_NE(missing.err.find("does not exist"), std::string::npos) << missing.err;
-  EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
+  ExpectError(missing, 1, "does not exist");
+  ExpectError(Alphactl("classify /nonexistent/points.bin --rank 1"), 1, "does not exist");
+  const std::string directory = std::filesystem::temp_directory_path();
+  ExpectError(Alphactl("summary " + Quote(directory) + " --rank 0"), 1, "is a directory");
+  ExpectError(Alphactl("triangulate " + Quote(directory)), 1, "is a directory");
+  const std::string truncated = WriteFile("alphactl_truncated.bin", std::string("\x05\0\0\0\0\0\0\0", 8));
+  ExpectError(Alphactl("spectrum " + Quote(truncated)), 1, "truncated");
+  std::filesystem::remove(truncated);
 
   const std::string bad = WriteFile("alphactl_bad.csv", "1,2\n3,oops\n");
-  const CommandResult parse = Alphactl("triangulate " + Quote(bad));
-  EXPECT_NE(parse.exit_code, 0);
-  EXPECT_NE(parse.err.find(":2:"), std::string::npos) << parse.err;
-  EXPECT_EQ(std::count(parse.err.begin(), parse.err.end(), '\n'), 1) << parse.err;
+  ExpectError(Alphactl("triangulate " + Quote(bad)), 1, ":2:");
+  ExpectError(Alphactl("summary " + Quote(bad) + " --rank 0"), 1, ":2:");
   std::filesystem::remove(bad);
 
   const std::string nan = WriteFile("alphactl_nan.csv", "0,0\n1,nan\n");
-  const CommandResult invalid = Alphactl("triangulate " + Quote(nan) + " --backend=cpu");
-  EXPECT_NE(invalid.exit_code, 0);
-  EXPECT_NE(invalid.err.find("point 1"), std::string::npos) << invalid.err;
+  ExpectError(Alphactl("triangulate " + Quote(nan) + " --backend=cpu"), 1, "point 1");
+  ExpectError(Alphactl("classify " + Quote(nan) + " --rank 0"), 1, "point 1");
   std::filesystem::remove(nan);
 
-  const CommandResult option = Alphactl("triangulate x.csv --backend=tpu");
-  EXPECT_NE(option.exit_code, 0);
-  EXPECT_NE(option.err.find("tpu"), std::string::npos) << option.err;
+  ExpectError(Alphactl("triangulate x.csv --backend=tpu"), 2, "tpu");
+  ExpectError(Alphactl("spectrum x.csv --backend tpu"), 2, "tpu");
+
+  const std::string square = Quote(SquareCsv());
+  ExpectError(Alphactl("classify " + square), 2, "missing threshold");
+  ExpectError(Alphactl("summary " + square + " --rank 1 --alpha 2"), 2, "only one threshold");
+  ExpectError(Alphactl("classify " + square + " --alpha-sq 1 --alpha-sq 2"), 2, "--alpha-sq given twice");
+  ExpectError(Alphactl("classify " + square + " --alpha-sq abc"), 2, "--alpha-sq 'abc'");
+  ExpectError(Alphactl("classify " + square + " --alpha-sq 0.5x"), 2, "--alpha-sq '0.5x'");
+  ExpectError(Alphactl("classify " + square + " --alpha-sq ''"), 2, "--alpha-sq ''");
+  ExpectError(Alphactl("classify " + square + " --alpha-sq nan"), 2, "--alpha-sq 'nan'");
+  ExpectError(Alphactl("classify " + square + " --alpha inf"), 2, "--alpha 'inf'");
+  ExpectError(Alphactl("classify " + square + " --alpha -1"), 2, "--alpha '-1'");
+  ExpectError(Alphactl("classify " + square + " --rank 1.5"), 2, "--rank '1.5'");
+  ExpectError(Alphactl("classify " + square + " --rank -1"), 2, "--rank '-1'");
+  ExpectError(Alphactl("classify " + square + " --rank 99999999999999999999"), 2, "--rank '99999999999999999999'");
+  ExpectError(Alphactl("classify " + square + " --rank 3"), 2, "--rank 3 is outside 0..2");
+  ExpectError(Alphactl("classify " + square + " --rank"), 2, "--rank needs a value");
+  ExpectError(Alphactl("classify " + square + " --rank 1 --mode sideways"), 2, "--mode 'sideways'");
+  ExpectError(Alphactl("classify " + square + " --rank 1 --vertex-rule x"), 2, "--vertex-rule 'x'");
+  ExpectError(Alphactl("classify " + square + " --rank 1 --frobnicate 3"), 2, "unknown option '--frobnicate'");
+  ExpectError(Alphactl("classify " + square + " " + square + " --rank 1"), 2, "unexpected argument");
+  ExpectError(Alphactl("classify --rank 1"), 2, "missing FILE");
+  ExpectError(Alphactl("shape " + square + " --rank 1"), 2, "missing --format");
+  ExpectError(Alphactl("shape " + square + " --rank 1 --format pdf"), 2, "--format 'pdf'");
+  ExpectError(Alphactl("shape " + square + " --rank 1 --format wkt --vertex-rule cgal"), 2, "--vertex-rule");
+  ExpectError(Alphactl("spectrum " + square + " --rank 1"), 2, "unknown option '--rank'");
+  ExpectError(Alphactl("frobnicate " + square), 2, "unknown command 'frobnicate'");
+}
+
+TEST(AlphactlTest, RealDataAgreesAcrossCommands) {
+  const std::string file = galpha::testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " is missing";
+  const nlohmann::json summary = nlohmann::json::parse(Succeeds("summary", file, "--rank 100"));
+  const std::string classes = Succeeds("classify", file, "--rank 100");
+  std::map<std::string, nlohmann::json> counts;
+  std::map<std::string, std::string> group{{"v", "vertices"}, {"e", "edges"}, {"t", "triangles"}};
+  for (const auto& [kind, name] : group) {
+    counts[name] = {{"EXTERIOR", 0}, {"SINGULAR", 0}, {"REGULAR", 0}, {"INTERIOR", 0}};
+  }
+  std::string previous_kind = "v";
+  std::vector<uint32_t> previous;
+  for (const std::string& line : SplitLines(classes)) {
+    std::istringstream fields(line);
+    std::string kind, word;
+    std::vector<uint32_t> indices;
+    fields >> kind;
+    while (fields >> word && std::isdigit(static_cast<unsigned char>(word[0]))) indices.push_back(std::stoul(word));
+    ASSERT_TRUE(group.count(kind)) << line;
+    ASSERT_EQ(indices.size(), kind == "v" ? 1u : kind == "e" ? 2u : 3u) << line;
+    EXPECT_TRUE(std::is_sorted(indices.begin(), indices.end())) << line;
+    if (kind == previous_kind) {
+      EXPECT_LT(previous, indices) << line;
+    } else {
+      EXPECT_EQ(std::string("vet").find(previous_kind) + 1, std::string("vet").find(kind)) << line;
+    }
+    previous_kind = kind;
+    previous = indices;
+    counts[group[kind]][word] = counts[group[kind]][word].get<int>() + 1;
+  }
+  for (const auto& [kind, name] : group) EXPECT_EQ(counts[name], summary[name]) << name;
+  EXPECT_EQ(summary["distinct_points"], summary["vertices"]["EXTERIOR"].get<int>() +
+                                            summary["vertices"]["SINGULAR"].get<int>() +
+                                            summary["vertices"]["REGULAR"].get<int>() +
+                                            summary["vertices"]["INTERIOR"].get<int>());
+  EXPECT_EQ(summary["points"], 1351);
+  EXPECT_EQ(summary["level"], 100);
+  EXPECT_EQ(SplitLines(Succeeds("spectrum", file, "")).size(), summary["spectrum_size"].get<size_t>());
+  EXPECT_EQ(summary["alpha_sq"].get<double>(), std::stod(SplitLines(Succeeds("spectrum", file, ""))[99]));
+  // The published double of rank 100, given back as --alpha-sq, is compared exactly: level 100 when
+  // it rounded up, 99 when it rounded down.
+  const int64_t level =
+      nlohmann::json::parse(Succeeds("summary", file, "--alpha-sq " + Printed(summary["alpha_sq"].get<double>())))
+          .at("level")
+          .get<int64_t>();
+  EXPECT_TRUE(level == 99 || level == 100) << level;
+
+  // The summary's interior area is the shape's area (same triangles, same sums).
+  const nlohmann::json shape = nlohmann::json::parse(Succeeds("shape", file, "--rank 100 --format geojson"));
+  double area = 0.0;
+  for (const auto& feature : shape["features"]) {
+    if (feature["properties"]["kind"] == "polygons") area = feature["properties"]["area"].get<double>();
+  }
+  EXPECT_EQ(area, summary["interior_area"].get<double>());
+}
+
+TEST(AlphactlTest, ProgressGoesToStandardErrorForLargeInputs) {
+  const std::string file = galpha::testdata::DataDir() + "/lidar_autzen.bin";  // 110000 points
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " is missing";
+  const CommandResult run = Alphactl("summary " + Quote(file) + " --rank 10");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out)["points"], 110000);
+  const std::vector<std::string> lines = SplitLines(run.err);
+  ASSERT_EQ(lines.size(), 3u) << run.err;
+  EXPECT_EQ(lines[0].rfind("alphactl: triangulation done (50%, ", 0), 0u) << lines[0];
+  EXPECT_EQ(lines[1].rfind("alphactl: alpha done (90%, ", 0), 0u) << lines[1];
+  EXPECT_EQ(lines[2].rfind("alphactl: components done (100%, ", 0), 0u) << lines[2];
+  // Small inputs are quiet (Run checks that stderr is empty).
+  Succeeds("summary", SquareCsv(), "--rank 0");
 }
 
 }  // namespace

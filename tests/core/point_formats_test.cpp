@@ -201,6 +201,15 @@ TEST_F(ReadPointsFileTest, MissingFileIsNotFoundForEveryFormat) {
   }
 }
 
+TEST_F(ReadPointsFileTest, DirectoryIsInvalidArgumentForEveryFormat) {
+  for (const char* name : {"d.csv", "d.npy", "d.bin", "d.geojson"}) {
+    std::filesystem::create_directories(dir_ / name);
+    const auto got = ReadPointsFile((dir_ / name).string());
+    EXPECT_EQ(got.status().code(), absl::StatusCode::kInvalidArgument) << name << ": " << got.status();
+    EXPECT_NE(got.status().message().find("directory"), absl::string_view::npos) << got.status();
+  }
+}
+
 TEST_F(ReadPointsFileTest, TruncatedBinIsDataLoss) {
   const std::string bin = (dir_ / "t.bin").string();
   ASSERT_TRUE(WritePointsBin(bin, Points({{5, 6}, {7, 8}})).ok());

@@ -1,0 +1,189 @@
+#include "client/cli_args.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+#include "absl/strings/str_cat.h"
+
+namespace galpha::alphactl {
+
+const char kUsage[] =
+    "usage: alphactl COMMAND FILE [OPTIONS]\n"
+    "Exact 2D alpha shapes of the points in FILE, computed locally (no server).\n"
+    "\n"
+    "commands:\n"
+    "  triangulate FILE            the Delaunay triangulation's counts and stage times, one JSON line\n"
+    "  spectrum FILE               the spectrum: one alpha_sq per line, ascending (%.17g)\n"
+    "  classify FILE THRESHOLD [--mode general|regularized] [--vertex-rule report|cgal]\n"
+    "                              every simplex at THRESHOLD: 'v i CLASS' (one per distinct point),\n"
+    "                              'e i j CLASS', 't i j k CLASS' (indices ascending), in that order\n"
+    "  summary FILE THRESHOLD [--mode general|regularized] [--vertex-rule report|cgal]\n"
+    "                              counts by class, components and interior area, one JSON line\n"
+    "  shape FILE THRESHOLD --format geojson|wkt|svg [--mode general|regularized]\n"
+    "                              the alpha shape as geometry\n"
+    "  masterlist FILE --rank K    the master-list entries of rank K (1..K): 'v i MU_LOW|MU_HIGH',\n"
+    "                              'e i j RHO|MU_LOW|MU_HIGH', 't i j k RHO'\n"
+    "  optimal FILE --components N\n"
+    "                              the smallest ranks with at most N components, one JSON line\n"
+    "                              (regularized: solid components with every point on a triangle)\n"
+    "  bench FILE [--repeat R]     builds R times (default 1): best stage times in ms, total, peak\n"
+    "                              memory, exact comparison counts, spectrum size, backend\n"
+    "\n"
+    "THRESHOLD, exactly one of:\n"
+    "  --alpha-sq A                a squared radius (CGAL's and PostGIS's alpha), compared exactly\n"
+    "  --alpha R                   a radius R >= 0 (R*R compared exactly)\n"
+    "  --rank K                    the K-th spectrum value (0: the points alone)\n"
+    "\n"
+    "every command also takes:\n"
+    "  --backend auto|cpu|cuda     where the engine runs (default auto: CUDA when a GPU is visible)\n"
+    "  -h, --help                  this text\n"
+    "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
+    "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
+    "--vertex-rule: vertex classes from incident edges (report) or incident triangles (cgal).\n"
+    "CLASS: EXTERIOR, SINGULAR, REGULAR or INTERIOR. Indices are input indices; a duplicate point\n"
+    "is named by its first occurrence.\n"
+    "\n"
+    "FILE: .bin (little-endian uint64 N, then N pairs of float64 x, y), .npy (float64, N x 2),\n"
+    "      .geojson/.json (Point, MultiPoint), or delimited text (CSV, TSV, whitespace: x and y\n"
+    "      first, optional header line)\n"
+    "\n"
+    "exit status: 0 success, 1 failure (unreadable file, bad input), 2 usage error (including a\n"
+    "rank outside the spectrum). Progress goes to standard error for 100000 points or more.\n";
+
+const std::string* CommandLine::Find(absl::string_view name) const {
+  for (const auto& [option, value] : options) {
+    if (option == name) return &value;
+  }
+  return nullptr;
+}
+
+absl::StatusOr<CommandLine> ParseCommandLine(absl::string_view command, absl::Span<const std::string> args,
+                                             absl::Span<const absl::string_view> allowed) {
+  CommandLine line;
+  bool options_ended = false;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (options_ended || arg.size() < 2 || arg[0] != '-') {
+      line.positional.push_back(arg);
+      continue;
+    }
+    if (arg == "--") {
+      options_ended = true;
+      continue;
+    }
+    if (arg[1] != '-') {
+      // A lone '-' is positional above; "-5" and "-x" are neither options nor files we expect.
+      return absl::InvalidArgumentError(absl::StrCat(command, ": unknown option '", arg, "'"));
+    }
+    const size_t equals = arg.find('=');
+    std::string name = arg.substr(2, equals == std::string::npos ? std::string::npos : equals - 2);
+    bool known = false;
+    for (absl::string_view a : allowed) known = known || a == name;
+    if (!known) {
+      return absl::InvalidArgumentError(absl::StrCat(command, ": unknown option '--", name, "'"));
+    }
+    std::string value;
+    if (equals != std::string::npos) {
+      value = arg.substr(equals + 1);
+    } else if (i + 1 < args.size()) {
+      value = args[++i];
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat(command, ": option --", name, " needs a value"));
+    }
+    if (line.Find(name) != nullptr) {
+      return absl::InvalidArgumentError(absl::StrCat(command, ": option --", name, " given twice"));
+    }
+    line.options.emplace_back(std::move(name), std::move(value));
+  }
+  return line;
+}
+
+absl::StatusOr<double> ParseFiniteDouble(absl::string_view option, const std::string& text) {
+  auto bad = [&](absl::string_view why) {
+    return absl::InvalidArgumentError(absl::StrCat("--", option, " '", text, "' is not ", why));
+  };
+  // strtod alone would skip leading spaces and accept "nan" and "inf".
+  if (text.empty() || std::isspace(static_cast<unsigned char>(text[0]))) return bad("a number");
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size()) return bad("a number");
+  if (!std::isfinite(value)) return bad("a finite number");
+  return value;
+}
+
+absl::StatusOr<int64_t> ParseInteger(absl::string_view option, const std::string& text, int64_t min_value) {
+  int64_t value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec == std::errc::invalid_argument || ptr != end) {
+    return absl::InvalidArgumentError(absl::StrCat("--", option, " '", text, "' is not an integer"));
+  }
+  if (ec == std::errc::result_out_of_range || value < min_value) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--", option, " '", text, "' is out of range (expected an integer >= ", min_value, ")"));
+  }
+  return value;
+}
+
+absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line) {
+  std::vector<absl::string_view> given;
+  for (const auto& [name, value] : line.options) {
+    if (name == "alpha-sq" || name == "alpha" || name == "rank") given.push_back(name);
+  }
+  if (given.empty()) {
+    return absl::InvalidArgumentError("missing threshold: give one of --alpha-sq A, --alpha R or --rank K");
+  }
+  if (given.size() > 1) {
+    return absl::InvalidArgumentError(absl::StrCat("give only one threshold, got --", given[0], " and --", given[1]));
+  }
+  ThresholdArg threshold;
+  const std::string& text = *line.Find(given[0]);
+  if (given[0] == "rank") {
+    auto rank = ParseInteger("rank", text, 0);
+    if (!rank.ok()) return rank.status();
+    threshold.kind = ThresholdArg::Kind::kRank;
+    threshold.rank = *rank;
+    return threshold;
+  }
+  auto value = ParseFiniteDouble(given[0], text);
+  if (!value.ok()) return value.status();
+  threshold.value = *value;
+  if (given[0] == "alpha-sq") {
+    threshold.kind = ThresholdArg::Kind::kAlphaSq;
+  } else {
+    if (*value < 0) {
+      return absl::InvalidArgumentError(absl::StrCat("--alpha '", text, "' is a radius and must be >= 0"));
+    }
+    threshold.kind = ThresholdArg::Kind::kAlpha;
+  }
+  return threshold;
+}
+
+absl::StatusOr<Backend> ParseBackend(const CommandLine& line) {
+  const std::string* name = line.Find("backend");
+  if (name == nullptr || *name == "auto") return Backend::kAuto;
+  if (*name == "cpu") return Backend::kCpu;
+  if (*name == "cuda") return Backend::kCuda;
+  return absl::InvalidArgumentError(absl::StrCat("unknown backend '", *name, "' (expected auto, cpu or cuda)"));
+}
+
+absl::StatusOr<ClassifyMode> ParseMode(const CommandLine& line) {
+  const std::string* name = line.Find("mode");
+  if (name == nullptr || *name == "general") return ClassifyMode::kGeneral;
+  if (*name == "regularized") return ClassifyMode::kRegularized;
+  return absl::InvalidArgumentError(absl::StrCat("unknown --mode '", *name, "' (expected general or regularized)"));
+}
+
+absl::StatusOr<VertexRule> ParseVertexRule(const CommandLine& line) {
+  const std::string* name = line.Find("vertex-rule");
+  if (name == nullptr || *name == "report") return VertexRule::kReport;
+  if (*name == "cgal") return VertexRule::kCgal;
+  return absl::InvalidArgumentError(absl::StrCat("unknown --vertex-rule '", *name, "' (expected report or cgal)"));
+}
+
+const char* ModeName(ClassifyMode mode) { return mode == ClassifyMode::kGeneral ? "general" : "regularized"; }
+
+const char* VertexRuleName(VertexRule rule) { return rule == VertexRule::kReport ? "report" : "cgal"; }
+
+}  // namespace galpha::alphactl

@@ -1,0 +1,128 @@
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "client/commands.hpp"
+#include "core/point_formats.hpp"
+#include "gpu/alpha_engine.hpp"
+
+namespace galpha::alphactl {
+
+namespace {
+
+/// Inputs at least this large report their build phases on stderr.
+constexpr size_t kProgressMinPoints = 100000;
+
+// Scripts read one line per error: a message never spans lines.
+std::string OneLine(absl::string_view message) {
+  std::string line(message);
+  for (char& c : line) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return line;
+}
+
+}  // namespace
+
+int UsageError(const absl::Status& status) {
+  std::fprintf(stderr, "alphactl: %s (see 'alphactl --help')\n", OneLine(status.message()).c_str());
+  return kExitUsage;
+}
+
+int ArgumentError(const absl::Status& status) {
+  std::fprintf(stderr, "alphactl: %s\n", OneLine(status.message()).c_str());
+  return kExitUsage;
+}
+
+int Failure(const absl::Status& status) {
+  std::fprintf(stderr, "alphactl: %s\n", OneLine(status.message()).c_str());
+  return kExitFailure;
+}
+
+absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
+                                       absl::Span<const absl::string_view> allowed) {
+  std::vector<absl::string_view> names(allowed.begin(), allowed.end());
+  names.push_back("backend");
+  auto line = ParseCommandLine(command, args, names);
+  if (!line.ok()) return line.status();
+  CommonArgs common;
+  if (line->positional.empty()) return absl::InvalidArgumentError(absl::StrCat(command, ": missing FILE"));
+  if (line->positional.size() > 1) {
+    return absl::InvalidArgumentError(absl::StrCat(command, ": unexpected argument '", line->positional[1], "'"));
+  }
+  common.file = line->positional[0];
+  auto backend = ParseBackend(*line);
+  if (!backend.ok()) return backend.status();
+  common.backend = *backend;
+  common.line = *std::move(line);
+  return common;
+}
+
+absl::StatusOr<std::vector<Point2>> ReadPoints(const std::string& file) {
+  // ReadPointsFile lets std::ifstream throw on a directory (reading one fails with EISDIR).
+  std::error_code error;
+  if (std::filesystem::is_directory(file, error)) {
+    return absl::InvalidArgumentError(absl::StrCat("points file '", file, "' is a directory"));
+  }
+  try {
+    return ReadPointsFile(file);
+  } catch (const std::exception& e) {
+    return absl::DataLossError(absl::StrCat("points file '", file, "' cannot be read: ", e.what()));
+  }
+}
+
+absl::StatusOr<AlphaFamily> LoadFamily(const std::string& file, Backend backend, size_t* input_points) {
+  auto points = ReadPoints(file);
+  if (!points.ok()) return points.status();
+  *input_points = points->size();
+  BuildOptions options;
+  options.backend = backend;
+  if (points->size() >= kProgressMinPoints) {
+    const auto start = std::chrono::steady_clock::now();
+    options.progress = [start](std::string_view phase, double fraction) {
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "alphactl: %.*s done (%.0f%%, %.2f s)\n", static_cast<int>(phase.size()), phase.data(),
+                   fraction * 100.0, seconds);
+    };
+  }
+  return BuildAlphaFamily(*points, options);
+}
+
+double LevelAlphaSq(const AlphaFamily& family, int64_t level) {
+  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
+}
+
+absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const ThresholdArg& threshold) {
+  ResolvedThreshold resolved;
+  absl::StatusOr<int64_t> level;
+  switch (threshold.kind) {
+    case ThresholdArg::Kind::kRank:
+      level = family.LevelForRank(threshold.rank);
+      if (!level.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("--rank ", threshold.rank, " is outside 0..", family.max_level(),
+                                                       " (the spectrum has ", family.max_level(), " values)"));
+      }
+      resolved.alpha_sq = LevelAlphaSq(family, *level);
+      break;
+    case ThresholdArg::Kind::kAlphaSq:
+      level = family.LevelForAlphaSq(threshold.value);
+      resolved.alpha_sq = threshold.value;
+      break;
+    case ThresholdArg::Kind::kAlpha:
+      level = family.LevelForAlpha(threshold.value);
+      resolved.alpha_sq = threshold.value * threshold.value;
+      break;
+  }
+  if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
+  resolved.level = *level;
+  return resolved;
+}
+
+}  // namespace galpha::alphactl

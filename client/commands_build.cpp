@@ -1,0 +1,129 @@
+// The commands about a build itself: triangulate (the Delaunay step alone), spectrum, bench.
+#include <algorithm>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "client/commands.hpp"
+#include "client/text_output.hpp"
+#include "gpu/delaunay.hpp"
+
+namespace galpha::alphactl {
+
+int RunTriangulate(Args args) {
+  auto common = ParseCommon("triangulate", args, {});
+  if (!common.ok()) return UsageError(common.status());
+  TriangulateOptions options;
+  options.backend = common->backend;
+
+  auto points = ReadPoints(common->file);
+  if (!points.ok()) return Failure(points.status());
+  auto tri = Triangulate(*points, options);
+  if (!tri.ok()) return Failure(tri.status());
+
+  size_t hull_edges = 0;
+  for (const auto& n : tri->neighbors) {
+    for (int32_t x : n) hull_edges += x == Triangulation::kNoNeighbor ? 1 : 0;
+  }
+  if (tri->triangles.empty()) hull_edges = tri->edges.size();
+  double total = 0.0;
+  std::string stages;
+  for (const auto& s : tri->stage_times) {
+    absl::StrAppend(&stages, stages.empty() ? "" : ", ", JsonString(s.stage), ": ", s.seconds * 1e3);
+    total += s.seconds;
+  }
+  std::printf(
+      "{\"file\": %s, \"points\": %zu, \"distinct_points\": %u, \"duplicates\": %zu, "
+      "\"triangles\": %zu, \"edges\": %zu, \"hull_edges\": %zu, \"backend\": \"%s\", "
+      "\"peak_memory_bytes\": %zu, \"total_ms\": %.3f, \"stage_ms\": {%s}}\n",
+      JsonString(common->file).c_str(), points->size(), tri->num_unique, points->size() - tri->num_unique,
+      tri->triangles.size(), tri->edges.size(), hull_edges, BackendName(tri->backend), tri->peak_memory_bytes,
+      total * 1e3, stages.c_str());
+  return kExitOk;
+}
+
+int RunSpectrum(Args args) {
+  auto common = ParseCommon("spectrum", args, {});
+  if (!common.ok()) return UsageError(common.status());
+  size_t input_points = 0;
+  auto family = LoadFamily(common->file, common->backend, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  ChunkedWriter out(stdout);
+  for (const double alpha_sq : family->spectrum()) {
+    out.AppendDouble(alpha_sq);
+    out.Append('\n');
+  }
+  if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
+  return kExitOk;
+}
+
+int RunBench(Args args) {
+  auto common = ParseCommon("bench", args, {"repeat"});
+  if (!common.ok()) return UsageError(common.status());
+  int64_t repeat = 1;
+  if (const std::string* text = common->line.Find("repeat")) {
+    auto parsed = ParseInteger("repeat", *text, 1);
+    if (!parsed.ok()) return UsageError(parsed.status());
+    repeat = *parsed;
+  }
+
+  // Best of `repeat` per stage, matched by name in the first build's order; the total is the
+  // best build's sum (not the sum of the per-stage bests).
+  std::vector<std::pair<std::string, double>> best;
+  double best_total = 0.0;
+  size_t input_points = 0;
+  std::optional<AlphaFamily> family;
+  for (int64_t run = 0; run < repeat; ++run) {
+    auto built = LoadFamily(common->file, common->backend, &input_points);
+    if (!built.ok()) return Failure(built.status());
+    double total = 0.0;
+    for (const StageTime& s : built->report().stage_times) {
+      total += s.seconds;
+      auto it = std::find_if(best.begin(), best.end(), [&](const auto& b) { return b.first == s.stage; });
+      if (it == best.end()) {
+        best.emplace_back(s.stage, s.seconds);
+      } else {
+        it->second = std::min(it->second, s.seconds);
+      }
+    }
+    best_total = run == 0 ? total : std::min(best_total, total);
+    family.emplace(*std::move(built));
+  }
+
+  const BuildReport& report = family->report();
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (const auto& [stage, seconds] : best) rows.emplace_back(stage, absl::StrFormat("%.3f", seconds * 1e3));
+  rows.emplace_back("total", absl::StrFormat("%.3f", best_total * 1e3));
+  rows.emplace_back("peak_memory_bytes", absl::StrCat(report.peak_memory_bytes));
+  rows.emplace_back("bytes_per_point",
+                    absl::StrFormat("%.1f", input_points == 0 ? 0.0
+                                                              : static_cast<double>(report.peak_memory_bytes) /
+                                                                    static_cast<double>(input_points)));
+  rows.emplace_back("comparisons_filter", absl::StrCat(report.comparisons.filter));
+  rows.emplace_back("comparisons_bounded_exact", absl::StrCat(report.comparisons.bounded_exact));
+  rows.emplace_back("comparisons_cpu_fallback", absl::StrCat(report.comparisons.cpu_fallback));
+  rows.emplace_back("spectrum_size", absl::StrCat(family->spectrum().size()));
+  rows.emplace_back("backend", report.backend);
+
+  size_t name_width = std::string("stage").size(), value_width = std::string("ms").size();
+  for (const auto& [name, value] : rows) {
+    name_width = std::max(name_width, name.size());
+    value_width = std::max(value_width, value.size());
+  }
+  const int nw = static_cast<int>(name_width), vw = static_cast<int>(value_width);
+  std::string table = absl::StrFormat("# %s: %zu points, %u distinct, best of %d build%s\n", common->file, input_points,
+                                      family->num_unique(), repeat, repeat == 1 ? "" : "s");
+  absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, "stage", vw, "ms");
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (i == best.size() + 1) absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, "measure", vw, "value");
+    absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, rows[i].first, vw, rows[i].second);
+  }
+  std::fputs(table.c_str(), stdout);
+  return kExitOk;
+}
+
+}  // namespace galpha::alphactl

@@ -1,0 +1,287 @@
+// The commands that query one family: classify, summary, shape, masterlist, optimal. Each checks its
+// whole command line before reading FILE, so a usage error costs no build.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "client/commands.hpp"
+#include "client/text_output.hpp"
+#include "core/predicates.hpp"
+#include "core/shape.hpp"
+
+namespace galpha::alphactl {
+
+namespace {
+
+/// classify's and summary's options after FILE.
+struct ClassifyArgs {
+  ThresholdArg threshold;
+  ClassifyMode mode = ClassifyMode::kGeneral;
+  VertexRule rule = VertexRule::kReport;
+};
+
+absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line) {
+  ClassifyArgs parsed;
+  auto threshold = ParseThreshold(line);
+  if (!threshold.ok()) return threshold.status();
+  parsed.threshold = *threshold;
+  auto mode = ParseMode(line);
+  if (!mode.ok()) return mode.status();
+  parsed.mode = *mode;
+  auto rule = ParseVertexRule(line);
+  if (!rule.ok()) return rule.status();
+  parsed.rule = *rule;
+  return parsed;
+}
+
+/// Edge ids ordered by their (smaller, larger) vertex indices.
+std::vector<std::pair<std::array<uint32_t, 2>, uint32_t>> EdgesInIndexOrder(const AlphaFamily& family) {
+  std::vector<std::pair<std::array<uint32_t, 2>, uint32_t>> order(family.edges().size());
+  for (uint32_t e = 0; e < order.size(); ++e) {
+    const auto& edge = family.edges()[e];
+    order[e] = {{std::min(edge[0], edge[1]), std::max(edge[0], edge[1])}, e};
+  }
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+/// Triangle ids ordered by their vertex indices, each triple sorted ascending.
+std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> TrianglesInIndexOrder(const AlphaFamily& family) {
+  std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> order(family.triangles().size());
+  for (uint32_t t = 0; t < order.size(); ++t) {
+    std::array<uint32_t, 3> key = family.triangles()[t];
+    std::sort(key.begin(), key.end());
+    order[t] = {key, t};
+  }
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+template <size_t N>
+void AppendSimplex(ChunkedWriter& out, char kind, const std::array<uint32_t, N>& vertices) {
+  out.Append(kind);
+  for (uint32_t v : vertices) {
+    out.Append(' ');
+    out.AppendUint(v);
+  }
+}
+
+const char* EndpointName(Endpoint endpoint) {
+  switch (endpoint) {
+    case Endpoint::kRho:
+      return "RHO";
+    case Endpoint::kMuLow:
+      return "MU_LOW";
+    case Endpoint::kMuHigh:
+      return "MU_HIGH";
+  }
+  return "UNKNOWN";
+}
+
+/// {"EXTERIOR":n,"SINGULAR":n,"REGULAR":n,"INTERIOR":n}
+std::string ClassCountsJson(const std::array<uint64_t, 4>& counts) {
+  std::string json = "{";
+  for (size_t c = 0; c < counts.size(); ++c) {
+    absl::StrAppend(&json, c > 0 ? "," : "", "\"", SimplexClassName(static_cast<SimplexClass>(c)), "\":", counts[c]);
+  }
+  return json + "}";
+}
+
+int FinishOutput(ChunkedWriter& out) {
+  if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
+  return kExitOk;
+}
+
+}  // namespace
+
+int RunClassify(Args args) {
+  auto common = ParseCommon("classify", args, {"alpha-sq", "alpha", "rank", "mode", "vertex-rule"});
+  if (!common.ok()) return UsageError(common.status());
+  auto options = ParseClassifyArgs(common->line);
+  if (!options.ok()) return UsageError(options.status());
+  size_t input_points = 0;
+  auto family = LoadFamily(common->file, common->backend, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  auto threshold = ResolveThreshold(*family, options->threshold);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+
+  const Classification classes = family->ClassifyAll(threshold->level, options->mode, options->rule);
+  ChunkedWriter out(stdout);
+  const std::vector<uint32_t>& representative = family->representative();
+  for (uint32_t v = 0; v < classes.vertices.size(); ++v) {
+    if (representative[v] != v) continue;
+    AppendSimplex<1>(out, 'v', {v});
+    out.Append(' ');
+    out.Append(SimplexClassName(classes.vertices[v]));
+    out.Append('\n');
+  }
+  for (const auto& [vertices, e] : EdgesInIndexOrder(*family)) {
+    AppendSimplex(out, 'e', vertices);
+    out.Append(' ');
+    out.Append(SimplexClassName(classes.edges[e]));
+    out.Append('\n');
+  }
+  for (const auto& [vertices, t] : TrianglesInIndexOrder(*family)) {
+    AppendSimplex(out, 't', vertices);
+    out.Append(' ');
+    out.Append(SimplexClassName(classes.triangles[t]));
+    out.Append('\n');
+  }
+  return FinishOutput(out);
+}
+
+int RunSummary(Args args) {
+  auto common = ParseCommon("summary", args, {"alpha-sq", "alpha", "rank", "mode", "vertex-rule"});
+  if (!common.ok()) return UsageError(common.status());
+  auto options = ParseClassifyArgs(common->line);
+  if (!options.ok()) return UsageError(options.status());
+  size_t input_points = 0;
+  auto family = LoadFamily(common->file, common->backend, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  auto threshold = ResolveThreshold(*family, options->threshold);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+
+  const Classification classes = family->ClassifyAll(threshold->level, options->mode, options->rule);
+  std::array<uint64_t, 4> vertices{}, edges{}, triangles{};
+  for (uint32_t v = 0; v < classes.vertices.size(); ++v) {
+    if (family->representative()[v] == v) ++vertices[static_cast<size_t>(classes.vertices[v])];
+  }
+  for (const SimplexClass c : classes.edges) ++edges[static_cast<size_t>(c)];
+  // The area as AssembleShape sums it (same formula, same order), so that it matches `shape`'s.
+  double interior_area = 0.0;
+  for (uint32_t t = 0; t < classes.triangles.size(); ++t) {
+    ++triangles[static_cast<size_t>(classes.triangles[t])];
+    if (classes.triangles[t] == SimplexClass::kInterior) {
+      const auto& tri = family->triangles()[t];
+      const auto& p = family->points();
+      interior_area += 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
+    }
+  }
+
+  const int64_t level = threshold->level;
+  const std::string json = absl::StrCat(
+      "{\"file\":", JsonString(common->file), ",\"points\":", input_points,
+      ",\"distinct_points\":", family->num_unique(), ",\"duplicates\":", family->num_duplicates(),
+      ",\"spectrum_size\":", family->spectrum().size(), ",\"level\":", level,
+      ",\"alpha_sq\":", JsonNumber(threshold->alpha_sq), ",\"mode\":\"", ModeName(options->mode),
+      "\",\"vertex_rule\":\"", VertexRuleName(options->rule), "\",\"vertices\":", ClassCountsJson(vertices),
+      ",\"edges\":", ClassCountsJson(edges), ",\"triangles\":", ClassCountsJson(triangles),
+      ",\"components\":", family->Components(level), ",\"solid_components\":", family->SolidComponents(level),
+      ",\"interior_area\":", JsonNumber(interior_area), ",\"backend\":", JsonString(family->report().backend), "}\n");
+  std::fputs(json.c_str(), stdout);
+  return kExitOk;
+}
+
+int RunShape(Args args) {
+  auto common = ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "mode", "format"});
+  if (!common.ok()) return UsageError(common.status());
+  auto threshold_arg = ParseThreshold(common->line);
+  if (!threshold_arg.ok()) return UsageError(threshold_arg.status());
+  auto mode = ParseMode(common->line);
+  if (!mode.ok()) return UsageError(mode.status());
+  const std::string* format = common->line.Find("format");
+  if (format == nullptr) return UsageError(absl::InvalidArgumentError("shape: missing --format geojson|wkt|svg"));
+  if (*format != "geojson" && *format != "wkt" && *format != "svg") {
+    return UsageError(
+        absl::InvalidArgumentError(absl::StrCat("unknown --format '", *format, "' (expected geojson, wkt or svg)")));
+  }
+  size_t input_points = 0;
+  auto family = LoadFamily(common->file, common->backend, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  auto threshold = ResolveThreshold(*family, *threshold_arg);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+
+  auto shape = AssembleShape(family->ComplexAt(threshold->level, *mode));
+  if (!shape.ok()) return Failure(shape.status());
+  const absl::Span<const Point2> points = family->points();
+  std::string text = *format == "geojson" ? ShapeToGeoJson(*shape, points)
+                     : *format == "wkt"   ? ShapeToWkt(*shape, points)
+                                          : ShapeToSvg(*shape, points);
+  if (text.empty() || text.back() != '\n') text += '\n';
+  ChunkedWriter out(stdout);
+  out.Append(text);
+  return FinishOutput(out);
+}
+
+int RunMasterList(Args args) {
+  auto common = ParseCommon("masterlist", args, {"rank"});
+  if (!common.ok()) return UsageError(common.status());
+  const std::string* rank_text = common->line.Find("rank");
+  if (rank_text == nullptr) return UsageError(absl::InvalidArgumentError("masterlist: missing --rank K"));
+  auto rank = ParseInteger("rank", *rank_text, 0);
+  if (!rank.ok()) return UsageError(rank.status());
+  size_t input_points = 0;
+  auto family = LoadFamily(common->file, common->backend, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  if (*rank < 1 || *rank > family->max_level()) {
+    return ArgumentError(absl::InvalidArgumentError(
+        family->max_level() == 0
+            ? absl::StrCat("--rank ", *rank, " is out of range: the spectrum is empty, the master list has no ranks")
+            : absl::StrCat("--rank ", *rank, " is outside 1..", family->max_level(), " (the spectrum has ",
+                           family->max_level(), " values)")));
+  }
+
+  ChunkedWriter out(stdout);
+  for (const MasterEntry& entry : family->MasterList(*rank)) {
+    switch (entry.kind) {
+      case SimplexKind::kVertex:
+        AppendSimplex<1>(out, 'v', {entry.id});
+        break;
+      case SimplexKind::kEdge: {
+        const auto& edge = family->edges()[entry.id];
+        AppendSimplex<2>(out, 'e', {std::min(edge[0], edge[1]), std::max(edge[0], edge[1])});
+        break;
+      }
+      case SimplexKind::kTriangle: {
+        std::array<uint32_t, 3> tri = family->triangles()[entry.id];
+        std::sort(tri.begin(), tri.end());
+        AppendSimplex(out, 't', tri);
+        break;
+      }
+    }
+    out.Append(' ');
+    out.Append(EndpointName(entry.endpoint));
+    out.Append('\n');
+  }
+  return FinishOutput(out);
+}
+
+int RunOptimal(Args args) {
+  auto common = ParseCommon("optimal", args, {"components"});
+  if (!common.ok()) return UsageError(common.status());
+  const std::string* text = common->line.Find("components");
+  if (text == nullptr) return UsageError(absl::InvalidArgumentError("optimal: missing --components N"));
+  auto components = ParseInteger("components", *text, 1);
+  if (!components.ok()) return UsageError(components.status());
+  size_t input_points = 0;
+  auto family = LoadFamily(common->file, common->backend, &input_points);
+  if (!family.ok()) return Failure(family.status());
+
+  // Counts are 32-bit: "at most N" for any larger N means the same as for the largest count.
+  const uint32_t n = static_cast<uint32_t>(std::min<int64_t>(*components, std::numeric_limits<uint32_t>::max()));
+  std::string json = absl::StrCat("{\"components\":", *components, ",\"regularized\":");
+  if (const std::optional<int64_t> level = family->OptimalLevelRegularized(n)) {
+    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(LevelAlphaSq(*family, *level)),
+                    ",\"solid_components\":", family->SolidComponents(*level), "}");
+  } else {
+    json += "null";
+  }
+  json += ",\"general\":";
+  if (const std::optional<int64_t> level = family->OptimalLevelGeneral(n)) {
+    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(LevelAlphaSq(*family, *level)),
+                    ",\"components\":", family->Components(*level), "}");
+  } else {
+    json += "null";
+  }
+  json += "}\n";
+  std::fputs(json.c_str(), stdout);
+  return kExitOk;
+}
+
+}  // namespace galpha::alphactl

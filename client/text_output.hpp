@@ -1,0 +1,44 @@
+// alphactl's output for scripts: a buffered writer for line-per-simplex output (millions of lines),
+// numbers printed exactly (%.17g) and JSON string literals.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "absl/strings/string_view.h"
+
+namespace galpha::alphactl {
+
+/// Collects text in a large buffer and writes it to `out` with fwrite in chunks of about 1 MiB.
+class ChunkedWriter {
+ public:
+  explicit ChunkedWriter(std::FILE* out);
+  ChunkedWriter(const ChunkedWriter&) = delete;
+  ChunkedWriter& operator=(const ChunkedWriter&) = delete;
+
+  void Append(absl::string_view text);
+  void Append(char c);
+  void AppendUint(uint64_t value);
+  /// %.17g: every double reads back exactly.
+  void AppendDouble(double value);
+  /// Writes what is buffered and flushes `out`. False when a write failed (the writer stops
+  /// writing after the first failure).
+  bool Finish();
+
+ private:
+  void MaybeFlush();
+
+  std::FILE* out_;
+  std::string buffer_;
+  bool failed_ = false;
+};
+
+/// `value` as printf's %.17g.
+std::string FormatDouble(double value);
+/// A JSON number for `value` (%.17g), or null when it is not finite (JSON has no NaN or infinity).
+std::string JsonNumber(double value);
+/// A JSON string literal for `text` (quotes, backslashes and control characters escaped).
+std::string JsonString(absl::string_view text);
+
+}  // namespace galpha::alphactl
