@@ -2,7 +2,8 @@
 # Run HERE (the build machine): builds the CUDA configuration and gathers what the GPU machine
 # needs into .carry/ (git-ignored): the test and benchmark binaries, the shared libraries they
 # use that a bare Ubuntu 24.04 + CUDA machine lacks (Abseil, GMP, MPFR, GEOS), and the data sets.
-# Then call the device tool with carry=[".carry"] and command "bench/gpu_run.sh".
+# Then call the device tool with carry=[".carry-pack"] and the command
+#   tar -xJf .carry-pack/carry.tar.xz && bash bench/gpu_run.sh test alpha
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake --preset cuda >/dev/null
@@ -11,11 +12,17 @@ rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
 for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
          tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test tests/core/radius_test \
-         tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/core/shape_test \
+         tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/gpu/alpha_bruteforce_test tests/core/shape_test \
          bench/delaunay_bench bench/alpha_bench client/alphactl; do
   if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
 done
 for b in "${bins[@]}"; do
   ldd "$b" | awk '/=> \//{print $3}' | grep -E 'libabsl|libgmp|libmpfr|libgtest|libbenchmark|libgeos' || true
 done | sort -u | while read -r lib; do cp -L "$lib" .carry/lib/; done
+# Symbols are not needed there and the carried folder must stay under 64 MiB.
+strip --strip-unneeded .carry/bin/* .carry/lib/*
 du -sh .carry
+# The binaries hold the CUDA code of the whole engine (about 13 MB each): compressed, they travel.
+rm -rf .carry-pack && mkdir -p .carry-pack
+tar -cJf .carry-pack/carry.tar.xz .carry
+du -sh .carry-pack

@@ -229,24 +229,24 @@ int RunMasterList(Args args) {
 
   ChunkedWriter out(stdout);
   for (const MasterEntry& entry : family->MasterList(*rank)) {
-    switch (entry.kind) {
+    switch (entry.kind()) {
       case SimplexKind::kVertex:
-        AppendSimplex<1>(out, 'v', {entry.id});
+        AppendSimplex<1>(out, 'v', {entry.id()});
         break;
       case SimplexKind::kEdge: {
-        const auto& edge = family->edges()[entry.id];
+        const auto& edge = family->edges()[entry.id()];
         AppendSimplex<2>(out, 'e', {std::min(edge[0], edge[1]), std::max(edge[0], edge[1])});
         break;
       }
       case SimplexKind::kTriangle: {
-        std::array<uint32_t, 3> tri = family->triangles()[entry.id];
+        std::array<uint32_t, 3> tri = family->triangles()[entry.id()];
         std::sort(tri.begin(), tri.end());
         AppendSimplex(out, 't', tri);
         break;
       }
     }
     out.Append(' ');
-    out.Append(EndpointName(entry.endpoint));
+    out.Append(EndpointName(entry.endpoint()));
     out.Append('\n');
   }
   return FinishOutput(out);

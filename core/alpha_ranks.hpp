@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/hd.hpp"
+
 namespace galpha {
 
 /// Rank r in 1..K names spectrum[r - 1]; rank 0 is alpha = 0. kNeverRank marks an interval end that
@@ -18,11 +20,25 @@ enum class SimplexKind : uint8_t { kVertex = 0, kEdge = 1, kTriangle = 2 };
 /// Which end point of a simplex's intervals a master-list entry stands for.
 enum class Endpoint : uint8_t { kRho = 0, kMuLow = 1, kMuHigh = 2 };
 
-struct MasterEntry {
-  uint32_t id;  // vertex: input index; edge: edge id; triangle: triangle id
-  SimplexKind kind;
-  Endpoint endpoint;
+/// One master-list entry, packed in 64 bits so that the engine's array is the list itself and its
+/// natural order is the order within a rank: kind (vertex < edge < triangle), then id, then end
+/// point.
+class MasterEntry {
+ public:
+  MasterEntry() = default;
+  GALPHA_HD MasterEntry(uint32_t id, SimplexKind kind, Endpoint endpoint)
+      : packed_((static_cast<uint64_t>(kind) << 34) | (static_cast<uint64_t>(id) << 2) |
+                static_cast<uint64_t>(endpoint)) {}
+  /// Vertex: input index; edge: edge id; triangle: triangle id.
+  GALPHA_HD uint32_t id() const { return static_cast<uint32_t>(packed_ >> 2); }
+  GALPHA_HD SimplexKind kind() const { return static_cast<SimplexKind>(packed_ >> 34); }
+  GALPHA_HD Endpoint endpoint() const { return static_cast<Endpoint>(packed_ & 3); }
+  GALPHA_HD uint64_t packed() const { return packed_; }
+
+ private:
+  uint64_t packed_ = 0;
 };
+static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "master entries are packed");
 
 /// How the exact order of the spectrum was decided, by comparison path (DESIGN.md section 3).
 struct ComparisonCounts {

@@ -312,7 +312,7 @@ GALPHA_HD inline uint32_t AtomicAddU32(uint32_t* p, uint32_t v) {
 /// A master-list entry packed so that its natural order is the order within a rank: vertex < edge
 /// < triangle, then id, then end point.
 GALPHA_HD inline uint64_t PackMasterEntry(SimplexKind kind, uint32_t id, Endpoint endpoint) {
-  return (static_cast<uint64_t>(kind) << 34) | (static_cast<uint64_t>(id) << 2) | static_cast<uint64_t>(endpoint);
+  return MasterEntry(id, kind, endpoint).packed();
 }
 
 /// Visits every master-list end point of every simplex (ranks 1..K; 0 and kNeverRank are not end

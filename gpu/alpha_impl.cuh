@@ -221,8 +221,21 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
     if (thrust::count(policy, long_segment.data(), long_segment.data() + (num_ranks + 1), uint8_t{1}) > 0) {
       const std::vector<uint8_t> host_long = long_segment.ToHostVector(num_ranks + 1);
       const std::vector<uint32_t> host_begin = master_begin.ToHostVector(num_ranks + 2);
-      for (uint32_t r = 0; r <= num_ranks; ++r) {
-        if (host_long[r]) thrust::sort(policy, master_entries.data() + host_begin[r], master_entries.data() + host_begin[r + 1]);
+      if constexpr (System::kHostMemory) {
+        // One pass over the simplices in order writes the long segments already sorted (items
+        // come by kind, then id, each with its end points in order): no sort of exact ties.
+        std::vector<uint32_t> cursor(host_begin.begin(), host_begin.end() - 1);
+        uint64_t* entries = master_entries.data();
+        auto place = [&](uint32_t rank, uint64_t packed) {
+          if (host_long[rank]) entries[cursor[rank]++] = packed;
+        };
+        for (uint32_t item = 0; item < num_items; ++item) endpoints.Visit(item, place);
+      } else {
+        for (uint32_t r = 0; r <= num_ranks; ++r) {
+          if (host_long[r]) {
+            thrust::sort(policy, master_entries.data() + host_begin[r], master_entries.data() + host_begin[r + 1]);
+          }
+        }
       }
     }
   }
@@ -238,14 +251,9 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   out->vertex_mu_high = vertex_mu_high.ToHostVector(n);
   out->vertex_tri_low = vertex_tri_low.ToHostVector(n);
   out->master_begin = master_begin.ToHostVector(static_cast<size_t>(num_ranks) + 2);
-  {
-    const std::vector<uint64_t> packed = master_entries.ToHostVector(num_master);
-    out->master.resize(num_master);
-    for (uint32_t i = 0; i < num_master; ++i) {
-      out->master[i] = MasterEntry{static_cast<uint32_t>(packed[i] >> 2), static_cast<SimplexKind>(packed[i] >> 34),
-                                   static_cast<Endpoint>(packed[i] & 3)};
-    }
-  }
+  static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
+  out->master.resize(num_master);
+  sys.ToHost(reinterpret_cast<uint64_t*>(out->master.data()), master_entries.data(), num_master);
   timer.EndStage("alpha_download");
   *peak_bytes = sys.peak_bytes();
 }

@@ -357,9 +357,9 @@ void CheckInvariants(const AlphaFamily& f) {
     const absl::Span<const MasterEntry> got = f.MasterList(rank);
     ASSERT_EQ(got.size(), expected.size()) << "rank " << rank;
     for (size_t i = 0; i < got.size(); ++i) {
-      ASSERT_EQ(got[i].kind, expected[i].kind) << "rank " << rank << " entry " << i;
-      ASSERT_EQ(got[i].id, expected[i].id) << "rank " << rank << " entry " << i;
-      ASSERT_EQ(got[i].endpoint, expected[i].endpoint) << "rank " << rank << " entry " << i;
+      ASSERT_EQ(got[i].kind(), expected[i].kind()) << "rank " << rank << " entry " << i;
+      ASSERT_EQ(got[i].id(), expected[i].id()) << "rank " << rank << " entry " << i;
+      ASSERT_EQ(got[i].endpoint(), expected[i].endpoint()) << "rank " << rank << " entry " << i;
     }
   }
   ASSERT_EQ(r.master_begin.back(), total);
