@@ -134,11 +134,13 @@ size_t StatusBytes(const char* field) {
 /// Peak resident growth of `fn`, in bytes (0 where the kernel cannot reset the peak).
 template <class Fn>
 size_t PeakGrowth(Fn&& fn) {
+  // Return memory freed by earlier runs first (so that reusing it counts again), then reset the
+  // peak to the resident set as it is now.
+  malloc_trim(0);
   {
     std::ofstream reset("/proc/self/clear_refs");
     reset << "5";
   }
-  malloc_trim(0);  // return memory freed by earlier runs, so that reuse of it counts again
   const size_t before = StatusBytes("VmRSS:");
   fn();
   const size_t peak = StatusBytes("VmHWM:");
