@@ -12,7 +12,7 @@ rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
 for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
          tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test tests/core/radius_test \
-         tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/gpu/alpha_bruteforce_test tests/core/shape_test \
+         tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/gpu/alpha_bruteforce_test tests/gpu/alpha_backend_identity_test tests/core/shape_test \
          bench/delaunay_bench bench/alpha_bench client/alphactl; do
   if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
 done

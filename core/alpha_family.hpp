@@ -91,7 +91,8 @@ class AlphaFamily {
   SimplexClass ClassifyVertex(uint32_t v, int64_t level, ClassifyMode mode, VertexRule rule) const;
   Classification ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const;
 
-  /// Master-list entries whose interval has rank `rank` (1..K) as an end point.
+  /// Master-list entries whose interval has rank `rank` (1..K) as an end point; empty for any
+  /// other rank (rank 0 and kNeverRank are not end points of the list).
   absl::Span<const MasterEntry> MasterList(int64_t rank) const;
 
   /// Connected components of the complex at `level` (GENERAL: simplices sharing a vertex connect;
