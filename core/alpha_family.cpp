@@ -3,10 +3,8 @@
 #include <gmpxx.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <numeric>
-#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -28,120 +26,9 @@ const char* SimplexClassName(SimplexClass c) {
   return "UNKNOWN";
 }
 
-namespace {
-
-/// Union-find by Rem's algorithm with splicing: one parent array in which a parent's index is
-/// never below its child's. One array instead of parent and size halves the cache misses, which
-/// is what the random accesses of a union-find pay for.
-class DisjointSets {
- public:
-  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0u); }
-  /// True when x and y were in different sets.
-  bool Union(uint32_t x, uint32_t y) {
-    std::vector<uint32_t>& p = parent_;
-    while (p[x] != p[y]) {
-      if (p[x] < p[y]) {
-        if (x == p[x]) {
-          p[x] = p[y];
-          return true;
-        }
-        const uint32_t next = p[x];
-        p[x] = p[y];
-        x = next;
-      } else {
-        if (y == p[y]) {
-          p[y] = p[x];
-          return true;
-        }
-        const uint32_t next = p[y];
-        p[y] = p[x];
-        y = next;
-      }
-    }
-    return false;
-  }
-  /// Asks the cache for x's parent slot ahead of a Union that will need it.
-  void Prefetch(uint32_t x) const { __builtin_prefetch(parent_.data() + x); }
-
- private:
-  std::vector<uint32_t> parent_;
-};
-
-/// How far ahead in the master list the curves' passes prefetch: entries (the simplex's record)
-/// and, half as far, the union-find slots it will touch. Union-find is latency-bound on random
-/// accesses; prefetching overlaps the misses.
-constexpr uint32_t kPrefetchRecord = 32;
-constexpr uint32_t kPrefetchSlot = 16;
-
-}  // namespace
-
 AlphaFamily::AlphaFamily(AlphaFamilyParts parts) : parts_(std::move(parts)) {
-  const auto start = std::chrono::steady_clock::now();
   const AlphaRanks& r = parts_.ranks;
-  const size_t levels = r.spectrum.size() + 1;
   const uint32_t num_tri = static_cast<uint32_t>(parts_.triangles.size());
-
-  // Both curves from the master list, which already orders every event by rank. GENERAL
-  // components start with every distinct point and lose one whenever an edge born at that rank
-  // (rho of an unattached edge, mu-low of an attached one) joins two of them; solid components gain
-  // one per triangle born and lose one whenever an edge becoming interior (mu-high) joins two. The
-  // two passes are independent: one thread each.
-  components_.assign(levels, parts_.num_unique);
-  solid_components_.assign(levels, 0);
-  const std::vector<MasterEntry>& master = r.master;
-  const uint32_t num_master = static_cast<uint32_t>(master.size());
-  auto general_pass = [&] {
-    DisjointSets points(parts_.points.size());
-    uint32_t joined = 0;
-    for (size_t level = 1; level < levels; ++level) {
-      for (uint32_t i = r.master_begin[level]; i < r.master_begin[level + 1]; ++i) {
-        if (i + kPrefetchRecord < num_master && master[i + kPrefetchRecord].kind() == SimplexKind::kEdge) {
-          __builtin_prefetch(parts_.edges.data() + master[i + kPrefetchRecord].id());
-        }
-        if (i + kPrefetchSlot < num_master && master[i + kPrefetchSlot].kind() == SimplexKind::kEdge) {
-          const std::array<uint32_t, 2>& ahead = parts_.edges[master[i + kPrefetchSlot].id()];
-          points.Prefetch(ahead[0]);
-          points.Prefetch(ahead[1]);
-        }
-        const MasterEntry entry = master[i];
-        if (entry.kind() != SimplexKind::kEdge) continue;
-        const uint32_t e = entry.id();
-        const bool born = entry.endpoint() == Endpoint::kRho ||
-                          (entry.endpoint() == Endpoint::kMuLow && r.edge_rho_rank[e] == 0);
-        if (born && points.Union(parts_.edges[e][0], parts_.edges[e][1])) ++joined;
-      }
-      components_[level] = parts_.num_unique - joined;
-    }
-  };
-  auto solid_pass = [&] {
-    DisjointSets triangles(num_tri);
-    int64_t solid = 0;
-    for (size_t level = 1; level < levels; ++level) {
-      for (uint32_t i = r.master_begin[level]; i < r.master_begin[level + 1]; ++i) {
-        if (i + kPrefetchRecord < num_master && master[i + kPrefetchRecord].endpoint() == Endpoint::kMuHigh) {
-          __builtin_prefetch(r.edge_triangles.data() + master[i + kPrefetchRecord].id());
-        }
-        if (i + kPrefetchSlot < num_master && master[i + kPrefetchSlot].endpoint() == Endpoint::kMuHigh &&
-            master[i + kPrefetchSlot].kind() == SimplexKind::kEdge) {
-          const std::array<int32_t, 2>& ahead = r.edge_triangles[master[i + kPrefetchSlot].id()];
-          triangles.Prefetch(static_cast<uint32_t>(ahead[0]));
-          triangles.Prefetch(static_cast<uint32_t>(ahead[1]));
-        }
-        const MasterEntry entry = master[i];
-        if (entry.kind() == SimplexKind::kTriangle) {
-          ++solid;
-        } else if (entry.kind() == SimplexKind::kEdge && entry.endpoint() == Endpoint::kMuHigh) {
-          const std::array<int32_t, 2>& t = r.edge_triangles[entry.id()];
-          if (triangles.Union(static_cast<uint32_t>(t[0]), static_cast<uint32_t>(t[1]))) --solid;
-        }
-      }
-      solid_components_[level] = static_cast<uint32_t>(solid);
-    }
-  };
-  std::thread solid_thread(solid_pass);
-  general_pass();
-  solid_thread.join();
-
   // Every point on a triangle from the largest first-triangle rank over the distinct points.
   if (num_tri > 0) {
     uint32_t worst = 0;
@@ -150,8 +37,6 @@ AlphaFamily::AlphaFamily(AlphaFamilyParts parts) : parts_(std::move(parts)) {
     }
     if (worst != kNeverRank) solid_level_ = worst;
   }
-  parts_.report.stage_times.push_back(
-      {"components", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()});
 }
 
 namespace {
@@ -285,12 +170,12 @@ absl::Span<const MasterEntry> AlphaFamily::MasterList(int64_t rank) const {
 
 uint32_t AlphaFamily::Components(int64_t level) const {
   if (level < 0) return 0;
-  return components_[static_cast<size_t>(std::min(level, max_level()))];
+  return parts_.ranks.components[static_cast<size_t>(std::min(level, max_level()))];
 }
 
 uint32_t AlphaFamily::SolidComponents(int64_t level) const {
   if (level < 0) return 0;
-  return solid_components_[static_cast<size_t>(std::min(level, max_level()))];
+  return parts_.ranks.solid_components[static_cast<size_t>(std::min(level, max_level()))];
 }
 
 std::optional<int64_t> AlphaFamily::OptimalLevelRegularized(uint32_t n) const {
@@ -298,16 +183,16 @@ std::optional<int64_t> AlphaFamily::OptimalLevelRegularized(uint32_t n) const {
   // Solid components are not monotone in alpha: a scan from the level where every point is
   // covered (O(K), once per query).
   for (int64_t level = *solid_level_; level <= max_level(); ++level) {
-    if (solid_components_[static_cast<size_t>(level)] <= n) return level;
+    if (parts_.ranks.solid_components[static_cast<size_t>(level)] <= n) return level;
   }
   return std::nullopt;
 }
 
 std::optional<int64_t> AlphaFamily::OptimalLevelGeneral(uint32_t n) const {
   // Components never increase with alpha: binary search for the first level with at most n.
-  if (components_.back() > n) return std::nullopt;
-  const auto it = std::partition_point(components_.begin(), components_.end(), [n](uint32_t c) { return c > n; });
-  return static_cast<int64_t>(it - components_.begin());
+  if (parts_.ranks.components.back() > n) return std::nullopt;
+  const auto it = std::partition_point(parts_.ranks.components.begin(), parts_.ranks.components.end(), [n](uint32_t c) { return c > n; });
+  return static_cast<int64_t>(it - parts_.ranks.components.begin());
 }
 
 ShapeComplex AlphaFamily::ComplexAt(int64_t level, ClassifyMode mode) const {

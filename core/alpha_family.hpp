@@ -59,7 +59,7 @@ struct Classification {
 
 class AlphaFamily {
  public:
-  /// Takes the parts and computes the component curves (one union-find pass over all ranks).
+  /// Takes the parts (the engine computed the component curves among them).
   explicit AlphaFamily(AlphaFamilyParts parts);
 
   const std::vector<Point2>& points() const { return parts_.points; }
@@ -115,8 +115,6 @@ class AlphaFamily {
 
  private:
   AlphaFamilyParts parts_;
-  std::vector<uint32_t> components_;        // per level 0..K
-  std::vector<uint32_t> solid_components_;  // per level 0..K
   std::optional<int64_t> solid_level_;
 };
 

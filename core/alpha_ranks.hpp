@@ -75,6 +75,11 @@ struct AlphaRanks {
   std::vector<uint32_t> master_begin;
   std::vector<MasterEntry> master;
 
+  /// Per level 0..K: connected components of the complex (GENERAL: simplices sharing a vertex
+  /// connect; every distinct point is in from level 0) and solid components (interior triangles
+  /// connected through shared edges, CGAL's number_of_solid_components).
+  std::vector<uint32_t> components, solid_components;
+
   ComparisonCounts comparisons;
 };
 

@@ -16,6 +16,7 @@ namespace galpha::detail {
 struct AlphaInput {
   const Point2* points = nullptr;
   uint32_t num_points = 0;
+  uint32_t num_unique = 0;                         // distinct points
   const uint32_t* representative = nullptr;       // num_points
   const std::array<uint32_t, 3>* triangles = nullptr;
   const std::array<int32_t, 3>* neighbors = nullptr;

@@ -28,6 +28,7 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   detail::AlphaInput in;
   in.points = tri.points.data();
   in.num_points = static_cast<uint32_t>(tri.points.size());
+  in.num_unique = tri.num_unique;
   in.representative = tri.representative.data();
   in.triangles = tri.triangles.data();
   in.neighbors = tri.neighbors.data();
@@ -59,9 +60,8 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   parts.num_unique = tri.num_unique;
   parts.triangles = std::move(tri.triangles);
   parts.edges = std::move(tri.edges);
-  AlphaFamily family(std::move(parts));  // times its own "components" stage
   report("components", 1.0);
-  return family;
+  return AlphaFamily(std::move(parts));
 }
 
 }  // namespace galpha

@@ -1,7 +1,7 @@
 // The alpha pipeline after the triangulation, written once over an execution system (CpuSystem or
 // CudaSystem): edge topology, radii and attachment, the exact spectrum (sort by certified keys,
 // exact repair of the runs whose keys may tie, merge of exact ties), ranks, intervals and the
-// master list (report chapters 3-4; DESIGN.md sections 2-3).
+// master list and the component curves (report chapters 3-4; DESIGN.md sections 2-3).
 #pragma once
 
 #include <thrust/copy.h>
@@ -24,6 +24,7 @@
 #include "gpu/alpha_backend.hpp"
 #include "gpu/alpha_functors.cuh"
 #include "gpu/alpha_host_repair.hpp"
+#include "gpu/component_curve.cuh"
 #include "gpu/engine_system.cuh"
 
 namespace galpha::detail {
@@ -241,6 +242,14 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   }
   timer.EndStage("master_list");
 
+  // Component curves over all levels (Borůvka spanning forests, component_curve.cuh).
+  Buffer<uint32_t, System> components(sys, static_cast<size_t>(num_ranks) + 1);
+  Buffer<uint32_t, System> solid_components(sys, static_cast<size_t>(num_ranks) + 1);
+  ComponentCurves(sys, n, in.num_unique, num_tri, num_edges, num_ranks, edges.data(), edge_tris.data(), tri_rank.data(),
+                  edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(), components.data(),
+                  solid_components.data());
+  timer.EndStage("components");
+
   out->tri_rank = tri_rank.ToHostVector(num_tri);
   out->edge_rho_rank = edge_rho_rank.ToHostVector(num_edges);
   out->edge_mu_low = edge_mu_low.ToHostVector(num_edges);
@@ -250,6 +259,8 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   out->vertex_mu_low = vertex_mu_low.ToHostVector(n);
   out->vertex_mu_high = vertex_mu_high.ToHostVector(n);
   out->vertex_tri_low = vertex_tri_low.ToHostVector(n);
+  out->components = components.ToHostVector(static_cast<size_t>(num_ranks) + 1);
+  out->solid_components = solid_components.ToHostVector(static_cast<size_t>(num_ranks) + 1);
   out->master_begin = master_begin.ToHostVector(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
   out->master.resize(num_master);
