@@ -210,6 +210,56 @@ struct RepairRun {
   }
 };
 
+/// 1 where a run starts (for numbering runs by a scan).
+struct RunStartAsU32 {
+  const uint8_t* link;
+  GALPHA_HD uint32_t operator()(uint32_t i) const { return i == 0 || link[i - 1] == 0 ? 1u : 0u; }
+};
+
+/// Clears settled[r] unless entry i and its run's first both have rho^2 exactly equal to one
+/// double (ExactDoubleRadiusSq): then the whole run is one exact value. Only runs still needing
+/// repair (settled starts as needs_host) are checked; concurrent writes only ever write 0.
+struct CheckRunOfOneDouble {
+  SimplexPoints simplex;
+  const uint32_t* ids;
+  const uint32_t* run_of;  // inclusive scan of run starts: run index + 1
+  const uint32_t* run_begin;
+  uint8_t* settled;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t r = run_of[i] - 1;
+    if (!settled[r]) return;
+    Point2 p[3], q[3];
+    const int n = simplex(ids[i], p), m = simplex(ids[run_begin[r]], q);
+    double a, b;
+    if (!ExactDoubleRadiusSq(p, n, &a) || !ExactDoubleRadiusSq(q, m, &b) || a != b) settled[r] = 0;
+  }
+};
+
+/// In a settled run, only the first entry starts a value.
+struct SettleRunOfOneDouble {
+  const uint32_t* run_of;
+  const uint32_t* run_begin;
+  const uint8_t* settled;
+  uint8_t* new_value;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t r = run_of[i] - 1;
+    if (settled[r]) new_value[i] = i == run_begin[r] ? 1 : 0;
+  }
+};
+
+/// Equalities a settled run proved: one per entry after its first.
+struct SettledComparisons {
+  const uint32_t* run_begin;
+  const uint8_t* settled;
+  GALPHA_HD uint64_t operator()(uint32_t r) const { return settled[r] ? run_begin[r + 1] - run_begin[r] - 1 : 0; }
+};
+
+struct StillNeedsHost {
+  const uint8_t* needs_host;
+  const uint8_t* settled;
+  GALPHA_HD uint8_t operator()(uint32_t r) const { return needs_host[r] && !settled[r] ? 1 : 0; }
+};
+
 struct ToU32 {
   GALPHA_HD uint32_t operator()(uint8_t v) const { return v; }
 };

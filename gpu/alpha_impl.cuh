@@ -7,6 +7,7 @@
 #include <thrust/copy.h>
 #include <thrust/count.h>
 #include <thrust/fill.h>
+#include <thrust/functional.h>
 #include <thrust/for_each.h>
 #include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -16,6 +17,7 @@
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
 #include <thrust/transform.h>
+#include <thrust/transform_reduce.h>
 
 #include <cstdint>
 #include <vector>
@@ -100,7 +102,6 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
     Buffer<uint32_t, System> run_begin(sys, num_entries + 1);
     const uint32_t num_runs = static_cast<uint32_t>(
         thrust::copy_if(policy, zero, zero + num_entries, run_begin.data(), IsRunStart{link.data()}) - run_begin.data());
-    link.Reset();
     sys.FromHost(run_begin.data() + num_runs, &num_entries, 1);
     const uint32_t* run_end = run_begin.data() + 1;
     Buffer<uint8_t, System> needs_host(sys, num_runs);
@@ -110,7 +111,26 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
                                  run_comparisons.data()});
     out->comparisons.bounded_exact +=
         thrust::reduce(policy, run_comparisons.data(), run_comparisons.data() + num_runs, uint64_t{0});
-    const uint32_t host_runs = static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
+    uint32_t host_runs = static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
+    if (host_runs > 0) {
+      // Long runs whose values are all exactly one double (a grid's congruent simplices) are
+      // settled here, in parallel: every entry checks itself against its run's first.
+      Buffer<uint32_t, System> run_of(sys, num_entries);
+      const auto starts = thrust::make_transform_iterator(zero, RunStartAsU32{link.data()});
+      thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
+      Buffer<uint8_t, System> settled(sys, num_runs);
+      thrust::copy_n(policy, needs_host.data(), num_runs, settled.data());
+      thrust::for_each_n(policy, zero, num_entries,
+                         CheckRunOfOneDouble{simplex, ids.data(), run_of.data(), run_begin.data(), settled.data()});
+      thrust::for_each_n(policy, zero, num_entries,
+                         SettleRunOfOneDouble{run_of.data(), run_begin.data(), settled.data(), new_value.data()});
+      out->comparisons.bounded_exact += thrust::transform_reduce(
+          policy, zero, zero + num_runs, SettledComparisons{run_begin.data(), settled.data()}, uint64_t{0},
+          thrust::plus<uint64_t>());
+      thrust::transform(policy, zero, zero + num_runs, needs_host.data(), StillNeedsHost{needs_host.data(), settled.data()});
+      host_runs = static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
+    }
+    link.Reset();
     if (host_runs > 0) {
       // Bring the whole order to the host once (rare: long runs of near or exact ties, such as a
       // grid's congruent triangles) and repair there.
