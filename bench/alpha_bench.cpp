@@ -31,9 +31,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
+#include "bench/bench_options.hpp"
 #include "core/alpha_family.hpp"
 #include "core/point_formats.hpp"
 #include "gpu/alpha_engine.hpp"
@@ -48,74 +47,9 @@ using Fb = CGAL::Alpha_shape_face_base_2<Kernel>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using CgalAlphaShape = CGAL::Alpha_shape_2<CGAL::Delaunay_triangulation_2<Kernel, Tds>>;
 
-struct BenchOptions {
-  Backend backend = Backend::kAuto;
-  int repeat = 3;
-  std::vector<size_t> sizes = {100000, 1000000};
-  std::vector<std::string> distributions = {"uniform", "gaussian", "clustered", "grid"};
-  uint64_t seed = 1;
-  size_t cgal_max = 1000000;
-  std::vector<std::string> data_files;
-};
-
 constexpr char kUsage[] =
     "usage: alpha_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...] [--dists=NAME,...]\n"
     "                   [--seed=N] [--cgal-max=N] [--data FILE.bin]...\n";
-
-absl::StatusOr<BenchOptions> ParseArgs(int argc, char** argv) {
-  BenchOptions options;
-  bool explicit_generated = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value_of = [&](const std::string& flag) -> const char* {
-      return arg.rfind(flag + "=", 0) == 0 ? argv[i] + flag.size() + 1 : nullptr;
-    };
-    if (const char* v = value_of("--backend")) {
-      const std::string name = v;
-      if (name == "auto") {
-        options.backend = Backend::kAuto;
-      } else if (name == "cpu") {
-        options.backend = Backend::kCpu;
-      } else if (name == "cuda") {
-        options.backend = Backend::kCuda;
-      } else {
-        return absl::InvalidArgumentError(absl::StrCat("unknown backend '", name, "'"));
-      }
-    } else if (const char* v = value_of("--repeat")) {
-      if (!absl::SimpleAtoi(v, &options.repeat) || options.repeat < 1) {
-        return absl::InvalidArgumentError(absl::StrCat("bad --repeat '", v, "'"));
-      }
-    } else if (const char* v = value_of("--seed")) {
-      if (!absl::SimpleAtoi(v, &options.seed)) return absl::InvalidArgumentError(absl::StrCat("bad --seed '", v, "'"));
-    } else if (const char* v = value_of("--cgal-max")) {
-      if (!absl::SimpleAtoi(v, &options.cgal_max)) {
-        return absl::InvalidArgumentError(absl::StrCat("bad --cgal-max '", v, "'"));
-      }
-    } else if (const char* v = value_of("--sizes")) {
-      options.sizes.clear();
-      for (absl::string_view part : absl::StrSplit(v, ',', absl::SkipEmpty())) {
-        size_t n;
-        if (!absl::SimpleAtoi(part, &n)) return absl::InvalidArgumentError(absl::StrCat("bad size '", part, "'"));
-        options.sizes.push_back(n);
-      }
-      explicit_generated = true;
-    } else if (const char* v = value_of("--dists")) {
-      options.distributions = absl::StrSplit(v, ',', absl::SkipEmpty());
-      for (const std::string& name : options.distributions) {
-        if (gen::FindDistribution(name) == nullptr) {
-          return absl::InvalidArgumentError(absl::StrCat("unknown distribution '", name, "'"));
-        }
-      }
-      explicit_generated = true;
-    } else if (arg == "--data" && i + 1 < argc) {
-      options.data_files.push_back(argv[++i]);
-    } else {
-      return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
-    }
-  }
-  if (!options.data_files.empty() && !explicit_generated) options.distributions.clear();
-  return options;
-}
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -268,7 +202,7 @@ void PrintStages(const std::vector<BenchResult>& results) {
 }
 
 int Main(int argc, char** argv) {
-  const absl::StatusOr<BenchOptions> options = ParseArgs(argc, argv);
+  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, true);
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
     return 2;

@@ -21,9 +21,8 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_split.h"
+#include "bench/bench_options.hpp"
 #include "core/point_io.hpp"
 #include "gpu/delaunay.hpp"
 #include "tests/support/point_generators.hpp"
@@ -33,15 +32,6 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using CgalDelaunay = CGAL::Delaunay_triangulation_2<Kernel>;
-
-struct BenchOptions {
-  Backend backend = Backend::kAuto;
-  int repeat = 3;
-  std::vector<size_t> sizes = {100000, 1000000};
-  std::vector<std::string> distributions = {"uniform", "gaussian", "clustered", "grid"};
-  uint64_t seed = 1;
-  std::vector<std::string> data_files;
-};
 
 // One input to time: a generated distribution at a size, or a file.
 struct BenchInput {
@@ -66,65 +56,6 @@ struct BenchResult {
 constexpr char kUsage[] =
     "usage: delaunay_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...]\n"
     "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]...\n";
-
-absl::StatusOr<BenchOptions> ParseArgs(int argc, char** argv) {
-  BenchOptions options;
-  bool explicit_generated = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value_of = [&](const std::string& flag) -> const char* {
-      return arg.rfind(flag + "=", 0) == 0 ? argv[i] + flag.size() + 1 : nullptr;
-    };
-    if (const char* v = value_of("--backend")) {
-      const std::string name = v;
-      if (name == "auto") {
-        options.backend = Backend::kAuto;
-      } else if (name == "cpu") {
-        options.backend = Backend::kCpu;
-      } else if (name == "cuda") {
-        options.backend = Backend::kCuda;
-      } else {
-        return absl::InvalidArgumentError(absl::StrCat("unknown backend '", name, "'"));
-      }
-    } else if (const char* v = value_of("--repeat")) {
-      if (!absl::SimpleAtoi(v, &options.repeat) || options.repeat < 1) {
-        return absl::InvalidArgumentError(absl::StrCat("bad --repeat '", v, "'"));
-      }
-    } else if (const char* v = value_of("--seed")) {
-      if (!absl::SimpleAtoi(v, &options.seed)) {
-        return absl::InvalidArgumentError(absl::StrCat("bad --seed '", v, "'"));
-      }
-    } else if (const char* v = value_of("--sizes")) {
-      options.sizes.clear();
-      for (absl::string_view part : absl::StrSplit(v, ',', absl::SkipEmpty())) {
-        size_t n;
-        if (!absl::SimpleAtoi(part, &n)) {
-          return absl::InvalidArgumentError(absl::StrCat("bad size '", part, "'"));
-        }
-        options.sizes.push_back(n);
-      }
-      explicit_generated = true;
-    } else if (const char* v = value_of("--dists")) {
-      options.distributions = absl::StrSplit(v, ',', absl::SkipEmpty());
-      for (const std::string& name : options.distributions) {
-        if (gen::FindDistribution(name) == nullptr) {
-          return absl::InvalidArgumentError(absl::StrCat("unknown distribution '", name, "'"));
-        }
-      }
-      explicit_generated = true;
-    } else if (arg == "--data" && i + 1 < argc) {
-      options.data_files.push_back(argv[++i]);
-    } else if (const char* v = value_of("--data")) {
-      options.data_files.push_back(v);
-    } else {
-      return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
-    }
-  }
-  if (!options.data_files.empty() && !explicit_generated) {
-    options.distributions.clear();
-  }
-  return options;
-}
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -221,7 +152,7 @@ void PrintStageTable(const std::vector<BenchResult>& results) {
 }
 
 int Main(int argc, char** argv) {
-  const absl::StatusOr<BenchOptions> options = ParseArgs(argc, argv);
+  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, false);
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
     return 2;

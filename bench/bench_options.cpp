@@ -1,0 +1,67 @@
+#include "bench/bench_options.hpp"
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha {
+
+absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, bool accept_cgal_max) {
+  BenchOptions options;
+  bool explicit_generated = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value_of = [&](const std::string& flag) -> const char* {
+      return arg.rfind(flag + "=", 0) == 0 ? argv[i] + flag.size() + 1 : nullptr;
+    };
+    if (const char* v = value_of("--backend")) {
+      const std::string name = v;
+      if (name == "auto") {
+        options.backend = Backend::kAuto;
+      } else if (name == "cpu") {
+        options.backend = Backend::kCpu;
+      } else if (name == "cuda") {
+        options.backend = Backend::kCuda;
+      } else {
+        return absl::InvalidArgumentError(absl::StrCat("unknown backend '", name, "'"));
+      }
+    } else if (const char* v = value_of("--repeat")) {
+      if (!absl::SimpleAtoi(v, &options.repeat) || options.repeat < 1) {
+        return absl::InvalidArgumentError(absl::StrCat("bad --repeat '", v, "'"));
+      }
+    } else if (const char* v = value_of("--seed")) {
+      if (!absl::SimpleAtoi(v, &options.seed)) return absl::InvalidArgumentError(absl::StrCat("bad --seed '", v, "'"));
+    } else if (const char* v = accept_cgal_max ? value_of("--cgal-max") : nullptr) {
+      if (!absl::SimpleAtoi(v, &options.cgal_max)) {
+        return absl::InvalidArgumentError(absl::StrCat("bad --cgal-max '", v, "'"));
+      }
+    } else if (const char* v = value_of("--sizes")) {
+      options.sizes.clear();
+      for (absl::string_view part : absl::StrSplit(v, ',', absl::SkipEmpty())) {
+        size_t n;
+        if (!absl::SimpleAtoi(part, &n)) return absl::InvalidArgumentError(absl::StrCat("bad size '", part, "'"));
+        options.sizes.push_back(n);
+      }
+      explicit_generated = true;
+    } else if (const char* v = value_of("--dists")) {
+      options.distributions = absl::StrSplit(v, ',', absl::SkipEmpty());
+      for (const std::string& name : options.distributions) {
+        if (gen::FindDistribution(name) == nullptr) {
+          return absl::InvalidArgumentError(absl::StrCat("unknown distribution '", name, "'"));
+        }
+      }
+      explicit_generated = true;
+    } else if (arg == "--data" && i + 1 < argc) {
+      options.data_files.push_back(argv[++i]);
+    } else if (const char* v = value_of("--data")) {
+      options.data_files.push_back(v);
+    } else {
+      return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
+    }
+  }
+  if (!options.data_files.empty() && !explicit_generated) options.distributions.clear();
+  return options;
+}
+
+}  // namespace galpha
