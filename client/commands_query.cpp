@@ -12,7 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/commands.hpp"
 #include "client/text_output.hpp"
-#include "core/predicates.hpp"
+#include "core/classification_summary.hpp"
 #include "core/shape.hpp"
 
 namespace galpha::alphactl {
@@ -148,21 +148,7 @@ int RunSummary(Args args) {
   if (!threshold.ok()) return ArgumentError(threshold.status());
 
   const Classification classes = family->ClassifyAll(threshold->level, options->mode, options->rule);
-  std::array<uint64_t, 4> vertices{}, edges{}, triangles{};
-  for (uint32_t v = 0; v < classes.vertices.size(); ++v) {
-    if (family->representative()[v] == v) ++vertices[static_cast<size_t>(classes.vertices[v])];
-  }
-  for (const SimplexClass c : classes.edges) ++edges[static_cast<size_t>(c)];
-  // The area as AssembleShape sums it (same formula, same order), so that it matches `shape`'s.
-  double interior_area = 0.0;
-  for (uint32_t t = 0; t < classes.triangles.size(); ++t) {
-    ++triangles[static_cast<size_t>(classes.triangles[t])];
-    if (classes.triangles[t] == SimplexClass::kInterior) {
-      const auto& tri = family->triangles()[t];
-      const auto& p = family->points();
-      interior_area += 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
-    }
-  }
+  const ClassificationSummary counts = SummarizeClassification(*family, classes);
 
   const int64_t level = threshold->level;
   const std::string json = absl::StrCat(
@@ -170,10 +156,10 @@ int RunSummary(Args args) {
       ",\"distinct_points\":", family->num_unique(), ",\"duplicates\":", family->num_duplicates(),
       ",\"spectrum_size\":", family->spectrum().size(), ",\"level\":", level,
       ",\"alpha_sq\":", JsonNumber(threshold->alpha_sq), ",\"mode\":\"", ModeName(options->mode),
-      "\",\"vertex_rule\":\"", VertexRuleName(options->rule), "\",\"vertices\":", ClassCountsJson(vertices),
-      ",\"edges\":", ClassCountsJson(edges), ",\"triangles\":", ClassCountsJson(triangles),
+      "\",\"vertex_rule\":\"", VertexRuleName(options->rule), "\",\"vertices\":", ClassCountsJson(counts.vertices),
+      ",\"edges\":", ClassCountsJson(counts.edges), ",\"triangles\":", ClassCountsJson(counts.triangles),
       ",\"components\":", family->Components(level), ",\"solid_components\":", family->SolidComponents(level),
-      ",\"interior_area\":", JsonNumber(interior_area), ",\"backend\":", JsonString(family->report().backend), "}\n");
+      ",\"interior_area\":", JsonNumber(counts.interior_area), ",\"backend\":", JsonString(family->report().backend), "}\n");
   std::fputs(json.c_str(), stdout);
   return kExitOk;
 }

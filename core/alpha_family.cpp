@@ -214,4 +214,22 @@ ShapeComplex AlphaFamily::ComplexAt(int64_t level, ClassifyMode mode) const {
   return complex;
 }
 
+namespace {
+template <typename T>
+size_t VectorBytes(const std::vector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+}  // namespace
+
+size_t AlphaFamily::HostBytes() const {
+  const AlphaRanks& r = parts_.ranks;
+  return sizeof(*this) + VectorBytes(parts_.points) + VectorBytes(parts_.representative) +
+         VectorBytes(parts_.triangles) + VectorBytes(parts_.edges) + VectorBytes(r.spectrum) +
+         VectorBytes(r.spectrum_simplex) + VectorBytes(r.tri_rank) + VectorBytes(r.edge_rho_rank) +
+         VectorBytes(r.edge_mu_low) + VectorBytes(r.edge_mu_high) + VectorBytes(r.edge_triangles) +
+         VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) + VectorBytes(r.vertex_tri_low) +
+         VectorBytes(r.master_begin) + VectorBytes(r.master) + VectorBytes(r.components) +
+         VectorBytes(r.solid_components);
+}
+
 }  // namespace galpha

@@ -71,6 +71,9 @@ class AlphaFamily {
   const AlphaRanks& ranks() const { return parts_.ranks; }
   const BuildReport& report() const { return parts_.report; }
 
+  /// Host memory the family holds (its arrays' capacities), in bytes: what a cache charges for it.
+  size_t HostBytes() const;
+
   /// The spectrum: nearest doubles of the distinct exact thresholds (alpha_sq), ascending.
   const std::vector<double>& spectrum() const { return parts_.ranks.spectrum; }
   int64_t max_level() const { return static_cast<int64_t>(parts_.ranks.spectrum.size()); }

@@ -16,11 +16,17 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   auto report = [&](std::string_view phase, double fraction) {
     if (options.progress) options.progress(phase, fraction);
   };
+  auto stop_requested = [&] { return options.cancelled && options.cancelled(); };
+  const auto cancelled_error = [&](const char* after) {
+    return absl::CancelledError(absl::StrCat("build of ", points.size(), " points cancelled after ", after));
+  };
+  if (stop_requested()) return cancelled_error("0 phases");
   TriangulateOptions topt;
   topt.backend = options.backend;
   topt.cuda_stream = options.cuda_stream;
   GALPHA_ASSIGN_OR_RETURN(Triangulation tri, Triangulate(points, topt));
   report("triangulation", 0.5);
+  if (stop_requested()) return cancelled_error("the triangulation");
 
   AlphaFamilyParts parts;
   parts.report.backend = BackendName(tri.backend);
@@ -53,6 +59,7 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
     return absl::InternalError(absl::StrCat("alpha family build failed: ", e.what()));
   }
   report("alpha", 0.9);
+  if (stop_requested()) return cancelled_error("the alpha pipeline");
   parts.report.peak_memory_bytes = std::max(tri.peak_memory_bytes, alpha_peak);
   parts.report.comparisons = parts.ranks.comparisons;
   parts.points = std::move(tri.points);

@@ -19,9 +19,12 @@ struct BuildOptions {
   void* cuda_stream = nullptr;
   /// Called after each phase ("triangulation", "alpha", "components") with the fraction done.
   std::function<void(std::string_view phase, double fraction)> progress;
+  /// Polled between phases; when it answers true the build stops, frees what it holds and returns
+  /// Cancelled (a server passes its client's cancellation and deadline here).
+  std::function<bool()> cancelled;
 };
 
-/// Builds the family. Errors as Triangulate's (gpu/delaunay.hpp).
+/// Builds the family. Errors as Triangulate's (gpu/delaunay.hpp), and Cancelled.
 absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options = {});
 
 }  // namespace galpha

@@ -1,0 +1,104 @@
+// galpha.v1.AlphaShapes on gRPC's callback API: Build streams points into the build scheduler and
+// caches the family; the queries answer from the cache (server/query_answers.hpp). Every RPC is
+// authenticated (when tokens are configured), scoped to its tenant, timed and counted.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "galpha/v1/alpha_shapes.grpc.pb.h"
+#include "gpu/delaunay.hpp"
+#include "gpu/device_streams.hpp"
+#include "server/build_scheduler.hpp"
+#include "server/build_stream.hpp"
+#include "server/family_cache.hpp"
+#include "server/metrics.hpp"
+#include "server/tenant_tokens.hpp"
+
+namespace galpha::server {
+
+/// Estimated peak working memory of one build, per point (measured peaks: 508 B/pt on an H100,
+/// 580 B/pt on the CPU backend; bench/README.md), with headroom.
+inline constexpr size_t kBuildBytesPerPoint = 640;
+
+struct ServiceOptions {
+  /// kAuto: the GPU when this build and machine have one, else the CPU.
+  Backend backend = Backend::kAuto;
+  /// Builds running at once (CUDA streams); 0: 4 on a GPU, 1 on the CPU (which uses every core).
+  int build_slots = 0;
+  /// Builds waiting for a slot before RESOURCE_EXHAUSTED.
+  size_t max_queued_builds = 16;
+  /// Working memory admitted to running builds; 0: 90% of the GPU's memory, or half the host's.
+  size_t build_memory_bytes = 0;
+  uint64_t max_points_per_build = 100'000'000;
+  /// Bytes of points held by uploads and builds at once.
+  size_t max_in_flight_bytes = size_t{8} << 30;
+  /// Byte budget of the family cache.
+  size_t cache_bytes = size_t{8} << 30;
+  TenantTokens tokens;
+};
+
+class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
+ public:
+  /// Unavailable when the CUDA backend is asked for and there is none.
+  static absl::StatusOr<std::unique_ptr<AlphaService>> Create(const ServiceOptions& options, ServerMetrics* metrics);
+  ~AlphaService() override;
+
+  /// The backend builds run on ("cuda" or "cpu").
+  const std::string& backend_name() const { return backend_name_; }
+  size_t build_slots() const { return scheduler_->slots(); }
+  size_t build_memory_bytes() const { return scheduler_->memory_budget_bytes(); }
+  FamilyCache& cache() { return *cache_; }
+
+  /// Refuses new builds (UNAVAILABLE); queued builds that have not started fail UNAVAILABLE,
+  /// running ones finish. Queries go on until the server shuts down.
+  void StartDraining();
+  /// Samples device memory into the metrics (the server calls this periodically on a GPU).
+  void SampleDeviceMemory();
+
+  grpc::ServerReadReactor<galpha::v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
+                                                            galpha::v1::BuildResponse* response) override;
+  grpc::ServerUnaryReactor* Describe(grpc::CallbackServerContext* context, const galpha::v1::DescribeRequest* request,
+                                     galpha::v1::DescribeResponse* response) override;
+  grpc::ServerWriteReactor<galpha::v1::ClassifyResponse>* Classify(
+      grpc::CallbackServerContext* context, const galpha::v1::ClassifyRequest* request) override;
+  grpc::ServerWriteReactor<galpha::v1::MasterListResponse>* MasterList(
+      grpc::CallbackServerContext* context, const galpha::v1::MasterListRequest* request) override;
+  grpc::ServerUnaryReactor* Spectrum(grpc::CallbackServerContext* context, const galpha::v1::SpectrumRequest* request,
+                                     galpha::v1::SpectrumResponse* response) override;
+  grpc::ServerWriteReactor<galpha::v1::ShapeResponse>* Shape(grpc::CallbackServerContext* context,
+                                                             const galpha::v1::ShapeRequest* request) override;
+  grpc::ServerUnaryReactor* Components(grpc::CallbackServerContext* context,
+                                       const galpha::v1::ComponentsRequest* request,
+                                       galpha::v1::ComponentsResponse* response) override;
+  grpc::ServerUnaryReactor* OptimalAlpha(grpc::CallbackServerContext* context,
+                                         const galpha::v1::OptimalAlphaRequest* request,
+                                         galpha::v1::OptimalAlphaResponse* response) override;
+  grpc::ServerUnaryReactor* Release(grpc::CallbackServerContext* context, const galpha::v1::ReleaseRequest* request,
+                                    galpha::v1::ReleaseResponse* response) override;
+
+ private:
+  friend class BuildReactor;
+  AlphaService(const ServiceOptions& options, ServerMetrics* metrics);
+
+  /// The caller's tenant, or Unauthenticated.
+  absl::StatusOr<std::string> Authenticate(grpc::CallbackServerContext* context) const;
+  /// The cached family of (tenant, handle), or NotFound / InvalidArgument.
+  absl::StatusOr<std::shared_ptr<const CachedFamily>> Lookup(grpc::CallbackServerContext* context,
+                                                             const std::string& handle);
+
+  ServiceOptions options_;
+  ServerMetrics* metrics_;
+  Backend backend_ = Backend::kCpu;
+  std::string backend_name_;
+  std::unique_ptr<CudaStreamPool> streams_;
+  std::unique_ptr<FamilyCache> cache_;
+  InFlightBytes in_flight_;
+  std::atomic<bool> draining_{false};
+  // Last: its workers run builds that use everything above, so it stops first.
+  std::unique_ptr<BuildScheduler> scheduler_;
+};
+
+}  // namespace galpha::server

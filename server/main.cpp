@@ -1,0 +1,108 @@
+// galpha_server: flags in, a running GalphaServer out; SIGTERM or SIGINT drains it (a second one
+// cuts the drain notice short). Prints one "listening" line per port on stdout so that scripts
+// started with port 0 learn the ports.
+#include <pthread.h>
+#include <signal.h>
+
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/strings/str_cat.h"
+#include "server/galpha_server.hpp"
+
+ABSL_FLAG(std::string, listen, "0.0.0.0:50051", "gRPC address (host:port; port 0 picks one)");
+ABSL_FLAG(std::string, metrics_listen, "0.0.0.0:9464", "Prometheus exporter address; empty turns it off");
+ABSL_FLAG(std::string, backend, "auto", "auto (GPU when present), cpu or cuda");
+ABSL_FLAG(int, build_slots, 0, "builds running at once (CUDA streams); 0: 4 on a GPU, 1 on the CPU");
+ABSL_FLAG(uint64_t, max_queued_builds, 16, "builds waiting for a slot before RESOURCE_EXHAUSTED");
+ABSL_FLAG(uint64_t, build_memory_bytes, 0, "working memory admitted to running builds; 0: 90% of the GPU's, or half the host's");
+ABSL_FLAG(uint64_t, max_points_per_build, 100000000, "largest point set one build accepts");
+ABSL_FLAG(uint64_t, max_in_flight_bytes, uint64_t{8} << 30, "bytes of points held by all uploads and builds at once");
+ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30, "byte budget of the family cache (LRU eviction)");
+ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
+ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key");
+ABSL_FLAG(std::string, token_file, "", "file of 'TOKEN TENANT' lines; when set, every call needs a bearer token");
+ABSL_FLAG(int, drain_notice_ms, 5000, "on SIGTERM: NOT_SERVING this long before refusing calls");
+ABSL_FLAG(int, drain_grace_ms, 25000, "then: how long running calls may finish before they are cancelled");
+
+namespace {
+
+int Fail(const std::string& message) {
+  std::fprintf(stderr, "galpha_server: %s\n", message.c_str());
+  return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage("galpha_server: the galpha.v1.AlphaShapes gRPC service. Flags: --helpfull");
+  absl::ParseCommandLine(argc, argv);
+  using galpha::server::ServerOptions;
+  ServerOptions options;
+  options.listen_address = absl::GetFlag(FLAGS_listen);
+  options.metrics_address = absl::GetFlag(FLAGS_metrics_listen);
+  options.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  options.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
+  options.drain_notice = std::chrono::milliseconds(absl::GetFlag(FLAGS_drain_notice_ms));
+  options.drain_grace = std::chrono::milliseconds(absl::GetFlag(FLAGS_drain_grace_ms));
+  const std::string backend = absl::GetFlag(FLAGS_backend);
+  if (backend == "auto") {
+    options.service.backend = galpha::Backend::kAuto;
+  } else if (backend == "cpu") {
+    options.service.backend = galpha::Backend::kCpu;
+  } else if (backend == "cuda") {
+    options.service.backend = galpha::Backend::kCuda;
+  } else {
+    return Fail(absl::StrCat("unknown --backend '", backend, "' (expected auto, cpu or cuda)"));
+  }
+  if (absl::GetFlag(FLAGS_build_slots) < 0) return Fail("--build_slots must be >= 0");
+  options.service.build_slots = absl::GetFlag(FLAGS_build_slots);
+  options.service.max_queued_builds = absl::GetFlag(FLAGS_max_queued_builds);
+  options.service.build_memory_bytes = absl::GetFlag(FLAGS_build_memory_bytes);
+  options.service.max_points_per_build = absl::GetFlag(FLAGS_max_points_per_build);
+  options.service.max_in_flight_bytes = absl::GetFlag(FLAGS_max_in_flight_bytes);
+  options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
+  if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
+    auto tokens = galpha::server::TenantTokens::ReadFile(path);
+    if (!tokens.ok()) return Fail(std::string(tokens.status().message()));
+    options.service.tokens = *std::move(tokens);
+  }
+
+  // Every thread the server starts inherits this mask, so only the sigwait below sees the signals.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  auto server = galpha::server::GalphaServer::Start(options);
+  if (!server.ok()) return Fail(std::string(server.status().message()));
+  galpha::server::GalphaServer& s = **server;
+  std::printf("galpha_server: listening on port %d (%s backend, %zu build slots, %s, %s)\n", s.port(),
+              s.service().backend_name().c_str(), s.service().build_slots(),
+              options.tls_cert_file.empty() ? "plaintext" : "TLS",
+              options.service.tokens.enabled() ? "bearer tokens required" : "no authentication");
+  if (s.metrics_port() != 0) std::printf("galpha_server: metrics on port %d\n", s.metrics_port());
+  std::fflush(stdout);
+
+  int signal_number = 0;
+  sigwait(&signals, &signal_number);
+  std::printf("galpha_server: signal %d: draining\n", signal_number);
+  std::fflush(stdout);
+  std::thread second_signal([&] {
+    int again = 0;
+    sigwait(&signals, &again);
+    s.CutNoticeShort();
+  });
+  second_signal.detach();  // it may wait forever; the process ends without it
+  s.Drain();
+  std::printf("galpha_server: stopped\n");
+  std::fflush(stdout);
+  return 0;
+}

@@ -1,0 +1,56 @@
+// The service's Prometheus metrics (DESIGN.md section 4), in base units, counters with `_total`,
+// no handle labels (handles are unbounded). The exporter serves them on its own port.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "core/alpha_family.hpp"
+#include "server/build_scheduler.hpp"
+#include "server/family_cache.hpp"
+
+namespace prometheus {
+class Registry;
+class Exposer;
+}  // namespace prometheus
+
+namespace galpha::server {
+
+class ServerMetrics final : public CacheObserver, public SchedulerObserver {
+ public:
+  ServerMetrics();
+  ~ServerMetrics() override;
+
+  /// Serves GET /metrics on `address` ("host:port"; port 0 picks one). Returns the bound port.
+  absl::StatusOr<int> StartExporter(const std::string& address);
+
+  /// A finished build: every stage's latency and the radius comparisons by path.
+  void RecordBuild(const BuildReport& report, double total_seconds);
+  /// A finished RPC with its status code name ("OK", "NOT_FOUND", ...).
+  void RecordRpc(std::string_view method, std::string_view code, double seconds);
+  /// Device memory in use (total - free) on the GPU, sampled by the server.
+  void SetDeviceMemoryInUse(double bytes);
+  /// 1 for the backend this server runs ("cuda" or "cpu").
+  void SetBackend(const std::string& backend);
+  /// Build requests refused before a slot (queue full, limits, memory).
+  void RecordRejectedBuild(std::string_view reason);
+
+  // CacheObserver
+  void OnLookup(bool hit) override;
+  void OnEviction() override;
+  void OnSize(size_t bytes, size_t entries) override;
+  // SchedulerObserver
+  void OnLoad(size_t queued, size_t running, size_t admitted_bytes) override;
+
+  prometheus::Registry& registry();
+
+ private:
+  struct Families;
+  std::shared_ptr<prometheus::Registry> registry_;
+  std::unique_ptr<Families> families_;
+  std::unique_ptr<prometheus::Exposer> exposer_;
+};
+
+}  // namespace galpha::server

@@ -1,0 +1,479 @@
+#include "server/query_answers.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "core/classification_summary.hpp"
+
+namespace galpha::server {
+
+namespace v1 = galpha::v1;
+
+namespace {
+
+double PublishedAlphaSq(const AlphaFamily& family, int64_t level) {
+  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
+}
+
+v1::ClassCounts ToClassCounts(const std::array<uint64_t, 4>& counts) {
+  v1::ClassCounts out;
+  out.set_exterior(counts[0]);
+  out.set_singular(counts[1]);
+  out.set_regular(counts[2]);
+  out.set_interior(counts[3]);
+  return out;
+}
+
+char ClassByte(SimplexClass c) { return static_cast<char>(static_cast<int>(c) + 1); }
+
+std::array<uint32_t, 2> SortedEdge(const std::array<uint32_t, 2>& e) {
+  return {std::min(e[0], e[1]), std::max(e[0], e[1])};
+}
+
+std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
+ public:
+  ClassifySource(std::shared_ptr<const CachedFamily> cached, Classification classes, ClassificationSummary counts,
+                 ResolvedLevel level, bool non_exterior_only, bool summary_only)
+      : cached_(std::move(cached)),
+        classes_(std::move(classes)),
+        counts_(counts),
+        level_(level),
+        non_exterior_only_(non_exterior_only),
+        phase_(summary_only ? Phase::kLastSummary : Phase::kSummary) {}
+
+  bool Next(v1::ClassifyResponse* message) override {
+    message->Clear();
+    const AlphaFamily& family = cached_->family();
+    while (true) {
+      switch (phase_) {
+        case Phase::kSummary:
+        case Phase::kLastSummary:
+          FillSummary(message->mutable_summary());
+          phase_ = phase_ == Phase::kSummary ? Phase::kVertices : Phase::kDone;
+          return true;
+        case Phase::kVertices:
+          if (FillChunk(message, v1::SIMPLEX_KIND_VERTEX, 1, family.points().size(), [&](size_t v, uint32_t* out) {
+                if (family.representative()[v] != v) return std::pair<SimplexClass, bool>{SimplexClass::kExterior, false};
+                out[0] = static_cast<uint32_t>(v);
+                return Emit(classes_.vertices[v]);
+              })) {
+            return true;
+          }
+          phase_ = Phase::kEdges;
+          position_ = 0;
+          break;
+        case Phase::kEdges: {
+          const std::vector<uint32_t>& order = cached_->EdgeOrder();
+          if (FillChunk(message, v1::SIMPLEX_KIND_EDGE, 2, order.size(), [&](size_t i, uint32_t* out) {
+                const uint32_t e = order[i];
+                const auto edge = SortedEdge(family.edges()[e]);
+                out[0] = edge[0];
+                out[1] = edge[1];
+                return Emit(classes_.edges[e]);
+              })) {
+            return true;
+          }
+          phase_ = Phase::kTriangles;
+          position_ = 0;
+          break;
+        }
+        case Phase::kTriangles: {
+          const std::vector<uint32_t>& order = cached_->TriangleOrder();
+          if (FillChunk(message, v1::SIMPLEX_KIND_TRIANGLE, 3, order.size(), [&](size_t i, uint32_t* out) {
+                const uint32_t t = order[i];
+                const auto tri = SortedTriangle(family.triangles()[t]);
+                out[0] = tri[0];
+                out[1] = tri[1];
+                out[2] = tri[2];
+                return Emit(classes_.triangles[t]);
+              })) {
+            return true;
+          }
+          phase_ = Phase::kDone;
+          break;
+        }
+        case Phase::kDone:
+          return false;
+      }
+    }
+  }
+
+ private:
+  enum class Phase { kSummary, kLastSummary, kVertices, kEdges, kTriangles, kDone };
+
+  // What a simplex contributes: its class, and whether it is sent.
+  std::pair<SimplexClass, bool> Emit(SimplexClass c) const {
+    return {c, !(non_exterior_only_ && c == SimplexClass::kExterior)};
+  }
+
+  void FillSummary(v1::ClassifySummary* summary) const {
+    const AlphaFamily& family = cached_->family();
+    summary->set_level(level_.level);
+    summary->set_alpha_sq(level_.alpha_sq);
+    *summary->mutable_vertices() = ToClassCounts(counts_.vertices);
+    *summary->mutable_edges() = ToClassCounts(counts_.edges);
+    *summary->mutable_triangles() = ToClassCounts(counts_.triangles);
+    summary->set_components(family.Components(level_.level));
+    summary->set_solid_components(family.SolidComponents(level_.level));
+    summary->set_interior_area(counts_.interior_area);
+  }
+
+  // Fills one chunk of `kind` from items position_..count-1; `item(i, out)` writes `arity`
+  // indices and returns (class, sent). Returns whether the chunk holds anything.
+  template <typename Item>
+  bool FillChunk(v1::ClassifyResponse* message, v1::SimplexKind kind, int arity, size_t count, Item item) {
+    v1::SimplexChunk* chunk = message->mutable_chunk();
+    chunk->set_kind(kind);
+    auto* indices = chunk->mutable_vertex_indices();
+    std::string* classes = chunk->mutable_classes();
+    const size_t budget = std::min<size_t>(kSimplicesPerChunk, count - std::min(position_, count));
+    indices->Resize(static_cast<int>(budget * static_cast<size_t>(arity)), 0);
+    classes->resize(budget);
+    uint32_t* out = indices->mutable_data();
+    size_t sent = 0;
+    for (; position_ < count && sent < kSimplicesPerChunk; ++position_) {
+      const auto [cls, emit] = item(position_, out + sent * static_cast<size_t>(arity));
+      if (!emit) continue;
+      (*classes)[sent] = ClassByte(cls);
+      ++sent;
+    }
+    indices->Truncate(static_cast<int>(sent * static_cast<size_t>(arity)));
+    classes->resize(sent);
+    if (sent == 0) {
+      message->clear_chunk();
+      return false;
+    }
+    return true;
+  }
+
+  std::shared_ptr<const CachedFamily> cached_;
+  Classification classes_;
+  ClassificationSummary counts_;
+  ResolvedLevel level_;
+  bool non_exterior_only_;
+  Phase phase_;
+  size_t position_ = 0;
+};
+
+class MasterListSource final : public ChunkSource<v1::MasterListResponse> {
+ public:
+  MasterListSource(std::shared_ptr<const CachedFamily> cached, int64_t first, int64_t last)
+      : cached_(std::move(cached)), rank_(first), last_(last) {
+    const auto& begin = cached_->family().ranks().master_begin;
+    position_ = begin[static_cast<size_t>(first)];
+    end_ = begin[static_cast<size_t>(last) + 1];
+  }
+
+  bool Next(v1::MasterListResponse* message) override {
+    message->Clear();
+    if (position_ >= end_) return false;
+    const AlphaFamily& family = cached_->family();
+    const auto& begin = family.ranks().master_begin;
+    const auto& master = family.ranks().master;
+    const size_t count = std::min<size_t>(kMasterEntriesPerChunk, end_ - position_);
+    message->mutable_ranks()->Reserve(static_cast<int>(count));
+    message->mutable_vertex_indices()->Reserve(static_cast<int>(count * 3));
+    std::string* kinds = message->mutable_kinds();
+    std::string* endpoints = message->mutable_endpoints();
+    for (size_t i = 0; i < count; ++i, ++position_) {
+      while (position_ >= begin[static_cast<size_t>(rank_) + 1]) ++rank_;
+      const MasterEntry entry = master[position_];
+      message->add_ranks(static_cast<uint64_t>(rank_));
+      kinds->push_back(static_cast<char>(static_cast<int>(entry.kind()) + 1));
+      endpoints->push_back(static_cast<char>(static_cast<int>(entry.endpoint()) + 1));
+      switch (entry.kind()) {
+        case SimplexKind::kVertex:
+          message->add_vertex_indices(entry.id());
+          break;
+        case SimplexKind::kEdge:
+          for (uint32_t v : SortedEdge(family.edges()[entry.id()])) message->add_vertex_indices(v);
+          break;
+        case SimplexKind::kTriangle:
+          for (uint32_t v : SortedTriangle(family.triangles()[entry.id()])) message->add_vertex_indices(v);
+          break;
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::shared_ptr<const CachedFamily> cached_;
+  int64_t rank_;
+  int64_t last_;
+  size_t position_ = 0;
+  size_t end_ = 0;
+};
+
+class ShapeTextSource final : public ChunkSource<v1::ShapeResponse> {
+ public:
+  explicit ShapeTextSource(std::string text) : text_(std::move(text)) {}
+  bool Next(v1::ShapeResponse* message) override {
+    message->Clear();
+    if (position_ >= text_.size()) return false;
+    const size_t count = std::min(kShapeTextBytesPerChunk, text_.size() - position_);
+    message->set_text(text_.substr(position_, count));
+    position_ += count;
+    return true;
+  }
+
+ private:
+  std::string text_;
+  size_t position_ = 0;
+};
+
+class ShapeRingsSource final : public ChunkSource<v1::ShapeResponse> {
+ public:
+  explicit ShapeRingsSource(ShapeGeometry shape) : shape_(std::move(shape)) {}
+  bool Next(v1::ShapeResponse* message) override {
+    message->Clear();
+    const bool first = !started_;
+    started_ = true;
+    if (!first && polygon_ >= shape_.polygons.size() && edge_ >= shape_.singular_edges.size() &&
+        point_ >= shape_.isolated_points.size()) {
+      return false;
+    }
+    v1::ShapeRings* rings = message->mutable_rings();
+    if (first) rings->set_area(shape_.area);
+    size_t indices = 0;
+    for (; polygon_ < shape_.polygons.size() && indices < kShapeIndicesPerChunk; ++polygon_) {
+      const ShapePolygon& polygon = shape_.polygons[polygon_];
+      v1::ShapePolygon* out = rings->add_polygons();
+      out->mutable_outer()->Add(polygon.outer.begin(), polygon.outer.end());
+      indices += polygon.outer.size();
+      for (const auto& hole : polygon.holes) {
+        out->add_holes()->mutable_vertex_indices()->Add(hole.begin(), hole.end());
+        indices += hole.size();
+      }
+    }
+    for (; edge_ < shape_.singular_edges.size() && indices < kShapeIndicesPerChunk; ++edge_, indices += 2) {
+      rings->add_singular_edges(shape_.singular_edges[edge_][0]);
+      rings->add_singular_edges(shape_.singular_edges[edge_][1]);
+    }
+    for (; point_ < shape_.isolated_points.size() && indices < kShapeIndicesPerChunk; ++point_, ++indices) {
+      rings->add_isolated_points(shape_.isolated_points[point_]);
+    }
+    return true;
+  }
+
+ private:
+  ShapeGeometry shape_;
+  bool started_ = false;
+  size_t polygon_ = 0, edge_ = 0, point_ = 0;
+};
+
+}  // namespace
+
+absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::Threshold& threshold) {
+  ResolvedLevel resolved;
+  absl::StatusOr<int64_t> level;
+  switch (threshold.value_case()) {
+    case v1::Threshold::kRank:
+      level = family.LevelForRank(threshold.rank());
+      if (!level.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("rank ", threshold.rank(), " is outside 0..",
+                                                       family.max_level(), " (the spectrum has ", family.max_level(),
+                                                       " values)"));
+      }
+      resolved.alpha_sq = PublishedAlphaSq(family, *level);
+      break;
+    case v1::Threshold::kAlphaSq:
+      level = family.LevelForAlphaSq(threshold.alpha_sq());
+      resolved.alpha_sq = threshold.alpha_sq();
+      break;
+    case v1::Threshold::kAlpha:
+      level = family.LevelForAlpha(threshold.alpha());
+      resolved.alpha_sq = threshold.alpha() * threshold.alpha();
+      break;
+    case v1::Threshold::VALUE_NOT_SET:
+      return absl::InvalidArgumentError("the request has no threshold: set alpha_sq, alpha or rank");
+  }
+  if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
+  resolved.level = *level;
+  return resolved;
+}
+
+ClassifyMode ToClassifyMode(v1::ClassifyMode mode) {
+  return mode == v1::CLASSIFY_MODE_REGULARIZED ? ClassifyMode::kRegularized : ClassifyMode::kGeneral;
+}
+
+VertexRule ToVertexRule(v1::VertexRule rule) {
+  return rule == v1::VERTEX_RULE_CGAL ? VertexRule::kCgal : VertexRule::kReport;
+}
+
+void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
+  const AlphaFamily& family = cached.family();
+  summary->set_name(cached.name());
+  summary->set_points(family.points().size());
+  summary->set_distinct_points(family.num_unique());
+  summary->set_duplicates(family.num_duplicates());
+  summary->set_triangles(family.triangles().size());
+  summary->set_edges(family.edges().size());
+  summary->set_spectrum_size(family.spectrum().size());
+  const BuildReport& report = family.report();
+  summary->set_backend(report.backend);
+  for (const StageTime& stage : report.stage_times) {
+    v1::StageTime* out = summary->add_stage_times();
+    out->set_stage(stage.stage);
+    out->set_seconds(stage.seconds);
+  }
+  summary->mutable_comparisons()->set_filter(report.comparisons.filter);
+  summary->mutable_comparisons()->set_device_exact(report.comparisons.bounded_exact);
+  summary->mutable_comparisons()->set_cpu_fallback(report.comparisons.cpu_fallback);
+  summary->set_peak_memory_bytes(report.peak_memory_bytes);
+  summary->set_family_bytes(cached.bytes());
+}
+
+absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifySource(
+    std::shared_ptr<const CachedFamily> cached, const v1::ClassifyRequest& request) {
+  const AlphaFamily& family = cached->family();
+  auto level = ResolveLevel(family, request.threshold());
+  if (!level.ok()) return level.status();
+  Classification classes =
+      family.ClassifyAll(level->level, ToClassifyMode(request.mode()), ToVertexRule(request.vertex_rule()));
+  const ClassificationSummary counts = SummarizeClassification(family, classes);
+  return std::make_unique<ClassifySource>(std::move(cached), std::move(classes), counts, *level,
+                                          request.non_exterior_only(), request.summary_only());
+}
+
+absl::StatusOr<std::unique_ptr<ChunkSource<v1::MasterListResponse>>> MakeMasterListSource(
+    std::shared_ptr<const CachedFamily> cached, const v1::MasterListRequest& request) {
+  const int64_t k = cached->family().max_level();
+  const int64_t first = request.first_rank();
+  const int64_t last = request.last_rank() == 0 ? first : request.last_rank();
+  if (k == 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rank ", first, " is out of range: the spectrum is empty, the master list has no ranks"));
+  }
+  if (first < 1 || first > k) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("first_rank ", first, " is outside 1..", k, " (the spectrum has ", k, " values)"));
+  }
+  if (last < first || last > k) {
+    return absl::InvalidArgumentError(absl::StrCat("last_rank ", last, " is outside ", first, "..", k));
+  }
+  return std::make_unique<MasterListSource>(std::move(cached), first, last);
+}
+
+absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
+    std::shared_ptr<const CachedFamily> cached, const v1::ShapeRequest& request) {
+  if (request.format() == v1::SHAPE_FORMAT_UNSPECIFIED) {
+    return absl::InvalidArgumentError("the shape request has no format: GEOJSON, WKT, SVG or RINGS");
+  }
+  const AlphaFamily& family = cached->family();
+  auto level = ResolveLevel(family, request.threshold());
+  if (!level.ok()) return level.status();
+  auto shape = AssembleShape(family.ComplexAt(level->level, ToClassifyMode(request.mode())));
+  if (!shape.ok()) return shape.status();
+  const absl::Span<const Point2> points = family.points();
+  switch (request.format()) {
+    case v1::SHAPE_FORMAT_GEOJSON:
+      return std::make_unique<ShapeTextSource>(ShapeToGeoJson(*shape, points));
+    case v1::SHAPE_FORMAT_WKT:
+      return std::make_unique<ShapeTextSource>(ShapeToWkt(*shape, points));
+    case v1::SHAPE_FORMAT_SVG:
+      return std::make_unique<ShapeTextSource>(ShapeToSvg(*shape, points));
+    case v1::SHAPE_FORMAT_RINGS:
+      return std::make_unique<ShapeRingsSource>(*std::move(shape));
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("unknown shape format ", static_cast<int>(request.format())));
+  }
+}
+
+absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family, const v1::SpectrumRequest& request) {
+  const int64_t k = family.max_level();
+  int64_t first = 1;
+  switch (request.start_case()) {
+    case v1::SpectrumRequest::kFirstRank:
+      first = request.first_rank();
+      if (first < 1 || first > k + 1) {
+        return absl::InvalidArgumentError(absl::StrCat("first_rank ", first, " is outside 1..", k + 1));
+      }
+      break;
+    case v1::SpectrumRequest::kAtLeastAlphaSq:
+      if (std::isnan(request.at_least_alpha_sq())) return absl::InvalidArgumentError("at_least_alpha_sq is NaN");
+      first = family.RankLowerBound(request.at_least_alpha_sq());
+      break;
+    case v1::SpectrumRequest::START_NOT_SET:
+      break;
+  }
+  uint32_t page = request.page_size() == 0 ? kDefaultSpectrumPage : request.page_size();
+  if (page > kMaxSpectrumPage) {
+    return absl::InvalidArgumentError(absl::StrCat("page_size ", page, " exceeds ", kMaxSpectrumPage));
+  }
+  v1::SpectrumResponse response;
+  response.set_first_rank(first);
+  response.set_spectrum_size(k);
+  const int64_t end = std::min<int64_t>(k, first - 1 + page);  // last rank on the page
+  const auto& spectrum = family.spectrum();
+  if (end >= first) {
+    response.mutable_alpha_sq()->Add(spectrum.begin() + (first - 1), spectrum.begin() + end);
+  }
+  response.set_next_rank(end < k ? end + 1 : 0);
+  return response;
+}
+
+absl::StatusOr<v1::ComponentsResponse> AnswerComponents(const AlphaFamily& family,
+                                                        const v1::ComponentsRequest& request) {
+  v1::ComponentsResponse response;
+  int64_t first = 0, last = 0;
+  switch (request.at_case()) {
+    case v1::ComponentsRequest::kThreshold: {
+      auto level = ResolveLevel(family, request.threshold());
+      if (!level.ok()) return level.status();
+      first = last = level->level;
+      break;
+    }
+    case v1::ComponentsRequest::kRanks: {
+      const int64_t k = family.max_level();
+      first = request.ranks().first();
+      last = request.ranks().last();
+      if (first < 0 || last > k || last < first) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("rank range ", first, "..", last, " is not within 0..", k, " (first <= last)"));
+      }
+      if (last - first + 1 > kMaxComponentLevels) {
+        return absl::InvalidArgumentError(absl::StrCat("rank range ", first, "..", last, " holds more than ",
+                                                       kMaxComponentLevels, " ranks: ask in pieces"));
+      }
+      break;
+    }
+    case v1::ComponentsRequest::AT_NOT_SET:
+      return absl::InvalidArgumentError("the request has neither a threshold nor a rank range");
+  }
+  response.set_first_level(first);
+  for (int64_t level = first; level <= last; ++level) {
+    response.add_components(family.Components(level));
+    response.add_solid_components(family.SolidComponents(level));
+  }
+  return response;
+}
+
+absl::StatusOr<v1::OptimalAlphaResponse> AnswerOptimalAlpha(const AlphaFamily& family,
+                                                            const v1::OptimalAlphaRequest& request) {
+  if (request.max_components() < 1) return absl::InvalidArgumentError("max_components must be at least 1");
+  v1::OptimalAlphaResponse response;
+  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(request.max_components())) {
+    v1::OptimalLevel* out = response.mutable_regularized();
+    out->set_rank(*level);
+    out->set_alpha_sq(PublishedAlphaSq(family, *level));
+    out->set_components(family.SolidComponents(*level));
+  }
+  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(request.max_components())) {
+    v1::OptimalLevel* out = response.mutable_general();
+    out->set_rank(*level);
+    out->set_alpha_sq(PublishedAlphaSq(family, *level));
+    out->set_components(family.Components(*level));
+  }
+  return response;
+}
+
+}  // namespace galpha::server

@@ -1,0 +1,71 @@
+// Answers to the service's queries, computed from a cached family: pure functions and chunk
+// generators over the protobuf messages, free of gRPC so that tests check them directly and the
+// service only moves them over the wire.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "core/alpha_family.hpp"
+#include "core/shape.hpp"
+#include "galpha/v1/alpha_shapes.pb.h"
+#include "server/cached_family.hpp"
+
+namespace galpha::server {
+
+/// Simplices per Classify chunk (at most 13 bytes each: well under gRPC's 4 MiB message limit).
+inline constexpr uint32_t kSimplicesPerChunk = 1u << 17;
+/// Master-list entries per MasterList message.
+inline constexpr uint32_t kMasterEntriesPerChunk = 1u << 17;
+/// Bytes of text per Shape message; indices per ShapeRings message (about).
+inline constexpr size_t kShapeTextBytesPerChunk = 1u << 20;
+inline constexpr size_t kShapeIndicesPerChunk = 1u << 18;
+/// Spectrum page sizes and the longest Components range.
+inline constexpr uint32_t kDefaultSpectrumPage = 65536;
+inline constexpr uint32_t kMaxSpectrumPage = 262144;
+inline constexpr int64_t kMaxComponentLevels = 262144;
+
+/// A threshold resolved against a family: its level and the alpha_sq it stands for.
+struct ResolvedLevel {
+  int64_t level = 0;
+  double alpha_sq = 0.0;
+};
+/// InvalidArgument: no threshold set, NaN, a negative alpha, a rank outside 0..K.
+absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const galpha::v1::Threshold& threshold);
+
+ClassifyMode ToClassifyMode(galpha::v1::ClassifyMode mode);
+VertexRule ToVertexRule(galpha::v1::VertexRule rule);
+
+/// Describe's and Build's summary of a cached family.
+void FillBuildSummary(const CachedFamily& cached, galpha::v1::BuildSummary* summary);
+
+/// A generator of a server-streamed answer: Next fills the next message, false when done.
+template <typename Message>
+class ChunkSource {
+ public:
+  virtual ~ChunkSource() = default;
+  virtual bool Next(Message* message) = 0;
+};
+
+/// Classify: the summary, then vertex, edge and triangle chunks in index order.
+absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>>> MakeClassifySource(
+    std::shared_ptr<const CachedFamily> cached, const galpha::v1::ClassifyRequest& request);
+
+/// MasterList for ranks first..last. InvalidArgument for ranks outside 1..K or last < first.
+absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::MasterListResponse>>> MakeMasterListSource(
+    std::shared_ptr<const CachedFamily> cached, const galpha::v1::MasterListRequest& request);
+
+/// Shape as text chunks or ring chunks. InvalidArgument for an unspecified format.
+absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ShapeResponse>>> MakeShapeSource(
+    std::shared_ptr<const CachedFamily> cached, const galpha::v1::ShapeRequest& request);
+
+absl::StatusOr<galpha::v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family,
+                                                            const galpha::v1::SpectrumRequest& request);
+absl::StatusOr<galpha::v1::ComponentsResponse> AnswerComponents(const AlphaFamily& family,
+                                                                const galpha::v1::ComponentsRequest& request);
+absl::StatusOr<galpha::v1::OptimalAlphaResponse> AnswerOptimalAlpha(const AlphaFamily& family,
+                                                                    const galpha::v1::OptimalAlphaRequest& request);
+
+}  // namespace galpha::server
