@@ -10,7 +10,7 @@ namespace galpha::alphactl {
 
 const char kUsage[] =
     "usage: alphactl COMMAND FILE [OPTIONS]\n"
-    "Exact 2D alpha shapes of the points in FILE, computed locally (no server).\n"
+    "Exact 2D alpha shapes of the points in FILE, computed locally, or by a galpha server (--server).\n"
     "\n"
     "commands:\n"
     "  triangulate FILE            the Delaunay triangulation's counts and stage times, one JSON line\n"
@@ -37,6 +37,9 @@ const char kUsage[] =
     "\n"
     "every command also takes:\n"
     "  --backend auto|cpu|cuda     where the engine runs (default auto: CUDA when a GPU is visible)\n"
+    "  --server HOST:PORT          run on a galpha server instead: FILE is hashed locally and uploaded\n"
+    "                              only when the server does not hold it; same output (not triangulate)\n"
+    "  --tls-ca FILE               with --server: talk TLS, trusting the PEM roots in FILE\n"
     "  -h, --help                  this text\n"
     "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
     "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
@@ -49,7 +52,8 @@ const char kUsage[] =
     "      first, optional header line)\n"
     "\n"
     "exit status: 0 success, 1 failure (unreadable file, bad input), 2 usage error (including a\n"
-    "rank outside the spectrum). Progress goes to standard error for 100000 points or more.\n";
+    "rank outside the spectrum). Progress goes to standard error for 100000 points or more.\n"
+    "environment: GALPHA_TOKEN, the bearer token a server with authentication expects.\n";
 
 const std::string* CommandLine::Find(absl::string_view name) const {
   for (const auto& [option, value] : options) {

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "client/commands.hpp"
 #include "core/point_formats.hpp"
 #include "gpu/alpha_engine.hpp"
@@ -50,6 +52,8 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
                                        absl::Span<const absl::string_view> allowed) {
   std::vector<absl::string_view> names(allowed.begin(), allowed.end());
   names.push_back("backend");
+  names.push_back("server");
+  names.push_back("tls-ca");
   auto line = ParseCommandLine(command, args, names);
   if (!line.ok()) return line.status();
   CommonArgs common;
@@ -61,8 +65,33 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
   auto backend = ParseBackend(*line);
   if (!backend.ok()) return backend.status();
   common.backend = *backend;
+  if (const std::string* server = line->Find("server")) {
+    if (server->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
+    if (line->Find("backend") != nullptr) {
+      return absl::InvalidArgumentError("--backend applies to local builds; with --server the server picks its backend");
+    }
+    common.server = *server;
+  }
+  if (const std::string* ca = line->Find("tls-ca")) {
+    if (common.server.empty()) return absl::InvalidArgumentError("--tls-ca needs --server");
+    common.tls_ca_file = *ca;
+  }
   common.line = *std::move(line);
   return common;
+}
+
+absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line) {
+  ClassifyArgs parsed;
+  auto threshold = ParseThreshold(line);
+  if (!threshold.ok()) return threshold.status();
+  parsed.threshold = *threshold;
+  auto mode = ParseMode(line);
+  if (!mode.ok()) return mode.status();
+  parsed.mode = *mode;
+  auto rule = ParseVertexRule(line);
+  if (!rule.ok()) return rule.status();
+  parsed.rule = *rule;
+  return parsed;
 }
 
 absl::StatusOr<std::vector<Point2>> ReadPoints(const std::string& file) {
@@ -123,6 +152,25 @@ absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, co
   if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
   resolved.level = *level;
   return resolved;
+}
+
+int PrintBenchTable(const std::string& file, size_t input_points, uint64_t distinct_points, int64_t repeat,
+                    size_t first_measure, const std::vector<std::pair<std::string, std::string>>& rows) {
+  size_t name_width = std::string("stage").size(), value_width = std::string("ms").size();
+  for (const auto& [name, value] : rows) {
+    name_width = std::max(name_width, name.size());
+    value_width = std::max(value_width, value.size());
+  }
+  const int nw = static_cast<int>(name_width), vw = static_cast<int>(value_width);
+  std::string table = absl::StrFormat("# %s: %zu points, %u distinct, best of %d build%s\n", file, input_points,
+                                      distinct_points, repeat, repeat == 1 ? "" : "s");
+  absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, "stage", vw, "ms");
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (i == first_measure) absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, "measure", vw, "value");
+    absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, rows[i].first, vw, rows[i].second);
+  }
+  std::fputs(table.c_str(), stdout);
+  return kExitOk;
 }
 
 }  // namespace galpha::alphactl

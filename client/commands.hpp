@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -43,11 +44,23 @@ struct CommonArgs {
   CommandLine line;
   std::string file;
   Backend backend = Backend::kAuto;
+  /// --server HOST:PORT: run against a galpha server instead of the embedded engine.
+  std::string server;
+  /// --tls-ca FILE: PEM roots; talk TLS to the server.
+  std::string tls_ca_file;
 };
-/// ParseCommandLine, then exactly one positional FILE and a valid --backend ("backend" is added to
-/// `allowed`). Errors are usage errors.
+/// ParseCommandLine, then exactly one positional FILE, a valid --backend, and --server / --tls-ca
+/// (added to `allowed`). --backend with --server, or --tls-ca without it, is a usage error.
 absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
                                        absl::Span<const absl::string_view> allowed);
+
+/// classify's and summary's options after FILE.
+struct ClassifyArgs {
+  ThresholdArg threshold;
+  ClassifyMode mode = ClassifyMode::kGeneral;
+  VertexRule rule = VertexRule::kReport;
+};
+absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line);
 
 /// ReadPointsFile, with a directory or an I/O exception reported as an error.
 absl::StatusOr<std::vector<Point2>> ReadPoints(const std::string& file);
@@ -66,7 +79,22 @@ struct ResolvedThreshold {
 /// Errors (InvalidArgument, for ArgumentError): a rank outside 0..K.
 absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const ThresholdArg& threshold);
 
+/// bench's table: a header line, then rows of (stage, ms) and, from row `first_measure` on,
+/// (measure, value) under their own heading. Returns kExitOk.
+int PrintBenchTable(const std::string& file, size_t input_points, uint64_t distinct_points, int64_t repeat,
+                    size_t first_measure, const std::vector<std::pair<std::string, std::string>>& rows);
+
 /// The alpha_sq of level `level` >= 0 as published: spectrum[level - 1], 0 for level 0.
 double LevelAlphaSq(const AlphaFamily& family, int64_t level);
+
+// ---- the same commands against a server (commands_remote.cpp), same output formats ----
+
+int RemoteSpectrum(const CommonArgs& common);
+int RemoteClassify(const CommonArgs& common, const ClassifyArgs& options);
+int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options);
+int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold, ClassifyMode mode, const std::string& format);
+int RemoteMasterList(const CommonArgs& common, int64_t rank);
+int RemoteOptimal(const CommonArgs& common, int64_t components);
+int RemoteBench(const CommonArgs& common, int64_t repeat);
 
 }  // namespace galpha::alphactl

@@ -17,6 +17,10 @@ namespace galpha::alphactl {
 int RunTriangulate(Args args) {
   auto common = ParseCommon("triangulate", args, {});
   if (!common.ok()) return UsageError(common.status());
+  if (!common->server.empty()) {
+    return UsageError(absl::InvalidArgumentError(
+        "triangulate runs locally only: a server builds whole families (use summary or bench with --server)"));
+  }
   TriangulateOptions options;
   options.backend = common->backend;
 
@@ -49,6 +53,7 @@ int RunTriangulate(Args args) {
 int RunSpectrum(Args args) {
   auto common = ParseCommon("spectrum", args, {});
   if (!common.ok()) return UsageError(common.status());
+  if (!common->server.empty()) return RemoteSpectrum(*common);
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());
@@ -70,6 +75,7 @@ int RunBench(Args args) {
     if (!parsed.ok()) return UsageError(parsed.status());
     repeat = *parsed;
   }
+  if (!common->server.empty()) return RemoteBench(*common, repeat);
 
   // Best of `repeat` per stage, matched by name in the first build's order; the total is the
   // best build's sum (not the sum of the per-stage bests).
@@ -109,21 +115,7 @@ int RunBench(Args args) {
   rows.emplace_back("spectrum_size", absl::StrCat(family->spectrum().size()));
   rows.emplace_back("backend", report.backend);
 
-  size_t name_width = std::string("stage").size(), value_width = std::string("ms").size();
-  for (const auto& [name, value] : rows) {
-    name_width = std::max(name_width, name.size());
-    value_width = std::max(value_width, value.size());
-  }
-  const int nw = static_cast<int>(name_width), vw = static_cast<int>(value_width);
-  std::string table = absl::StrFormat("# %s: %zu points, %u distinct, best of %d build%s\n", common->file, input_points,
-                                      family->num_unique(), repeat, repeat == 1 ? "" : "s");
-  absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, "stage", vw, "ms");
-  for (size_t i = 0; i < rows.size(); ++i) {
-    if (i == best.size() + 1) absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, "measure", vw, "value");
-    absl::StrAppendFormat(&table, "%-*s  %*s\n", nw, rows[i].first, vw, rows[i].second);
-  }
-  std::fputs(table.c_str(), stdout);
-  return kExitOk;
+  return PrintBenchTable(common->file, input_points, family->num_unique(), repeat, best.size() + 1, rows);
 }
 
 }  // namespace galpha::alphactl

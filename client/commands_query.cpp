@@ -19,27 +19,6 @@ namespace galpha::alphactl {
 
 namespace {
 
-/// classify's and summary's options after FILE.
-struct ClassifyArgs {
-  ThresholdArg threshold;
-  ClassifyMode mode = ClassifyMode::kGeneral;
-  VertexRule rule = VertexRule::kReport;
-};
-
-absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line) {
-  ClassifyArgs parsed;
-  auto threshold = ParseThreshold(line);
-  if (!threshold.ok()) return threshold.status();
-  parsed.threshold = *threshold;
-  auto mode = ParseMode(line);
-  if (!mode.ok()) return mode.status();
-  parsed.mode = *mode;
-  auto rule = ParseVertexRule(line);
-  if (!rule.ok()) return rule.status();
-  parsed.rule = *rule;
-  return parsed;
-}
-
 /// Edge ids ordered by their (smaller, larger) vertex indices.
 std::vector<std::pair<std::array<uint32_t, 2>, uint32_t>> EdgesInIndexOrder(const AlphaFamily& family) {
   std::vector<std::pair<std::array<uint32_t, 2>, uint32_t>> order(family.edges().size());
@@ -63,36 +42,6 @@ std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> TrianglesInIndexOrder(
   return order;
 }
 
-template <size_t N>
-void AppendSimplex(ChunkedWriter& out, char kind, const std::array<uint32_t, N>& vertices) {
-  out.Append(kind);
-  for (uint32_t v : vertices) {
-    out.Append(' ');
-    out.AppendUint(v);
-  }
-}
-
-const char* EndpointName(Endpoint endpoint) {
-  switch (endpoint) {
-    case Endpoint::kRho:
-      return "RHO";
-    case Endpoint::kMuLow:
-      return "MU_LOW";
-    case Endpoint::kMuHigh:
-      return "MU_HIGH";
-  }
-  return "UNKNOWN";
-}
-
-/// {"EXTERIOR":n,"SINGULAR":n,"REGULAR":n,"INTERIOR":n}
-std::string ClassCountsJson(const std::array<uint64_t, 4>& counts) {
-  std::string json = "{";
-  for (size_t c = 0; c < counts.size(); ++c) {
-    absl::StrAppend(&json, c > 0 ? "," : "", "\"", SimplexClassName(static_cast<SimplexClass>(c)), "\":", counts[c]);
-  }
-  return json + "}";
-}
-
 int FinishOutput(ChunkedWriter& out) {
   if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
   return kExitOk;
@@ -105,6 +54,7 @@ int RunClassify(Args args) {
   if (!common.ok()) return UsageError(common.status());
   auto options = ParseClassifyArgs(common->line);
   if (!options.ok()) return UsageError(options.status());
+  if (!common->server.empty()) return RemoteClassify(*common, *options);
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());
@@ -141,6 +91,7 @@ int RunSummary(Args args) {
   if (!common.ok()) return UsageError(common.status());
   auto options = ParseClassifyArgs(common->line);
   if (!options.ok()) return UsageError(options.status());
+  if (!common->server.empty()) return RemoteSummary(*common, *options);
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());
@@ -177,6 +128,7 @@ int RunShape(Args args) {
     return UsageError(
         absl::InvalidArgumentError(absl::StrCat("unknown --format '", *format, "' (expected geojson, wkt or svg)")));
   }
+  if (!common->server.empty()) return RemoteShape(*common, *threshold_arg, *mode, *format);
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());
@@ -202,6 +154,7 @@ int RunMasterList(Args args) {
   if (rank_text == nullptr) return UsageError(absl::InvalidArgumentError("masterlist: missing --rank K"));
   auto rank = ParseInteger("rank", *rank_text, 0);
   if (!rank.ok()) return UsageError(rank.status());
+  if (!common->server.empty()) return RemoteMasterList(*common, *rank);
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());
@@ -245,6 +198,7 @@ int RunOptimal(Args args) {
   if (text == nullptr) return UsageError(absl::InvalidArgumentError("optimal: missing --components N"));
   auto components = ParseInteger("components", *text, 1);
   if (!components.ok()) return UsageError(components.status());
+  if (!common->server.empty()) return RemoteOptimal(*common, *components);
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());

@@ -70,4 +70,27 @@ std::string JsonString(absl::string_view text) {
   return out + "\"";
 }
 
+const char* EndpointName(Endpoint endpoint) {
+  switch (endpoint) {
+    case Endpoint::kRho:
+      return "RHO";
+    case Endpoint::kMuLow:
+      return "MU_LOW";
+    case Endpoint::kMuHigh:
+      return "MU_HIGH";
+  }
+  return "UNKNOWN";
+}
+
+std::string ClassCountsJson(const std::array<uint64_t, 4>& counts) {
+  std::string json = "{";
+  for (size_t c = 0; c < counts.size(); ++c) {
+    json += c > 0 ? ",\"" : "\"";
+    json += SimplexClassName(static_cast<SimplexClass>(c));
+    json += "\":";
+    json += std::to_string(counts[c]);
+  }
+  return json + "}";
+}
+
 }  // namespace galpha::alphactl

@@ -2,11 +2,15 @@
 // numbers printed exactly (%.17g) and JSON string literals.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <string>
 
 #include "absl/strings/string_view.h"
+#include "core/alpha_family.hpp"
+#include "core/alpha_ranks.hpp"
 
 namespace galpha::alphactl {
 
@@ -40,5 +44,21 @@ std::string FormatDouble(double value);
 std::string JsonNumber(double value);
 /// A JSON string literal for `text` (quotes, backslashes and control characters escaped).
 std::string JsonString(absl::string_view text);
+
+/// Appends KIND and the vertex indices: "v 3", "e 1 4", "t 0 2 5".
+template <size_t N>
+void AppendSimplex(ChunkedWriter& out, char kind, const std::array<uint32_t, N>& vertices) {
+  out.Append(kind);
+  for (uint32_t v : vertices) {
+    out.Append(' ');
+    out.AppendUint(v);
+  }
+}
+
+/// "RHO", "MU_LOW", "MU_HIGH".
+const char* EndpointName(Endpoint endpoint);
+
+/// {"EXTERIOR":n,"SINGULAR":n,"REGULAR":n,"INTERIOR":n}, indexed by SimplexClass.
+std::string ClassCountsJson(const std::array<uint64_t, 4>& counts);
 
 }  // namespace galpha::alphactl

@@ -1,0 +1,21 @@
+// Builds without the service (GALPHA_BUILD_SERVER=OFF) have no --server mode: each remote entry
+// point says so as a usage error.
+#include "client/commands.hpp"
+
+namespace galpha::alphactl {
+
+namespace {
+int NoServer() {
+  return UsageError(absl::UnimplementedError("this alphactl was built without the service: --server is not available"));
+}
+}  // namespace
+
+int RemoteSpectrum(const CommonArgs&) { return NoServer(); }
+int RemoteClassify(const CommonArgs&, const ClassifyArgs&) { return NoServer(); }
+int RemoteSummary(const CommonArgs&, const ClassifyArgs&) { return NoServer(); }
+int RemoteShape(const CommonArgs&, const ThresholdArg&, ClassifyMode, const std::string&) { return NoServer(); }
+int RemoteMasterList(const CommonArgs&, int64_t) { return NoServer(); }
+int RemoteOptimal(const CommonArgs&, int64_t) { return NoServer(); }
+int RemoteBench(const CommonArgs&, int64_t) { return NoServer(); }
+
+}  // namespace galpha::alphactl

@@ -1,0 +1,377 @@
+// alphactl's commands against a galpha server (--server HOST:PORT): the file is read and hashed
+// locally, uploaded only when the server does not hold its handle yet, and every answer is printed
+// in exactly the format of the local commands, so that scripts do not care where the work ran.
+// The bearer token, when the server needs one, comes from the environment (GALPHA_TOKEN), never
+// from the command line, where other users of the machine could read it.
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "client/commands.hpp"
+#include "client/galpha_client.hpp"
+#include "client/text_output.hpp"
+#include "core/point_set_handle.hpp"
+
+namespace galpha::alphactl {
+
+namespace v1 = galpha::v1;
+
+namespace {
+
+constexpr size_t kProgressMinPoints = 100000;
+
+/// A family on the server: the connection, the handle and its summary.
+struct RemoteFamily {
+  std::unique_ptr<client::AlphaClient> client;
+  client::BuildResult build;
+  size_t input_points = 0;
+};
+
+absl::StatusOr<std::unique_ptr<client::AlphaClient>> ConnectTo(const CommonArgs& common) {
+  client::ClientOptions options;
+  options.target = common.server;
+  if (const char* token = std::getenv("GALPHA_TOKEN")) options.bearer_token = token;
+  if (!common.tls_ca_file.empty()) {
+    std::ifstream in(common.tls_ca_file);
+    if (!in) return absl::NotFoundError(absl::StrCat("cannot read the --tls-ca file '", common.tls_ca_file, "'"));
+    std::stringstream pem;
+    pem << in.rdbuf();
+    options.tls_root_certs_pem = pem.str();
+  }
+  return client::AlphaClient::Connect(options);
+}
+
+absl::Status ServerError(const CommonArgs& common, const absl::Status& status) {
+  return absl::Status(status.code(), absl::StrCat("server ", common.server, ": ", status.message()));
+}
+
+/// Reads FILE, then finds or builds its family on the server (progress on stderr for large files).
+absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_upload_if_cached = true) {
+  auto points = ReadPoints(common.file);
+  if (!points.ok()) return points.status();
+  RemoteFamily remote;
+  remote.input_points = points->size();
+  auto connected = ConnectTo(common);
+  if (!connected.ok()) return connected.status();
+  remote.client = *std::move(connected);
+  client::BuildCallOptions options;
+  options.name = common.file;
+  options.skip_upload_if_cached = skip_upload_if_cached;
+  const bool verbose = points->size() >= kProgressMinPoints;
+  const auto start = std::chrono::steady_clock::now();
+  if (verbose) {
+    options.progress = [start, total = points->size(), last = size_t{0}](uint64_t sent) mutable {
+      // About ten lines per upload.
+      if (sent != total && sent - last < total / 10) return;
+      last = sent;
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::fprintf(stderr, "alphactl: uploaded %llu of %zu points (%.2f s)\n", static_cast<unsigned long long>(sent),
+                   total, seconds);
+    };
+  }
+  auto built = remote.client->Build(*points, options);
+  if (!built.ok()) return ServerError(common, built.status());
+  remote.build = *std::move(built);
+  if (verbose) {
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "alphactl: %s on the server (%.2f s)\n",
+                 remote.build.cached ? "family found" : "family built", seconds);
+  }
+  return remote;
+}
+
+/// The proto threshold of a command-line threshold; a rank outside 0..K gives the local
+/// command's error message (the summary knows K).
+absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, const RemoteFamily& remote) {
+  v1::Threshold out;
+  const int64_t k = static_cast<int64_t>(remote.build.summary.spectrum_size());
+  switch (threshold.kind) {
+    case ThresholdArg::Kind::kRank:
+      if (threshold.rank < 0 || threshold.rank > k) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("--rank ", threshold.rank, " is outside 0..", k, " (the spectrum has ", k, " values)"));
+      }
+      out.set_rank(threshold.rank);
+      break;
+    case ThresholdArg::Kind::kAlphaSq:
+      out.set_alpha_sq(threshold.value);
+      break;
+    case ThresholdArg::Kind::kAlpha:
+      out.set_alpha(threshold.value);
+      break;
+  }
+  return out;
+}
+
+v1::ClassifyMode ToProto(ClassifyMode mode) {
+  return mode == ClassifyMode::kRegularized ? v1::CLASSIFY_MODE_REGULARIZED : v1::CLASSIFY_MODE_GENERAL;
+}
+
+v1::VertexRule ToProto(VertexRule rule) {
+  return rule == VertexRule::kCgal ? v1::VERTEX_RULE_CGAL : v1::VERTEX_RULE_REPORT;
+}
+
+/// A query's failure: INVALID_ARGUMENT is the user's (exit 2), anything else a failure (exit 1).
+int QueryError(const CommonArgs& common, const absl::Status& status) {
+  if (absl::IsInvalidArgument(status)) return ArgumentError(status);
+  return Failure(ServerError(common, status));
+}
+
+int FinishOutput(ChunkedWriter& out) {
+  if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
+  return kExitOk;
+}
+
+std::array<uint64_t, 4> FromProto(const v1::ClassCounts& counts) {
+  return {counts.exterior(), counts.singular(), counts.regular(), counts.interior()};
+}
+
+}  // namespace
+
+int RemoteSpectrum(const CommonArgs& common) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  ChunkedWriter out(stdout);
+  v1::SpectrumRequest request;
+  request.set_handle(remote->build.handle);
+  request.set_page_size(262144);
+  int64_t next = 1;
+  while (next != 0) {
+    request.set_first_rank(next);
+    auto page = remote->client->Spectrum(request);
+    if (!page.ok()) return QueryError(common, page.status());
+    for (const double alpha_sq : page->alpha_sq()) {
+      out.AppendDouble(alpha_sq);
+      out.Append('\n');
+    }
+    next = page->next_rank();
+  }
+  return FinishOutput(out);
+}
+
+int RemoteClassify(const CommonArgs& common, const ClassifyArgs& options) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  auto threshold = ToThreshold(options.threshold, *remote);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+  v1::ClassifyRequest request;
+  request.set_handle(remote->build.handle);
+  *request.mutable_threshold() = *threshold;
+  request.set_mode(ToProto(options.mode));
+  request.set_vertex_rule(ToProto(options.rule));
+  ChunkedWriter out(stdout);
+  absl::Status status = remote->client->Classify(request, [&](const v1::ClassifyResponse& message) {
+    if (!message.has_chunk()) return absl::OkStatus();
+    const v1::SimplexChunk& chunk = message.chunk();
+    const int arity = chunk.kind() == v1::SIMPLEX_KIND_VERTEX ? 1 : chunk.kind() == v1::SIMPLEX_KIND_EDGE ? 2 : 3;
+    const char kind = "?vet"[arity];
+    if (static_cast<size_t>(chunk.vertex_indices_size()) != chunk.classes().size() * static_cast<size_t>(arity)) {
+      return absl::DataLossError("a Classify chunk's indices and classes disagree in length");
+    }
+    for (size_t i = 0; i < chunk.classes().size(); ++i) {
+      const int code = static_cast<unsigned char>(chunk.classes()[i]);
+      if (code < 1 || code > 4) return absl::DataLossError(absl::StrCat("unknown simplex class ", code));
+      out.Append(kind);
+      for (int k = 0; k < arity; ++k) {
+        out.Append(' ');
+        out.AppendUint(chunk.vertex_indices(static_cast<int>(i) * arity + k));
+      }
+      out.Append(' ');
+      out.Append(SimplexClassName(static_cast<SimplexClass>(code - 1)));
+      out.Append('\n');
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return QueryError(common, status);
+  return FinishOutput(out);
+}
+
+int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  auto threshold = ToThreshold(options.threshold, *remote);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+  v1::ClassifyRequest request;
+  request.set_handle(remote->build.handle);
+  *request.mutable_threshold() = *threshold;
+  request.set_mode(ToProto(options.mode));
+  request.set_vertex_rule(ToProto(options.rule));
+  request.set_summary_only(true);
+  v1::ClassifySummary summary;
+  absl::Status status = remote->client->Classify(request, [&](const v1::ClassifyResponse& message) {
+    if (message.has_summary()) summary = message.summary();
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return QueryError(common, status);
+  const v1::BuildSummary& build = remote->build.summary;
+  const std::string json = absl::StrCat(
+      "{\"file\":", JsonString(common.file), ",\"points\":", remote->input_points,
+      ",\"distinct_points\":", build.distinct_points(), ",\"duplicates\":", build.duplicates(),
+      ",\"spectrum_size\":", build.spectrum_size(), ",\"level\":", summary.level(),
+      ",\"alpha_sq\":", JsonNumber(summary.alpha_sq()), ",\"mode\":\"", ModeName(options.mode),
+      "\",\"vertex_rule\":\"", VertexRuleName(options.rule), "\",\"vertices\":", ClassCountsJson(FromProto(summary.vertices())),
+      ",\"edges\":", ClassCountsJson(FromProto(summary.edges())),
+      ",\"triangles\":", ClassCountsJson(FromProto(summary.triangles())), ",\"components\":", summary.components(),
+      ",\"solid_components\":", summary.solid_components(), ",\"interior_area\":", JsonNumber(summary.interior_area()),
+      ",\"backend\":", JsonString(build.backend()), "}\n");
+  std::fputs(json.c_str(), stdout);
+  return kExitOk;
+}
+
+int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, ClassifyMode mode,
+                const std::string& format) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  auto threshold = ToThreshold(threshold_arg, *remote);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+  v1::ShapeRequest request;
+  request.set_handle(remote->build.handle);
+  *request.mutable_threshold() = *threshold;
+  request.set_mode(ToProto(mode));
+  request.set_format(format == "geojson" ? v1::SHAPE_FORMAT_GEOJSON
+                     : format == "wkt"   ? v1::SHAPE_FORMAT_WKT
+                                         : v1::SHAPE_FORMAT_SVG);
+  ChunkedWriter out(stdout);
+  char last = '\n';
+  bool any = false;
+  absl::Status status = remote->client->Shape(request, [&](const v1::ShapeResponse& message) {
+    if (!message.text().empty()) {
+      out.Append(message.text());
+      last = message.text().back();
+      any = true;
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return QueryError(common, status);
+  if (!any || last != '\n') out.Append('\n');
+  return FinishOutput(out);
+}
+
+int RemoteMasterList(const CommonArgs& common, int64_t rank) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  const int64_t k = static_cast<int64_t>(remote->build.summary.spectrum_size());
+  if (rank < 1 || rank > k) {
+    return ArgumentError(absl::InvalidArgumentError(
+        k == 0 ? absl::StrCat("--rank ", rank, " is out of range: the spectrum is empty, the master list has no ranks")
+               : absl::StrCat("--rank ", rank, " is outside 1..", k, " (the spectrum has ", k, " values)")));
+  }
+  v1::MasterListRequest request;
+  request.set_handle(remote->build.handle);
+  request.set_first_rank(rank);
+  ChunkedWriter out(stdout);
+  absl::Status status = remote->client->MasterList(request, [&](const v1::MasterListResponse& message) {
+    int index = 0;
+    for (size_t i = 0; i < message.kinds().size(); ++i) {
+      const int kind = static_cast<unsigned char>(message.kinds()[i]);
+      const int endpoint = static_cast<unsigned char>(message.endpoints()[i]);
+      if (kind < 1 || kind > 3 || endpoint < 1 || endpoint > 3 || index + kind > message.vertex_indices_size()) {
+        return absl::DataLossError("a MasterList message is malformed");
+      }
+      out.Append("?vet"[kind]);
+      for (int v = 0; v < kind; ++v) {
+        out.Append(' ');
+        out.AppendUint(message.vertex_indices(index++));
+      }
+      out.Append(' ');
+      out.Append(EndpointName(static_cast<Endpoint>(endpoint - 1)));
+      out.Append('\n');
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return QueryError(common, status);
+  return FinishOutput(out);
+}
+
+int RemoteOptimal(const CommonArgs& common, int64_t components) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  v1::OptimalAlphaRequest request;
+  request.set_handle(remote->build.handle);
+  request.set_max_components(
+      static_cast<uint32_t>(std::min<int64_t>(components, std::numeric_limits<uint32_t>::max())));
+  auto answer = remote->client->OptimalAlpha(request);
+  if (!answer.ok()) return QueryError(common, answer.status());
+  std::string json = absl::StrCat("{\"components\":", components, ",\"regularized\":");
+  if (answer->has_regularized()) {
+    absl::StrAppend(&json, "{\"rank\":", answer->regularized().rank(),
+                    ",\"alpha_sq\":", JsonNumber(answer->regularized().alpha_sq()),
+                    ",\"solid_components\":", answer->regularized().components(), "}");
+  } else {
+    json += "null";
+  }
+  json += ",\"general\":";
+  if (answer->has_general()) {
+    absl::StrAppend(&json, "{\"rank\":", answer->general().rank(), ",\"alpha_sq\":", JsonNumber(answer->general().alpha_sq()),
+                    ",\"components\":", answer->general().components(), "}");
+  } else {
+    json += "null";
+  }
+  json += "}\n";
+  std::fputs(json.c_str(), stdout);
+  return kExitOk;
+}
+
+int RemoteBench(const CommonArgs& common, int64_t repeat) {
+  // Each run releases the handle first, so that the server builds again instead of finding it.
+  std::vector<std::pair<std::string, double>> best;
+  double best_engine = 0.0, best_rpc = 0.0;
+  v1::BuildSummary summary;
+  size_t input_points = 0;
+  for (int64_t run = 0; run < repeat; ++run) {
+    auto points = ReadPoints(common.file);
+    if (!points.ok()) return Failure(points.status());
+    input_points = points->size();
+    auto connected = ConnectTo(common);
+    if (!connected.ok()) return Failure(connected.status());
+    auto released = (*connected)->Release(PointSetHandle(*points));
+    if (!released.ok()) return Failure(ServerError(common, released.status()));
+    client::BuildCallOptions options;
+    options.name = common.file;
+    options.skip_upload_if_cached = false;
+    const auto start = std::chrono::steady_clock::now();
+    auto built = (*connected)->Build(*points, options);
+    const double rpc = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!built.ok()) return Failure(ServerError(common, built.status()));
+    summary = built->summary;
+    double engine = 0.0;
+    for (const v1::StageTime& s : summary.stage_times()) {
+      engine += s.seconds();
+      auto it = std::find_if(best.begin(), best.end(), [&](const auto& b) { return b.first == s.stage(); });
+      if (it == best.end()) {
+        best.emplace_back(s.stage(), s.seconds());
+      } else {
+        it->second = std::min(it->second, s.seconds());
+      }
+    }
+    best_engine = run == 0 ? engine : std::min(best_engine, engine);
+    best_rpc = run == 0 ? rpc : std::min(best_rpc, rpc);
+  }
+  std::vector<std::pair<std::string, std::string>> rows;
+  for (const auto& [stage, seconds] : best) rows.emplace_back(stage, absl::StrFormat("%.3f", seconds * 1e3));
+  rows.emplace_back("total", absl::StrFormat("%.3f", best_engine * 1e3));
+  rows.emplace_back("rpc_total", absl::StrFormat("%.3f", best_rpc * 1e3));
+  rows.emplace_back("peak_memory_bytes", absl::StrCat(summary.peak_memory_bytes()));
+  rows.emplace_back("bytes_per_point",
+                    absl::StrFormat("%.1f", input_points == 0 ? 0.0
+                                                              : static_cast<double>(summary.peak_memory_bytes()) /
+                                                                    static_cast<double>(input_points)));
+  rows.emplace_back("comparisons_filter", absl::StrCat(summary.comparisons().filter()));
+  rows.emplace_back("comparisons_bounded_exact", absl::StrCat(summary.comparisons().device_exact()));
+  rows.emplace_back("comparisons_cpu_fallback", absl::StrCat(summary.comparisons().cpu_fallback()));
+  rows.emplace_back("spectrum_size", absl::StrCat(summary.spectrum_size()));
+  rows.emplace_back("backend", summary.backend());
+  return PrintBenchTable(common.file, input_points, summary.distinct_points(), repeat, best.size() + 2, rows);
+}
+
+}  // namespace galpha::alphactl

@@ -1,0 +1,169 @@
+#include "client/galpha_client.hpp"
+
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "absl/strings/str_cat.h"
+#include "core/point_set_handle.hpp"
+
+namespace galpha::client {
+
+namespace v1 = galpha::v1;
+
+absl::Status FromGrpc(const grpc::Status& status) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+absl::StatusOr<std::unique_ptr<AlphaClient>> AlphaClient::Connect(const ClientOptions& options) {
+  if (options.target.empty()) return absl::InvalidArgumentError("no server address (host:port)");
+  std::unique_ptr<AlphaClient> client(new AlphaClient());
+  client->options_ = options;
+  std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+  if (!options.tls_root_certs_pem.empty()) {
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = options.tls_root_certs_pem;
+    credentials = grpc::SslCredentials(ssl);
+  }
+  grpc::ChannelArguments arguments;
+  // Answers are chunked below 4 MiB, but a large Describe or Components answer may exceed it.
+  arguments.SetMaxReceiveMessageSize(std::numeric_limits<int>::max());
+  client->channel_ = grpc::CreateCustomChannel(options.target, credentials, arguments);
+  client->stub_ = v1::AlphaShapes::NewStub(client->channel_);
+  return client;
+}
+
+void AlphaClient::PrepareContext(grpc::ClientContext* context) const {
+  if (!options_.bearer_token.empty()) context->AddMetadata("authorization", "Bearer " + options_.bearer_token);
+  if (options_.deadline.count() > 0) context->set_deadline(std::chrono::system_clock::now() + options_.deadline);
+}
+
+absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, const BuildCallOptions& options) {
+  BuildResult result;
+  if (options.skip_upload_if_cached) {
+    const std::string handle = PointSetHandle(points);
+    auto described = Describe(handle);
+    if (described.ok()) {
+      result.handle = handle;
+      result.cached = true;
+      result.summary = described->summary();
+      return result;
+    }
+    if (!absl::IsNotFound(described.status())) return described.status();
+  }
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  v1::BuildResponse response;
+  std::unique_ptr<grpc::ClientWriter<v1::BuildRequest>> writer = stub_->Build(&context, &response);
+  v1::BuildRequest message;
+  message.mutable_header()->set_name(options.name);
+  message.mutable_header()->set_expected_points(points.size());
+  bool open = writer->Write(message);
+  for (size_t begin = 0; open && begin < points.size(); begin += kPointsPerChunk) {
+    const size_t count = std::min(kPointsPerChunk, points.size() - begin);
+    auto* coordinates = message.mutable_points()->mutable_coordinates();
+    const double* data = &points[begin].x;
+    coordinates->Assign(data, data + 2 * count);
+    open = writer->Write(message);
+    if (open && options.progress) options.progress(begin + count);
+  }
+  // A write fails when the server has already answered (an error): Finish returns that answer.
+  if (open) writer->WritesDone();
+  absl::Status status = FromGrpc(writer->Finish());
+  if (!status.ok()) return status;
+  result.handle = response.handle();
+  result.cached = response.cached();
+  result.uploaded = true;
+  result.summary = response.summary();
+  return result;
+}
+
+absl::StatusOr<v1::DescribeResponse> AlphaClient::Describe(const std::string& handle) {
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  v1::DescribeRequest request;
+  request.set_handle(handle);
+  v1::DescribeResponse response;
+  absl::Status status = FromGrpc(stub_->Describe(&context, request, &response));
+  if (!status.ok()) return status;
+  return response;
+}
+
+absl::StatusOr<v1::SpectrumResponse> AlphaClient::Spectrum(const v1::SpectrumRequest& request) {
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  v1::SpectrumResponse response;
+  absl::Status status = FromGrpc(stub_->Spectrum(&context, request, &response));
+  if (!status.ok()) return status;
+  return response;
+}
+
+absl::StatusOr<v1::ComponentsResponse> AlphaClient::Components(const v1::ComponentsRequest& request) {
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  v1::ComponentsResponse response;
+  absl::Status status = FromGrpc(stub_->Components(&context, request, &response));
+  if (!status.ok()) return status;
+  return response;
+}
+
+absl::StatusOr<v1::OptimalAlphaResponse> AlphaClient::OptimalAlpha(const v1::OptimalAlphaRequest& request) {
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  v1::OptimalAlphaResponse response;
+  absl::Status status = FromGrpc(stub_->OptimalAlpha(&context, request, &response));
+  if (!status.ok()) return status;
+  return response;
+}
+
+absl::StatusOr<v1::ReleaseResponse> AlphaClient::Release(const std::string& handle) {
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  v1::ReleaseRequest request;
+  request.set_handle(handle);
+  v1::ReleaseResponse response;
+  absl::Status status = FromGrpc(stub_->Release(&context, request, &response));
+  if (!status.ok()) return status;
+  return response;
+}
+
+template <typename Response, typename Request>
+absl::Status AlphaClient::ReadStream(
+    std::unique_ptr<grpc::ClientReader<Response>> (v1::AlphaShapes::Stub::*call)(grpc::ClientContext*, const Request&),
+    const Request& request, const std::function<absl::Status(const Response&)>& on_message) {
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  std::unique_ptr<grpc::ClientReader<Response>> reader = ((*stub_).*call)(&context, request);
+  Response message;
+  absl::Status consumer_error;
+  while (reader->Read(&message)) {
+    consumer_error = on_message(message);
+    if (!consumer_error.ok()) {
+      context.TryCancel();
+      while (reader->Read(&message)) {
+      }
+      break;
+    }
+  }
+  absl::Status status = FromGrpc(reader->Finish());
+  return consumer_error.ok() ? status : consumer_error;
+}
+
+absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
+                                   const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message) {
+  return ReadStream(&v1::AlphaShapes::Stub::Classify, request, on_message);
+}
+
+absl::Status AlphaClient::MasterList(const v1::MasterListRequest& request,
+                                     const std::function<absl::Status(const v1::MasterListResponse&)>& on_message) {
+  return ReadStream(&v1::AlphaShapes::Stub::MasterList, request, on_message);
+}
+
+absl::Status AlphaClient::Shape(const v1::ShapeRequest& request,
+                                const std::function<absl::Status(const v1::ShapeResponse&)>& on_message) {
+  return ReadStream(&v1::AlphaShapes::Stub::Shape, request, on_message);
+}
+
+}  // namespace galpha::client

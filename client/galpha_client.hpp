@@ -1,0 +1,92 @@
+// The C++ client library of galpha.v1.AlphaShapes: connect (plaintext or TLS, optional bearer
+// token), build a point set (computing its handle locally and skipping the upload when the server
+// already holds it), and run every query, with gRPC statuses returned as absl::Status.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "absl/types/span.h"
+#include "core/point.hpp"
+#include "galpha/v1/alpha_shapes.grpc.pb.h"
+
+namespace galpha::client {
+
+struct ClientOptions {
+  /// "host:port".
+  std::string target;
+  /// PEM root certificates: set turns TLS on.
+  std::string tls_root_certs_pem;
+  /// Sent as "authorization: Bearer TOKEN" when not empty.
+  std::string bearer_token;
+  /// Per-call deadline; zero: none.
+  std::chrono::milliseconds deadline{0};
+};
+
+/// Points per Build chunk: 1 MiB of doubles, well under gRPC's 4 MiB message limit.
+inline constexpr size_t kPointsPerChunk = 65536;
+
+struct BuildResult {
+  std::string handle;
+  /// The server already held the family (nothing was computed).
+  bool cached = false;
+  /// The points were streamed (false when the handle was found before any upload).
+  bool uploaded = false;
+  galpha::v1::BuildSummary summary;
+};
+
+struct BuildCallOptions {
+  std::string name;
+  /// Ask Describe first and skip the upload when the server holds the handle.
+  bool skip_upload_if_cached = true;
+  /// Called after each chunk with the number of points sent.
+  std::function<void(uint64_t sent)> progress;
+};
+
+/// gRPC status to absl::Status (the codes are the same numbers).
+absl::Status FromGrpc(const grpc::Status& status);
+
+class AlphaClient {
+ public:
+  /// Does not contact the server (gRPC connects lazily); errors only for unreadable options.
+  static absl::StatusOr<std::unique_ptr<AlphaClient>> Connect(const ClientOptions& options);
+
+  absl::StatusOr<BuildResult> Build(absl::Span<const Point2> points, const BuildCallOptions& options = {});
+  absl::StatusOr<galpha::v1::DescribeResponse> Describe(const std::string& handle);
+  absl::StatusOr<galpha::v1::SpectrumResponse> Spectrum(const galpha::v1::SpectrumRequest& request);
+  absl::StatusOr<galpha::v1::ComponentsResponse> Components(const galpha::v1::ComponentsRequest& request);
+  absl::StatusOr<galpha::v1::OptimalAlphaResponse> OptimalAlpha(const galpha::v1::OptimalAlphaRequest& request);
+  absl::StatusOr<galpha::v1::ReleaseResponse> Release(const std::string& handle);
+
+  /// Server-streamed answers: `on_message` sees each message; an error it returns cancels the
+  /// call and is returned.
+  absl::Status Classify(const galpha::v1::ClassifyRequest& request,
+                        const std::function<absl::Status(const galpha::v1::ClassifyResponse&)>& on_message);
+  absl::Status MasterList(const galpha::v1::MasterListRequest& request,
+                          const std::function<absl::Status(const galpha::v1::MasterListResponse&)>& on_message);
+  absl::Status Shape(const galpha::v1::ShapeRequest& request,
+                     const std::function<absl::Status(const galpha::v1::ShapeResponse&)>& on_message);
+
+  /// For callers that need more (tests, benchmarks): a context with the token and deadline set.
+  void PrepareContext(grpc::ClientContext* context) const;
+  galpha::v1::AlphaShapes::Stub& stub() { return *stub_; }
+  const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
+
+ private:
+  template <typename Response, typename Request>
+  absl::Status ReadStream(
+      std::unique_ptr<grpc::ClientReader<Response>> (galpha::v1::AlphaShapes::Stub::*call)(grpc::ClientContext*,
+                                                                                         const Request&),
+      const Request& request, const std::function<absl::Status(const Response&)>& on_message);
+
+  ClientOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<galpha::v1::AlphaShapes::Stub> stub_;
+};
+
+}  // namespace galpha::client
