@@ -51,6 +51,8 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   size_t build_slots() const { return scheduler_->slots(); }
   size_t build_memory_bytes() const { return scheduler_->memory_budget_bytes(); }
   FamilyCache& cache() { return *cache_; }
+  /// Bytes of points held by uploads and builds right now.
+  size_t in_flight_bytes() const { return in_flight_.held(); }
 
   /// Refuses new builds (UNAVAILABLE); queued builds that have not started fail UNAVAILABLE,
   /// running ones finish. Queries go on until the server shuts down.

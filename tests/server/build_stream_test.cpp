@@ -1,0 +1,427 @@
+// The Build stream decoder against the protocol (proto/galpha/v1/alpha_shapes.proto, BuildRequest):
+// the order of header and chunks, every limit as the messages arrive, NaN and infinity named by
+// their index in the whole stream, the points decoded bit for bit and the handle independent of
+// how the points are split into chunks; and the server-wide bytes in flight, held and given back.
+#include "server/build_stream.hpp"
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/types/span.h"
+#include "core/point_set_handle.hpp"
+#include "gtest/gtest.h"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha::server {
+namespace {
+
+namespace v1 = galpha::v1;
+
+v1::BuildRequest Header(uint64_t expected_points, const std::string& name = "test") {
+  v1::BuildRequest message;
+  message.mutable_header()->set_name(name);
+  message.mutable_header()->set_expected_points(expected_points);
+  return message;
+}
+
+v1::BuildRequest Chunk(const std::vector<double>& coordinates) {
+  v1::BuildRequest message;
+  message.mutable_points()->mutable_coordinates()->Add(coordinates.begin(), coordinates.end());
+  return message;
+}
+
+v1::BuildRequest Chunk(absl::Span<const Point2> points) {
+  v1::BuildRequest message;
+  auto* coordinates = message.mutable_points()->mutable_coordinates();
+  for (const Point2& p : points) {
+    coordinates->Add(p.x);
+    coordinates->Add(p.y);
+  }
+  return message;
+}
+
+// A chunk that is present but holds no coordinates (the oneof case is set).
+v1::BuildRequest EmptyChunk() {
+  v1::BuildRequest message;
+  message.mutable_points();
+  return message;
+}
+
+uint64_t Bits(double value) {
+  uint64_t bits;
+  std::memcpy(&bits, &value, sizeof(bits));
+  return bits;
+}
+
+TEST(BuildStreamDecoderTest, DecodesHeaderAndChunks) {
+  const std::vector<Point2> points = gen::Uniform(10, 1);
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(10, "ten points")).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(absl::MakeConstSpan(points).subspan(0, 4))).ok());
+  EXPECT_EQ(decoder.points_received(), 4u);
+  ASSERT_TRUE(decoder.Add(Chunk(absl::MakeConstSpan(points).subspan(4))).ok());
+  EXPECT_EQ(decoder.points_received(), 10u);
+  absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ((*decoded)->header.name(), "ten points");
+  EXPECT_EQ((*decoded)->header.expected_points(), 10u);
+  EXPECT_EQ((*decoded)->points, points);
+  EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
+  EXPECT_TRUE(IsWellFormedHandle((*decoded)->handle));
+}
+
+TEST(BuildStreamDecoderTest, HeaderMustComeFirst) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  const absl::Status status = decoder.Add(Chunk(std::vector<double>{1.0, 2.0}));
+  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_NE(status.message().find("header"), absl::string_view::npos) << status;
+  EXPECT_EQ(decoder.points_received(), 0u);
+}
+
+TEST(BuildStreamDecoderTest, EmptyChunkBeforeHeaderIsRefused) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  EXPECT_TRUE(absl::IsInvalidArgument(decoder.Add(EmptyChunk())));
+}
+
+TEST(BuildStreamDecoderTest, SecondHeaderIsRefused) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})).ok());
+  const absl::Status status = decoder.Add(Header(0));
+  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_NE(status.message().find("second header"), absl::string_view::npos) << status;
+}
+
+TEST(BuildStreamDecoderTest, OddNumberOfDoublesIsRefused) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})).ok());
+  const absl::Status status = decoder.Add(Chunk(std::vector<double>{3.0, 4.0, 5.0}));
+  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_NE(status.message().find("odd"), absl::string_view::npos) << status;
+  EXPECT_EQ(decoder.points_received(), 1u) << "a refused chunk adds nothing";
+}
+
+// Whether `message` names point `index` exactly ("point 7 ", not "point 70").
+bool NamesPoint(absl::string_view message, uint64_t index) {
+  return message.find(absl::StrCat("point ", index, " ")) != absl::string_view::npos;
+}
+
+TEST(BuildStreamDecoderTest, NanNamesTheGlobalPointIndex) {
+  // The NaN is the y of the 5th point (index 4) of the second chunk; the first chunk holds 3
+  // points, so the point's index in the stream is 3 + 4 = 7.
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(3, 2))).ok());
+  std::vector<Point2> second = gen::Uniform(6, 3);
+  second[4].y = std::numeric_limits<double>::quiet_NaN();
+  const absl::Status status = decoder.Add(Chunk(second));
+  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_TRUE(NamesPoint(status.message(), 7)) << status;
+  EXPECT_NE(status.message().find("NaN"), absl::string_view::npos) << status;
+  EXPECT_NE(status.message().find(" y "), absl::string_view::npos) << status;
+  EXPECT_EQ(decoder.points_received(), 3u) << "a refused chunk adds nothing";
+}
+
+TEST(BuildStreamDecoderTest, InfinityNamesTheGlobalPointIndex) {
+  for (const double bad : {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
+    SCOPED_TRACE(bad);
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    ASSERT_TRUE(decoder.Add(Header(20)).ok());
+    ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(5, 4))).ok());
+    ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(2, 5))).ok());
+    std::vector<Point2> third = gen::Uniform(4, 6);
+    third[0].x = bad;  // index 5 + 2 + 0 = 7
+    const absl::Status status = decoder.Add(Chunk(third));
+    EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+    EXPECT_TRUE(NamesPoint(status.message(), 7)) << status;
+    EXPECT_NE(status.message().find("infinite"), absl::string_view::npos) << status;
+    EXPECT_NE(status.message().find(" x "), absl::string_view::npos) << status;
+  }
+}
+
+TEST(BuildStreamDecoderTest, NanInTheFirstPoint) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  const absl::Status status =
+      decoder.Add(Chunk(std::vector<double>{std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0, 1.0}));
+  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_TRUE(NamesPoint(status.message(), 0)) << status;
+}
+
+TEST(BuildStreamDecoderTest, MessageWithNeitherHeaderNorPointsIsRefused) {
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    EXPECT_TRUE(absl::IsInvalidArgument(decoder.Add(v1::BuildRequest())));
+  }
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    ASSERT_TRUE(decoder.Add(Header(0)).ok());
+    const absl::Status status = decoder.Add(v1::BuildRequest());
+    EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+    EXPECT_NE(status.message().find("neither"), absl::string_view::npos) << status;
+  }
+}
+
+TEST(BuildStreamDecoderTest, AnnouncedCountOverTheLimitIsRefusedAtTheHeader) {
+  BuildStreamLimits limits;
+  limits.max_points = 100;
+  BuildStreamDecoder decoder(limits, nullptr);
+  const absl::Status status = decoder.Add(Header(101));
+  EXPECT_TRUE(absl::IsResourceExhausted(status)) << status;
+  EXPECT_NE(status.message().find("100"), absl::string_view::npos) << status;
+
+  BuildStreamDecoder at_limit(limits, nullptr);
+  EXPECT_TRUE(at_limit.Add(Header(100)).ok());
+}
+
+TEST(BuildStreamDecoderTest, UnannouncedCountOverTheLimitIsRefusedAtTheChunk) {
+  BuildStreamLimits limits;
+  limits.max_points = 5;
+  BuildStreamDecoder decoder(limits, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(3, 7))).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(2, 8))).ok()) << "exactly the limit is allowed";
+  const absl::Status status = decoder.Add(Chunk(gen::Uniform(1, 9)));
+  EXPECT_TRUE(absl::IsResourceExhausted(status)) << status;
+  EXPECT_EQ(decoder.points_received(), 5u);
+}
+
+TEST(BuildStreamDecoderTest, FewerPointsThanAnnouncedIsRefusedAtFinish) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(10)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(9, 10))).ok());
+  const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  EXPECT_TRUE(absl::IsInvalidArgument(decoded.status())) << decoded.status();
+  EXPECT_NE(decoded.status().message().find("9"), absl::string_view::npos) << decoded.status();
+}
+
+TEST(BuildStreamDecoderTest, MorePointsThanAnnouncedIsRefusedAtTheChunk) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(10)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(8, 11))).ok());
+  const absl::Status status = decoder.Add(Chunk(gen::Uniform(3, 12)));
+  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_EQ(decoder.points_received(), 8u);
+}
+
+TEST(BuildStreamDecoderTest, EmptyStreamIsRefused) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  EXPECT_TRUE(absl::IsInvalidArgument(decoded.status())) << decoded.status();
+  EXPECT_NE(decoded.status().message().find("empty"), absl::string_view::npos) << decoded.status();
+}
+
+TEST(BuildStreamDecoderTest, HeaderWithZeroPointsIsAnEmptyPointSet) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_TRUE((*decoded)->points.empty());
+  EXPECT_EQ((*decoded)->handle, PointSetHandle({}));
+}
+
+TEST(BuildStreamDecoderTest, NothingIsAcceptedAfterFinish) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_TRUE(decoder.Finish().ok());
+  EXPECT_TRUE(absl::IsFailedPrecondition(decoder.Add(Chunk(std::vector<double>{1.0, 2.0}))));
+  EXPECT_TRUE(absl::IsFailedPrecondition(decoder.Finish().status()));
+}
+
+// Decodes `points` split at `cuts` (ascending point counts; a repeated cut is an empty chunk).
+absl::StatusOr<std::string> DecodeSplit(const std::vector<Point2>& points, const std::vector<size_t>& cuts,
+                                        bool announce, std::vector<Point2>* decoded_points) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  if (absl::Status s = decoder.Add(Header(announce ? points.size() : 0)); !s.ok()) return s;
+  size_t begin = 0;
+  std::vector<size_t> ends = cuts;
+  ends.push_back(points.size());
+  for (const size_t end : ends) {
+    const v1::BuildRequest chunk =
+        end == begin ? EmptyChunk() : Chunk(absl::MakeConstSpan(points).subspan(begin, end - begin));
+    if (absl::Status s = decoder.Add(chunk); !s.ok()) return s;
+    begin = end;
+  }
+  absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  if (!decoded.ok()) return decoded.status();
+  *decoded_points = (*decoded)->points;
+  return (*decoded)->handle;
+}
+
+TEST(BuildStreamDecoderTest, HandleDoesNotDependOnTheSplit) {
+  const std::vector<Point2> points = gen::WithDuplicates(100, 13);
+  const std::string expected = PointSetHandle(points);
+  const std::vector<std::vector<size_t>> splits = {
+      {},                           // one chunk
+      {0},                          // an empty chunk first
+      {50},                         // halves
+      {1, 2, 3, 99},                // single points at both ends
+      {10, 10, 10, 40, 100},        // empty chunks in the middle and at the end
+      {0, 0, 33, 66, 66, 100, 100}  // empty chunks everywhere
+  };
+  for (const bool announce : {false, true}) {
+    for (const std::vector<size_t>& cuts : splits) {
+      SCOPED_TRACE(absl::StrCat("announce ", announce, ", cuts ", cuts.size(), " first ", cuts.empty() ? 0 : cuts[0]));
+      std::vector<Point2> decoded_points;
+      const absl::StatusOr<std::string> handle = DecodeSplit(points, cuts, announce, &decoded_points);
+      ASSERT_TRUE(handle.ok()) << handle.status();
+      EXPECT_EQ(*handle, expected);
+      EXPECT_EQ(decoded_points, points);
+    }
+  }
+  // One point per chunk.
+  std::vector<size_t> every;
+  for (size_t i = 1; i < points.size(); ++i) every.push_back(i);
+  std::vector<Point2> decoded_points;
+  const absl::StatusOr<std::string> handle = DecodeSplit(points, every, true, &decoded_points);
+  ASSERT_TRUE(handle.ok()) << handle.status();
+  EXPECT_EQ(*handle, expected);
+}
+
+TEST(BuildStreamDecoderTest, DifferentPointsGiveDifferentHandles) {
+  std::vector<Point2> points = gen::Uniform(20, 14);
+  std::vector<Point2> decoded_points;
+  const absl::StatusOr<std::string> a = DecodeSplit(points, {}, false, &decoded_points);
+  std::swap(points[0], points[1]);  // order matters: answers name points by index
+  const absl::StatusOr<std::string> b = DecodeSplit(points, {}, false, &decoded_points);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_NE(*a, *b);
+}
+
+TEST(BuildStreamDecoderTest, PointsAreDecodedBitForBit) {
+  const std::vector<double> coordinates = {-0.0,
+                                           0.0,
+                                           std::numeric_limits<double>::denorm_min(),
+                                           -std::numeric_limits<double>::denorm_min(),
+                                           1e300,
+                                           -1e300,
+                                           std::numeric_limits<double>::max(),
+                                           std::numeric_limits<double>::lowest(),
+                                           std::numeric_limits<double>::min() / 3.0,  // subnormal
+                                           0.1,
+                                           1.0 / 3.0,
+                                           -12345.678901234567};
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_TRUE(decoder.Add(Header(coordinates.size() / 2)).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>(coordinates.begin(), coordinates.begin() + 4))).ok());
+  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>(coordinates.begin() + 4, coordinates.end()))).ok());
+  const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  const std::vector<Point2>& points = (*decoded)->points;
+  ASSERT_EQ(points.size() * 2, coordinates.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(Bits(points[i].x), Bits(coordinates[2 * i]));
+    EXPECT_EQ(Bits(points[i].y), Bits(coordinates[2 * i + 1]));
+  }
+  EXPECT_TRUE(std::signbit(points[0].x)) << "-0.0 keeps its sign";
+  EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
+  // -0.0 and 0.0 are equal doubles but different inputs: their handles differ.
+  std::vector<Point2> positive_zero = points;
+  positive_zero[0].x = 0.0;
+  EXPECT_NE(PointSetHandle(positive_zero), (*decoded)->handle);
+}
+
+// ---- InFlightBytes --------------------------------------------------------------------------------
+
+TEST(InFlightBytesTest, ReservesUpToTheLimit) {
+  InFlightBytes in_flight(100);
+  EXPECT_EQ(in_flight.limit(), 100u);
+  EXPECT_TRUE(in_flight.TryReserve(60));
+  EXPECT_FALSE(in_flight.TryReserve(41));
+  EXPECT_EQ(in_flight.held(), 60u) << "a refused reservation holds nothing";
+  EXPECT_TRUE(in_flight.TryReserve(40));
+  EXPECT_EQ(in_flight.held(), 100u);
+  in_flight.Release(100);
+  EXPECT_EQ(in_flight.held(), 0u);
+}
+
+TEST(InFlightBytesTest, ZeroLimitAdmitsEverything) {
+  InFlightBytes in_flight(0);
+  EXPECT_TRUE(in_flight.TryReserve(size_t{1} << 40));
+  EXPECT_TRUE(in_flight.TryReserve(size_t{1} << 40));
+  EXPECT_EQ(in_flight.held(), size_t{2} << 40);
+}
+
+TEST(InFlightBytesTest, AnnouncedStreamOverTheLimitIsRefusedAndReleasePointsFreesTheBytes) {
+  InFlightBytes in_flight(100 * sizeof(Point2));
+  auto first = std::make_unique<BuildStreamDecoder>(BuildStreamLimits{}, &in_flight);
+  ASSERT_TRUE(first->Add(Header(60)).ok());
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "the announced size is reserved up front";
+
+  BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
+  const absl::Status refused = second.Add(Header(60));
+  EXPECT_TRUE(absl::IsResourceExhausted(refused)) << refused;
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2));
+
+  const std::vector<Point2> points = gen::Uniform(60, 15);
+  ASSERT_TRUE(first->Add(Chunk(points)).ok());
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "announced chunks reserve nothing more";
+  const absl::StatusOr<DecodedBuild*> decoded = first->Finish();
+  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "Finish keeps the reservation";
+  first->ReleasePoints();
+  EXPECT_EQ(in_flight.held(), 0u);
+  EXPECT_TRUE((*decoded)->points.empty());
+  first.reset();
+  EXPECT_EQ(in_flight.held(), 0u) << "the destructor does not release twice";
+
+  BuildStreamDecoder third(BuildStreamLimits{}, &in_flight);
+  ASSERT_TRUE(third.Add(Header(60)).ok());
+  ASSERT_TRUE(third.Add(Chunk(points)).ok());
+  const absl::StatusOr<DecodedBuild*> third_decoded = third.Finish();
+  ASSERT_TRUE(third_decoded.ok()) << third_decoded.status();
+  EXPECT_EQ((*third_decoded)->handle, PointSetHandle(points));
+}
+
+TEST(InFlightBytesTest, DestructorFreesTheBytes) {
+  InFlightBytes in_flight(100 * sizeof(Point2));
+  {
+    BuildStreamDecoder first(BuildStreamLimits{}, &in_flight);
+    ASSERT_TRUE(first.Add(Header(70)).ok());
+    ASSERT_TRUE(first.Add(Chunk(gen::Uniform(70, 16))).ok());
+    ASSERT_TRUE(first.Finish().ok());
+    BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
+    EXPECT_TRUE(absl::IsResourceExhausted(second.Add(Header(70))));
+    EXPECT_EQ(in_flight.held(), 70 * sizeof(Point2));
+  }
+  EXPECT_EQ(in_flight.held(), 0u);
+  BuildStreamDecoder third(BuildStreamLimits{}, &in_flight);
+  EXPECT_TRUE(third.Add(Header(70)).ok());
+}
+
+TEST(InFlightBytesTest, UnannouncedChunksReserveAsTheyArrive) {
+  InFlightBytes in_flight(100 * sizeof(Point2));
+  BuildStreamDecoder first(BuildStreamLimits{}, &in_flight);
+  ASSERT_TRUE(first.Add(Header(0)).ok());
+  EXPECT_EQ(in_flight.held(), 0u);
+  ASSERT_TRUE(first.Add(Chunk(gen::Uniform(30, 17))).ok());
+  EXPECT_EQ(in_flight.held(), 30 * sizeof(Point2));
+  ASSERT_TRUE(first.Add(Chunk(gen::Uniform(30, 18))).ok());
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2));
+
+  BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
+  ASSERT_TRUE(second.Add(Header(0)).ok());
+  ASSERT_TRUE(second.Add(Chunk(gen::Uniform(40, 19))).ok()) << "exactly the limit";
+  const absl::Status refused = second.Add(Chunk(gen::Uniform(1, 20)));
+  EXPECT_TRUE(absl::IsResourceExhausted(refused)) << refused;
+  EXPECT_EQ(in_flight.held(), 100 * sizeof(Point2));
+
+  first.ReleasePoints();
+  EXPECT_EQ(in_flight.held(), 40 * sizeof(Point2));
+  EXPECT_TRUE(second.Add(Chunk(gen::Uniform(1, 20))).ok()) << "the released bytes are available again";
+  EXPECT_EQ(second.points_received(), 41u);
+  second.ReleasePoints();
+  EXPECT_EQ(in_flight.held(), 0u);
+}
+
+}  // namespace
+}  // namespace galpha::server

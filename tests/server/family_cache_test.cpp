@@ -1,0 +1,396 @@
+// The family cache with real families (small point sets built on the CPU backend): hits and misses,
+// least-recently-used eviction under a byte budget, tenants kept apart, the first of two racing
+// inserts kept, the observer agreeing with the statistics, and a family in use outliving its
+// eviction. Also the index orders a CachedFamily computes for Classify.
+#include "server/family_cache.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "gpu/alpha_engine.hpp"
+#include "gtest/gtest.h"
+#include "server/cached_family.hpp"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha::server {
+namespace {
+
+std::shared_ptr<const CachedFamily> MakeFamily(const std::vector<Point2>& points, const std::string& name) {
+  BuildOptions options;
+  options.backend = Backend::kCpu;
+  absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(points, options);
+  if (!family.ok()) {
+    ADD_FAILURE() << name << ": " << family.status();
+    return nullptr;
+  }
+  return std::make_shared<const CachedFamily>(*std::move(family), name, points.size());
+}
+
+// Records every callback, so that tests compare it with GetStats().
+class RecordingObserver : public CacheObserver {
+ public:
+  void OnLookup(bool hit) override { ++(hit ? hits : misses); }
+  void OnEviction() override { ++evictions; }
+  void OnSize(size_t bytes, size_t entries) override {
+    last_bytes = bytes;
+    last_entries = entries;
+    ++size_reports;
+  }
+
+  uint64_t hits = 0, misses = 0, evictions = 0, size_reports = 0;
+  size_t last_bytes = 0, last_entries = 0;
+};
+
+void ExpectObserverAgrees(const RecordingObserver& observer, const FamilyCache& cache) {
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(observer.hits, stats.hits);
+  EXPECT_EQ(observer.misses, stats.misses);
+  EXPECT_EQ(observer.evictions, stats.evictions);
+  EXPECT_EQ(observer.last_bytes, stats.bytes);
+  EXPECT_EQ(observer.last_entries, stats.entries);
+}
+
+class FamilyCacheTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    a_ = MakeFamily(gen::Uniform(40, 1), "a");
+    b_ = MakeFamily(gen::Uniform(50, 2), "b");
+    c_ = MakeFamily(gen::Uniform(60, 3), "c");
+    ASSERT_NE(a_, nullptr);
+    ASSERT_NE(b_, nullptr);
+    ASSERT_NE(c_, nullptr);
+    // Any two fit, all three do not.
+    two_fit_ = std::max({a_->bytes() + b_->bytes(), b_->bytes() + c_->bytes(), a_->bytes() + c_->bytes()});
+    ASSERT_LT(two_fit_, a_->bytes() + b_->bytes() + c_->bytes());
+  }
+
+  std::shared_ptr<const CachedFamily> a_, b_, c_;
+  size_t two_fit_ = 0;
+};
+
+TEST_F(FamilyCacheTest, FindCountsMissesAndHits) {
+  RecordingObserver observer;
+  FamilyCache cache(size_t{1} << 30, &observer);
+  EXPECT_EQ(observer.size_reports, 1u) << "the constructor reports the empty cache";
+  EXPECT_EQ(cache.byte_budget(), size_t{1} << 30);
+
+  EXPECT_EQ(cache.Find("", "h-a"), nullptr);
+  auto inserted = cache.Insert("", "h-a", a_);
+  ASSERT_TRUE(inserted.ok()) << inserted.status();
+  EXPECT_EQ(inserted->get(), a_.get());
+  EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
+  EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
+  EXPECT_EQ(cache.Find("", "h-b"), nullptr);
+
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(stats.hits, 2u);
+  EXPECT_EQ(stats.misses, 2u);
+  EXPECT_EQ(stats.entries, 1u);
+  EXPECT_EQ(stats.bytes, a_->bytes());
+  EXPECT_EQ(stats.evictions, 0u);
+  ExpectObserverAgrees(observer, cache);
+}
+
+TEST_F(FamilyCacheTest, EvictsTheLeastRecentlyUsed) {
+  RecordingObserver observer;
+  FamilyCache cache(two_fit_, &observer);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  EXPECT_EQ(cache.GetStats().entries, 2u);
+  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(stats.evictions, 1u);
+  EXPECT_EQ(stats.entries, 2u);
+  EXPECT_EQ(stats.bytes, b_->bytes() + c_->bytes());
+  EXPECT_LE(stats.bytes, cache.byte_budget());
+  EXPECT_EQ(cache.Find("", "h-a"), nullptr) << "a was the least recently used";
+  EXPECT_EQ(cache.Find("", "h-b").get(), b_.get());
+  EXPECT_EQ(cache.Find("", "h-c").get(), c_.get());
+  ExpectObserverAgrees(observer, cache);
+}
+
+TEST_F(FamilyCacheTest, FindMakesAFamilyTheMostRecentlyUsed) {
+  RecordingObserver observer;
+  FamilyCache cache(two_fit_, &observer);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_EQ(cache.Find("", "h-a").get(), a_.get());  // now b is the least recently used
+  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+
+  EXPECT_EQ(cache.GetStats().evictions, 1u);
+  EXPECT_EQ(cache.GetStats().bytes, a_->bytes() + c_->bytes());
+  EXPECT_EQ(cache.Find("", "h-b"), nullptr) << "b was the least recently used";
+  EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
+  EXPECT_EQ(cache.Find("", "h-c").get(), c_.get());
+  ExpectObserverAgrees(observer, cache);
+}
+
+TEST_F(FamilyCacheTest, ReinsertMakesAFamilyTheMostRecentlyUsed) {
+  FamilyCache cache(two_fit_, nullptr);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());  // an existing key is touched, not added
+  EXPECT_EQ(cache.GetStats().entries, 2u);
+  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  EXPECT_EQ(cache.Find("", "h-b"), nullptr);
+  EXPECT_NE(cache.Find("", "h-a"), nullptr);
+}
+
+TEST_F(FamilyCacheTest, EvictsAsManyAsNeeded) {
+  // a and b fit together; c alone fills the budget, so both go.
+  const size_t budget = std::max(a_->bytes() + b_->bytes(), c_->bytes());
+  ASSERT_LT(budget, a_->bytes() + c_->bytes());
+  ASSERT_LT(budget, b_->bytes() + c_->bytes());
+  RecordingObserver observer;
+  FamilyCache cache(budget, &observer);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  EXPECT_EQ(cache.GetStats().evictions, 2u);
+  EXPECT_EQ(cache.GetStats().entries, 1u);
+  EXPECT_EQ(cache.GetStats().bytes, c_->bytes());
+  ExpectObserverAgrees(observer, cache);
+}
+
+TEST_F(FamilyCacheTest, FamilyLargerThanTheBudgetIsRefused) {
+  RecordingObserver observer;
+  FamilyCache cache(c_->bytes() - 1, &observer);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  const auto refused = cache.Insert("", "h-c", c_);
+  EXPECT_TRUE(absl::IsResourceExhausted(refused.status())) << refused.status();
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(stats.evictions, 0u) << "a refused family evicts nothing";
+  EXPECT_EQ(stats.entries, 1u);
+  EXPECT_EQ(stats.bytes, a_->bytes());
+  EXPECT_EQ(cache.Find("", "h-c"), nullptr);
+  EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
+  ExpectObserverAgrees(observer, cache);
+
+  FamilyCache exact(c_->bytes(), nullptr);
+  EXPECT_TRUE(exact.Insert("", "h-c", c_).ok()) << "a family exactly the budget fits";
+}
+
+TEST_F(FamilyCacheTest, TenantsAreIsolated) {
+  FamilyCache cache(size_t{1} << 30, nullptr);
+  ASSERT_TRUE(cache.Insert("alice", "h", a_).ok());
+  EXPECT_EQ(cache.Find("bob", "h"), nullptr);
+  EXPECT_EQ(cache.Find("", "h"), nullptr);
+  EXPECT_EQ(cache.Find("alice", "h").get(), a_.get());
+
+  const auto bobs = cache.Insert("bob", "h", b_);
+  ASSERT_TRUE(bobs.ok());
+  EXPECT_EQ(bobs->get(), b_.get()) << "the same handle under another tenant is another entry";
+  EXPECT_EQ(cache.GetStats().entries, 2u);
+  EXPECT_EQ(cache.GetStats().bytes, a_->bytes() + b_->bytes());
+  EXPECT_EQ(cache.Find("alice", "h").get(), a_.get());
+  EXPECT_EQ(cache.Find("bob", "h").get(), b_.get());
+
+  EXPECT_TRUE(cache.Erase("bob", "h"));
+  EXPECT_EQ(cache.Find("bob", "h"), nullptr);
+  EXPECT_EQ(cache.Find("alice", "h").get(), a_.get()) << "erasing one tenant's entry keeps the other's";
+}
+
+TEST_F(FamilyCacheTest, TenantAndHandleDoNotRunTogether) {
+  // A key built by plain concatenation would confuse ("ab", "c") with ("a", "bc").
+  FamilyCache cache(size_t{1} << 30, nullptr);
+  ASSERT_TRUE(cache.Insert("ab", "c", a_).ok());
+  EXPECT_EQ(cache.Find("a", "bc"), nullptr);
+  EXPECT_EQ(cache.Find("abc", ""), nullptr);
+}
+
+TEST_F(FamilyCacheTest, InsertOfAnExistingKeyReturnsTheCachedFamily) {
+  RecordingObserver observer;
+  FamilyCache cache(size_t{1} << 30, &observer);
+  const auto first = cache.Insert("", "h", a_);
+  ASSERT_TRUE(first.ok());
+  // A second build of the same points races with the first: its family is another object.
+  const std::shared_ptr<const CachedFamily> again = MakeFamily(gen::Uniform(40, 1), "a again");
+  ASSERT_NE(again, nullptr);
+  ASSERT_NE(again.get(), a_.get());
+  const auto second = cache.Insert("", "h", again);
+  ASSERT_TRUE(second.ok());
+  EXPECT_EQ(second->get(), a_.get());
+  EXPECT_EQ(cache.Find("", "h").get(), a_.get());
+  EXPECT_EQ(cache.GetStats().entries, 1u);
+  EXPECT_EQ(cache.GetStats().bytes, a_->bytes());
+  ExpectObserverAgrees(observer, cache);
+}
+
+TEST_F(FamilyCacheTest, Erase) {
+  RecordingObserver observer;
+  FamilyCache cache(size_t{1} << 30, &observer);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  EXPECT_FALSE(cache.Erase("", "h-c"));
+  EXPECT_FALSE(cache.Erase("other", "h-a"));
+  EXPECT_TRUE(cache.Erase("", "h-a"));
+  EXPECT_FALSE(cache.Erase("", "h-a")) << "Erase is idempotent";
+  EXPECT_EQ(cache.Find("", "h-a"), nullptr);
+  EXPECT_EQ(cache.Find("", "h-b").get(), b_.get());
+
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(stats.entries, 1u);
+  EXPECT_EQ(stats.bytes, b_->bytes());
+  EXPECT_EQ(stats.evictions, 0u) << "an erase is not an eviction";
+  ExpectObserverAgrees(observer, cache);
+
+  EXPECT_TRUE(cache.Erase("", "h-b"));
+  EXPECT_EQ(cache.GetStats().bytes, 0u);
+  EXPECT_EQ(cache.GetStats().entries, 0u);
+  ExpectObserverAgrees(observer, cache);
+  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok()) << "an erased key can be cached again";
+  EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
+}
+
+TEST_F(FamilyCacheTest, StatsAndObserverAgreeThroughAMixedSequence) {
+  RecordingObserver observer;
+  FamilyCache cache(two_fit_, &observer);
+  const std::vector<std::shared_ptr<const CachedFamily>> families = {a_, b_, c_};
+  for (int round = 0; round < 5; ++round) {
+    for (size_t i = 0; i < families.size(); ++i) {
+      const std::string handle = absl::StrCat("h", i);
+      if (cache.Find("", handle) == nullptr) {
+        ASSERT_TRUE(cache.Insert("", handle, families[i]).ok());
+      }
+      ExpectObserverAgrees(observer, cache);
+      EXPECT_LE(cache.GetStats().bytes, cache.byte_budget());
+    }
+    if (round == 2) cache.Erase("", "h1");
+    ExpectObserverAgrees(observer, cache);
+  }
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(stats.hits + stats.misses, 15u);
+  EXPECT_GT(stats.evictions, 0u);
+  EXPECT_EQ(stats.entries, 2u);
+}
+
+TEST_F(FamilyCacheTest, FamilyHeldByACallerOutlivesItsEviction) {
+  FamilyCache cache(two_fit_, nullptr);
+  ASSERT_TRUE(cache.Insert("", "h-a", MakeFamily(gen::Uniform(40, 1), "held")).ok());
+  std::shared_ptr<const CachedFamily> held = cache.Find("", "h-a");
+  ASSERT_NE(held, nullptr);
+  const size_t points = held->family().points().size();
+  const size_t triangles = held->family().triangles().size();
+  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  ASSERT_EQ(cache.Find("", "h-a"), nullptr) << "evicted";
+  EXPECT_EQ(held.use_count(), 1) << "the caller's reference is the only one left";
+  EXPECT_EQ(held->name(), "held");
+  EXPECT_EQ(held->family().points().size(), points);
+  EXPECT_EQ(held->family().triangles().size(), triangles);
+  EXPECT_EQ(held->EdgeOrder().size(), held->family().edges().size());
+}
+
+TEST_F(FamilyCacheTest, ConcurrentLookupsAndInsertsAreCounted) {
+  RecordingObserver observer;  // called under the cache's lock, so plain counters suffice
+  FamilyCache cache(two_fit_, &observer);
+  const std::vector<std::shared_ptr<const CachedFamily>> families = {a_, b_, c_};
+  constexpr int kThreads = 4;
+  constexpr int kLookups = 300;
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < kLookups; ++i) {
+        const size_t f = static_cast<size_t>(i + t) % families.size();
+        const std::string handle = absl::StrCat("h", f);
+        std::shared_ptr<const CachedFamily> found = cache.Find("", handle);
+        if (found == nullptr) {
+          const auto inserted = cache.Insert("", handle, families[f]);
+          if (!inserted.ok()) ADD_FAILURE() << inserted.status();
+        } else if (found.get() != families[f].get()) {
+          ADD_FAILURE() << "handle " << handle << " found another family";
+        }
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  const FamilyCache::Stats stats = cache.GetStats();
+  EXPECT_EQ(stats.hits + stats.misses, uint64_t{kThreads * kLookups});
+  EXPECT_LE(stats.bytes, cache.byte_budget());
+  ExpectObserverAgrees(observer, cache);
+}
+
+// ---- CachedFamily's index orders ------------------------------------------------------------------
+
+void ExpectIsPermutation(const std::vector<uint32_t>& order, size_t n) {
+  ASSERT_EQ(order.size(), n);
+  std::vector<bool> seen(n, false);
+  for (const uint32_t id : order) {
+    ASSERT_LT(id, n);
+    EXPECT_FALSE(seen[id]) << "id " << id << " appears twice";
+    seen[id] = true;
+  }
+}
+
+TEST(CachedFamilyTest, OrdersArePermutationsSortedByVertexIndices) {
+  for (const gen::NamedGenerator& generator : gen::AllDistributions()) {
+    SCOPED_TRACE(generator.name);
+    const std::vector<Point2> points = generator.generate(300, 21);
+    const std::shared_ptr<const CachedFamily> cached = MakeFamily(points, generator.name);
+    ASSERT_NE(cached, nullptr);
+    const AlphaFamily& family = cached->family();
+    const size_t bytes = cached->bytes();
+
+    const std::vector<uint32_t>& edge_order = cached->EdgeOrder();
+    ExpectIsPermutation(edge_order, family.edges().size());
+    std::vector<std::array<uint32_t, 2>> edges;
+    for (const uint32_t e : edge_order) {
+      const auto& edge = family.edges()[e];
+      edges.push_back({std::min(edge[0], edge[1]), std::max(edge[0], edge[1])});
+    }
+    EXPECT_TRUE(std::is_sorted(edges.begin(), edges.end()));
+    EXPECT_TRUE(std::adjacent_find(edges.begin(), edges.end()) == edges.end()) << "an edge appears twice";
+
+    const std::vector<uint32_t>& triangle_order = cached->TriangleOrder();
+    ExpectIsPermutation(triangle_order, family.triangles().size());
+    std::vector<std::array<uint32_t, 3>> triangles;
+    for (const uint32_t t : triangle_order) {
+      std::array<uint32_t, 3> triangle = family.triangles()[t];
+      std::sort(triangle.begin(), triangle.end());
+      triangles.push_back(triangle);
+    }
+    EXPECT_TRUE(std::is_sorted(triangles.begin(), triangles.end()));
+    EXPECT_TRUE(std::adjacent_find(triangles.begin(), triangles.end()) == triangles.end());
+
+    EXPECT_EQ(&cached->EdgeOrder(), &edge_order) << "computed once";
+    EXPECT_EQ(cached->bytes(), bytes) << "the charge does not change once the orders exist";
+    EXPECT_GE(bytes, family.HostBytes() + (edges.size() + triangles.size()) * sizeof(uint32_t));
+  }
+}
+
+TEST(CachedFamilyTest, OrdersOfTinyInputs) {
+  for (size_t n = 0; n <= 3; ++n) {
+    SCOPED_TRACE(n);
+    const std::shared_ptr<const CachedFamily> cached = MakeFamily(gen::Uniform(n, 22), "tiny");
+    ASSERT_NE(cached, nullptr);
+    ExpectIsPermutation(cached->EdgeOrder(), cached->family().edges().size());
+    ExpectIsPermutation(cached->TriangleOrder(), cached->family().triangles().size());
+    EXPECT_EQ(cached->name(), "tiny");
+  }
+}
+
+TEST(CachedFamilyTest, OrdersAreSafeToComputeFromManyThreads) {
+  const std::shared_ptr<const CachedFamily> cached = MakeFamily(gen::Uniform(2000, 23), "shared");
+  ASSERT_NE(cached, nullptr);
+  std::vector<const std::vector<uint32_t>*> seen(4, nullptr);
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < seen.size(); ++t) {
+    threads.emplace_back([&, t] { seen[t] = t % 2 == 0 ? &cached->EdgeOrder() : &cached->TriangleOrder(); });
+  }
+  for (std::thread& thread : threads) thread.join();
+  for (size_t t = 0; t < seen.size(); ++t) {
+    EXPECT_EQ(seen[t], t % 2 == 0 ? &cached->EdgeOrder() : &cached->TriangleOrder());
+  }
+  ExpectIsPermutation(cached->EdgeOrder(), cached->family().edges().size());
+}
+
+}  // namespace
+}  // namespace galpha::server
