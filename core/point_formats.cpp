@@ -140,6 +140,10 @@ absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, c
     document = nlohmann::json::parse(text.begin(), text.end());
   } catch (const nlohmann::json::parse_error& e) {
     return absl::InvalidArgumentError(absl::StrCat(source, ": not valid JSON at byte ", e.byte));
+  } catch (const nlohmann::json::exception& e) {
+    // A number beyond the range of a double (1e400) is valid JSON that nlohmann refuses with
+    // out_of_range; found by the point-format fuzzer.
+    return absl::InvalidArgumentError(absl::StrCat(source, ": JSON the parser cannot represent (", e.what(), ")"));
   }
   std::vector<Point2> points;
   const absl::Status status = AppendGeoJsonPoints(document, "", source, &points);

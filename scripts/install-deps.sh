@@ -13,6 +13,12 @@ packages=(
   nlohmann-json3-dev     # GeoJSON point files
   libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
   libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
+  libssl-dev             # SHA-256 of point sets: content-derived handles
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # the gRPC service
+  prometheus-cpp-dev libcivetweb-dev  # the metrics exporter
+  openssl                # the TLS tests make a self-signed certificate
+  curl                   # the README's service walk-through scrapes /metrics
+  clang libclang-rt-14-dev  # libFuzzer: the fuzz targets run briefly in CI
 )
 
 missing=()

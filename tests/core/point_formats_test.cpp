@@ -147,6 +147,13 @@ TEST(ParsePointsGeoJsonTest, BareGeometriesAndGeometryCollection) {
                Points({{3, 4}}));
 }
 
+TEST(ParsePointsGeoJsonTest, NumbersBeyondADoubleAreAnErrorNotACrash) {
+  // Found by tests/fuzz: nlohmann::json throws out_of_range (not parse_error) for 1e400.
+  const auto overflow = ParsePointsGeoJson(R"({"type": "Point", "coordinates": [1e400, 0]})", "big.json");
+  ASSERT_EQ(overflow.status().code(), absl::StatusCode::kInvalidArgument) << overflow.status();
+  EXPECT_NE(overflow.status().message().find("big.json"), std::string::npos) << overflow.status();
+}
+
 TEST(ParsePointsGeoJsonTest, ErrorsNameThePlace) {
   const auto line = ParsePointsGeoJson(R"({"type": "FeatureCollection", "features": [
       {"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 2]}},
