@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The README's second command, and what CI runs: installs what is needed, builds every target
 # (the CUDA backend too when nvcc is present, for one architecture) and runs the whole test suite.
-# Tests that need a GPU skip themselves on machines without one.
+# Tests that need a GPU skip themselves on machines without one. Then the fuzz targets run briefly.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -10,3 +10,5 @@ if [ -x /usr/local/cuda/bin/nvcc ] || command -v nvcc >/dev/null; then preset=cu
 cmake --preset "$preset"
 cmake --build --preset "$preset" -j"$(nproc)"
 ctest --preset "$preset"
+# The fuzz targets, briefly (20 s each): parsers of untrusted input must not crash.
+tests/fuzz/run.sh 20

@@ -452,14 +452,13 @@ std::vector<StreamedEntry> ExpectedMasterList(const AlphaFamily& family, int64_t
       std::vector<uint32_t> indices;
       switch (entry.kind()) {
         case SimplexKind::kVertex:
-          indices = {entry.id()};
+          indices.push_back(entry.id());
           break;
         case SimplexKind::kEdge:
-          indices = {family.edges()[entry.id()][0], family.edges()[entry.id()][1]};
+          for (const uint32_t v : family.edges()[entry.id()]) indices.push_back(v);
           break;
         case SimplexKind::kTriangle:
-          indices = {family.triangles()[entry.id()][0], family.triangles()[entry.id()][1],
-                     family.triangles()[entry.id()][2]};
+          for (const uint32_t v : family.triangles()[entry.id()]) indices.push_back(v);
           break;
       }
       std::sort(indices.begin(), indices.end());
