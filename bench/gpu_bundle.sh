@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Run HERE (the build machine): builds the CUDA configuration and gathers what the GPU machine
 # needs into .carry/ (git-ignored): the test and benchmark binaries, the shared libraries they
-# use that a bare Ubuntu 24.04 + CUDA machine lacks (Abseil, GMP, MPFR, GEOS), and the data sets.
+# use that a bare Ubuntu 24.04 + CUDA machine lacks (Abseil, GMP, MPFR, GEOS, gRPC, protobuf,
+# prometheus-cpp and what they pull in), and the data sets.
 # Then call the device tool with carry=[".carry-pack"] and the command
 #   tar -xJf .carry-pack/carry.tar.xz && bash bench/gpu_run.sh test alpha
 set -euo pipefail
@@ -13,11 +14,14 @@ bins=()
 for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
          tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test tests/core/radius_test \
          tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/gpu/alpha_bruteforce_test tests/gpu/alpha_backend_identity_test tests/core/shape_test \
-         bench/delaunay_bench bench/alpha_bench client/alphactl; do
+         bench/delaunay_bench bench/alpha_bench client/alphactl \
+         bench/service_bench server/galpha_server tests/server/service_test; do
   if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
 done
 for b in "${bins[@]}"; do
-  ldd "$b" | awk '/=> \//{print $3}' | grep -E 'libabsl|libgmp|libmpfr|libgtest|libbenchmark|libgeos' || true
+  # Everything but the C/C++ runtime, OpenMP and the driver, which the GPU machine has (newer).
+  ldd "$b" | awk '/=> \//{print $3}' |
+    grep -vE '/(libc|libm|libpthread|libdl|librt|libstdc\+\+|libgcc_s|libgomp|libcuda)\.so|ld-linux' || true
 done | sort -u | while read -r lib; do cp -L "$lib" .carry/lib/; done
 # Symbols are not needed there and the carried folder must stay under 64 MiB.
 strip --strip-unneeded .carry/bin/* .carry/lib/*

@@ -8,6 +8,8 @@
 #   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
 #           its first run (the benchmark distributions)
 #   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run
+#   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
+#           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
 # short summary goes to standard output.
 set -uo pipefail
@@ -69,6 +71,13 @@ for phase in "${phases[@]}"; do
       done
       # One file for all test logs: at most 8 files come back from the machine.
       for f in "$out"/*_test.log; do { echo "=== $(basename "$f")"; cat "$f"; } >>"$out/tests.log"; rm -f "$f"; done
+      ;;
+    service)
+      run_step service 300 env GALPHA_SERVICE_BACKEND=cuda .carry/bin/service_test
+      grep -E '^\[  (PASSED|FAILED) |Failure' "$out/service.log" | head -n 20
+      # shellcheck disable=SC2086
+      run_step service 420 .carry/bin/service_bench ${GALPHA_SERVICE_BENCH_ARGS:---backend=cuda --points=1000000 --clients=1,2,4,8 --repeat=3}
+      sed -n '/^service_bench:/,$p' "$out/service.log"
       ;;
     bench)
       [ -x .carry/bin/delaunay_bench ] || { echo "no delaunay_bench in .carry"; status=1; continue; }

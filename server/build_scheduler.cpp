@@ -27,13 +27,14 @@ absl::Status BuildScheduler::Submit(size_t memory_bytes, Job job) {
                                                      " bytes of working memory; this server admits at most ",
                                                      memory_budget_, " bytes per build"));
   }
-  // Jobs waiting for a slot are queued; a job that a free slot takes at once is not.
-  const size_t idle = workers_.size() - running_;
-  if (queue_.size() >= max_queue_ + idle) {
+  // A job that a free slot takes at once (a slot idle and its memory admitted) is not queued; the
+  // others wait, and at most max_queue_ of them may.
+  queue_.push_back(Pending{memory_bytes, std::move(job)});
+  if (WaitingLocked() > max_queue_) {
+    queue_.pop_back();
     return absl::ResourceExhaustedError(absl::StrCat("the build queue is full (", max_queue_,
                                                      " builds waiting for ", workers_.size(), " slots); retry later"));
   }
-  queue_.push_back(Pending{memory_bytes, std::move(job)});
   ReportLoad();
   changed_.notify_all();
   return absl::OkStatus();
@@ -45,11 +46,23 @@ void BuildScheduler::Stop() {
   changed_.notify_all();
 }
 
-void BuildScheduler::ReportLoad() {
-  if (observer_ != nullptr) {
-    const size_t idle = workers_.size() - running_;
-    observer_->OnLoad(queue_.size() > idle ? queue_.size() - idle : 0, running_, admitted_bytes_);
+size_t BuildScheduler::WaitingLocked() const {
+  // The jobs at the head that free slots and the memory budget admit now start at once (FIFO:
+  // the first that cannot start holds back the rest).
+  size_t free_slots = workers_.size() - running_;
+  size_t admitted = admitted_bytes_;
+  size_t starting = 0;
+  for (const Pending& pending : queue_) {
+    if (free_slots == 0 || (memory_budget_ != 0 && admitted + pending.memory_bytes > memory_budget_)) break;
+    --free_slots;
+    admitted += pending.memory_bytes;
+    ++starting;
   }
+  return queue_.size() - starting;
+}
+
+void BuildScheduler::ReportLoad() {
+  if (observer_ != nullptr) observer_->OnLoad(WaitingLocked(), running_, admitted_bytes_);
 }
 
 void BuildScheduler::WorkerLoop(BuildSlot slot) {

@@ -65,6 +65,8 @@ class BuildScheduler {
   };
   void WorkerLoop(BuildSlot slot);
   void ReportLoad();
+  /// Queued jobs that cannot start now (the lock held).
+  size_t WaitingLocked() const;
 
   const size_t max_queue_;
   const size_t memory_budget_;

@@ -1,21 +1,37 @@
 #include "server/tenant_tokens.hpp"
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 
 namespace galpha::server {
 
 absl::StatusOr<TenantTokens> TenantTokens::ReadFile(const std::string& path) {
+  // Fail closed: a token file that cannot be read, or names no token, must not start a server
+  // without authentication (a directory opens fine as an ifstream and reads as empty).
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    return absl::NotFoundError(absl::StrCat("the token file '", path, "' does not exist"));
+  }
+  if (!std::filesystem::is_regular_file(path, error)) {
+    return absl::InvalidArgumentError(absl::StrCat("the token file '", path, "' is not a regular file"));
+  }
   std::ifstream in(path);
-  if (!in) return absl::NotFoundError(absl::StrCat("cannot read the token file '", path, "'"));
   std::stringstream text;
   text << in.rdbuf();
-  return Parse(text.str(), path);
+  if (!in && !in.eof()) return absl::PermissionDeniedError(absl::StrCat("cannot read the token file '", path, "'"));
+  auto tokens = Parse(text.str(), path);
+  if (tokens.ok() && !tokens->enabled()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the token file '", path, "' lists no tokens: authentication would be off"));
+  }
+  return tokens;
 }
 
 absl::StatusOr<TenantTokens> TenantTokens::Parse(const std::string& text, const std::string& origin) {
@@ -43,9 +59,11 @@ absl::StatusOr<std::string> TenantTokens::TenantOf(const std::string* authorizat
     return absl::UnauthenticatedError("this server requires an 'authorization: Bearer TOKEN' header");
   }
   absl::string_view value = *authorization;
-  if (!absl::ConsumePrefix(&value, "Bearer ")) {
+  // The scheme name is case-insensitive (RFC 7235 section 2.1).
+  if (value.size() < 7 || !absl::EqualsIgnoreCase(value.substr(0, 7), "bearer ")) {
     return absl::UnauthenticatedError("the authorization header must be 'Bearer TOKEN'");
   }
+  value.remove_prefix(7);
   const auto it = tenant_of_token_.find(std::string(absl::StripAsciiWhitespace(value)));
   if (it == tenant_of_token_.end()) return absl::UnauthenticatedError("the bearer token is not known to this server");
   return it->second;

@@ -14,14 +14,15 @@ class TenantTokens {
  public:
   /// No tokens: authentication is off, every caller is the tenant "".
   TenantTokens() = default;
-  /// InvalidArgument naming the line for a malformed line or a repeated token; NotFound for a
-  /// missing file.
+  /// InvalidArgument naming the line for a malformed line or a repeated token, or for a file that
+  /// is not a regular file or lists no token (fail closed); NotFound for a missing file.
   static absl::StatusOr<TenantTokens> ReadFile(const std::string& path);
   /// From "TOKEN TENANT" lines (the file's content).
   static absl::StatusOr<TenantTokens> Parse(const std::string& text, const std::string& origin);
 
   bool enabled() const { return !tenant_of_token_.empty(); }
-  /// The tenant of an "authorization" header value ("Bearer TOKEN"); Unauthenticated otherwise.
+  /// The tenant of an "authorization" header value ("Bearer TOKEN", the scheme in any case);
+  /// Unauthenticated otherwise.
   /// With authentication off: "" for any value.
   absl::StatusOr<std::string> TenantOf(const std::string* authorization) const;
 

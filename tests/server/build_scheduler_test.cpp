@@ -316,6 +316,33 @@ TEST(BuildSchedulerTest, TwoBuildsOfSixtyNeverOverlap) {
   ExpectIdle(recorder);
 }
 
+// A slot that is idle only because the head of the queue waits for memory is not free capacity:
+// the second job waits (for memory, on an idle slot), so it is queued, and with max_queue 1 a
+// third job is refused.
+TEST(BuildSchedulerTest, JobsWaitingForMemoryCountAsQueued) {
+  LoadRecorder recorder;
+  Gate first_started, release_first;
+  std::atomic<int> later_calls{0};
+  {
+    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/1, /*memory_budget_bytes=*/100,
+                             &recorder);
+    ASSERT_TRUE(scheduler
+                    .Submit(60, [&](const BuildSlot&, bool) {
+                      first_started.Open();
+                      release_first.Wait();
+                    })
+                    .ok());
+    ASSERT_TRUE(first_started.Wait());
+    ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 1; }));
+    ASSERT_TRUE(scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; }).ok());
+    EXPECT_EQ(recorder.last().queued, 1u) << "the second job waits for memory, so it is queued";
+    const absl::Status third = scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; });
+    EXPECT_TRUE(absl::IsResourceExhausted(third)) << "max_queue 1, one job already waiting: " << third;
+    release_first.Open();
+  }
+  ExpectIdle(recorder);
+}
+
 TEST(BuildSchedulerTest, ZeroBudgetAdmitsEverything) {
   Gate both_started;
   std::atomic<int> started{0};

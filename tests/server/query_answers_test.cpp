@@ -78,7 +78,7 @@ const std::vector<NamedFamily>& Families() {
 
 // Enough points that every kind of Classify chunk, and the master list, span several messages.
 std::shared_ptr<const CachedFamily> LargeFamily() {
-  static const std::shared_ptr<const CachedFamily> family = Build(gen::Uniform(70000, 8), "uniform_70000");
+  static const std::shared_ptr<const CachedFamily> family = Build(gen::Uniform(50000, 8), "uniform_50000");
   return family;
 }
 
@@ -321,13 +321,16 @@ void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::
     return;
   }
   std::vector<StreamedSimplex> streamed;
+  std::array<size_t, 4> chunks_of_kind{};
   int last_kind = v1::SIMPLEX_KIND_VERTEX;
   for (size_t m = 1; m < messages.size(); ++m) {
     ASSERT_EQ(messages[m].part_case(), v1::ClassifyResponse::kChunk) << "message " << m;
     const v1::SimplexChunk& chunk = messages[m].chunk();
     const int kind = chunk.kind();
     ASSERT_GE(kind, last_kind) << "kinds come in order vertex, edge, triangle";
+    ASSERT_LE(kind, v1::SIMPLEX_KIND_TRIANGLE);
     last_kind = kind;
+    ++chunks_of_kind[static_cast<size_t>(kind)];
     const size_t arity = static_cast<size_t>(kind);  // SIMPLEX_KIND_VERTEX = 1, EDGE = 2, TRIANGLE = 3
     const size_t simplices = chunk.classes().size();
     EXPECT_GT(simplices, 0u) << "no empty chunks";
@@ -341,6 +344,13 @@ void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::
   }
   if (chunks_out != nullptr) *chunks_out = messages.size() - 1;
   const std::vector<StreamedSimplex> expected = ExpectedSimplices(family, classes, request.non_exterior_only());
+  // Every chunk but the last of its kind is full.
+  std::array<size_t, 4> expected_of_kind{};
+  for (const StreamedSimplex& simplex : expected) ++expected_of_kind[static_cast<size_t>(std::get<0>(simplex))];
+  for (size_t kind = 1; kind <= 3; ++kind) {
+    EXPECT_EQ(chunks_of_kind[kind], (expected_of_kind[kind] + kSimplicesPerChunk - 1) / kSimplicesPerChunk)
+        << "chunks of kind " << kind;
+  }
   ASSERT_EQ(streamed.size(), expected.size());
   for (size_t i = 0; i < expected.size(); ++i) {
     if (streamed[i] != expected[i]) {
@@ -428,15 +438,19 @@ TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
 TEST(QueryAnswersTest, ClassifyChunksNeverExceedTheLimit) {
   const std::shared_ptr<const CachedFamily> cached = LargeFamily();
   ASSERT_NE(cached, nullptr);
-  ASSERT_GT(cached->family().edges().size(), 2 * size_t{kSimplicesPerChunk}) << "the test needs several edge chunks";
-  ASSERT_GT(cached->family().triangles().size(), size_t{kSimplicesPerChunk});
-  for (const bool non_exterior_only : {false, true}) {
-    v1::ClassifyRequest request;
-    *request.mutable_threshold() = Rank(cached->family().max_level() / 2);
-    request.set_non_exterior_only(non_exterior_only);
-    size_t chunks = 0;
-    CheckClassify(cached, request, &chunks);
-    EXPECT_GE(chunks, non_exterior_only ? 3u : 5u);
+  ASSERT_GT(cached->family().edges().size(), size_t{kSimplicesPerChunk}) << "the test needs several edge chunks";
+  for (const int64_t rank : {cached->family().max_level() / 2, cached->family().max_level()}) {
+    for (const bool non_exterior_only : {false, true}) {
+      v1::ClassifyRequest request;
+      *request.mutable_threshold() = Rank(rank);
+      request.set_non_exterior_only(non_exterior_only);
+      size_t chunks = 0;
+      CheckClassify(cached, request, &chunks);
+      // Every simplex is sent, or (at rank K) none is exterior: edges take two chunks.
+      if (!non_exterior_only || rank == cached->family().max_level()) {
+        EXPECT_GE(chunks, 4u) << "vertices, edges in two chunks, triangles";
+      }
+    }
   }
 }
 
@@ -478,7 +492,8 @@ void CheckMasterList(const std::shared_ptr<const CachedFamily>& cached, int64_t 
   auto source = MakeMasterListSource(cached, request);
   ASSERT_TRUE(source.ok()) << source.status();
   std::vector<StreamedEntry> streamed;
-  for (const v1::MasterListResponse& message : Drain(**source)) {
+  const std::vector<v1::MasterListResponse> messages = Drain(**source);
+  for (const v1::MasterListResponse& message : messages) {
     const size_t entries = static_cast<size_t>(message.ranks_size());
     EXPECT_GT(entries, 0u);
     EXPECT_LE(entries, kMasterEntriesPerChunk);
@@ -499,6 +514,8 @@ void CheckMasterList(const std::shared_ptr<const CachedFamily>& cached, int64_t 
     EXPECT_EQ(position, message.vertex_indices_size());
   }
   const std::vector<StreamedEntry> expected = ExpectedMasterList(cached->family(), first, last);
+  EXPECT_EQ(messages.size(), (expected.size() + kMasterEntriesPerChunk - 1) / kMasterEntriesPerChunk)
+      << "every message but the last is full";
   ASSERT_EQ(streamed.size(), expected.size());
   for (size_t i = 0; i < expected.size(); ++i) {
     if (streamed[i] != expected[i]) {

@@ -37,6 +37,9 @@ using testing::StartServer;
 using testing::TestServerOptions;
 using testing::WaitFor;
 
+/// A build that takes long enough (a second or more) for a test to act while it runs.
+size_t SlowBuildPoints() { return testing::TestBackend() == "cuda" ? 4000000 : 400000; }
+
 AlphaFamily LocalFamily(const std::vector<Point2>& points) {
   BuildOptions options;
   options.backend = Backend::kCpu;
@@ -129,7 +132,7 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
   EXPECT_EQ(summary.triangles(), local.triangles().size());
   EXPECT_EQ(summary.edges(), local.edges().size());
   EXPECT_EQ(summary.spectrum_size(), local.spectrum().size());
-  EXPECT_EQ(summary.backend(), "cpu");
+  EXPECT_EQ(summary.backend(), testing::TestBackend());
   EXPECT_GT(summary.family_bytes(), 0u);
 
   EXPECT_EQ(SpectrumRemote(client, built->handle, 1000), local.spectrum());
@@ -459,7 +462,7 @@ TEST(ServiceTest, FullQueueAnswersResourceExhausted) {
   options.service.max_queued_builds = 0;
   auto server = StartServer(options);
   ASSERT_NE(server, nullptr);
-  const std::vector<Point2> large = gen::Uniform(400000, 11);
+  const std::vector<Point2> large = gen::Uniform(SlowBuildPoints(), 11);
   absl::StatusOr<client::BuildResult> first = absl::UnknownError("not run");
   std::thread runner([&] { first = ClientOf(*server)->Build(large); });
   ASSERT_TRUE(WaitFor([&] { return ScrapeMetric(*server, "galpha_builds_in_flight") == 1.0; }, 60));
@@ -497,7 +500,7 @@ TEST(ServiceTest, DeadlineStopsARunningBuild) {
   options.deadline = std::chrono::milliseconds(300);
   auto client = client::AlphaClient::Connect(options);
   ASSERT_TRUE(client.ok());
-  auto built = (*client)->Build(gen::Uniform(600000, 13));
+  auto built = (*client)->Build(gen::Uniform(SlowBuildPoints() * 3 / 2, 13));
   EXPECT_EQ(built.status().code(), absl::StatusCode::kDeadlineExceeded) << built.status();
   // The build stops at its next phase boundary and frees what it held.
   EXPECT_TRUE(WaitFor([&] { return ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 60));
@@ -562,7 +565,7 @@ TEST(ServiceTest, MetricsAreScrapedOverHttp) {
   EXPECT_EQ(MetricValue(page, "galpha_cache_misses_total"), 3.0);  // skip check, build, unknown handle
   EXPECT_EQ(MetricValue(page, "galpha_builds_in_flight"), 0.0);
   EXPECT_EQ(MetricValue(page, "galpha_build_queue_length"), 0.0);
-  EXPECT_EQ(MetricValue(page, "galpha_backend_info{backend=\"cpu\"}"), 1.0);
+  EXPECT_EQ(MetricValue(page, "galpha_backend_info{backend=\"" + testing::TestBackend() + "\"}"), 1.0);
 }
 
 TEST(ServiceTest, HealthReflectionAndDrain) {

@@ -19,13 +19,18 @@
 
 namespace galpha::server::testing {
 
+std::string TestBackend() {
+  const char* backend = std::getenv("GALPHA_SERVICE_BACKEND");
+  return backend != nullptr && std::string(backend) == "cuda" ? "cuda" : "cpu";
+}
+
 ServerOptions TestServerOptions() {
   ServerOptions options;
   options.listen_address = "127.0.0.1:0";
   options.metrics_address = "127.0.0.1:0";
   options.drain_notice = std::chrono::milliseconds(0);
   options.drain_grace = std::chrono::milliseconds(5000);
-  options.service.backend = Backend::kCpu;
+  options.service.backend = TestBackend() == "cuda" ? Backend::kCuda : Backend::kCpu;
   return options;
 }
 

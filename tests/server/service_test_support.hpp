@@ -11,6 +11,9 @@
 
 namespace galpha::server::testing {
 
+/// The backend the tests' servers run: "cpu", or "cuda" when GALPHA_SERVICE_BACKEND=cuda (the GPU
+/// machine's run of bench/gpu_run.sh).
+std::string TestBackend();
 /// Options for a test server: loopback, ports picked by the system, a short drain.
 ServerOptions TestServerOptions();
 /// Starts the server; fails the test (ADD_FAILURE) and returns null when it cannot.

@@ -75,14 +75,22 @@ TEST(TenantTokensTest, ReadFileOfAMissingFileIsNotFound) {
   EXPECT_NE(tokens.status().message().find(path), absl::string_view::npos) << tokens.status();
 }
 
-// KNOWN BUG (server/tenant_tokens.cpp, ReadFile): std::ifstream opens a directory on Linux and the
-// read then fails silently, so the path of a directory parses as an empty table: authentication is
-// turned off (fail-open) for a server started with --token_file pointing at a directory (a
-// mis-mounted secret volume, for example). A file that cannot be read must be an error.
+// std::ifstream opens a directory on Linux and the read then fails silently: a directory must not
+// parse as an empty table, which would turn authentication off (fail-open) for a server started
+// with --token_file pointing at a mis-mounted secret volume.
 TEST(TenantTokensTest, ReadFileOfADirectoryIsAnError) {
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::ReadFile(::testing::TempDir());
   EXPECT_FALSE(tokens.ok()) << "a directory was read as a token table with authentication "
                             << (tokens.ok() && tokens->enabled() ? "on" : "off");
+}
+
+TEST(TenantTokensTest, ReadFileOfAFileWithoutTokensIsAnError) {
+  const std::string path = ::testing::TempDir() + "galpha_tenant_tokens_test_empty.txt";
+  std::ofstream(path) << "# every token revoked\n\n";
+  const absl::StatusOr<TenantTokens> tokens = TenantTokens::ReadFile(path);
+  EXPECT_TRUE(absl::IsInvalidArgument(tokens.status())) << tokens.status();
+  EXPECT_NE(tokens.status().message().find("lists no tokens"), absl::string_view::npos) << tokens.status();
+  std::remove(path.c_str());
 }
 
 TEST(TenantTokensTest, ReadFileParsesTheFileAndNamesItInErrors) {
@@ -129,6 +137,8 @@ TEST(TenantTokensTest, EnabledRequiresAKnownBearerToken) {
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok"), "alice");
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer other"), "bob");
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok "), "alice") << "trailing whitespace is not part of the token";
+  EXPECT_EQ(TenantOrCode(*tokens, "bearer tok"), "alice") << "the scheme is case-insensitive (RFC 7235)";
+  EXPECT_EQ(TenantOrCode(*tokens, "BEARER other"), "bob");
 
   for (const std::string value : {"Basic x", "Basic tok", "tok", "Bearertok", "Bearer", "Bearer ", "Bearer unknown",
                                   "Bearer tokx", "Bearer alice", "", "Bearer tok other"}) {
