@@ -154,9 +154,19 @@ Classification AlphaFamily::ClassifyAll(int64_t level, ClassifyMode mode, Vertex
   c.vertices.resize(parts_.points.size());
   c.edges.resize(parts_.edges.size());
   c.triangles.resize(parts_.triangles.size());
-  for (uint32_t v = 0; v < c.vertices.size(); ++v) c.vertices[v] = ClassifyVertex(v, level, mode, rule);
-  for (uint32_t e = 0; e < c.edges.size(); ++e) c.edges[e] = ClassifyEdge(e, level, mode);
-  for (uint32_t t = 0; t < c.triangles.size(); ++t) c.triangles[t] = ClassifyTriangle(t, level);
+  // Independent per simplex: the host's cores share the work (a served family answers Classify
+  // calls while other builds run, so the loops stay simple and static).
+  const int64_t nv = static_cast<int64_t>(c.vertices.size()), ne = static_cast<int64_t>(c.edges.size()),
+                nt = static_cast<int64_t>(c.triangles.size());
+#pragma omp parallel
+  {
+#pragma omp for schedule(static) nowait
+    for (int64_t v = 0; v < nv; ++v) c.vertices[v] = ClassifyVertex(static_cast<uint32_t>(v), level, mode, rule);
+#pragma omp for schedule(static) nowait
+    for (int64_t e = 0; e < ne; ++e) c.edges[e] = ClassifyEdge(static_cast<uint32_t>(e), level, mode);
+#pragma omp for schedule(static) nowait
+    for (int64_t t = 0; t < nt; ++t) c.triangles[t] = ClassifyTriangle(static_cast<uint32_t>(t), level);
+  }
   return c;
 }
 

@@ -18,13 +18,17 @@ class CachedFamily {
 
   const AlphaFamily& family() const { return family_; }
   const std::string& name() const { return name_; }
-  /// Bytes charged to the cache: the family, plus the index orders once computed (reserved up
-  /// front so that the charge never changes while cached).
+  /// Bytes charged to the cache: the family, plus the index orders and ordered vertices once
+  /// computed (charged up front so that the charge never changes while cached).
   size_t bytes() const { return bytes_; }
 
   /// Edge ids sorted by their (smaller, larger) vertex pair; triangle ids by sorted vertex triple.
   const std::vector<uint32_t>& EdgeOrder() const;
   const std::vector<uint32_t>& TriangleOrder() const;
+  /// The vertices of the edges (pairs) and triangles (ascending triples) in those orders, flat: so
+  /// that Classify copies index runs instead of gathering them one simplex at a time.
+  const std::vector<uint32_t>& EdgeVerticesInOrder() const;
+  const std::vector<uint32_t>& TriangleVerticesInOrder() const;
 
  private:
   void ComputeOrders() const;
@@ -34,6 +38,7 @@ class CachedFamily {
   size_t bytes_ = 0;
   mutable std::once_flag orders_once_;
   mutable std::vector<uint32_t> edge_order_, triangle_order_;
+  mutable std::vector<uint32_t> edge_vertices_, triangle_vertices_;
 };
 
 }  // namespace galpha::server

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <utility>
 #include <vector>
 
@@ -71,36 +72,21 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
           phase_ = Phase::kEdges;
           position_ = 0;
           break;
-        case Phase::kEdges: {
-          const std::vector<uint32_t>& order = cached_->EdgeOrder();
-          if (FillChunk(message, v1::SIMPLEX_KIND_EDGE, 2, order.size(), [&](size_t i, uint32_t* out) {
-                const uint32_t e = order[i];
-                const auto edge = SortedEdge(family.edges()[e]);
-                out[0] = edge[0];
-                out[1] = edge[1];
-                return Emit(classes_.edges[e]);
-              })) {
+        case Phase::kEdges:
+          if (FillOrdered(message, v1::SIMPLEX_KIND_EDGE, 2, cached_->EdgeVerticesInOrder(), cached_->EdgeOrder(),
+                          classes_.edges)) {
             return true;
           }
           phase_ = Phase::kTriangles;
           position_ = 0;
           break;
-        }
-        case Phase::kTriangles: {
-          const std::vector<uint32_t>& order = cached_->TriangleOrder();
-          if (FillChunk(message, v1::SIMPLEX_KIND_TRIANGLE, 3, order.size(), [&](size_t i, uint32_t* out) {
-                const uint32_t t = order[i];
-                const auto tri = SortedTriangle(family.triangles()[t]);
-                out[0] = tri[0];
-                out[1] = tri[1];
-                out[2] = tri[2];
-                return Emit(classes_.triangles[t]);
-              })) {
+        case Phase::kTriangles:
+          if (FillOrdered(message, v1::SIMPLEX_KIND_TRIANGLE, 3, cached_->TriangleVerticesInOrder(),
+                          cached_->TriangleOrder(), classes_.triangles)) {
             return true;
           }
           phase_ = Phase::kDone;
           break;
-        }
         case Phase::kDone:
           return false;
       }
@@ -125,6 +111,35 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
     summary->set_components(family.Components(level_.level));
     summary->set_solid_components(family.SolidComponents(level_.level));
     summary->set_interior_area(counts_.interior_area);
+  }
+
+  // Fills one chunk of edges or triangles from position_ on: the ordered vertices are copied in a
+  // run and the classes gathered through the order; with non_exterior_only, item by item.
+  bool FillOrdered(v1::ClassifyResponse* message, v1::SimplexKind kind, int arity,
+                   const std::vector<uint32_t>& vertices, const std::vector<uint32_t>& order,
+                   const std::vector<SimplexClass>& classes) {
+    const size_t count = order.size();
+    if (non_exterior_only_) {
+      return FillChunk(message, kind, arity, count, [&](size_t i, uint32_t* out) {
+        for (int k = 0; k < arity; ++k) out[k] = vertices[i * static_cast<size_t>(arity) + static_cast<size_t>(k)];
+        return Emit(classes[order[i]]);
+      });
+    }
+    if (position_ >= count) return false;
+    const size_t n = std::min<size_t>(kSimplicesPerChunk, count - position_);
+    const size_t a = static_cast<size_t>(arity);
+    v1::SimplexChunk* chunk = message->mutable_chunk();
+    chunk->set_kind(kind);
+    chunk->mutable_vertex_indices()->Resize(static_cast<int>(n * a), 0);
+    std::memcpy(chunk->mutable_vertex_indices()->mutable_data(), vertices.data() + position_ * a,
+                n * a * sizeof(uint32_t));
+    std::string* bytes = chunk->mutable_classes();
+    bytes->resize(n);
+    char* out = bytes->data();
+    const uint32_t* ids = order.data() + position_;
+    for (size_t j = 0; j < n; ++j) out[j] = ClassByte(classes[ids[j]]);
+    position_ += n;
+    return true;
   }
 
   // Fills one chunk of `kind` from items position_..count-1; `item(i, out)` writes `arity`
