@@ -35,15 +35,18 @@ absl::StatusOr<std::unique_ptr<AlphaClient>> AlphaClient::Connect(const ClientOp
   return client;
 }
 
-void AlphaClient::PrepareContext(grpc::ClientContext* context) const {
+void AlphaClient::PrepareContext(grpc::ClientContext* context, const std::string& handle) const {
+  if (!handle.empty()) context->AddMetadata(kHandleHeader, handle);
   if (!options_.bearer_token.empty()) context->AddMetadata("authorization", "Bearer " + options_.bearer_token);
   if (options_.deadline.count() > 0) context->set_deadline(std::chrono::system_clock::now() + options_.deadline);
 }
 
 absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, const BuildCallOptions& options) {
   BuildResult result;
+  // The handle before the upload: to skip it when the server holds the family, and to route the
+  // stream to the replica that would hold it.
+  const std::string handle = PointSetHandle(points);
   if (options.skip_upload_if_cached) {
-    const std::string handle = PointSetHandle(points);
     auto described = Describe(handle);
     if (described.ok()) {
       result.handle = handle;
@@ -54,7 +57,7 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
     if (!absl::IsNotFound(described.status())) return described.status();
   }
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, handle);
   v1::BuildResponse response;
   std::unique_ptr<grpc::ClientWriter<v1::BuildRequest>> writer = stub_->Build(&context, &response);
   v1::BuildRequest message;
@@ -82,7 +85,7 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
 
 absl::StatusOr<v1::DescribeResponse> AlphaClient::Describe(const std::string& handle) {
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, handle);
   v1::DescribeRequest request;
   request.set_handle(handle);
   v1::DescribeResponse response;
@@ -93,7 +96,7 @@ absl::StatusOr<v1::DescribeResponse> AlphaClient::Describe(const std::string& ha
 
 absl::StatusOr<v1::SpectrumResponse> AlphaClient::Spectrum(const v1::SpectrumRequest& request) {
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, request.handle());
   v1::SpectrumResponse response;
   absl::Status status = FromGrpc(stub_->Spectrum(&context, request, &response));
   if (!status.ok()) return status;
@@ -102,7 +105,7 @@ absl::StatusOr<v1::SpectrumResponse> AlphaClient::Spectrum(const v1::SpectrumReq
 
 absl::StatusOr<v1::ComponentsResponse> AlphaClient::Components(const v1::ComponentsRequest& request) {
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, request.handle());
   v1::ComponentsResponse response;
   absl::Status status = FromGrpc(stub_->Components(&context, request, &response));
   if (!status.ok()) return status;
@@ -111,7 +114,7 @@ absl::StatusOr<v1::ComponentsResponse> AlphaClient::Components(const v1::Compone
 
 absl::StatusOr<v1::OptimalAlphaResponse> AlphaClient::OptimalAlpha(const v1::OptimalAlphaRequest& request) {
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, request.handle());
   v1::OptimalAlphaResponse response;
   absl::Status status = FromGrpc(stub_->OptimalAlpha(&context, request, &response));
   if (!status.ok()) return status;
@@ -120,7 +123,7 @@ absl::StatusOr<v1::OptimalAlphaResponse> AlphaClient::OptimalAlpha(const v1::Opt
 
 absl::StatusOr<v1::ReleaseResponse> AlphaClient::Release(const std::string& handle) {
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, handle);
   v1::ReleaseRequest request;
   request.set_handle(handle);
   v1::ReleaseResponse response;
@@ -131,10 +134,10 @@ absl::StatusOr<v1::ReleaseResponse> AlphaClient::Release(const std::string& hand
 
 template <typename Response, typename Request>
 absl::Status AlphaClient::ReadStream(
-    std::unique_ptr<grpc::ClientReader<Response>> (v1::AlphaShapes::Stub::*call)(grpc::ClientContext*, const Request&),
+    const std::string& handle, std::unique_ptr<grpc::ClientReader<Response>> (v1::AlphaShapes::Stub::*call)(grpc::ClientContext*, const Request&),
     const Request& request, const std::function<absl::Status(const Response&)>& on_message) {
   grpc::ClientContext context;
-  PrepareContext(&context);
+  PrepareContext(&context, handle);
   std::unique_ptr<grpc::ClientReader<Response>> reader = ((*stub_).*call)(&context, request);
   Response message;
   absl::Status consumer_error;
@@ -153,17 +156,17 @@ absl::Status AlphaClient::ReadStream(
 
 absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
                                    const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message) {
-  return ReadStream(&v1::AlphaShapes::Stub::Classify, request, on_message);
+  return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Classify, request, on_message);
 }
 
 absl::Status AlphaClient::MasterList(const v1::MasterListRequest& request,
                                      const std::function<absl::Status(const v1::MasterListResponse&)>& on_message) {
-  return ReadStream(&v1::AlphaShapes::Stub::MasterList, request, on_message);
+  return ReadStream(request.handle(), &v1::AlphaShapes::Stub::MasterList, request, on_message);
 }
 
 absl::Status AlphaClient::Shape(const v1::ShapeRequest& request,
                                 const std::function<absl::Status(const v1::ShapeResponse&)>& on_message) {
-  return ReadStream(&v1::AlphaShapes::Stub::Shape, request, on_message);
+  return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Shape, request, on_message);
 }
 
 }  // namespace galpha::client

@@ -28,6 +28,10 @@ struct ClientOptions {
   std::chrono::milliseconds deadline{0};
 };
 
+/// The request header a gRPC-aware load balancer hashes on (deploy/k8s/envoy.yaml), so that a
+/// handle's Build and queries reach the replica that holds it. Sent on every call with a handle.
+inline constexpr char kHandleHeader[] = "x-galpha-handle";
+
 /// Points per Build chunk: 1 MiB of doubles, well under gRPC's 4 MiB message limit.
 inline constexpr size_t kPointsPerChunk = 65536;
 
@@ -72,14 +76,15 @@ class AlphaClient {
   absl::Status Shape(const galpha::v1::ShapeRequest& request,
                      const std::function<absl::Status(const galpha::v1::ShapeResponse&)>& on_message);
 
-  /// For callers that need more (tests, benchmarks): a context with the token and deadline set.
-  void PrepareContext(grpc::ClientContext* context) const;
+  /// For callers that need more (tests, benchmarks): a context with the token and deadline set,
+  /// and the handle in the routing header (kHandleHeader) when one is given.
+  void PrepareContext(grpc::ClientContext* context, const std::string& handle = "") const;
   galpha::v1::AlphaShapes::Stub& stub() { return *stub_; }
   const std::shared_ptr<grpc::Channel>& channel() const { return channel_; }
 
  private:
   template <typename Response, typename Request>
-  absl::Status ReadStream(
+  absl::Status ReadStream(const std::string& handle,
       std::unique_ptr<grpc::ClientReader<Response>> (galpha::v1::AlphaShapes::Stub::*call)(grpc::ClientContext*,
                                                                                          const Request&),
       const Request& request, const std::function<absl::Status(const Response&)>& on_message);

@@ -1,25 +1,41 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package galpha needs to build, test and benchmark. Used by the README's
-# commands and by CI. The CUDA toolkit (nvcc, and the CCCL headers that both backends compile
+# Installs every Debian 12 package galpha needs to build, test and benchmark (--profile=all, the
+# default), or only what the server and alphactl need to build (--profile=server: the container
+# image's build stage, deploy/build-server.sh). Used by the README's commands, CI and the image. The CUDA toolkit (nvcc, and the CCCL headers that both backends compile
 # against) is expected at /usr/local/cuda; it is not a Debian package.
 set -euo pipefail
 
-packages=(
+# What the server and alphactl need to build (the container image installs only this: --profile server).
+server_packages=(
   build-essential cmake ninja-build pkg-config
   libabsl-dev            # Status / StatusOr, strings, flags
-  libgtest-dev libgmock-dev
-  libbenchmark-dev
-  libgmp-dev             # exact rational oracle in tests
+  libgmp-dev             # exact rational fallback of the radius comparisons
   nlohmann-json3-dev     # GeoJSON point files
-  libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
-  libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
   libssl-dev             # SHA-256 of point sets: content-derived handles
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # the gRPC service
   prometheus-cpp-dev libcivetweb-dev  # the metrics exporter
+)
+# Everything else the tests, benchmarks and CI need (the default profile, "all").
+test_packages=(
+  libgtest-dev libgmock-dev
+  libbenchmark-dev
+  libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
+  libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
   openssl                # the TLS tests make a self-signed certificate
   curl                   # the README's service walk-through scrapes /metrics
   clang libclang-rt-14-dev  # libFuzzer: the fuzz targets run briefly in CI
 )
+
+profile=all
+for arg in "$@"; do
+  case "$arg" in
+    --profile=server) profile=server ;;
+    --profile=all) profile=all ;;
+    *) echo "usage: install-deps.sh [--profile=all|server]" >&2; exit 2 ;;
+  esac
+done
+packages=("${server_packages[@]}")
+[ "$profile" = server ] || packages+=("${test_packages[@]}")
 
 missing=()
 for p in "${packages[@]}"; do
@@ -30,6 +46,14 @@ if ((${#missing[@]})); then
   [ "$(id -u)" -eq 0 ] || sudo="sudo"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# deploy/k8s/validate.sh runs on Node.js and npm: any installed ones do (machines often carry
+# NodeSource's, whose nodejs package conflicts with Debian's npm package), else Debian's.
+if [ "$profile" = all ] && ! command -v npm >/dev/null; then
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends nodejs npm
 fi
 
 if [ ! -f /usr/local/cuda/include/cccl/thrust/version.h ] && [ ! -f /usr/local/cuda/include/thrust/version.h ]; then

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's second command, and what CI runs: installs what is needed, builds every target
 # (the CUDA backend too when nvcc is present, for one architecture) and runs the whole test suite.
-# Tests that need a GPU skip themselves on machines without one. Then the fuzz targets run briefly.
+# Tests that need a GPU skip themselves on machines without one. Then the fuzz targets run briefly,
+# the Kubernetes manifests are validated and the container image's build steps run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -12,3 +13,7 @@ cmake --build --preset "$preset" -j"$(nproc)"
 ctest --preset "$preset"
 # The fuzz targets, briefly (20 s each): parsers of untrusted input must not crash.
 tests/fuzz/run.sh 20
+# Deployment: the manifests against their schemas, and the container image's build steps (no
+# Docker engine here: deploy/build-server.sh is what the Dockerfile runs).
+deploy/k8s/validate.sh
+deploy/build-server.sh build/image-root

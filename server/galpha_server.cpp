@@ -59,7 +59,8 @@ absl::StatusOr<std::unique_ptr<GalphaServer>> GalphaServer::Start(const ServerOp
   }
   grpc::HealthCheckServiceInterface* health = server->server_->GetHealthCheckService();
   health->SetServingStatus(true);
-  health->SetServingStatus("galpha.v1.AlphaShapes", true);
+  health->SetServingStatus(kApiHealthService, true);
+  health->SetServingStatus(kLivenessHealthService, true);
 
   if (!options.metrics_address.empty()) {
     auto port = server->metrics_->StartExporter(options.metrics_address);
@@ -95,7 +96,10 @@ void GalphaServer::Drain() {
     draining_ = true;
   }
   grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();
-  health->SetServingStatus(false);
+  // Readiness ("" and the API) goes NOT_SERVING; liveness stays SERVING, so that an orchestrator
+  // lets the drain finish instead of restarting the process.
+  health->SetServingStatus("", false);
+  health->SetServingStatus(kApiHealthService, false);
   service_->StartDraining();
   {
     std::unique_lock<std::mutex> lock(mutex_);

@@ -21,6 +21,10 @@ class Server;
 
 namespace galpha::server {
 
+/// Health service names: readiness (NOT_SERVING while draining) and liveness (SERVING until exit).
+inline constexpr char kApiHealthService[] = "galpha.v1.AlphaShapes";
+inline constexpr char kLivenessHealthService[] = "galpha.liveness";
+
 struct ServerOptions {
   /// gRPC listening address; port 0 picks a free port (see GalphaServer::port()).
   std::string listen_address = "0.0.0.0:50051";

@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <signal.h>
 
+#include <chrono>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -12,6 +13,8 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "absl/strings/str_cat.h"
+#include "grpcpp/grpcpp.h"
+#include "grpc/health/v1/health.grpc.pb.h"
 #include "server/galpha_server.hpp"
 
 ABSL_FLAG(std::string, listen, "0.0.0.0:50051", "gRPC address (host:port; port 0 picks one)");
@@ -29,6 +32,9 @@ ABSL_FLAG(std::string, tls_key, "", "PEM private key");
 ABSL_FLAG(std::string, token_file, "", "file of 'TOKEN TENANT' lines; when set, every call needs a bearer token");
 ABSL_FLAG(int, drain_notice_ms, 5000, "on SIGTERM: NOT_SERVING this long before refusing calls");
 ABSL_FLAG(int, drain_grace_ms, 25000, "then: how long running calls may finish before they are cancelled");
+ABSL_FLAG(std::string, health_check, "",
+          "instead of serving: ask the server at this address (plaintext) whether the API is SERVING; "
+          "exit 0 if so, 1 otherwise (the container image's HEALTHCHECK)");
 
 namespace {
 
@@ -37,11 +43,27 @@ int Fail(const std::string& message) {
   return 1;
 }
 
+/// The --health_check mode: one grpc.health.v1 Check of the API, with a 3 s deadline.
+int CheckHealth(const std::string& address) {
+  auto stub = grpc::health::v1::Health::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(3));
+  grpc::health::v1::HealthCheckRequest request;
+  request.set_service(galpha::server::kApiHealthService);
+  grpc::health::v1::HealthCheckResponse response;
+  const grpc::Status status = stub->Check(&context, request, &response);
+  if (!status.ok()) return Fail(absl::StrCat("health check of ", address, ": ", status.error_message()));
+  const std::string name = grpc::health::v1::HealthCheckResponse::ServingStatus_Name(response.status());
+  std::printf("%s\n", name.c_str());
+  return response.status() == grpc::health::v1::HealthCheckResponse::SERVING ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   absl::SetProgramUsageMessage("galpha_server: the galpha.v1.AlphaShapes gRPC service. Flags: --helpfull");
   absl::ParseCommandLine(argc, argv);
+  if (const std::string address = absl::GetFlag(FLAGS_health_check); !address.empty()) return CheckHealth(address);
   using galpha::server::ServerOptions;
   ServerOptions options;
   options.listen_address = absl::GetFlag(FLAGS_listen);

@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "tests/support/data_files.hpp"
+#include "tests/support/server_process.hpp"
 
 namespace {
 
@@ -45,61 +46,11 @@ CommandResult Alphactl(const std::string& args, const std::string& environment =
   return run;
 }
 
-/// galpha_server as a child process on a free port.
-class ServerProcess {
- public:
-  explicit ServerProcess(const std::string& extra_flags = "") {
-    log_ = std::filesystem::temp_directory_path() / ("galpha_server_" + std::to_string(getpid()) + ".log");
-    pid_ = fork();
-    if (pid_ == 0) {
-      const std::string command = std::string("exec ") + GALPHA_SERVER +
-                                  " --listen 127.0.0.1:0 --metrics_listen 127.0.0.1:0 --backend cpu "
-                                  "--drain_notice_ms 200 " +
-                                  extra_flags + " >" + log_ + " 2>&1";
-      execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    for (int i = 0; i < 1000 && port_ == 0; ++i) {
-      const std::string text = Slurp(log_);
-      const size_t at = text.find("listening on port ");
-      if (at != std::string::npos) port_ = std::atoi(text.c_str() + at + 18);
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  }
-  ~ServerProcess() {
-    if (pid_ > 0 && !stopped_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-    std::filesystem::remove(log_);
-  }
-  int port() const { return port_; }
-  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
-  std::string log() const { return Slurp(log_); }
-  /// SIGTERM, then the exit status (or -1 when it did not exit within `seconds`).
-  int Terminate(double seconds) {
-    kill(pid_, SIGTERM);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-    while (std::chrono::steady_clock::now() < deadline) {
-      int status = 0;
-      if (waitpid(pid_, &status, WNOHANG) == pid_) {
-        stopped_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-    return -1;
-  }
-
- private:
-  pid_t pid_ = -1;
-  int port_ = 0;
-  bool stopped_ = false;
-  std::string log_;
-};
+using galpha::testing::ServerProcess;
+constexpr char kServerFlags[] = "--drain_notice_ms 200";
 
 TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
-  ServerProcess server;
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
   const std::string file = galpha::testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
   const char* commands[] = {
@@ -131,7 +82,7 @@ TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
 }
 
 TEST(AlphactlRemoteTest, ErrorsKeepTheLocalExitCodes) {
-  ServerProcess server;
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
   const std::string file = galpha::testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
   const CommandResult local = Alphactl("masterlist " + file + " --rank 999999999");
@@ -153,7 +104,7 @@ TEST(AlphactlRemoteTest, ErrorsKeepTheLocalExitCodes) {
 TEST(AlphactlRemoteTest, TokensComeFromTheEnvironment) {
   const std::string tokens = std::filesystem::temp_directory_path() / ("galpha_tokens_" + std::to_string(getpid()));
   std::ofstream(tokens) << "# test tokens\nsecret-1 team-one\n";
-  ServerProcess server("--token_file " + tokens);
+  ServerProcess server(GALPHA_SERVER, std::string(kServerFlags) + " --token_file " + tokens);
   ASSERT_GT(server.port(), 0) << server.log();
   const std::string file = galpha::testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
   const CommandResult without = Alphactl("summary --rank 1 " + file + " --server " + server.address());
@@ -165,9 +116,14 @@ TEST(AlphactlRemoteTest, TokensComeFromTheEnvironment) {
 }
 
 TEST(AlphactlRemoteTest, SigtermDrainsAndExitsCleanly) {
-  ServerProcess server;
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
-  EXPECT_EQ(server.Terminate(30), 0) << server.log();
+  // The container image's health check: exit 0 while the API is SERVING.
+  const std::string check = std::string(GALPHA_SERVER) + " --health_check " + server.address() + " >/dev/null 2>&1";
+  EXPECT_EQ(std::system(check.c_str()), 0);
+  const std::string nowhere = std::string(GALPHA_SERVER) + " --health_check 127.0.0.1:1 >/dev/null 2>&1";
+  EXPECT_NE(std::system(nowhere.c_str()), 0);
+  EXPECT_EQ(server.Signal(SIGTERM, 30), 0) << server.log();
   const std::string log = server.log();
   EXPECT_NE(log.find("draining"), std::string::npos) << log;
   EXPECT_NE(log.find("stopped"), std::string::npos) << log;

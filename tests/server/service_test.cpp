@@ -583,8 +583,11 @@ TEST(ServiceTest, HealthReflectionAndDrain) {
   auto built = client->Build(gen::Uniform(500, 41));
   ASSERT_TRUE(built.ok());
 
+  EXPECT_EQ(testing::HealthOf(channel, "galpha.liveness"), "SERVING");
   std::thread drain([&] { server->Drain(); });
   EXPECT_TRUE(WaitFor([&] { return testing::HealthOf(channel, "") == "NOT_SERVING"; }, 5));
+  EXPECT_EQ(testing::HealthOf(channel, "galpha.v1.AlphaShapes"), "NOT_SERVING");
+  EXPECT_EQ(testing::HealthOf(channel, "galpha.liveness"), "SERVING");
   // During the notice: new builds are refused, queries still answered.
   client::BuildCallOptions upload;
   upload.skip_upload_if_cached = false;

@@ -1,0 +1,224 @@
+// Faults against the real galpha_server process on the CPU backend (issue: deployment and
+// operations): SIGTERM during a build, clients that vanish mid-upload, a burst of builds over the
+// queue limit, malformed and oversized messages, a slow reader of a large Classify stream. After
+// each, the server is still up and answering, and its resident memory is back near its baseline.
+#include <gtest/gtest.h>
+#include <grpcpp/generic/generic_stub.h>
+#include <grpcpp/grpcpp.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "client/galpha_client.hpp"
+#include "core/point_set_handle.hpp"
+#include "service_test_support.hpp"
+#include "tests/support/point_generators.hpp"
+#include "tests/support/server_process.hpp"
+
+namespace galpha::server {
+namespace {
+
+namespace v1 = galpha::v1;
+using galpha::testing::ServerProcess;
+using galpha::testing::SpawnShell;
+using galpha::testing::WaitChild;
+using testing::WaitFor;
+
+std::unique_ptr<client::AlphaClient> ClientOf(const ServerProcess& server) {
+  client::ClientOptions options;
+  options.target = server.address();
+  options.deadline = std::chrono::seconds(120);
+  return *client::AlphaClient::Connect(options);
+}
+
+double Metric(const ServerProcess& server, const std::string& series) {
+  return testing::MetricValue(testing::HttpGet(server.metrics_port(), "/metrics"), series);
+}
+
+client::BuildCallOptions Upload() {
+  client::BuildCallOptions call;
+  call.skip_upload_if_cached = false;
+  return call;
+}
+
+/// Resident memory once the server is idle again: nothing in flight, nothing cached (the caller
+/// released its handles). glibc returns freed memory lazily: allow a little slack.
+void ExpectBackToBaseline(const ServerProcess& server, size_t baseline) {
+  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_builds_in_flight") == 0.0; }, 60));
+  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_cache_entries") == 0.0; }, 10));
+  const size_t slack = std::max<size_t>(64u << 20, baseline / 2);
+  size_t now = 0;
+  // Connections and their buffers go away a little after their calls end.
+  EXPECT_TRUE(WaitFor([&] { return (now = server.ResidentBytes()) <= baseline + slack; }, 10))
+      << "resident " << now << " bytes, baseline " << baseline << " bytes";
+}
+
+/// Starts the server and measures its baseline after one build and release (so that lazily
+/// created pools and threads are counted in the baseline, not as a leak).
+size_t WarmBaseline(const ServerProcess& server) {
+  auto client = ClientOf(server);
+  const auto points = gen::Uniform(100000, 77);
+  EXPECT_TRUE(client->Build(points, Upload()).ok());
+  EXPECT_TRUE(client->Release(PointSetHandle(points)).ok());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  return server.ResidentBytes();
+}
+
+TEST(FaultTest, SigtermDuringABuildFinishesItAndRefusesNewWork) {
+  ServerProcess server(GALPHA_SERVER, "--drain_notice_ms 1500 --drain_grace_ms 60000 --build_slots 1");
+  ASSERT_GT(server.port(), 0) << server.log();
+  absl::StatusOr<client::BuildResult> running = absl::UnknownError("not run");
+  std::thread builder([&] { running = ClientOf(server)->Build(gen::Uniform(400000, 1), Upload()); });
+  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_builds_in_flight") == 1.0; }, 60));
+  const auto start = std::chrono::steady_clock::now();
+  kill(server.pid(), SIGTERM);
+
+  auto other = ClientOf(server);
+  EXPECT_TRUE(WaitFor([&] { return testing::HealthOf(other->channel(), "") == "NOT_SERVING"; }, 1.0));
+  const auto refused = other->Build(gen::Uniform(100, 2), Upload());
+  EXPECT_TRUE(absl::IsUnavailable(refused.status())) << refused.status();
+  builder.join();
+  EXPECT_TRUE(running.ok()) << "the build running at SIGTERM must finish: " << running.status();
+  const int status = server.Signal(0, 90);
+  EXPECT_EQ(status, 0) << server.log();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 1.5 + 60 + 5) << "the process must exit within notice + grace";
+}
+
+TEST(FaultTest, SigtermWithAShortGraceCancelsTheBuildCleanly) {
+  ServerProcess server(GALPHA_SERVER, "--drain_notice_ms 0 --drain_grace_ms 200 --build_slots 1");
+  ASSERT_GT(server.port(), 0) << server.log();
+  absl::StatusOr<client::BuildResult> running = absl::UnknownError("not run");
+  std::thread builder([&] { running = ClientOf(server)->Build(gen::Uniform(600000, 3), Upload()); });
+  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_builds_in_flight") == 1.0; }, 60));
+  const auto start = std::chrono::steady_clock::now();
+  const int status = server.Signal(SIGTERM, 60);
+  builder.join();
+  EXPECT_EQ(status, 0) << server.log();
+  EXPECT_FALSE(running.ok()) << "a build cut by the grace period fails; it does not hang";
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // The build stops at its next phase boundary, so the exit may pass the grace by one phase.
+  EXPECT_LT(seconds, 30.0) << server.log();
+}
+
+TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
+  ServerProcess server(GALPHA_SERVER, "--drain_notice_ms 0 --build_slots 1 --max_queued_builds 2 "
+                                      "--max_message_bytes 2097152");
+  ASSERT_GT(server.port(), 0) << server.log();
+  const size_t baseline = WarmBaseline(server);
+  ASSERT_GT(baseline, 0u);
+
+  // Clients that die mid-upload: their uploads are dropped and their reservations freed.
+  std::vector<pid_t> vanishing;
+  for (int i = 0; i < 4; ++i) {
+    vanishing.push_back(SpawnShell(std::string(GALPHA_FAULT_CLIENT) + " vanish " + server.address() + " 1000000 >/dev/null"));
+  }
+  for (pid_t pid : vanishing) EXPECT_EQ(WaitChild(pid, 60), 0);
+
+  // A burst over the queue limit: one runs, two wait, the rest are refused at once.
+  constexpr int kBurst = 8;
+  std::vector<absl::StatusOr<client::BuildResult>> results(kBurst, absl::UnknownError("not run"));
+  std::vector<std::vector<Point2>> inputs;
+  for (int i = 0; i < kBurst; ++i) inputs.push_back(gen::Uniform(150000, 100 + static_cast<uint64_t>(i)));
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kBurst; ++i) {
+    threads.emplace_back([&, i] { results[static_cast<size_t>(i)] = ClientOf(server)->Build(inputs[static_cast<size_t>(i)], Upload()); });
+  }
+  for (auto& t : threads) t.join();
+  int ok = 0, exhausted = 0;
+  for (const auto& r : results) {
+    ok += r.ok() ? 1 : 0;
+    exhausted += absl::IsResourceExhausted(r.status()) ? 1 : 0;
+  }
+  EXPECT_EQ(ok + exhausted, kBurst);
+  EXPECT_GE(ok, 3);
+  EXPECT_GE(exhausted, 1);
+  EXPECT_EQ(Metric(server, "galpha_builds_rejected_total{reason=\"queue_or_memory\"}"), static_cast<double>(exhausted));
+
+  // Malformed bytes where a request belongs, and a message over the limit.
+  auto client = ClientOf(server);
+  grpc::GenericStub generic(client->channel());
+  grpc::ClientContext context;
+  grpc::Slice garbage(std::string("\xff\xff\xff\xff\x0f garbage", 14));
+  grpc::ByteBuffer request(&garbage, 1), response;
+  std::mutex mutex;
+  std::condition_variable done;
+  bool finished = false;
+  grpc::Status garbage_status;
+  generic.UnaryCall(&context, "/galpha.v1.AlphaShapes/Describe", grpc::StubOptions(), &request, &response,
+                    [&](grpc::Status s) {
+                      std::lock_guard<std::mutex> lock(mutex);
+                      garbage_status = s;
+                      finished = true;
+                      done.notify_all();
+                    });
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    ASSERT_TRUE(done.wait_for(lock, std::chrono::seconds(30), [&] { return finished; }));
+  }
+  EXPECT_FALSE(garbage_status.ok());
+  {
+    grpc::ClientContext big_context;
+    v1::BuildResponse big_response;
+    auto writer = client->stub().Build(&big_context, &big_response);
+    v1::BuildRequest header;
+    header.mutable_header();
+    writer->Write(header);
+    v1::BuildRequest big;
+    big.mutable_points()->mutable_coordinates()->Resize(400000, 0.5);  // 3.2 MB > 2 MiB
+    writer->Write(big);
+    writer->WritesDone();
+    EXPECT_EQ(writer->Finish().error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  }
+
+  // Still serving, and back to the baseline once everything is released.
+  EXPECT_EQ(testing::HealthOf(client->channel(), "galpha.v1.AlphaShapes"), "SERVING");
+  for (const auto& input : inputs) ASSERT_TRUE(client->Release(PointSetHandle(input)).ok());
+  ExpectBackToBaseline(server, baseline);
+}
+
+TEST(FaultTest, ASlowReaderDoesNotHoldUpOthers) {
+  ServerProcess server(GALPHA_SERVER, "--drain_notice_ms 0");
+  ASSERT_GT(server.port(), 0) << server.log();
+  const size_t baseline = WarmBaseline(server);
+  auto client = ClientOf(server);
+  const auto points = gen::Uniform(300000, 9);
+  auto built = client->Build(points, Upload());
+  ASSERT_TRUE(built.ok()) << built.status();
+
+  // About 15 messages of ~1 MB, read one per 300 ms: the stream lasts seconds, and the server
+  // holds one message for it at a time.
+  const std::string log = std::filesystem::temp_directory_path() / ("slow_reader_" + std::to_string(getpid()));
+  const pid_t reader = SpawnShell(std::string(GALPHA_FAULT_CLIENT) + " slow-classify " + server.address() + " " +
+                                  built->handle + " 300 >" + log);
+  ASSERT_TRUE(WaitFor([&] { return std::filesystem::exists(log) && std::filesystem::file_size(log) > 0; }, 30));
+  for (int i = 0; i < 20; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    ASSERT_TRUE(client->Describe(built->handle).ok());
+    v1::ComponentsRequest components;
+    components.set_handle(built->handle);
+    components.mutable_threshold()->set_rank(i);
+    ASSERT_TRUE(client->Components(components).ok());
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
+  }
+  EXPECT_TRUE(std::filesystem::exists(log));
+  // A reader that is killed mid-stream leaves nothing behind.
+  kill(reader, SIGKILL);
+  WaitChild(reader, 10);
+  std::filesystem::remove(log);
+  ASSERT_TRUE(client->Release(built->handle).ok());
+  EXPECT_EQ(testing::HealthOf(client->channel(), "galpha.v1.AlphaShapes"), "SERVING");
+  ExpectBackToBaseline(server, baseline);
+}
+
+}  // namespace
+}  // namespace galpha::server
