@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -659,6 +660,60 @@ TEST(ServiceTest, TlsAndTenantScopedTokens) {
   ASSERT_TRUE(released.ok());
   EXPECT_TRUE(a->Describe(built->handle).ok());  // B's release dropped only B's entry
   std::filesystem::remove_all(dir);
+}
+
+/// Records the routing header of every call it gets, and answers NOT_FOUND / UNAVAILABLE.
+class HeaderRecorder final : public v1::AlphaShapes::CallbackService {
+ public:
+  std::vector<std::string> headers() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return headers_;
+  }
+  grpc::ServerUnaryReactor* Describe(grpc::CallbackServerContext* context, const v1::DescribeRequest*,
+                                     v1::DescribeResponse*) override {
+    Record(context);
+    auto* reactor = context->DefaultReactor();
+    reactor->Finish(grpc::Status(grpc::StatusCode::NOT_FOUND, "recorder"));
+    return reactor;
+  }
+  grpc::ServerReadReactor<v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
+                                                   v1::BuildResponse*) override {
+    Record(context);
+    class Refuse final : public grpc::ServerReadReactor<v1::BuildRequest> {
+     public:
+      Refuse() { Finish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "recorder")); }
+      void OnDone() override { delete this; }
+    };
+    return new Refuse();
+  }
+
+ private:
+  void Record(grpc::CallbackServerContext* context) {
+    const auto it = context->client_metadata().find(client::kHandleHeader);
+    std::lock_guard<std::mutex> lock(mutex_);
+    headers_.push_back(it == context->client_metadata().end() ? "(none)"
+                                                              : std::string(it->second.data(), it->second.size()));
+  }
+  std::mutex mutex_;
+  std::vector<std::string> headers_;
+};
+
+TEST(ServiceTest, TheClientSendsTheHandleForRouting) {
+  HeaderRecorder recorder;
+  grpc::ServerBuilder builder;
+  int port = 0;
+  builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port);
+  builder.RegisterService(&recorder);
+  auto server = builder.BuildAndStart();
+  ASSERT_NE(server, nullptr);
+  client::ClientOptions options;
+  options.target = "127.0.0.1:" + std::to_string(port);
+  auto client = *client::AlphaClient::Connect(options);
+  const std::vector<Point2> points = gen::Uniform(1000, 61);
+  // Describe (is it cached?) then the upload: both carry the handle computed before uploading.
+  EXPECT_TRUE(absl::IsUnavailable(client->Build(points).status()));
+  EXPECT_EQ(recorder.headers(), std::vector<std::string>(2, PointSetHandle(points)));
+  server->Shutdown();
 }
 
 }  // namespace
