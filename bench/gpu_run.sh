@@ -8,6 +8,7 @@
 #   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
 #           its first run (the benchmark distributions)
 #   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run
+#   identity the CUDA/CPU identity test alone
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
 #           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
@@ -71,6 +72,12 @@ for phase in "${phases[@]}"; do
       done
       # One file for all test logs: at most 8 files come back from the machine.
       for f in "$out"/*_test.log; do { echo "=== $(basename "$f")"; cat "$f"; } >>"$out/tests.log"; rm -f "$f"; done
+      ;;
+    identity)
+      # The CUDA/CPU identity test alone (every generator and data set): the quick correctness
+      # check after an engine change, before the benchmarks.
+      run_step identity 300 .carry/bin/alpha_backend_identity_test
+      grep -E '^\[  (PASSED|FAILED) |Failure|SKIPPED' "$out/identity.log" | head -n 20
       ;;
     service)
       run_step service 300 env GALPHA_SERVICE_BACKEND=cuda .carry/bin/service_test
