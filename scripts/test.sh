@@ -13,6 +13,8 @@ cmake --build --preset "$preset" -j"$(nproc)"
 ctest --preset "$preset"
 # The fuzz targets, briefly (20 s each): parsers of untrusted input must not crash.
 tests/fuzz/run.sh 20
+# The API's style (buf lint).
+proto/lint.sh
 # Deployment: the manifests against their schemas, and the container image's build steps (no
 # Docker engine here: deploy/build-server.sh is what the Dockerfile runs).
 deploy/k8s/validate.sh
