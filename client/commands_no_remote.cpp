@@ -6,7 +6,8 @@ namespace galpha::alphactl {
 
 namespace {
 int NoServer() {
-  return UsageError(absl::UnimplementedError("this alphactl was built without the service: --server is not available"));
+  return UsageError(absl::InvalidArgumentError(
+      "this alphactl was built without the service (GALPHA_BUILD_SERVER=OFF): --server is not available"));
 }
 }  // namespace
 
