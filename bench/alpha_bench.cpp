@@ -36,6 +36,7 @@
 #include "core/alpha_family.hpp"
 #include "core/point_formats.hpp"
 #include "gpu/alpha_engine.hpp"
+#include "gpu/sort_floor.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {
@@ -90,7 +91,9 @@ struct BenchResult {
   size_t galpha_rss = 0;
   size_t galpha_engine_peak = 0;
   double classify_ms = 0;
+  double floor_ms = -1;  // one backend sort of the spectrum's (key, value) pairs
   size_t spectrum = 0;
+  size_t sort_pairs = 0;
   ComparisonCounts counts;
   std::vector<StageTime> stages;
   double cgal_ms = -1;  // not run above --cgal-max
@@ -129,6 +132,7 @@ BenchResult RunOne(const std::string& name, const std::vector<Point2>& points, c
       result.counts = family->report().comparisons;
       result.galpha_engine_peak = family->report().peak_memory_bytes;
       result.spectrum = family->spectrum().size();
+      result.sort_pairs = family->triangles().size() + family->edges().size();
       result.transfer_ms = 0;
       for (const StageTime& s : result.stages) {
         if (IsTransferStage(s.stage)) result.transfer_ms += s.seconds * 1e3;
@@ -138,6 +142,11 @@ BenchResult RunOne(const std::string& name, const std::vector<Point2>& points, c
       result.classify_ms = MillisecondsSince(start);
       if (c.edges.size() != family->edges().size()) result.error = "classification size mismatch";
     }
+  }
+  if (result.error.empty() && !result.stages.empty()) {
+    // The spectrum sorts one (key, id) pair per triangle and edge: 2n + 3n pairs or so.
+    auto floor = MeasureSortFloorSeconds(result.sort_pairs, options.backend);
+    if (floor.ok()) result.floor_ms = *floor * 1e3;
   }
   if (points.size() > options.cgal_max) return result;
   std::vector<Kernel::Point_2> cgal_points;
@@ -157,8 +166,8 @@ void PrintHeader() {
   std::printf(
       "| input | n | galpha backend | galpha ms (whole family) | of which transfers ms | CGAL EPEC ms | "
       "CGAL/galpha | galpha peak RSS B/pt | engine peak B/pt | CGAL peak RSS B/pt | classify all ms | "
-      "spectrum | exact cmp (filter / bounded / CPU fallback) |\n"
-      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+      "spectrum | exact cmp (filter / bounded / CPU fallback) | floor sort ms | (whole - transfers) / floor |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n");
 }
 
 void PrintRow(const BenchResult& r) {
@@ -178,12 +187,20 @@ void PrintRow(const BenchResult& r) {
   }
   std::string spectrum = absl::StrCat(r.spectrum);
   if (r.cgal_ms >= 0 && r.cgal_spectrum != r.spectrum) absl::StrAppend(&spectrum, " (CGAL ", r.cgal_spectrum, ": MISMATCH)");
-  std::printf("| %s | %zu | %s | %.1f | %.1f | %s | %s | %.0f | %.0f | %s | %.1f | %s | %llu / %llu / %llu |\n",
+  std::string floor = "-", over_floor = "-";
+  if (r.floor_ms > 0) {
+    char text[48];
+    std::snprintf(text, sizeof text, "%.2f", r.floor_ms);
+    floor = text;
+    std::snprintf(text, sizeof text, "%.1f", (r.galpha_ms - r.transfer_ms) / r.floor_ms);
+    over_floor = text;
+  }
+  std::printf("| %s | %zu | %s | %.1f | %.1f | %s | %s | %.0f | %.0f | %s | %.1f | %s | %llu / %llu / %llu | %s | %s |\n",
               r.name.c_str(), r.n, r.backend.c_str(), r.galpha_ms, r.transfer_ms, cgal.c_str(), ratio.c_str(),
               static_cast<double>(r.galpha_rss) / n, static_cast<double>(r.galpha_engine_peak) / n,
               cgal_mem.c_str(), r.classify_ms, spectrum.c_str(), static_cast<unsigned long long>(r.counts.filter),
               static_cast<unsigned long long>(r.counts.bounded_exact),
-              static_cast<unsigned long long>(r.counts.cpu_fallback));
+              static_cast<unsigned long long>(r.counts.cpu_fallback), floor.c_str(), over_floor.c_str());
   std::fflush(stdout);
 }
 

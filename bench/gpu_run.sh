@@ -7,7 +7,8 @@
 #           (default 240), one process per test so that a hang names its test
 #   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
 #           its first run (the benchmark distributions)
-#   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run
+#   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run,
+#           the floor sort of the spectrum's pairs, and 100M uniform points on the GPU
 #   identity the CUDA/CPU identity test alone
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
 #           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
@@ -103,6 +104,8 @@ for phase in "${phases[@]}"; do
       # at 100K and 1M, then the GPU alone at 10M; then the CPU backend on this machine's cores.
       run_step alpha 300 .carry/bin/alpha_bench --backend=cuda --sizes=100000,1000000 --repeat=3
       run_step alpha 120 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --repeat=2 --cgal-max=0
+      # 100M points: whether they fit on one 80 GB GPU (about 51 GB at the measured 508 B/pt).
+      run_step alpha 300 .carry/bin/alpha_bench --backend=cuda --sizes=100000000 --dists=uniform --repeat=1 --cgal-max=0
       run_step alpha 150 .carry/bin/alpha_bench --backend=cpu --sizes=1000000 --repeat=1 --cgal-max=0
       grep -E '^\|' "$out/alpha.log"
       ;;

@@ -6,6 +6,10 @@ namespace galpha::detail {
 
 bool CudaDeviceVisible() { return false; }
 
+double SortFloorOnCuda(size_t) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
 void TriangulateOnCuda(const Point2*, uint32_t, void*, DelaunayOutput*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
