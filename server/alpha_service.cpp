@@ -183,7 +183,6 @@ class BuildReactor final : public grpc::ServerReadReactor<v1::BuildRequest> {
     const auto start = Clock::now();
     absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(build_->points, options);
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    const uint64_t input_points = build_->points.size();
     decoder_.ReleasePoints();
     if (!family.ok()) {
       ReturnFreedMemory();
@@ -193,7 +192,7 @@ class BuildReactor final : public grpc::ServerReadReactor<v1::BuildRequest> {
     service_->metrics_->RecordBuild(family->report(), seconds);
     // The last owner of a family (the cache, or a query still streaming from it after a release
     // or an eviction) frees hundreds of megabytes: give them back to the system right then.
-    std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family), build_->header.name(), input_points),
+    std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family), build_->header.name()),
                                                [](const CachedFamily* f) {
                                                  delete f;
                                                  ReturnFreedMemory();

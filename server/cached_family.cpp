@@ -6,7 +6,7 @@
 
 namespace galpha::server {
 
-CachedFamily::CachedFamily(AlphaFamily family, std::string name, uint64_t /*input_points*/)
+CachedFamily::CachedFamily(AlphaFamily family, std::string name)
     : family_(std::move(family)), name_(std::move(name)) {
   bytes_ = sizeof(*this) + family_.HostBytes() + name_.capacity() +
            family_.edges().size() * 3 * sizeof(uint32_t) +

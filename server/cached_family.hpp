@@ -14,7 +14,7 @@ namespace galpha::server {
 
 class CachedFamily {
  public:
-  CachedFamily(AlphaFamily family, std::string name, uint64_t input_points);
+  CachedFamily(AlphaFamily family, std::string name);
 
   const AlphaFamily& family() const { return family_; }
   const std::string& name() const { return name_; }

@@ -30,7 +30,7 @@ std::shared_ptr<const CachedFamily> MakeFamily(const std::vector<Point2>& points
     ADD_FAILURE() << name << ": " << family.status();
     return nullptr;
   }
-  return std::make_shared<const CachedFamily>(*std::move(family), name, points.size());
+  return std::make_shared<const CachedFamily>(*std::move(family), name);
 }
 
 // Records every callback, so that tests compare it with GetStats().

@@ -43,7 +43,7 @@ std::shared_ptr<const CachedFamily> Build(const std::vector<Point2>& points, con
     ADD_FAILURE() << name << ": " << family.status();
     return nullptr;
   }
-  return std::make_shared<const CachedFamily>(*std::move(family), name, points.size());
+  return std::make_shared<const CachedFamily>(*std::move(family), name);
 }
 
 // Points (i, 2i + 1) in shuffled order: exactly collinear, so edges only.
