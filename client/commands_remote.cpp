@@ -121,6 +121,18 @@ v1::VertexRule ToProto(VertexRule rule) {
   return rule == VertexRule::kCgal ? v1::VERTEX_RULE_CGAL : v1::VERTEX_RULE_REPORT;
 }
 
+/// classify's and summary's request: the family's handle and the command line's options.
+absl::StatusOr<v1::ClassifyRequest> ClassifyRequestFor(const ClassifyArgs& options, const RemoteFamily& remote) {
+  auto threshold = ToThreshold(options.threshold, remote);
+  if (!threshold.ok()) return threshold.status();
+  v1::ClassifyRequest request;
+  request.set_handle(remote.build.handle);
+  *request.mutable_threshold() = *threshold;
+  request.set_mode(ToProto(options.mode));
+  request.set_vertex_rule(ToProto(options.rule));
+  return request;
+}
+
 /// A query's failure: INVALID_ARGUMENT is the user's (exit 2), anything else a failure (exit 1).
 int QueryError(const CommonArgs& common, const absl::Status& status) {
   if (absl::IsInvalidArgument(status)) return ArgumentError(status);
@@ -162,15 +174,10 @@ int RemoteSpectrum(const CommonArgs& common) {
 int RemoteClassify(const CommonArgs& common, const ClassifyArgs& options) {
   auto remote = OpenRemote(common);
   if (!remote.ok()) return Failure(remote.status());
-  auto threshold = ToThreshold(options.threshold, *remote);
-  if (!threshold.ok()) return ArgumentError(threshold.status());
-  v1::ClassifyRequest request;
-  request.set_handle(remote->build.handle);
-  *request.mutable_threshold() = *threshold;
-  request.set_mode(ToProto(options.mode));
-  request.set_vertex_rule(ToProto(options.rule));
+  auto request = ClassifyRequestFor(options, *remote);
+  if (!request.ok()) return ArgumentError(request.status());
   ChunkedWriter out(stdout);
-  absl::Status status = remote->client->Classify(request, [&](const v1::ClassifyResponse& message) {
+  absl::Status status = remote->client->Classify(*request, [&](const v1::ClassifyResponse& message) {
     if (!message.has_chunk()) return absl::OkStatus();
     const v1::SimplexChunk& chunk = message.chunk();
     const int arity = chunk.kind() == v1::SIMPLEX_KIND_VERTEX ? 1 : chunk.kind() == v1::SIMPLEX_KIND_EDGE ? 2 : 3;
@@ -199,16 +206,11 @@ int RemoteClassify(const CommonArgs& common, const ClassifyArgs& options) {
 int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
   auto remote = OpenRemote(common);
   if (!remote.ok()) return Failure(remote.status());
-  auto threshold = ToThreshold(options.threshold, *remote);
-  if (!threshold.ok()) return ArgumentError(threshold.status());
-  v1::ClassifyRequest request;
-  request.set_handle(remote->build.handle);
-  *request.mutable_threshold() = *threshold;
-  request.set_mode(ToProto(options.mode));
-  request.set_vertex_rule(ToProto(options.rule));
-  request.set_summary_only(true);
+  auto request = ClassifyRequestFor(options, *remote);
+  if (!request.ok()) return ArgumentError(request.status());
+  request->set_summary_only(true);
   v1::ClassifySummary summary;
-  absl::Status status = remote->client->Classify(request, [&](const v1::ClassifyResponse& message) {
+  absl::Status status = remote->client->Classify(*request, [&](const v1::ClassifyResponse& message) {
     if (message.has_summary()) summary = message.summary();
     return absl::OkStatus();
   });
