@@ -128,16 +128,29 @@ double LevelAlphaSq(const AlphaFamily& family, int64_t level) {
   return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
 }
 
+absl::Status CheckThresholdRank(int64_t rank, int64_t k) {
+  if (rank >= 0 && rank <= k) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("--rank ", rank, " is outside 0..", k, " (the spectrum has ", k, " values)"));
+}
+
+absl::Status CheckMasterListRank(int64_t rank, int64_t k) {
+  if (rank >= 1 && rank <= k) return absl::OkStatus();
+  if (k == 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--rank ", rank, " is out of range: the spectrum is empty, the master list has no ranks"));
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat("--rank ", rank, " is outside 1..", k, " (the spectrum has ", k, " values)"));
+}
+
 absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const ThresholdArg& threshold) {
   ResolvedThreshold resolved;
   absl::StatusOr<int64_t> level;
   switch (threshold.kind) {
     case ThresholdArg::Kind::kRank:
+      if (absl::Status s = CheckThresholdRank(threshold.rank, family.max_level()); !s.ok()) return s;
       level = family.LevelForRank(threshold.rank);
-      if (!level.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("--rank ", threshold.rank, " is outside 0..", family.max_level(),
-                                                       " (the spectrum has ", family.max_level(), " values)"));
-      }
       resolved.alpha_sq = LevelAlphaSq(family, *level);
       break;
     case ThresholdArg::Kind::kAlphaSq:

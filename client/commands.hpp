@@ -84,6 +84,12 @@ absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, co
 int PrintBenchTable(const std::string& file, size_t input_points, uint64_t distinct_points, int64_t repeat,
                     size_t first_measure, const std::vector<std::pair<std::string, std::string>>& rows);
 
+/// The checks of a --rank against a spectrum of `k` values, shared by the local and the remote
+/// commands so that both print the same line: a threshold rank must be in 0..K, a master-list
+/// rank in 1..K. OK, or InvalidArgument (for ArgumentError).
+absl::Status CheckThresholdRank(int64_t rank, int64_t k);
+absl::Status CheckMasterListRank(int64_t rank, int64_t k);
+
 /// The alpha_sq of level `level` >= 0 as published: spectrum[level - 1], 0 for level 0.
 double LevelAlphaSq(const AlphaFamily& family, int64_t level);
 

@@ -158,13 +158,7 @@ int RunMasterList(Args args) {
   size_t input_points = 0;
   auto family = LoadFamily(common->file, common->backend, &input_points);
   if (!family.ok()) return Failure(family.status());
-  if (*rank < 1 || *rank > family->max_level()) {
-    return ArgumentError(absl::InvalidArgumentError(
-        family->max_level() == 0
-            ? absl::StrCat("--rank ", *rank, " is out of range: the spectrum is empty, the master list has no ranks")
-            : absl::StrCat("--rank ", *rank, " is outside 1..", family->max_level(), " (the spectrum has ",
-                           family->max_level(), " values)")));
-  }
+  if (absl::Status s = CheckMasterListRank(*rank, family->max_level()); !s.ok()) return ArgumentError(s);
 
   ChunkedWriter out(stdout);
   for (const MasterEntry& entry : family->MasterList(*rank)) {

@@ -97,10 +97,7 @@ absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, const R
   const int64_t k = static_cast<int64_t>(remote.build.summary.spectrum_size());
   switch (threshold.kind) {
     case ThresholdArg::Kind::kRank:
-      if (threshold.rank < 0 || threshold.rank > k) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("--rank ", threshold.rank, " is outside 0..", k, " (the spectrum has ", k, " values)"));
-      }
+      if (absl::Status s = CheckThresholdRank(threshold.rank, k); !s.ok()) return s;
       out.set_rank(threshold.rank);
       break;
     case ThresholdArg::Kind::kAlphaSq:
@@ -263,11 +260,7 @@ int RemoteMasterList(const CommonArgs& common, int64_t rank) {
   auto remote = OpenRemote(common);
   if (!remote.ok()) return Failure(remote.status());
   const int64_t k = static_cast<int64_t>(remote->build.summary.spectrum_size());
-  if (rank < 1 || rank > k) {
-    return ArgumentError(absl::InvalidArgumentError(
-        k == 0 ? absl::StrCat("--rank ", rank, " is out of range: the spectrum is empty, the master list has no ranks")
-               : absl::StrCat("--rank ", rank, " is outside 1..", k, " (the spectrum has ", k, " values)")));
-  }
+  if (absl::Status s = CheckMasterListRank(rank, k); !s.ok()) return ArgumentError(s);
   v1::MasterListRequest request;
   request.set_handle(remote->build.handle);
   request.set_first_rank(rank);

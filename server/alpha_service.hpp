@@ -49,7 +49,6 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   /// The backend builds run on ("cuda" or "cpu").
   const std::string& backend_name() const { return backend_name_; }
   size_t build_slots() const { return scheduler_->slots(); }
-  size_t build_memory_bytes() const { return scheduler_->memory_budget_bytes(); }
   FamilyCache& cache() { return *cache_; }
   /// Bytes of points held by uploads and builds right now.
   size_t in_flight_bytes() const { return in_flight_.held(); }

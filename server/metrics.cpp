@@ -113,8 +113,6 @@ ServerMetrics::ServerMetrics()
 
 ServerMetrics::~ServerMetrics() = default;
 
-prometheus::Registry& ServerMetrics::registry() { return *registry_; }
-
 absl::StatusOr<int> ServerMetrics::StartExporter(const std::string& address) {
   try {
     exposer_ = std::make_unique<prometheus::Exposer>(address);

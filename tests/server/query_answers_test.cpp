@@ -23,6 +23,7 @@
 #include "gpu/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
+#include "tests/server/cached_family_fixture.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha::server {
@@ -36,14 +37,7 @@ struct NamedFamily {
 };
 
 std::shared_ptr<const CachedFamily> Build(const std::vector<Point2>& points, const std::string& name) {
-  BuildOptions options;
-  options.backend = Backend::kCpu;
-  absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(points, options);
-  if (!family.ok()) {
-    ADD_FAILURE() << name << ": " << family.status();
-    return nullptr;
-  }
-  return std::make_shared<const CachedFamily>(*std::move(family), name);
+  return testing::MakeCachedFamily(points, name);
 }
 
 // Points (i, 2i + 1) in shuffled order: exactly collinear, so edges only.

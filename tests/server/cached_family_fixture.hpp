@@ -1,0 +1,29 @@
+// A served family built from points on the CPU backend, for the tests of the service's modules.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "gpu/alpha_engine.hpp"
+#include "server/cached_family.hpp"
+
+namespace galpha::server::testing {
+
+/// The family of `points` as the service caches it; null (and a test failure) when the build fails.
+inline std::shared_ptr<const CachedFamily> MakeCachedFamily(const std::vector<Point2>& points,
+                                                            const std::string& name) {
+  BuildOptions options;
+  options.backend = Backend::kCpu;
+  absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(points, options);
+  if (!family.ok()) {
+    ADD_FAILURE() << name << ": " << family.status();
+    return nullptr;
+  }
+  return std::make_shared<const CachedFamily>(*std::move(family), name);
+}
+
+}  // namespace galpha::server::testing
