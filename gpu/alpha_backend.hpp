@@ -1,9 +1,11 @@
-// The seam between BuildAlphaFamily() and the two backends that run the one templated alpha
-// pipeline (alpha_impl.cuh) after the triangulation. Plain C++ and std types only.
+// The seam between BuildAlphaFamily() and the two backends that run the one templated build
+// (triangulation, delaunay_impl.cuh, then the alpha pipeline, alpha_impl.cuh, on the triangulation
+// where it lies). Plain C++ and std types only.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/alpha_ranks.hpp"
@@ -12,26 +14,39 @@
 
 namespace galpha::detail {
 
-/// A triangulation as the alpha pipeline reads it (host memory, borrowed).
+/// A triangulation in host memory, borrowed: what the host's exact repairs read.
 struct AlphaInput {
   const Point2* points = nullptr;
   uint32_t num_points = 0;
-  uint32_t num_unique = 0;                         // distinct points
-  const uint32_t* representative = nullptr;       // num_points
+  uint32_t num_unique = 0;  // distinct points
   const std::array<uint32_t, 3>* triangles = nullptr;
-  const std::array<int32_t, 3>* neighbors = nullptr;
-  const uint32_t* tri_edge_begin = nullptr;
   uint32_t num_triangles = 0;
   const std::array<uint32_t, 2>* edges = nullptr;
   uint32_t num_edges = 0;
 };
 
-/// Runs the alpha pipeline on the OpenMP backend; fills everything in `out` but the triangulation.
-void BuildAlphaOnCpu(const AlphaInput& in, AlphaRanks* out, std::vector<StageTime>* stage_times,
-                     size_t* peak_bytes);
+/// What a backend's build hands back; BuildAlphaFamily() moves it into an AlphaFamily.
+struct FamilyOutput {
+  std::vector<uint32_t> representative;
+  uint32_t num_unique = 0;
+  std::vector<std::array<uint32_t, 3>> triangles;
+  std::vector<std::array<uint32_t, 2>> edges;
+  AlphaRanks ranks;
+  std::vector<StageTime> stage_times;
+  size_t peak_memory_bytes = 0;
+};
+
+/// Called between the build's phases: after the triangulation, `after_triangulation` runs (it
+/// reports progress and may throw EngineError kCancelled to stop the build).
+struct BuildHooks {
+  std::function<void()> after_triangulation;
+};
+
+/// Builds the family of `n` finite points on the OpenMP backend. Throws EngineError (or a
+/// Thrust/std exception) on failure.
+void BuildFamilyOnCpu(const Point2* points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out);
 
 /// The same on the CUDA backend, on `stream` (a cudaStream_t, or nullptr for one of its own).
-void BuildAlphaOnCuda(const AlphaInput& in, void* stream, AlphaRanks* out,
-                      std::vector<StageTime>* stage_times, size_t* peak_bytes);
+void BuildFamilyOnCuda(const Point2* points, uint32_t n, void* stream, const BuildHooks& hooks, FamilyOutput* out);
 
 }  // namespace galpha::detail

@@ -1,14 +1,13 @@
-// The OpenMP instantiation of the alpha pipeline.
+// The OpenMP instantiation of the family build.
 #include "gpu/alpha_backend.hpp"
 #include "gpu/alpha_impl.cuh"
 #include "gpu/engine_system.cuh"
 
 namespace galpha::detail {
 
-void BuildAlphaOnCpu(const AlphaInput& in, AlphaRanks* out, std::vector<StageTime>* stage_times,
-                     size_t* peak_bytes) {
+void BuildFamilyOnCpu(const Point2* points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out) {
   CpuSystem system;
-  RunAlphaPipeline(system, in, out, stage_times, peak_bytes);
+  RunFamilyBuild(system, points, n, hooks, out);
 }
 
 }  // namespace galpha::detail

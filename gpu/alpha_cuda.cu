@@ -1,4 +1,4 @@
-// The CUDA instantiation of the alpha pipeline: one stream, stream-ordered memory.
+// The CUDA instantiation of the family build: one stream, stream-ordered memory.
 #include <cuda_runtime.h>
 
 #include "gpu/alpha_backend.hpp"
@@ -7,16 +7,15 @@
 
 namespace galpha::detail {
 
-void BuildAlphaOnCuda(const AlphaInput& in, void* stream, AlphaRanks* out, std::vector<StageTime>* stage_times,
-                      size_t* peak_bytes) {
+void BuildFamilyOnCuda(const Point2* points, uint32_t n, void* stream, const BuildHooks& hooks, FamilyOutput* out) {
   if (stream != nullptr) {
     CudaSystem system(static_cast<cudaStream_t>(stream));
-    RunAlphaPipeline(system, in, out, stage_times, peak_bytes);
+    RunFamilyBuild(system, points, n, hooks, out);
     return;
   }
   OwnedStream owned;
   CudaSystem system(owned.get());
-  RunAlphaPipeline(system, in, out, stage_times, peak_bytes);
+  RunFamilyBuild(system, points, n, hooks, out);
 }
 
 }  // namespace galpha::detail

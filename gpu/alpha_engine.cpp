@@ -1,14 +1,14 @@
 #include "gpu/alpha_engine.hpp"
 
-#include <algorithm>
-#include <exception>
-#include <new>
+#include <string>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/input_validation.hpp"
 #include "core/status_macros.hpp"
 #include "gpu/alpha_backend.hpp"
 #include "gpu/delaunay_backend.hpp"
+#include "gpu/engine_status.hpp"
 
 namespace galpha {
 
@@ -20,53 +20,43 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   const auto cancelled_error = [&](const char* after) {
     return absl::CancelledError(absl::StrCat("build of ", points.size(), " points cancelled after ", after));
   };
+  GALPHA_RETURN_IF_ERROR(ValidatePoints(points));
+  GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
   if (stop_requested()) return cancelled_error("0 phases");
-  TriangulateOptions topt;
-  topt.backend = options.backend;
-  topt.cuda_stream = options.cuda_stream;
-  GALPHA_ASSIGN_OR_RETURN(Triangulation tri, Triangulate(points, topt));
-  report("triangulation", 0.5);
-  if (stop_requested()) return cancelled_error("the triangulation");
+  const auto n = static_cast<uint32_t>(points.size());
 
-  AlphaFamilyParts parts;
-  parts.report.backend = BackendName(tri.backend);
-  parts.report.stage_times = std::move(tri.stage_times);
-  detail::AlphaInput in;
-  in.points = tri.points.data();
-  in.num_points = static_cast<uint32_t>(tri.points.size());
-  in.num_unique = tri.num_unique;
-  in.representative = tri.representative.data();
-  in.triangles = tri.triangles.data();
-  in.neighbors = tri.neighbors.data();
-  in.tri_edge_begin = tri.tri_edge_begin.data();
-  in.num_triangles = static_cast<uint32_t>(tri.triangles.size());
-  in.edges = tri.edges.data();
-  in.num_edges = static_cast<uint32_t>(tri.edges.size());
-  size_t alpha_peak = 0;
-  try {
-    if (tri.backend == Backend::kCuda) {
-      detail::BuildAlphaOnCuda(in, options.cuda_stream, &parts.ranks, &parts.report.stage_times, &alpha_peak);
-    } else {
-      detail::BuildAlphaOnCpu(in, &parts.ranks, &parts.report.stage_times, &alpha_peak);
+  // One engine call: the triangulation stays where it was built (device memory on CUDA) and the
+  // alpha pipeline reads it there; only the finished family comes back to the host.
+  detail::FamilyOutput built;
+  detail::BuildHooks hooks;
+  hooks.after_triangulation = [&] {
+    report("triangulation", 0.5);
+    if (stop_requested()) {
+      throw detail::EngineError(detail::EngineError::Kind::kCancelled,
+                                std::string(cancelled_error("the triangulation").message()));
     }
-  } catch (const detail::EngineError& e) {
-    if (e.kind() == detail::EngineError::Kind::kResourceExhausted) return absl::ResourceExhaustedError(e.what());
-    return absl::InternalError(e.what());
-  } catch (const std::bad_alloc&) {
-    return absl::ResourceExhaustedError(absl::StrCat("out of memory while building the alpha family of ",
-                                                     points.size(), " points"));
-  } catch (const std::exception& e) {
-    return absl::InternalError(absl::StrCat("alpha family build failed: ", e.what()));
-  }
+  };
+  GALPHA_RETURN_IF_ERROR(detail::RunEngine(absl::StrCat("building the alpha family of ", n, " points"), [&] {
+    if (backend == Backend::kCuda) {
+      detail::BuildFamilyOnCuda(points.data(), n, options.cuda_stream, hooks, &built);
+    } else {
+      detail::BuildFamilyOnCpu(points.data(), n, hooks, &built);
+    }
+  }));
   report("alpha", 0.9);
   if (stop_requested()) return cancelled_error("the alpha pipeline");
-  parts.report.peak_memory_bytes = std::max(tri.peak_memory_bytes, alpha_peak);
-  parts.report.comparisons = parts.ranks.comparisons;
-  parts.points = std::move(tri.points);
-  parts.representative = std::move(tri.representative);
-  parts.num_unique = tri.num_unique;
-  parts.triangles = std::move(tri.triangles);
-  parts.edges = std::move(tri.edges);
+
+  AlphaFamilyParts parts;
+  parts.report.backend = BackendName(backend);
+  parts.report.stage_times = std::move(built.stage_times);
+  parts.report.peak_memory_bytes = built.peak_memory_bytes;
+  parts.report.comparisons = built.ranks.comparisons;
+  parts.points.assign(points.begin(), points.end());
+  parts.representative = std::move(built.representative);
+  parts.num_unique = built.num_unique;
+  parts.triangles = std::move(built.triangles);
+  parts.edges = std::move(built.edges);
+  parts.ranks = std::move(built.ranks);
   report("components", 1.0);
   return AlphaFamily(std::move(parts));
 }

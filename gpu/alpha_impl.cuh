@@ -27,47 +27,68 @@
 #include "gpu/alpha_functors.cuh"
 #include "gpu/alpha_host_repair.hpp"
 #include "gpu/component_curve.cuh"
+#include "gpu/delaunay_impl.cuh"
 #include "gpu/engine_system.cuh"
 
 namespace galpha::detail {
 
+/// Runs the alpha pipeline on the triangulation `t` (in `sys`'s memory, with its points kept) and
+/// downloads the family into `out`: triangles, edges, duplicate map and rank tables. `host_points`
+/// is the same input in host memory (the host's exact repairs read it).
 template <class System>
-void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::vector<StageTime>* stage_times,
-                      size_t* peak_bytes) {
+void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points, StageTimer<System>& timer,
+                      FamilyOutput* family) {
   static_assert(sizeof(TriIdx) == sizeof(std::array<uint32_t, 3>), "layout of the host triangles");
   static_assert(sizeof(TriNb) == sizeof(std::array<int32_t, 3>), "layout of the host neighbours");
   static_assert(sizeof(EdgeIdx) == sizeof(std::array<uint32_t, 2>), "layout of the host edges");
   static_assert(sizeof(EdgeTris) == sizeof(std::array<int32_t, 2>), "layout of the edge triangles");
-  StageTimer<System> timer(sys, stage_times);
+  static_assert(sizeof(TriIdx) == sizeof(Tri) && sizeof(TriNb) == sizeof(TriNbr) && sizeof(EdgeIdx) == sizeof(EdgePair),
+                "the triangulation's layout is the pipeline's");
+  AlphaRanks* out = &family->ranks;
   auto policy = sys.policy();
-  const uint32_t n = in.num_points, num_tri = in.num_triangles, num_edges = in.num_edges;
+  const uint32_t n = static_cast<uint32_t>(t.points.size());
+  const uint32_t num_tri = static_cast<uint32_t>(t.tri.size()), num_edges = static_cast<uint32_t>(t.edges.size());
   const uint32_t num_simplices = num_tri + num_edges;
   thrust::counting_iterator<uint32_t> zero(0);
 
-  Buffer<Point2, System> points(sys, n);
-  Buffer<uint32_t, System> representative(sys, n);
-  Buffer<TriIdx, System> tri(sys, num_tri);
-  Buffer<TriNb, System> nbr(sys, num_tri);
-  Buffer<uint32_t, System> edge_begin(sys, num_tri);
-  Buffer<EdgeIdx, System> edges(sys, num_edges);
-  sys.FromHost(points.data(), in.points, n);
-  sys.FromHost(representative.data(), in.representative, n);
-  sys.FromHost(tri.data(), reinterpret_cast<const TriIdx*>(in.triangles), num_tri);
-  sys.FromHost(nbr.data(), reinterpret_cast<const TriNb*>(in.neighbors), num_tri);
-  sys.FromHost(edge_begin.data(), in.tri_edge_begin, num_tri);
-  sys.FromHost(edges.data(), reinterpret_cast<const EdgeIdx*>(in.edges), num_edges);
-  timer.EndStage("alpha_upload");
+  Buffer<uint32_t, System>& representative = t.representative;
+  auto& points = t.points;
+  const TriIdx* tri_data = reinterpret_cast<const TriIdx*>(t.tri.data());
+  const TriNb* nbr_data = reinterpret_cast<const TriNb*>(t.nbr.data());
+  const EdgeIdx* edge_data = reinterpret_cast<const EdgeIdx*>(t.edges.data());
+
+  // The triangles and edges go to the host once, into the family: at the end, or earlier when one
+  // of the rare host repairs needs them.
+  family->triangles.resize(num_tri);
+  family->edges.resize(num_edges);
+  bool mesh_on_host = false;
+  AlphaInput host_input;
+  host_input.points = host_points;
+  host_input.num_points = n;
+  host_input.num_unique = t.num_unique;
+  host_input.triangles = family->triangles.data();
+  host_input.num_triangles = num_tri;
+  host_input.edges = family->edges.data();
+  host_input.num_edges = num_edges;
+  auto host_mesh = [&]() -> const AlphaInput& {
+    if (!mesh_on_host) {
+      sys.Download({{family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)},
+                    {family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)}});
+      mesh_on_host = true;
+    }
+    return host_input;
+  };
 
   // Edge topology: the incident triangles of every edge (none for a collinear chain).
   Buffer<EdgeTris, System> edge_tris(sys, num_edges);
   thrust::fill_n(policy, edge_tris.data(), num_edges, EdgeTris{{-1, -1}});
-  thrust::for_each_n(policy, zero, num_tri, WriteEdgeTriangles{tri.data(), nbr.data(), edge_begin.data(), edge_tris.data()});
-  nbr.Reset();
-  edge_begin.Reset();
+  thrust::for_each_n(policy, zero, num_tri, WriteEdgeTriangles{tri_data, nbr_data, t.edge_begin.data(), edge_tris.data()});
+  t.nbr.Reset();
+  t.edge_begin.Reset();
   timer.EndStage("edge_topology");
 
   // Radii and attachment: one certified key per simplex.
-  const SimplexPoints simplex{points.data(), tri.data(), edges.data(), num_tri};
+  const SimplexPoints simplex{points.data(), tri_data, edge_data, num_tri};
   Buffer<uint64_t, System> keys(sys, num_simplices);
   Buffer<uint8_t, System> uncertified(sys, num_simplices);
   thrust::for_each_n(policy, zero, num_simplices,
@@ -142,7 +163,7 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
       for (uint32_t r = 0; r < num_runs; ++r) {
         if (host_needs[r]) runs.push_back({host_begin[r], host_begin[r + 1]});
       }
-      RepairRunsOnHost(in, runs, host_ids.data(), host_new.data(), &out->comparisons);
+      RepairRunsOnHost(host_mesh(), runs, host_ids.data(), host_new.data(), &out->comparisons);
       sys.FromHost(ids.data(), host_ids.data(), num_entries);
       sys.FromHost(new_value.data(), host_new.data(), num_entries);
     }
@@ -157,7 +178,7 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
     std::vector<uint32_t> host_ids = ids.ToHostVector(num_entries);
     std::vector<uint8_t> host_new = new_value.ToHostVector(num_entries);
     std::vector<uint32_t> odd = odd_ids.ToHostVector(num_odd);
-    MergeUncertifiedOnHost(in, odd, &host_ids, &host_new, &out->comparisons);
+    MergeUncertifiedOnHost(host_mesh(), odd, &host_ids, &host_new, &out->comparisons);
     total_entries = static_cast<uint32_t>(host_ids.size());
     ids = Buffer<uint32_t, System>(sys, total_entries);
     new_value = Buffer<uint8_t, System>(sys, total_entries);
@@ -203,7 +224,7 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   thrust::fill_n(policy, vertex_mu_high.data(), n, uint32_t{0});
   thrust::fill_n(policy, vertex_tri_low.data(), n, kNeverRank);
   thrust::for_each_n(policy, zero, num_edges,
-                     EdgeIntervals{edges.data(), edge_tris.data(), tri_rank.data(), edge_rho_rank.data(),
+                     EdgeIntervals{edge_data, edge_tris.data(), tri_rank.data(), edge_rho_rank.data(),
                                    edge_mu_low.data(), edge_mu_high.data(), keys.data(), num_tri,
                                    vertex_mu_low.data(), vertex_mu_high.data(), vertex_tri_low.data()});
   // Representatives first (their own values), then duplicates copy them.
@@ -260,31 +281,65 @@ void RunAlphaPipeline(System& sys, const AlphaInput& in, AlphaRanks* out, std::v
   // Component curves over all levels (Borůvka spanning forests, component_curve.cuh).
   Buffer<uint32_t, System> components(sys, static_cast<size_t>(num_ranks) + 1);
   Buffer<uint32_t, System> solid_components(sys, static_cast<size_t>(num_ranks) + 1);
-  ComponentCurves(sys, n, in.num_unique, num_tri, num_edges, num_ranks, edges.data(), edge_tris.data(), tri_rank.data(),
+  ComponentCurves(sys, n, t.num_unique, num_tri, num_edges, num_ranks, edge_data, edge_tris.data(), tri_rank.data(),
                   edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(), components.data(),
                   solid_components.data());
   timer.EndStage("components");
 
-  out->spectrum = spectrum.ToHostVector(num_ranks);
-  out->spectrum_simplex = spectrum_simplex.ToHostVector(num_ranks);
-  if (any_needs_host) NearestValuesOnHost(in, needs_host.ToHostVector(num_ranks), out);
-  out->tri_rank = tri_rank.ToHostVector(num_tri);
-  out->edge_rho_rank = edge_rho_rank.ToHostVector(num_edges);
-  out->edge_mu_low = edge_mu_low.ToHostVector(num_edges);
-  out->edge_mu_high = edge_mu_high.ToHostVector(num_edges);
+  // One pipelined download of the whole family.
+  out->spectrum.resize(num_ranks);
+  out->spectrum_simplex.resize(num_ranks);
+  out->tri_rank.resize(num_tri);
+  out->edge_rho_rank.resize(num_edges);
+  out->edge_mu_low.resize(num_edges);
+  out->edge_mu_high.resize(num_edges);
   out->edge_triangles.resize(num_edges);
-  sys.ToHost(reinterpret_cast<EdgeTris*>(out->edge_triangles.data()), edge_tris.data(), num_edges);
-  out->vertex_mu_low = vertex_mu_low.ToHostVector(n);
-  out->vertex_mu_high = vertex_mu_high.ToHostVector(n);
-  out->vertex_tri_low = vertex_tri_low.ToHostVector(n);
-  out->components = components.ToHostVector(static_cast<size_t>(num_ranks) + 1);
-  out->solid_components = solid_components.ToHostVector(static_cast<size_t>(num_ranks) + 1);
-  out->master_begin = master_begin.ToHostVector(static_cast<size_t>(num_ranks) + 2);
+  out->vertex_mu_low.resize(n);
+  out->vertex_mu_high.resize(n);
+  out->vertex_tri_low.resize(n);
+  out->components.resize(static_cast<size_t>(num_ranks) + 1);
+  out->solid_components.resize(static_cast<size_t>(num_ranks) + 1);
+  out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
   out->master.resize(num_master);
-  sys.ToHost(reinterpret_cast<uint64_t*>(out->master.data()), master_entries.data(), num_master);
-  timer.EndStage("alpha_download");
-  *peak_bytes = sys.peak_bytes();
+  family->representative.resize(n);
+  family->num_unique = t.num_unique;
+  std::vector<HostCopy> copies = {
+      {out->spectrum.data(), spectrum.data(), size_t{num_ranks} * sizeof(double)},
+      {out->spectrum_simplex.data(), spectrum_simplex.data(), size_t{num_ranks} * sizeof(uint32_t)},
+      {out->tri_rank.data(), tri_rank.data(), size_t{num_tri} * sizeof(uint32_t)},
+      {out->edge_rho_rank.data(), edge_rho_rank.data(), size_t{num_edges} * sizeof(uint32_t)},
+      {out->edge_mu_low.data(), edge_mu_low.data(), size_t{num_edges} * sizeof(uint32_t)},
+      {out->edge_mu_high.data(), edge_mu_high.data(), size_t{num_edges} * sizeof(uint32_t)},
+      {out->edge_triangles.data(), edge_tris.data(), size_t{num_edges} * sizeof(EdgeTris)},
+      {out->vertex_mu_low.data(), vertex_mu_low.data(), size_t{n} * sizeof(uint32_t)},
+      {out->vertex_mu_high.data(), vertex_mu_high.data(), size_t{n} * sizeof(uint32_t)},
+      {out->vertex_tri_low.data(), vertex_tri_low.data(), size_t{n} * sizeof(uint32_t)},
+      {out->components.data(), components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+      {out->solid_components.data(), solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+      {out->master_begin.data(), master_begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
+      {out->master.data(), master_entries.data(), size_t{num_master} * sizeof(uint64_t)},
+      {family->representative.data(), representative.data(), size_t{n} * sizeof(uint32_t)}};
+  if (!mesh_on_host) {
+    copies.push_back({family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)});
+    copies.push_back({family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)});
+    mesh_on_host = true;
+  }
+  sys.Download(copies);
+  if (any_needs_host) NearestValuesOnHost(host_mesh(), needs_host.ToHostVector(num_ranks), out);
+  timer.EndStage("download");
+}
+
+/// The whole build on one system: triangulation, then the alpha pipeline on the triangulation
+/// where it lies, then one download of the family.
+template <class System>
+void RunFamilyBuild(System& sys, const Point2* host_points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out) {
+  StageTimer<System> timer(sys, &out->stage_times);
+  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, n, /*keep_points=*/true, timer);
+  if (hooks.after_triangulation) hooks.after_triangulation();
+  RunAlphaPipeline(sys, t, host_points, timer, out);
+  timer.Finish();
+  out->peak_memory_bytes = sys.peak_bytes();
 }
 
 }  // namespace galpha::detail

@@ -1,16 +1,21 @@
 // The CUDA backend's execution system: stream-ordered allocation (cudaMallocAsync from the device's
-// memory pool, also for Thrust's temporaries), Thrust's par_nosync policy on one stream, and every
-// CUDA call checked. Only compiled by nvcc.
+// memory pool, also for Thrust's temporaries), Thrust's par_nosync policy on one stream, large host
+// transfers through pinned staging, stage times by CUDA events, and every CUDA call checked. Only
+// compiled by nvcc.
 #pragma once
 
 #include <cuda_runtime.h>
 
+#include <cstdint>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include <thrust/system/cuda/execution_policy.h>
 
 #include "gpu/delaunay_backend.hpp"
 #include "gpu/engine_system.cuh"
+#include "gpu/host_copy.hpp"
 
 namespace galpha::detail {
 
@@ -44,6 +49,12 @@ class StreamOrderedAllocator {
   MemoryLedger* ledger_;
 };
 
+/// Keeps device memory freed by a build in the current device's pool for the next build. By
+/// default the pool returns it to the driver at every synchronisation, and the next build's
+/// cudaMallocAsync maps it again: at 1M points that cost more than the pipeline's own work.
+/// The pool then holds the high-water mark of concurrent builds (nvidia-smi shows it as used).
+void RetainFreedDeviceMemory();
+
 /// The CUDA backend on one stream.
 class CudaSystem {
  public:
@@ -54,7 +65,10 @@ class CudaSystem {
   /// an H100, 2026-11-22.
   static constexpr uint32_t kRepairStepsPerRound = 16;
 
-  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) {}
+  /// Copies of at least this many bytes go through pinned staging (pinned_staging.cuh).
+  static constexpr size_t kStagedFrom = size_t{1} << 20;
+
+  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) { RetainFreedDeviceMemory(); }
   CudaSystem(const CudaSystem&) = delete;
   CudaSystem& operator=(const CudaSystem&) = delete;
 
@@ -77,19 +91,16 @@ class CudaSystem {
 
   template <class T>
   void ToHost(T* host, const T* device, size_t count) {
-    if (count == 0) return;
-    CheckCuda(cudaMemcpyAsync(host, device, count * sizeof(T), cudaMemcpyDeviceToHost, stream_),
-              "cudaMemcpyAsync to host");
-    CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+    Download({{host, device, count * sizeof(T)}});
   }
   template <class T>
   void FromHost(T* device, const T* host, size_t count) {
-    if (count == 0) return;
-    CheckCuda(cudaMemcpyAsync(device, host, count * sizeof(T), cudaMemcpyHostToDevice, stream_),
-              "cudaMemcpyAsync to device");
-    // The host buffer may be pageable and short-lived: wait until the copy has consumed it.
-    CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+    Upload({{const_cast<T*>(host), device, count * sizeof(T)}});
   }
+  /// Copies device buffers to host buffers, all in one pipeline; returns when they have arrived.
+  void Download(const std::vector<HostCopy>& copies);
+  /// Copies host buffers to device buffers; returns when the host buffers may be reused.
+  void Upload(const std::vector<HostCopy>& copies);
   template <class T>
   T Read(const T* device) {
     T value;
@@ -100,6 +111,26 @@ class CudaSystem {
     CheckCuda(cudaGetLastError(), "kernel launch");
     CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
   }
+
+  /// Stage marks are events on the stream: a stage's time is the stream's, with no host sync at
+  /// stage ends (StageTimer reads them all once, at the end of the build).
+  using StageMark = cudaEvent_t;
+  StageMark MarkStage() {
+    CheckCuda(cudaGetLastError(), "kernel launch");
+    cudaEvent_t event = nullptr;
+    CheckCuda(cudaEventCreate(&event), "cudaEventCreate");
+    const cudaError_t recorded = cudaEventRecord(event, stream_);
+    if (recorded != cudaSuccess) cudaEventDestroy(event);
+    CheckCuda(recorded, "cudaEventRecord");
+    return event;
+  }
+  double SecondsBetween(StageMark from, StageMark to) {
+    CheckCuda(cudaEventSynchronize(to), "cudaEventSynchronize (stage mark)");
+    float ms = 0;
+    CheckCuda(cudaEventElapsedTime(&ms, from, to), "cudaEventElapsedTime");
+    return ms * 1e-3;
+  }
+  void ReleaseMark(StageMark mark) { cudaEventDestroy(mark); }
 
  private:
   cudaStream_t stream_;

@@ -10,6 +10,7 @@
 #include "core/input_validation.hpp"
 #include "core/status_macros.hpp"
 #include "gpu/delaunay_backend.hpp"
+#include "gpu/engine_status.hpp"
 
 namespace galpha {
 
@@ -27,19 +28,7 @@ const char* BackendName(Backend backend) {
 
 bool CudaBackendAvailable() { return detail::CudaDeviceVisible(); }
 
-namespace {
-
-absl::Status ToStatus(const detail::EngineError& error) {
-  switch (error.kind()) {
-    case detail::EngineError::Kind::kResourceExhausted:
-      return absl::ResourceExhaustedError(error.what());
-    case detail::EngineError::Kind::kUnavailable:
-      return absl::UnavailableError(error.what());
-    case detail::EngineError::Kind::kInternal:
-      break;
-  }
-  return absl::InternalError(error.what());
-}
+namespace detail {
 
 absl::StatusOr<Backend> ResolveBackend(Backend requested) {
   const bool cuda = CudaBackendAvailable();
@@ -55,26 +44,43 @@ absl::StatusOr<Backend> ResolveBackend(Backend requested) {
   return absl::InvalidArgumentError("unknown backend");
 }
 
-}  // namespace
+absl::Status RunEngine(const std::string& what, const std::function<void()>& body) {
+  try {
+    body();
+  } catch (const EngineError& e) {
+    switch (e.kind()) {
+      case EngineError::Kind::kResourceExhausted:
+        return absl::ResourceExhaustedError(absl::StrCat(what, ": ", e.what()));
+      case EngineError::Kind::kUnavailable:
+        return absl::UnavailableError(e.what());
+      case EngineError::Kind::kCancelled:
+        return absl::CancelledError(e.what());
+      case EngineError::Kind::kInternal:
+        break;
+    }
+    return absl::InternalError(absl::StrCat(what, ": ", e.what()));
+  } catch (const std::bad_alloc&) {
+    return absl::ResourceExhaustedError(absl::StrCat("out of memory while ", what));
+  } catch (const std::exception& e) {  // Thrust reports CUDA failures as system_error
+    return absl::InternalError(absl::StrCat(what, " failed: ", e.what()));
+  }
+  return absl::OkStatus();
+}
+
+}  // namespace detail
 
 absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points, const TriangulateOptions& options) {
   GALPHA_RETURN_IF_ERROR(ValidatePoints(points));
-  GALPHA_ASSIGN_OR_RETURN(const Backend backend, ResolveBackend(options.backend));
+  GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
   const auto n = static_cast<uint32_t>(points.size());
   detail::DelaunayOutput raw;
-  try {
+  GALPHA_RETURN_IF_ERROR(detail::RunEngine(absl::StrCat("triangulating ", n, " points"), [&] {
     if (backend == Backend::kCuda) {
       detail::TriangulateOnCuda(points.data(), n, options.cuda_stream, &raw);
     } else {
       detail::TriangulateOnCpu(points.data(), n, &raw);
     }
-  } catch (const detail::EngineError& e) {
-    return ToStatus(e);
-  } catch (const std::bad_alloc& e) {
-    return absl::ResourceExhaustedError(absl::StrCat("out of memory while triangulating ", n, " points"));
-  } catch (const std::exception& e) {  // Thrust reports CUDA failures as system_error
-    return absl::InternalError(absl::StrCat("triangulation failed: ", e.what()));
-  }
+  }));
   Triangulation result;
   result.points.assign(points.begin(), points.end());
   result.representative = std::move(raw.representative);

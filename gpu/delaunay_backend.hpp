@@ -30,7 +30,7 @@ struct DelaunayOutput {
 /// turned into an absl::Status once, at the engine boundary.
 class EngineError : public std::runtime_error {
  public:
-  enum class Kind { kInternal, kResourceExhausted, kUnavailable };
+  enum class Kind { kInternal, kResourceExhausted, kUnavailable, kCancelled };
   EngineError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }
 

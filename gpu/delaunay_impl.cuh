@@ -348,20 +348,36 @@ class DelaunayBuilder {
   uint32_t generation_ = 0;
 };
 
-template <class T, class System>
-void CopyOut(System& sys, const Buffer<T, System>& buffer, size_t count, void* host) {
-  sys.ToHost(static_cast<T*>(host), buffer.data(), count);
-}
-
-/// Runs the whole triangulation of `n` host points on `sys`, filling `out`.
+/// A triangulation in an execution system's memory, named by input indices: what the alpha
+/// pipeline reads without a round trip through the host.
 template <class System>
-void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, DelaunayOutput* out) {
+struct SystemTriangulation {
+  explicit SystemTriangulation(System& sys)
+      : points(sys, 0), representative(sys, 0), tri(sys, 0), nbr(sys, 0), edge_begin(sys, 0), edges(sys, 0) {}
+  /// The input as given (kept only when asked for).
+  Buffer<Point2, System> points;
+  /// For every input index, its first occurrence.
+  Buffer<uint32_t, System> representative;
+  uint32_t num_unique = 0;
+  /// Finite triangles (input indices, counter-clockwise), neighbours (-1 on the hull), the first
+  /// owned edge of each triangle, and the edges by the ownership rule.
+  Buffer<Tri, System> tri;
+  Buffer<TriNbr, System> nbr;
+  Buffer<uint32_t, System> edge_begin;
+  Buffer<EdgePair, System> edges;
+};
+
+/// Triangulates `n` host points on `sys`; the result stays in the system's memory. With
+/// `keep_points` the uploaded input is kept in the result (else it is freed as soon as possible).
+template <class System>
+SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_points, uint32_t n, bool keep_points,
+                                                StageTimer<System>& timer) {
   static_assert(sizeof(std::array<uint32_t, 3>) == sizeof(Tri), "triangle layout");
   static_assert(sizeof(std::array<int32_t, 3>) == sizeof(TriNbr), "neighbour layout");
   static_assert(sizeof(std::array<uint32_t, 2>) == sizeof(EdgePair), "edge layout");
-  StageTimer<System> timer(sys, &out->stage_times);
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
+  SystemTriangulation<System> result(sys);
 
   // The input as given; freed once the distinct points are gathered in Hilbert order.
   Buffer<Point2, System> input(sys, n);
@@ -370,8 +386,7 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
 
   // Exact duplicates: sort by (point, index); each run's head is the first occurrence.
   Buffer<uint32_t, System> unique(sys, n);
-  // Stays on the device until the download stage: a transfer, not part of the dedupe's time.
-  Buffer<uint32_t, System> representative(sys, n);
+  result.representative = Buffer<uint32_t, System>(sys, n);
   uint32_t m = 0;
   {
     Buffer<uint32_t, System> sorted(sys, n);
@@ -387,12 +402,13 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     }
     thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data()});
     thrust::inclusive_scan(pol, head.begin(), head.end(), head.begin(), thrust::maximum<uint32_t>());
-    thrust::for_each(pol, first, first + n, WriteRepresentative{sorted.data(), head.data(), representative.data()});
+    thrust::for_each(pol, first, first + n,
+                     WriteRepresentative{sorted.data(), head.data(), result.representative.data()});
     m = static_cast<uint32_t>(
         thrust::copy_if(pol, sorted.begin(), sorted.end(), first, unique.begin(), IsRunHead{head.data()}) -
         unique.begin());
   }
-  out->num_unique = m;
+  result.num_unique = m;
   timer.EndStage("dedupe");
 
   // Fewer than three distinct points, or all on one line: no triangles, the sorted chain of edges.
@@ -405,14 +421,12 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
   }
   if (collinear) {
     const uint32_t num_edges = m > 1 ? m - 1 : 0;
-    Buffer<EdgePair, System> edges(sys, num_edges);
-    thrust::for_each(pol, first, first + num_edges, WriteChainEdge{unique.data(), edges.data()});
-    out->edges.resize(num_edges);
-    CopyOut(sys, edges, num_edges, out->edges.data());
-    out->representative = representative.ToHostVector(n);
+    result.edges = Buffer<EdgePair, System>(sys, num_edges);
+    thrust::for_each(pol, first, first + num_edges, WriteChainEdge{unique.data(), result.edges.data()});
+    unique.Reset();
+    if (keep_points) result.points = std::move(input);
     timer.EndStage("collinear_chain");
-    out->peak_memory_bytes = sys.peak_bytes();
-    return;
+    return result;
   }
 
   // Hilbert order of the distinct points: neighbours in the order are neighbours in the plane.
@@ -425,7 +439,11 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
     thrust::sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
     thrust::for_each(pol, first, first + m, GatherVertex{input.data(), unique.data(), vertex_points.data()});
   }
-  input.Reset();
+  if (keep_points) {
+    result.points = std::move(input);
+  } else {
+    input.Reset();
+  }
   timer.EndStage("hilbert_sort");
 
   // The first triangle: vertices 0, 1 and the first vertex off their line.
@@ -465,33 +483,47 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
                                    thrust::plus<int32_t>());
   const int32_t num_finite =
       static_cast<int32_t>(thrust::count_if(pol, tfirst, tfirst + num_tri, IsFiniteTri{mesh}));
-  Buffer<Tri, System> out_tri(sys, num_finite);
-  Buffer<TriNbr, System> out_nbr(sys, num_finite);
-  thrust::for_each(pol, tfirst, tfirst + num_tri, WriteFiniteTriangle{mesh, finite_id.data(), out_tri.data(), out_nbr.data()});
+  result.tri = Buffer<Tri, System>(sys, num_finite);
+  result.nbr = Buffer<TriNbr, System>(sys, num_finite);
+  thrust::for_each(pol, tfirst, tfirst + num_tri,
+                   WriteFiniteTriangle{mesh, finite_id.data(), result.tri.data(), result.nbr.data()});
   finite_id.Reset();
   builder.reset();  // `mesh` dangles from here on
-  Buffer<uint32_t, System> edge_begin(sys, num_finite);
-  thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_finite, edge_begin.begin(),
-                                   CountOwnedEdges{out_tri.data(), out_nbr.data()}, 0u, thrust::plus<uint32_t>());
-  const uint32_t num_edges = sys.Read(edge_begin.data() + num_finite - 1) +
+  vertex_points.Reset();
+  unique.Reset();
+  result.edge_begin = Buffer<uint32_t, System>(sys, num_finite);
+  const Tri* out_tri = result.tri.data();
+  const TriNbr* out_nbr = result.nbr.data();
+  thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_finite, result.edge_begin.begin(),
+                                   CountOwnedEdges{out_tri, out_nbr}, 0u, thrust::plus<uint32_t>());
+  const uint32_t num_edges = sys.Read(result.edge_begin.data() + num_finite - 1) +
                              thrust::transform_reduce(pol, tfirst + num_finite - 1, tfirst + num_finite,
-                                                      CountOwnedEdges{out_tri.data(), out_nbr.data()}, 0u,
-                                                      thrust::plus<uint32_t>());
-  Buffer<EdgePair, System> edges(sys, num_edges);
+                                                      CountOwnedEdges{out_tri, out_nbr}, 0u, thrust::plus<uint32_t>());
+  result.edges = Buffer<EdgePair, System>(sys, num_edges);
   thrust::for_each(pol, tfirst, tfirst + num_finite,
-                   WriteOwnedEdges{out_tri.data(), out_nbr.data(), edge_begin.data(), edges.data()});
+                   WriteOwnedEdges{out_tri, out_nbr, result.edge_begin.data(), result.edges.data()});
   timer.EndStage("output");
+  return result;
+}
 
-  out->triangles.resize(num_finite);
-  out->neighbors.resize(num_finite);
-  out->tri_edge_begin.resize(num_finite);
-  out->edges.resize(num_edges);
-  CopyOut(sys, out_tri, num_finite, out->triangles.data());
-  CopyOut(sys, out_nbr, num_finite, out->neighbors.data());
-  CopyOut(sys, edge_begin, num_finite, out->tri_edge_begin.data());
-  CopyOut(sys, edges, num_edges, out->edges.data());
-  out->representative = representative.ToHostVector(n);
+/// Runs the whole triangulation of `n` host points on `sys` and downloads it into `out`.
+template <class System>
+void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, DelaunayOutput* out) {
+  StageTimer<System> timer(sys, &out->stage_times);
+  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, n, /*keep_points=*/false, timer);
+  out->num_unique = t.num_unique;
+  out->triangles.resize(t.tri.size());
+  out->neighbors.resize(t.nbr.size());
+  out->tri_edge_begin.resize(t.edge_begin.size());
+  out->edges.resize(t.edges.size());
+  out->representative.resize(n);
+  sys.Download({{out->triangles.data(), t.tri.data(), t.tri.size() * sizeof(Tri)},
+                {out->neighbors.data(), t.nbr.data(), t.nbr.size() * sizeof(TriNbr)},
+                {out->tri_edge_begin.data(), t.edge_begin.data(), t.edge_begin.size() * sizeof(uint32_t)},
+                {out->edges.data(), t.edges.data(), t.edges.size() * sizeof(EdgePair)},
+                {out->representative.data(), t.representative.data(), size_t{n} * sizeof(uint32_t)}});
   timer.EndStage("download");
+  timer.Finish();
   out->peak_memory_bytes = sys.peak_bytes();
 }
 

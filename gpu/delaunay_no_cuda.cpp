@@ -14,7 +14,7 @@ void TriangulateOnCuda(const Point2*, uint32_t, void*, DelaunayOutput*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 
-void BuildAlphaOnCuda(const AlphaInput&, void*, AlphaRanks*, std::vector<StageTime>*, size_t*) {
+void BuildFamilyOnCuda(const Point2*, uint32_t, void*, const BuildHooks&, FamilyOutput*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 

@@ -15,6 +15,7 @@
 #include <thrust/system/omp/execution_policy.h>
 
 #include "gpu/delaunay_backend.hpp"
+#include "gpu/host_copy.hpp"
 
 namespace galpha::detail {
 
@@ -91,11 +92,17 @@ class CpuSystem {
 
   template <class T>
   void ToHost(T* host, const T* system, size_t count) {
-    if (count != 0) std::memcpy(host, system, count * sizeof(T));
+    ParallelCopy(host, system, count * sizeof(T));
   }
   template <class T>
   void FromHost(T* system, const T* host, size_t count) {
-    if (count != 0) std::memcpy(system, host, count * sizeof(T));
+    ParallelCopy(system, host, count * sizeof(T));
+  }
+  void Download(const std::vector<HostCopy>& copies) {
+    for (const HostCopy& c : copies) ParallelCopy(c.host, c.system, c.bytes);
+  }
+  void Upload(const std::vector<HostCopy>& copies) {
+    for (const HostCopy& c : copies) ParallelCopy(const_cast<void*>(c.system), c.host, c.bytes);
   }
   template <class T>
   T Read(const T* system) {
@@ -103,6 +110,11 @@ class CpuSystem {
   }
   /// Waits for queued work; the CPU backend runs synchronously.
   void Synchronize() {}
+
+  using StageMark = std::chrono::steady_clock::time_point;
+  StageMark MarkStage() { return std::chrono::steady_clock::now(); }
+  double SecondsBetween(StageMark from, StageMark to) { return std::chrono::duration<double>(to - from).count(); }
+  void ReleaseMark(StageMark) {}
 
  private:
   MemoryLedger ledger_;  // declared before temp_, which points at it
@@ -155,24 +167,36 @@ class Buffer {
   size_t size_;
 };
 
-/// Records stage times: synchronizes the system at each stage end so a stage's time is its own.
+/// Records stage times as marks in the system's own order of work (CUDA events on the stream, the
+/// clock on the CPU): a stage's time is from the previous mark to its own, and no stage end waits
+/// for the device. Finish() reads the marks (one wait, for the last) into the stage list.
 template <class System>
 class StageTimer {
  public:
-  StageTimer(System& system, std::vector<StageTime>* out)
-      : system_(system), out_(out), start_(std::chrono::steady_clock::now()) {}
+  StageTimer(System& system, std::vector<StageTime>* out) : system_(system), out_(out), start_(system.MarkStage()) {}
+  StageTimer(const StageTimer&) = delete;
+  StageTimer& operator=(const StageTimer&) = delete;
+  ~StageTimer() {
+    system_.ReleaseMark(start_);
+    for (auto& [name, mark] : ends_) system_.ReleaseMark(mark);
+  }
 
-  void EndStage(const char* name) {
-    system_.Synchronize();
-    const auto now = std::chrono::steady_clock::now();
-    out_->push_back({name, std::chrono::duration<double>(now - start_).count()});
-    start_ = now;
+  void EndStage(const char* name) { ends_.emplace_back(name, system_.MarkStage()); }
+
+  /// Appends every ended stage to the output, in order.
+  void Finish() {
+    typename System::StageMark from = start_;
+    for (auto& [name, mark] : ends_) {
+      out_->push_back({name, system_.SecondsBetween(from, mark)});
+      from = mark;
+    }
   }
 
  private:
   System& system_;
   std::vector<StageTime>* out_;
-  std::chrono::steady_clock::time_point start_;
+  typename System::StageMark start_;
+  std::vector<std::pair<const char*, typename System::StageMark>> ends_;
 };
 
 }  // namespace galpha::detail

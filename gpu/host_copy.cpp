@@ -1,0 +1,29 @@
+#include "gpu/host_copy.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+namespace galpha::detail {
+
+void ParallelCopy(void* dst, const void* src, size_t bytes) {
+  // Below a few MiB the fork/join of a parallel region costs more than it saves.
+  constexpr size_t kParallelFrom = size_t{4} << 20;
+  constexpr size_t kBlock = size_t{1} << 20;
+  if (bytes < kParallelFrom) {
+    if (bytes != 0) std::memcpy(dst, src, bytes);
+    return;
+  }
+  auto* out = static_cast<char*>(dst);
+  const auto* in = static_cast<const char*>(src);
+  const int64_t blocks = static_cast<int64_t>((bytes + kBlock - 1) / kBlock);
+#pragma omp parallel for schedule(static)
+  for (int64_t b = 0; b < blocks; ++b) {
+    const size_t begin = static_cast<size_t>(b) * kBlock;
+    std::memcpy(out + begin, in + begin, std::min(kBlock, bytes - begin));
+  }
+}
+
+}  // namespace galpha::detail
