@@ -63,7 +63,7 @@ int RunClassify(Args args) {
 
   const Classification classes = family->ClassifyAll(threshold->level, options->mode, options->rule);
   ChunkedWriter out(stdout);
-  const std::vector<uint32_t>& representative = family->representative();
+  const auto& representative = family->representative();
   for (uint32_t v = 0; v < classes.vertices.size(); ++v) {
     if (representative[v] != v) continue;
     AppendSimplex<1>(out, 'v', {v});

@@ -226,7 +226,7 @@ ShapeComplex AlphaFamily::ComplexAt(int64_t level, ClassifyMode mode) const {
 
 namespace {
 template <typename T>
-size_t VectorBytes(const std::vector<T>& v) {
+size_t VectorBytes(const HostVector<T>& v) {
   return v.capacity() * sizeof(T);
 }
 }  // namespace

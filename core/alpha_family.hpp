@@ -41,11 +41,11 @@ struct BuildReport {
 
 /// The raw parts a family is assembled from (moved in by the builder).
 struct AlphaFamilyParts {
-  std::vector<Point2> points;
-  std::vector<uint32_t> representative;
+  HostVector<Point2> points;
+  HostVector<uint32_t> representative;
   uint32_t num_unique = 0;
-  std::vector<std::array<uint32_t, 3>> triangles;  // counter-clockwise, input indices
-  std::vector<std::array<uint32_t, 2>> edges;      // (smaller, larger) input index
+  HostVector<std::array<uint32_t, 3>> triangles;  // counter-clockwise, input indices
+  HostVector<std::array<uint32_t, 2>> edges;      // (smaller, larger) input index
   AlphaRanks ranks;
   BuildReport report;
 };
@@ -62,12 +62,12 @@ class AlphaFamily {
   /// Takes the parts (the engine computed the component curves among them).
   explicit AlphaFamily(AlphaFamilyParts parts);
 
-  const std::vector<Point2>& points() const { return parts_.points; }
-  const std::vector<uint32_t>& representative() const { return parts_.representative; }
+  const HostVector<Point2>& points() const { return parts_.points; }
+  const HostVector<uint32_t>& representative() const { return parts_.representative; }
   uint32_t num_unique() const { return parts_.num_unique; }
   uint32_t num_duplicates() const { return static_cast<uint32_t>(parts_.points.size()) - parts_.num_unique; }
-  const std::vector<std::array<uint32_t, 3>>& triangles() const { return parts_.triangles; }
-  const std::vector<std::array<uint32_t, 2>>& edges() const { return parts_.edges; }
+  const HostVector<std::array<uint32_t, 3>>& triangles() const { return parts_.triangles; }
+  const HostVector<std::array<uint32_t, 2>>& edges() const { return parts_.edges; }
   const AlphaRanks& ranks() const { return parts_.ranks; }
   const BuildReport& report() const { return parts_.report; }
 
@@ -75,7 +75,7 @@ class AlphaFamily {
   size_t HostBytes() const;
 
   /// The spectrum: nearest doubles of the distinct exact thresholds (alpha_sq), ascending.
-  const std::vector<double>& spectrum() const { return parts_.ranks.spectrum; }
+  const HostVector<double>& spectrum() const { return parts_.ranks.spectrum; }
   int64_t max_level() const { return static_cast<int64_t>(parts_.ranks.spectrum.size()); }
 
   /// Level of alpha_sq = `alpha_sq`, exactly. InvalidArgument for NaN.

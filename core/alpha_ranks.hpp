@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/hd.hpp"
+#include "core/host_vector.hpp"
 
 namespace galpha {
 
@@ -54,31 +55,31 @@ struct AlphaRanks {
   /// The spectrum: the doubles nearest to the distinct exact births of triangles and unattached
   /// edges, strictly increasing in exact value (nearest doubles of neighbours may coincide only
   /// when both round to the same double).
-  std::vector<double> spectrum;
+  HostVector<double> spectrum;
   /// For every rank r, a simplex whose exact rho^2 is spectrum[r - 1]: id < #triangles is a
   /// triangle, otherwise the edge id - #triangles. Used to compare user thresholds exactly.
-  std::vector<uint32_t> spectrum_simplex;
+  HostVector<uint32_t> spectrum_simplex;
 
-  std::vector<uint32_t> tri_rank;  ///< per triangle: rank of rho (its birth)
+  HostVector<uint32_t> tri_rank;  ///< per triangle: rank of rho (its birth)
   /// Per edge: rank of rho when unattached, 0 when attached; mu-low (first incident triangle in,
   /// kNeverRank without triangles); mu-high (both in; kNeverRank on the hull).
-  std::vector<uint32_t> edge_rho_rank, edge_mu_low, edge_mu_high;
+  HostVector<uint32_t> edge_rho_rank, edge_mu_low, edge_mu_high;
   /// Per edge: its incident triangles (-1 where there is none).
-  std::vector<std::array<int32_t, 2>> edge_triangles;
+  HostVector<std::array<int32_t, 2>> edge_triangles;
   /// Per input index (duplicates repeat their representative's values): mu-low (first incident
   /// edge in), mu-high (every incident edge interior; kNeverRank on the hull), and the rank at
   /// which the first incident triangle is in (CGAL's vertex rule and the regularized mode).
-  std::vector<uint32_t> vertex_mu_low, vertex_mu_high, vertex_tri_low;
+  HostVector<uint32_t> vertex_mu_low, vertex_mu_high, vertex_tri_low;
 
   /// Master list in CSR form: entries of rank r are master[master_begin[r] .. master_begin[r+1]),
   /// r in 0..K (rank 0 is always empty), ordered vertex < edge < triangle, then by id and end point.
-  std::vector<uint32_t> master_begin;
-  std::vector<MasterEntry> master;
+  HostVector<uint32_t> master_begin;
+  HostVector<MasterEntry> master;
 
   /// Per level 0..K: connected components of the complex (GENERAL: simplices sharing a vertex
   /// connect; every distinct point is in from level 0) and solid components (interior triangles
   /// connected through shared edges, CGAL's number_of_solid_components).
-  std::vector<uint32_t> components, solid_components;
+  HostVector<uint32_t> components, solid_components;
 
   ComparisonCounts comparisons;
 };

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/alpha_ranks.hpp"
+#include "core/host_vector.hpp"
 #include "core/point.hpp"
 #include "core/stage_time.hpp"
 
@@ -27,10 +28,10 @@ struct AlphaInput {
 
 /// What a backend's build hands back; BuildAlphaFamily() moves it into an AlphaFamily.
 struct FamilyOutput {
-  std::vector<uint32_t> representative;
+  HostVector<uint32_t> representative;
   uint32_t num_unique = 0;
-  std::vector<std::array<uint32_t, 3>> triangles;
-  std::vector<std::array<uint32_t, 2>> edges;
+  HostVector<std::array<uint32_t, 3>> triangles;
+  HostVector<std::array<uint32_t, 2>> edges;
   AlphaRanks ranks;
   std::vector<StageTime> stage_times;
   size_t peak_memory_bytes = 0;

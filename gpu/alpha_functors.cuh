@@ -351,11 +351,23 @@ struct FinishVertexIntervals {
   }
 };
 
-GALPHA_HD inline uint32_t AtomicAddU32(uint32_t* p, uint32_t v) {
+/// *p += 1, atomically; returns the value before. On the device the threads of a warp that
+/// increment the same counter combine first (one atomic per distinct counter and warp): a grid's
+/// millions of exactly tied radii all count into two or three ranks, and one atomic per thread on
+/// one address serialises the whole pass.
+GALPHA_HD inline uint32_t AtomicIncrement(uint32_t* p) {
 #if defined(__CUDA_ARCH__)
-  return atomicAdd(p, v);
+  const unsigned active = __activemask();
+  const unsigned peers = __match_any_sync(active, reinterpret_cast<unsigned long long>(p));
+  unsigned lane;
+  asm("mov.u32 %0, %%laneid;" : "=r"(lane));
+  const int leader = __ffs(peers) - 1;
+  uint32_t base = 0;
+  if (static_cast<int>(lane) == leader) base = atomicAdd(p, static_cast<uint32_t>(__popc(peers)));
+  base = __shfl_sync(peers, base, leader);
+  return base + static_cast<uint32_t>(__popc(peers & ((1u << lane) - 1u)));
 #else
-  return __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+  return __atomic_fetch_add(p, 1u, __ATOMIC_RELAXED);
 #endif
 }
 
@@ -407,7 +419,7 @@ struct CountMasterEntries {
   MasterEndpoints endpoints;
   uint32_t* count;
   GALPHA_HD void operator()(uint32_t item) const {
-    auto visit = [this](uint32_t rank, uint64_t) { AtomicAddU32(&count[rank], 1); };
+    auto visit = [this](uint32_t rank, uint64_t) { AtomicIncrement(&count[rank]); };
     endpoints.Visit(item, visit);
   }
 };
@@ -418,7 +430,7 @@ struct FillMasterEntries {
   uint32_t* cursor;
   uint64_t* entries;
   GALPHA_HD void operator()(uint32_t item) const {
-    auto visit = [this](uint32_t rank, uint64_t packed) { entries[AtomicAddU32(&cursor[rank], 1)] = packed; };
+    auto visit = [this](uint32_t rank, uint64_t packed) { entries[AtomicIncrement(&cursor[rank])] = packed; };
     endpoints.Visit(item, visit);
   }
 };

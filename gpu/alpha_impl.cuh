@@ -57,26 +57,30 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   const TriNb* nbr_data = reinterpret_cast<const TriNb*>(t.nbr.data());
   const EdgeIdx* edge_data = reinterpret_cast<const EdgeIdx*>(t.edges.data());
 
-  // The triangles and edges go to the host once, into the family: at the end, or earlier when one
-  // of the rare host repairs needs them.
-  family->triangles.resize(num_tri);
-  family->edges.resize(num_edges);
+  // The triangles and edges go to the host once, into the family: with the rest at the end, or
+  // earlier when one of the rare host repairs needs them. (The host arrays are sized only then:
+  // sizing is cheap, but the host must not stall the stream in between.)
   bool mesh_on_host = false;
   AlphaInput host_input;
-  host_input.points = host_points;
-  host_input.num_points = n;
-  host_input.num_unique = t.num_unique;
-  host_input.triangles = family->triangles.data();
-  host_input.num_triangles = num_tri;
-  host_input.edges = family->edges.data();
-  host_input.num_edges = num_edges;
+  auto describe_host_mesh = [&]() -> const AlphaInput& {
+    host_input.points = host_points;
+    host_input.num_points = n;
+    host_input.num_unique = t.num_unique;
+    host_input.triangles = family->triangles.data();
+    host_input.num_triangles = num_tri;
+    host_input.edges = family->edges.data();
+    host_input.num_edges = num_edges;
+    return host_input;
+  };
   auto host_mesh = [&]() -> const AlphaInput& {
     if (!mesh_on_host) {
+      family->triangles.resize(num_tri);
+      family->edges.resize(num_edges);
       sys.Download({{family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)},
                     {family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)}});
       mesh_on_host = true;
     }
-    return host_input;
+    return describe_host_mesh();
   };
 
   // Edge topology: the incident triangles of every edge (none for a collinear chain).
@@ -286,7 +290,8 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
                   solid_components.data());
   timer.EndStage("components");
 
-  // One pipelined download of the whole family.
+  // One pipelined download of the whole family (the host arrays are not zeroed first: the copy is
+  // their first touch, on every core; core/host_vector.hpp).
   out->spectrum.resize(num_ranks);
   out->spectrum_simplex.resize(num_ranks);
   out->tri_rank.resize(num_tri);
@@ -321,12 +326,14 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
       {out->master.data(), master_entries.data(), size_t{num_master} * sizeof(uint64_t)},
       {family->representative.data(), representative.data(), size_t{n} * sizeof(uint32_t)}};
   if (!mesh_on_host) {
+    family->triangles.resize(num_tri);
+    family->edges.resize(num_edges);
     copies.push_back({family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)});
     copies.push_back({family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)});
     mesh_on_host = true;
   }
   sys.Download(copies);
-  if (any_needs_host) NearestValuesOnHost(host_mesh(), needs_host.ToHostVector(num_ranks), out);
+  if (any_needs_host) NearestValuesOnHost(describe_host_mesh(), needs_host.ToHostVector(num_ranks), out);
   timer.EndStage("download");
 }
 

@@ -85,7 +85,7 @@ struct HookComponent {
     const uint32_t other = target[c];
     if (best[other] == best[c] && c < other) return;  // the other side hooks to us
     parent[c] = other;
-    AtomicAddU32(&merges_at_rank[static_cast<uint32_t>(best[c] >> 32)], 1);
+    AtomicIncrement(&merges_at_rank[static_cast<uint32_t>(best[c] >> 32)]);
   }
 };
 
@@ -197,7 +197,7 @@ struct CountTriangleBirth {
   const uint32_t* tri_rank;
   uint32_t* births_at_rank;
   GALPHA_HD void operator()(uint32_t t) const {
-    if (tri_rank[t] != kNeverRank) AtomicAddU32(&births_at_rank[tri_rank[t]], 1);
+    if (tri_rank[t] != kNeverRank) AtomicIncrement(&births_at_rank[tri_rank[t]]);
   }
 };
 

@@ -263,7 +263,7 @@ std::vector<StreamedSimplex> ExpectedSimplices(const AlphaFamily& family, const 
 }
 
 // Counts per class of ClassifyAll, as ClassCounts (vertices: distinct points only).
-v1::ClassCounts Count(const std::vector<SimplexClass>& classes, const std::vector<uint32_t>* representative) {
+v1::ClassCounts Count(const std::vector<SimplexClass>& classes, const HostVector<uint32_t>* representative) {
   std::array<uint64_t, 4> counts{};
   for (uint32_t i = 0; i < classes.size(); ++i) {
     if (representative == nullptr || (*representative)[i] == i) ++counts[static_cast<size_t>(classes[i])];
