@@ -57,30 +57,28 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   const TriNb* nbr_data = reinterpret_cast<const TriNb*>(t.nbr.data());
   const EdgeIdx* edge_data = reinterpret_cast<const EdgeIdx*>(t.edges.data());
 
-  // The triangles and edges go to the host once, into the family: with the rest at the end, or
-  // earlier when one of the rare host repairs needs them. (The host arrays are sized only then:
-  // sizing is cheap, but the host must not stall the stream in between.)
-  bool mesh_on_host = false;
+  // The triangulation's arrays the family keeps go to the host beside the pipeline, from now on
+  // (the host arrays are sized at once: sizing a HostVector touches no memory).
+  family->triangles.resize(num_tri);
+  family->edges.resize(num_edges);
+  family->representative.resize(n);
+  family->num_unique = t.num_unique;
+  auto mesh_download = sys.DownloadAsync(
+      {{family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)},
+       {family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)},
+       {family->representative.data(), representative.data(), size_t{n} * sizeof(uint32_t)}});
   AlphaInput host_input;
-  auto describe_host_mesh = [&]() -> const AlphaInput& {
-    host_input.points = host_points;
-    host_input.num_points = n;
-    host_input.num_unique = t.num_unique;
-    host_input.triangles = family->triangles.data();
-    host_input.num_triangles = num_tri;
-    host_input.edges = family->edges.data();
-    host_input.num_edges = num_edges;
-    return host_input;
-  };
+  host_input.points = host_points;
+  host_input.num_points = n;
+  host_input.num_unique = t.num_unique;
+  host_input.triangles = family->triangles.data();
+  host_input.num_triangles = num_tri;
+  host_input.edges = family->edges.data();
+  host_input.num_edges = num_edges;
+  // The rare host repairs read the mesh on the host.
   auto host_mesh = [&]() -> const AlphaInput& {
-    if (!mesh_on_host) {
-      family->triangles.resize(num_tri);
-      family->edges.resize(num_edges);
-      sys.Download({{family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)},
-                    {family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)}});
-      mesh_on_host = true;
-    }
-    return describe_host_mesh();
+    mesh_download.Wait();
+    return host_input;
   };
 
   // Edge topology: the incident triangles of every edge (none for a collinear chain).
@@ -238,6 +236,30 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   keys.Reset();
   timer.EndStage("intervals");
 
+  // The spectrum, the ranks and the intervals are final: they go to the host beside the master
+  // list and the component curves (which only read them).
+  out->spectrum.resize(num_ranks);
+  out->spectrum_simplex.resize(num_ranks);
+  out->tri_rank.resize(num_tri);
+  out->edge_rho_rank.resize(num_edges);
+  out->edge_mu_low.resize(num_edges);
+  out->edge_mu_high.resize(num_edges);
+  out->edge_triangles.resize(num_edges);
+  out->vertex_mu_low.resize(n);
+  out->vertex_mu_high.resize(n);
+  out->vertex_tri_low.resize(n);
+  auto tables_download = sys.DownloadAsync(
+      {{out->spectrum.data(), spectrum.data(), size_t{num_ranks} * sizeof(double)},
+       {out->spectrum_simplex.data(), spectrum_simplex.data(), size_t{num_ranks} * sizeof(uint32_t)},
+       {out->tri_rank.data(), tri_rank.data(), size_t{num_tri} * sizeof(uint32_t)},
+       {out->edge_rho_rank.data(), edge_rho_rank.data(), size_t{num_edges} * sizeof(uint32_t)},
+       {out->edge_mu_low.data(), edge_mu_low.data(), size_t{num_edges} * sizeof(uint32_t)},
+       {out->edge_mu_high.data(), edge_mu_high.data(), size_t{num_edges} * sizeof(uint32_t)},
+       {out->edge_triangles.data(), edge_tris.data(), size_t{num_edges} * sizeof(EdgeTris)},
+       {out->vertex_mu_low.data(), vertex_mu_low.data(), size_t{n} * sizeof(uint32_t)},
+       {out->vertex_mu_high.data(), vertex_mu_high.data(), size_t{n} * sizeof(uint32_t)},
+       {out->vertex_tri_low.data(), vertex_tri_low.data(), size_t{n} * sizeof(uint32_t)}});
+
   // Master list in CSR form: count the end points per rank, scan, place each entry in its rank's
   // segment, then sort every segment (O(entries): no global sort).
   const MasterEndpoints endpoints{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
@@ -290,50 +312,20 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
                   solid_components.data());
   timer.EndStage("components");
 
-  // One pipelined download of the whole family (the host arrays are not zeroed first: the copy is
-  // their first touch, on every core; core/host_vector.hpp).
-  out->spectrum.resize(num_ranks);
-  out->spectrum_simplex.resize(num_ranks);
-  out->tri_rank.resize(num_tri);
-  out->edge_rho_rank.resize(num_edges);
-  out->edge_mu_low.resize(num_edges);
-  out->edge_mu_high.resize(num_edges);
-  out->edge_triangles.resize(num_edges);
-  out->vertex_mu_low.resize(n);
-  out->vertex_mu_high.resize(n);
-  out->vertex_tri_low.resize(n);
+  // The rest of the family, then the downloads started earlier (the host arrays are not zeroed
+  // first: the copies are their first touch, on every core; core/host_vector.hpp).
   out->components.resize(static_cast<size_t>(num_ranks) + 1);
   out->solid_components.resize(static_cast<size_t>(num_ranks) + 1);
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
   out->master.resize(num_master);
-  family->representative.resize(n);
-  family->num_unique = t.num_unique;
-  std::vector<HostCopy> copies = {
-      {out->spectrum.data(), spectrum.data(), size_t{num_ranks} * sizeof(double)},
-      {out->spectrum_simplex.data(), spectrum_simplex.data(), size_t{num_ranks} * sizeof(uint32_t)},
-      {out->tri_rank.data(), tri_rank.data(), size_t{num_tri} * sizeof(uint32_t)},
-      {out->edge_rho_rank.data(), edge_rho_rank.data(), size_t{num_edges} * sizeof(uint32_t)},
-      {out->edge_mu_low.data(), edge_mu_low.data(), size_t{num_edges} * sizeof(uint32_t)},
-      {out->edge_mu_high.data(), edge_mu_high.data(), size_t{num_edges} * sizeof(uint32_t)},
-      {out->edge_triangles.data(), edge_tris.data(), size_t{num_edges} * sizeof(EdgeTris)},
-      {out->vertex_mu_low.data(), vertex_mu_low.data(), size_t{n} * sizeof(uint32_t)},
-      {out->vertex_mu_high.data(), vertex_mu_high.data(), size_t{n} * sizeof(uint32_t)},
-      {out->vertex_tri_low.data(), vertex_tri_low.data(), size_t{n} * sizeof(uint32_t)},
-      {out->components.data(), components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
-      {out->solid_components.data(), solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
-      {out->master_begin.data(), master_begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
-      {out->master.data(), master_entries.data(), size_t{num_master} * sizeof(uint64_t)},
-      {family->representative.data(), representative.data(), size_t{n} * sizeof(uint32_t)}};
-  if (!mesh_on_host) {
-    family->triangles.resize(num_tri);
-    family->edges.resize(num_edges);
-    copies.push_back({family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)});
-    copies.push_back({family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)});
-    mesh_on_host = true;
-  }
-  sys.Download(copies);
-  if (any_needs_host) NearestValuesOnHost(describe_host_mesh(), needs_host.ToHostVector(num_ranks), out);
+  sys.Download({{out->components.data(), components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+                {out->solid_components.data(), solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+                {out->master_begin.data(), master_begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
+                {out->master.data(), master_entries.data(), size_t{num_master} * sizeof(uint64_t)}});
+  tables_download.Wait();
+  mesh_download.Wait();
+  if (any_needs_host) NearestValuesOnHost(host_input, needs_host.ToHostVector(num_ranks), out);
   timer.EndStage("download");
 }
 

@@ -50,6 +50,33 @@ void CudaSystem::Download(const std::vector<HostCopy>& copies) {
   if (any) CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
 }
 
+PendingDownload CudaSystem::DownloadAsync(std::vector<HostCopy> copies) {
+  if (copy_stream_ == nullptr) {
+    CheckCuda(cudaStreamCreateWithFlags(&copy_stream_, cudaStreamNonBlocking), "cudaStreamCreate (copies)");
+  }
+  CheckCuda(cudaGetLastError(), "kernel launch");
+  cudaEvent_t ready = nullptr;
+  CheckCuda(cudaEventCreateWithFlags(&ready, cudaEventDisableTiming), "cudaEventCreate");
+  const cudaError_t recorded = cudaEventRecord(ready, stream_);
+  if (recorded == cudaSuccess) {
+    // The copy stream starts only once the build's stream has produced the data.
+    const cudaError_t waited = cudaStreamWaitEvent(copy_stream_, ready, 0);
+    cudaEventDestroy(ready);  // released once the wait is done
+    CheckCuda(waited, "cudaStreamWaitEvent");
+  } else {
+    cudaEventDestroy(ready);
+    CheckCuda(recorded, "cudaEventRecord");
+  }
+  int device = 0;
+  CheckCuda(cudaGetDevice(&device), "cudaGetDevice");
+  cudaStream_t copy_stream = copy_stream_;
+  return PendingDownload(std::async(std::launch::async, [copies = std::move(copies), copy_stream, device] {
+    CheckCuda(cudaSetDevice(device), "cudaSetDevice (download thread)");
+    PinnedStaging staging;
+    staging.Download(copies, copy_stream);
+  }));
+}
+
 void CudaSystem::Upload(const std::vector<HostCopy>& copies) {
   if (AnyLarge(copies)) {
     PinnedStaging staging;

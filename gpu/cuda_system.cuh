@@ -7,8 +7,10 @@
 #include <cuda_runtime.h>
 
 #include <cstdint>
+#include <future>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <thrust/system/cuda/execution_policy.h>
@@ -55,6 +57,30 @@ class StreamOrderedAllocator {
 /// The pool then holds the high-water mark of concurrent builds (nvidia-smi shows it as used).
 void RetainFreedDeviceMemory();
 
+/// A download running beside the build's stream (CudaSystem::DownloadAsync). Waits for the copy
+/// when destroyed, so that it never outlives the buffers it reads (declare it after them).
+class PendingDownload {
+ public:
+  PendingDownload() = default;
+  explicit PendingDownload(std::future<void> done) : done_(std::move(done)) {}
+  PendingDownload(PendingDownload&&) = default;
+  PendingDownload& operator=(PendingDownload&& other) noexcept {
+    if (done_.valid()) done_.wait();
+    done_ = std::move(other.done_);
+    return *this;
+  }
+  ~PendingDownload() {
+    if (done_.valid()) done_.wait();
+  }
+  /// Returns once the host buffers hold the data; rethrows the copy's failure.
+  void Wait() {
+    if (done_.valid()) done_.get();
+  }
+
+ private:
+  std::future<void> done_;
+};
+
 /// The CUDA backend on one stream.
 class CudaSystem {
  public:
@@ -69,6 +95,9 @@ class CudaSystem {
   static constexpr size_t kStagedFrom = size_t{1} << 20;
 
   explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) { RetainFreedDeviceMemory(); }
+  ~CudaSystem() {
+    if (copy_stream_ != nullptr) cudaStreamDestroy(copy_stream_);
+  }
   CudaSystem(const CudaSystem&) = delete;
   CudaSystem& operator=(const CudaSystem&) = delete;
 
@@ -101,6 +130,11 @@ class CudaSystem {
   void Download(const std::vector<HostCopy>& copies);
   /// Copies host buffers to device buffers; returns when the host buffers may be reused.
   void Upload(const std::vector<HostCopy>& copies);
+  /// Starts copying device buffers, as they are once the work queued so far is done, to host
+  /// buffers while the build goes on: on a second stream, by a host thread of its own (the link
+  /// and the host's page faults overlap the later stages). The device buffers must stay
+  /// unchanged until the returned download is waited for.
+  PendingDownload DownloadAsync(std::vector<HostCopy> copies);
   template <class T>
   T Read(const T* device) {
     T value;
@@ -134,6 +168,7 @@ class CudaSystem {
 
  private:
   cudaStream_t stream_;
+  cudaStream_t copy_stream_ = nullptr;  // DownloadAsync's, made on first use
   MemoryLedger ledger_;  // declared before temp_, which points at it
   StreamOrderedAllocator temp_;
 };
