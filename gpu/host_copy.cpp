@@ -26,4 +26,9 @@ void ParallelCopy(void* dst, const void* src, size_t bytes) {
   }
 }
 
+void LeaveCoresToOthers(int cores) {
+  // nthreads-var is per thread: only this thread's later parallel regions are narrower.
+  omp_set_num_threads(std::max(1, omp_get_num_procs() - cores));
+}
+
 }  // namespace galpha::detail

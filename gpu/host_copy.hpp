@@ -17,4 +17,8 @@ struct HostCopy {
 /// memcpy(dst, src, bytes), in parallel when `bytes` is large.
 void ParallelCopy(void* dst, const void* src, size_t bytes);
 
+/// The calling thread's parallel copies leave `cores` of the host's cores to other threads (a
+/// download beside the build leaves the build's own thread room to launch and wait).
+void LeaveCoresToOthers(int cores);
+
 }  // namespace galpha::detail
