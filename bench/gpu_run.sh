@@ -2,7 +2,8 @@
 # Run ON THE GPU MACHINE (H100/H200, CUDA 13, no Abseil/CGAL there) from the repository root,
 # with .carry/ made by bench/gpu_bundle.sh. Phases, in the order given (default: smoke test bench):
 #   smoke   alphactl triangulate on every data set, CUDA then CPU backend, each under a timeout
-#   sanitize  compute-sanitizer memcheck and racecheck of one small CUDA triangulation
+#   sanitize  compute-sanitizer memcheck, racecheck and synccheck of one small CUDA triangulation,
+#           then memcheck of one whole family build (two streams, pinned staging)
 #   test    the test binaries (CUDA backend included), each test under GALPHA_TEST_TIMEOUT seconds
 #           (default 240), one process per test so that a hang names its test
 #   bench   delaunay_bench (CUDA vs CGAL on the same machine); GALPHA_BENCH_ARGS overrides the args of
@@ -10,6 +11,8 @@
 #   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run,
 #           the floor sort of the spectrum's pairs, and 100M uniform points on the GPU
 #   identity the CUDA/CPU identity test alone
+#   profile Nsight Systems (nsys, when the machine has it) over one 1M-point family build: the
+#           kernels and the CUDA API calls (waits) by total time
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
 #           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
@@ -57,6 +60,8 @@ for phase in "${phases[@]}"; do
         run_step sanitize 240 compute-sanitizer --tool "$tool" --error-exitcode 9 \
           .carry/bin/alphactl triangulate "$small" --backend=cuda
       done
+      run_step sanitize 300 compute-sanitizer --tool memcheck --error-exitcode 9 \
+        .carry/bin/alphactl bench "$small" --backend=cuda
       grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race" "$out/sanitize.log" | sort | uniq -c | head -n 20
       ;;
     test)
@@ -73,6 +78,19 @@ for phase in "${phases[@]}"; do
       done
       # One file for all test logs: at most 8 files come back from the machine.
       for f in "$out"/*_test.log; do { echo "=== $(basename "$f")"; cat "$f"; } >>"$out/tests.log"; rm -f "$f"; done
+      ;;
+    profile)
+      nsys_bin=$(command -v nsys || ls /usr/local/cuda/bin/nsys /opt/nvidia/nsight-systems/*/bin/nsys 2>/dev/null | head -n 1)
+      if [ -z "$nsys_bin" ]; then
+        echo "profile: no nsys on this machine"
+        continue
+      fi
+      run_step profile 300 "$nsys_bin" profile --force-overwrite=true -o "$out/family_1m" --stats=false \
+        .carry/bin/alpha_bench --backend=cuda --sizes=1000000 --dists=uniform --repeat=3 --cgal-max=0
+      run_step profile 120 "$nsys_bin" stats --force-export=true --report cuda_gpu_kern_sum,cuda_api_sum \
+        --format csv --output "$out/family_1m" "$out/family_1m.nsys-rep"
+      rm -f "$out/family_1m.nsys-rep" "$out/family_1m.sqlite"
+      for f in "$out"/family_1m_*.csv; do echo "== $f"; head -n 16 "$f"; done
       ;;
     identity)
       # The CUDA/CPU identity test alone (every generator and data set): the quick correctness

@@ -86,8 +86,14 @@ void PinnedStaging::Download(const std::vector<HostCopy>& copies, cudaStream_t s
   const std::vector<Piece> pieces = CutIntoPieces(copies);
   auto issue = [&](size_t i) {
     const int slot = static_cast<int>(i % 2);
-    CheckCuda(cudaMemcpyAsync(slots_->memory[slot], pieces[i].device, pieces[i].bytes, cudaMemcpyDeviceToHost, stream),
-              "cudaMemcpyAsync to pinned staging");
+    // In DMAs of at most kDmaBytes: a download beside the build shares the device-to-host copy
+    // engine with the build's own small reads (counts it waits for), which would otherwise queue
+    // behind a whole slot.
+    for (size_t at = 0; at < pieces[i].bytes; at += kDmaBytes) {
+      CheckCuda(cudaMemcpyAsync(slots_->memory[slot] + at, pieces[i].device + at,
+                                std::min(kDmaBytes, pieces[i].bytes - at), cudaMemcpyDeviceToHost, stream),
+                "cudaMemcpyAsync to pinned staging");
+    }
     CheckCuda(cudaEventRecord(slots_->done[slot], stream), "cudaEventRecord");
   };
   if (!pieces.empty()) issue(0);

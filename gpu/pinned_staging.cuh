@@ -19,6 +19,8 @@ namespace galpha::detail {
 class PinnedStaging {
  public:
   static constexpr size_t kSlotBytes = size_t{16} << 20;
+  /// Largest single DMA of a download (see Download).
+  static constexpr size_t kDmaBytes = size_t{1} << 20;
 
   PinnedStaging();
   ~PinnedStaging();
