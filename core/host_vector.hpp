@@ -1,10 +1,10 @@
-// HostVector: a std::vector whose elements are default-initialised (not zeroed) when it grows,
-// for the large arrays a build fills in one copy (the family's tables, hundreds of bytes a point).
+// HostVector: a std::vector that writes nothing into its elements when it grows (plain data), for
+// the large arrays a build fills in one copy (the family's tables, hundreds of bytes a point).
 //
 // Why: a std::vector<uint32_t>(n) zeroes its memory on one thread before the copy overwrites it,
 // and touching fresh memory first is what costs (the kernel faults in and clears every 4 KiB
-// page: about 2 GB/s on one core of the H100 host). With default-initialisation the parallel copy
-// that fills the array is the first touch, spread over every core; large blocks are also offered
+// page: about 2 GB/s on one core of the H100 host). Without it the parallel copy that fills the
+// array is the first touch, spread over every core; large blocks are also offered
 // to transparent huge pages (512x fewer faults where the kernel grants them).
 #pragma once
 
@@ -55,10 +55,15 @@ class DefaultInitAllocator {
     }
   }
 
-  /// Default-initialisation: nothing is written for trivially constructible types.
+  /// Growing writes nothing for types that are trivially copyable and destructible (plain data,
+  /// even with default member initialisers such as MasterEntry's): the copy that fills the array
+  /// creates its objects (implicit-lifetime types, P0593). Their values are unspecified until then.
+  /// Other types are default-initialised.
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
+    if constexpr (!(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>)) {
+      ::new (static_cast<void*>(p)) U;
+    }
   }
   template <class U, class... Args>
   void construct(U* p, Args&&... args) {
