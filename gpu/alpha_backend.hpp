@@ -18,12 +18,9 @@ namespace galpha::detail {
 /// A triangulation in host memory, borrowed: what the host's exact repairs read.
 struct AlphaInput {
   const Point2* points = nullptr;
-  uint32_t num_points = 0;
-  uint32_t num_unique = 0;  // distinct points
   const std::array<uint32_t, 3>* triangles = nullptr;
-  uint32_t num_triangles = 0;
+  uint32_t num_triangles = 0;  // simplex ids below this are triangles, the rest edges
   const std::array<uint32_t, 2>* edges = nullptr;
-  uint32_t num_edges = 0;
 };
 
 /// What a backend's build hands back; BuildAlphaFamily() moves it into an AlphaFamily.

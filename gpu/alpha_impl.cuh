@@ -69,12 +69,9 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
        {family->representative.data(), representative.data(), size_t{n} * sizeof(uint32_t)}});
   AlphaInput host_input;
   host_input.points = host_points;
-  host_input.num_points = n;
-  host_input.num_unique = t.num_unique;
   host_input.triangles = family->triangles.data();
   host_input.num_triangles = num_tri;
   host_input.edges = family->edges.data();
-  host_input.num_edges = num_edges;
   // The rare host repairs read the mesh on the host.
   auto host_mesh = [&]() -> const AlphaInput& {
     mesh_download.Wait();
