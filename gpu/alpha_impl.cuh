@@ -327,7 +327,7 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
 }
 
 /// The whole build on one system: triangulation, then the alpha pipeline on the triangulation
-/// where it lies, then one download of the family.
+/// where it lies; the family comes back to the host once (partly beside the last stages).
 template <class System>
 void RunFamilyBuild(System& sys, const Point2* host_points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out) {
   StageTimer<System> timer(sys, &out->stage_times);
