@@ -32,6 +32,21 @@ bool AnyLarge(const std::vector<HostCopy>& copies) {
   return false;
 }
 
+/// Small copies (a count, a few values): straight to or from pageable memory, one wait for all
+/// (the host buffers may be short-lived).
+void CopyDirectly(const std::vector<HostCopy>& copies, cudaMemcpyKind kind, cudaStream_t stream) {
+  bool any = false;
+  for (const HostCopy& c : copies) {
+    if (c.bytes == 0) continue;
+    void* system = const_cast<void*>(c.system);
+    const bool to_host = kind == cudaMemcpyDeviceToHost;
+    CheckCuda(cudaMemcpyAsync(to_host ? c.host : system, to_host ? system : c.host, c.bytes, kind, stream),
+              to_host ? "cudaMemcpyAsync to host" : "cudaMemcpyAsync to device");
+    any = true;
+  }
+  if (any) CheckCuda(cudaStreamSynchronize(stream), "cudaStreamSynchronize");
+}
+
 }  // namespace
 
 void CudaSystem::Download(const std::vector<HostCopy>& copies) {
@@ -40,14 +55,7 @@ void CudaSystem::Download(const std::vector<HostCopy>& copies) {
     staging.Download(copies, stream_);
     return;
   }
-  // Small copies (a count, a few values): straight from pageable memory, one sync for all.
-  bool any = false;
-  for (const HostCopy& c : copies) {
-    if (c.bytes == 0) continue;
-    CheckCuda(cudaMemcpyAsync(c.host, c.system, c.bytes, cudaMemcpyDeviceToHost, stream_), "cudaMemcpyAsync to host");
-    any = true;
-  }
-  if (any) CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+  CopyDirectly(copies, cudaMemcpyDeviceToHost, stream_);
 }
 
 PendingDownload CudaSystem::DownloadAsync(std::vector<HostCopy> copies) {
@@ -72,8 +80,10 @@ PendingDownload CudaSystem::DownloadAsync(std::vector<HostCopy> copies) {
   cudaStream_t copy_stream = copy_stream_;
   return PendingDownload(std::async(std::launch::async, [copies = std::move(copies), copy_stream, device] {
     CheckCuda(cudaSetDevice(device), "cudaSetDevice (download thread)");
-    // Spinning copy threads on every core would delay the build's own thread (its launches and
-    // its waits for counts): measured +3 ms on the 1M pipeline when the copy took all 16 cores.
+    // Copy threads on every core would compete with the build's own thread (its launches and its
+    // waits for counts), so three cores are left to it. (On the H100 host this changed nothing
+    // measurable; what slowed the pipeline beside a download was the shared copy engine, see
+    // PinnedStaging::Download.)
     LeaveCoresToOthers(3);
     PinnedStaging staging;
     staging.Download(copies, copy_stream);
@@ -86,15 +96,7 @@ void CudaSystem::Upload(const std::vector<HostCopy>& copies) {
     staging.Upload(copies, stream_);
     return;
   }
-  bool any = false;
-  for (const HostCopy& c : copies) {
-    if (c.bytes == 0) continue;
-    CheckCuda(cudaMemcpyAsync(const_cast<void*>(c.system), c.host, c.bytes, cudaMemcpyHostToDevice, stream_),
-              "cudaMemcpyAsync to device");
-    any = true;
-  }
-  // The host buffers may be pageable and short-lived: wait until the copies have consumed them.
-  if (any) CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
+  CopyDirectly(copies, cudaMemcpyHostToDevice, stream_);
 }
 
 }  // namespace galpha::detail
