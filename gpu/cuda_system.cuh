@@ -8,16 +8,21 @@
 
 #include <cstdint>
 #include <future>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <cub/device/device_select.cuh>
+#include <thrust/fill.h>
 #include <thrust/system/cuda/execution_policy.h>
 
 #include "gpu/delaunay_backend.hpp"
+#include "gpu/atomic_increment.cuh"
 #include "gpu/engine_system.cuh"
 #include "gpu/host_copy.hpp"
+#include "gpu/pinned_staging.cuh"
 
 namespace galpha::detail {
 
@@ -81,6 +86,26 @@ class PendingDownload {
   std::future<void> done_;
 };
 
+/// ForEachBelow's kernel: a grid-stride loop up to a count read on the device (one item when the
+/// count is null: RunSingle).
+template <class F>
+__global__ void ForEachBelowKernel(const uint32_t* count, F f) {
+  const uint32_t n = count == nullptr ? 1u : *count;
+  const uint32_t stride = gridDim.x * blockDim.x;
+  for (uint32_t i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += stride) f(i);
+}
+
+/// AppendIf's kernel.
+template <class InIt, class FlagIt, class Keep, class OutIt>
+__global__ void AppendIfKernel(const uint32_t* count, uint32_t per_item, InIt in, FlagIt flags, Keep keep, OutIt out,
+                               uint32_t* out_count) {
+  const uint32_t n = per_item * *count;
+  const uint32_t stride = gridDim.x * blockDim.x;
+  for (uint32_t i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += stride) {
+    if (keep(flags[i])) out[AtomicIncrement(out_count)] = in[i];
+  }
+}
+
 /// The CUDA backend on one stream.
 class CudaSystem {
  public:
@@ -94,7 +119,13 @@ class CudaSystem {
   /// Copies of at least this many bytes go through pinned staging (pinned_staging.cuh).
   static constexpr size_t kStagedFrom = size_t{1} << 20;
 
-  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) { RetainFreedDeviceMemory(); }
+  explicit CudaSystem(cudaStream_t stream) : stream_(stream), temp_(stream, &ledger_) {
+    RetainFreedDeviceMemory();
+    int device = 0, sms = 0;
+    CheckCuda(cudaGetDevice(&device), "cudaGetDevice");
+    CheckCuda(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, device), "cudaDeviceGetAttribute");
+    grid_blocks_ = static_cast<unsigned>(sms) * kBlocksPerSm;
+  }
   ~CudaSystem() {
     if (copy_stream_ != nullptr) cudaStreamDestroy(copy_stream_);
   }
@@ -146,6 +177,106 @@ class CudaSystem {
     CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
   }
 
+  /// A count on its way to the host (ReadCountLater), redeemed by CountOf.
+  struct CountTicket {
+    int word;
+  };
+  /// Starts copying `*device`, as it is once the work queued so far is done, without waiting:
+  /// the host goes on queueing work and asks for the value a step later. At most
+  /// PinnedCounters::kWords tickets may be outstanding.
+  CountTicket ReadCountLater(const uint32_t* device) {
+    CheckCuda(cudaGetLastError(), "kernel launch");
+    if (!counters_) counters_ = std::make_unique<PinnedCounters>();
+    const int word = next_counter_word_;
+    next_counter_word_ = (next_counter_word_ + 1) % PinnedCounters::kWords;
+    counters_->StartRead(word, device, stream_);
+    return {word};
+  }
+  uint32_t CountOf(CountTicket ticket) { return counters_->Finish(ticket.word); }
+
+  /// Keeps, in place and in order, the first `n` items of `data` whose flag satisfies `keep`;
+  /// their number goes to `*count` in device memory (no host sync).
+  template <class DataIt, class FlagIt, class Keep>
+  void SelectFlaggedInPlace(DataIt data, FlagIt flags, uint32_t n, Keep keep, uint32_t* count) {
+    if (n == 0) {
+      thrust::fill(policy(), count, count + 1, 0u);
+      return;
+    }
+    size_t bytes = 0;
+    CheckCuda(cub::DeviceSelect::FlaggedIf(nullptr, bytes, data, flags, count, n, keep, stream_),
+              "cub::DeviceSelect::FlaggedIf (size)");
+    TempBytes temp(temp_, bytes);
+    CheckCuda(cub::DeviceSelect::FlaggedIf(temp.data, bytes, data, flags, count, n, keep, stream_),
+              "cub::DeviceSelect::FlaggedIf");
+  }
+  /// Runs f(i) for every i below `*count`, a count in device memory set by earlier work on the
+  /// stream: the launch does not wait for it (a fixed grid strides over whatever it is).
+  template <class F>
+  void ForEachBelow(const uint32_t* count, F f) {
+    ForEachBelowKernel<<<grid_blocks_, kBlockThreads, 0, stream_>>>(count, f);
+    CheckCuda(cudaGetLastError(), "kernel launch");
+  }
+  /// Appends the items among the first `per_item * *count` of `in` whose flag satisfies `keep`
+  /// to `out` from position `*out_count` on, and adds their number to `*out_count`; both counts
+  /// in device memory (no host sync, and fit for a recording). The order is that of `in` within
+  /// a warp's items (the threads of a warp take consecutive slots) and roughly so across warps.
+  template <class InIt, class FlagIt, class Keep, class OutIt>
+  void AppendIf(const uint32_t* count, uint32_t per_item, InIt in, FlagIt flags, Keep keep, OutIt out,
+                uint32_t* out_count) {
+    AppendIfKernel<<<grid_blocks_, kBlockThreads, 0, stream_>>>(count, per_item, in, flags, keep, out, out_count);
+    CheckCuda(cudaGetLastError(), "kernel launch");
+  }
+  /// Runs f(0) once, in stream order.
+  template <class F>
+  void RunSingle(F f) {
+    ForEachBelowKernel<<<1, 1, 0, stream_>>>(nullptr, f);
+    CheckCuda(cudaGetLastError(), "kernel launch");
+  }
+
+  /// Work recorded once as a CUDA graph and replayed by Replay: one launch for what was tens of
+  /// kernels (the host's launch cost, ~5 us a kernel on an H100's host, bounds loops of small
+  /// kernels). The stream waits for the graph's last launch before the graph is destroyed.
+  class Recording {
+   public:
+    Recording() = default;
+    ~Recording() {
+      if (exec_ == nullptr) return;
+      cudaStreamSynchronize(stream_);
+      cudaGraphExecDestroy(exec_);
+      cudaGetLastError();
+    }
+    Recording(const Recording&) = delete;
+    Recording& operator=(const Recording&) = delete;
+
+   private:
+    friend class CudaSystem;
+    cudaGraphExec_t exec_ = nullptr;
+    cudaStream_t stream_ = nullptr;
+  };
+  /// Records `body` (stream work only: launches, no waits, no allocations) into `recording` the
+  /// first time, then launches the recording on the stream.
+  template <class Body>
+  void Replay(Recording& recording, Body&& body) {
+    if (recording.exec_ == nullptr) {
+      CheckCuda(cudaStreamBeginCapture(stream_, cudaStreamCaptureModeThreadLocal), "cudaStreamBeginCapture");
+      cudaGraph_t graph = nullptr;
+      try {
+        body();
+      } catch (...) {
+        cudaStreamEndCapture(stream_, &graph);
+        if (graph != nullptr) cudaGraphDestroy(graph);
+        cudaGetLastError();
+        throw;
+      }
+      CheckCuda(cudaStreamEndCapture(stream_, &graph), "cudaStreamEndCapture");
+      const cudaError_t instantiated = cudaGraphInstantiate(&recording.exec_, graph, 0);
+      cudaGraphDestroy(graph);
+      CheckCuda(instantiated, "cudaGraphInstantiate");
+      recording.stream_ = stream_;
+    }
+    CheckCuda(cudaGraphLaunch(recording.exec_, stream_), "cudaGraphLaunch");
+  }
+
   /// Stage marks are events on the stream: a stage's time is the stream's, with no host sync at
   /// stage ends (StageTimer reads them all once, at the end of the build).
   using StageMark = cudaEvent_t;
@@ -167,10 +298,28 @@ class CudaSystem {
   void ReleaseMark(StageMark mark) { cudaEventDestroy(mark); }
 
  private:
+  /// Temporary storage of a CUB call, from the stream-ordered pool, returned at scope end.
+  struct TempBytes {
+    TempBytes(StreamOrderedAllocator& allocator, size_t bytes)
+        : allocator(allocator), bytes(bytes), data(allocator.allocate(static_cast<std::ptrdiff_t>(bytes))) {}
+    ~TempBytes() { allocator.deallocate(data, bytes); }
+    TempBytes(const TempBytes&) = delete;
+    TempBytes& operator=(const TempBytes&) = delete;
+    StreamOrderedAllocator& allocator;
+    size_t bytes;
+    char* data;
+  };
+
   cudaStream_t stream_;
   cudaStream_t copy_stream_ = nullptr;  // DownloadAsync's, made on first use
   MemoryLedger ledger_;  // declared before temp_, which points at it
   StreamOrderedAllocator temp_;
+  std::unique_ptr<PinnedCounters> counters_;  // ReadCountLater's, leased on first use
+  int next_counter_word_ = 0;
+  // ForEachBelow's fixed grid: enough blocks to fill every multiprocessor, striding over the rest.
+  static constexpr unsigned kBlockThreads = 256;
+  static constexpr unsigned kBlocksPerSm = 8;
+  unsigned grid_blocks_ = 0;
 };
 
 /// A stream owned for the duration of one call when the caller brings none.

@@ -126,33 +126,44 @@ struct LinkFlips {
   }
 };
 
+/// Starts a flip iteration: zeroes the count of the next list and moves to a new generation of
+/// stamps. One thread.
+struct StartFlipIteration {
+  uint32_t* next_count;
+  uint32_t* generation;
+  GALPHA_HD void operator()(uint32_t) const {
+    *next_count = 0;
+    *generation += 1;
+  }
+};
+
 /// Clears the votes and partners one iteration used, and lists the triangles to check next: both
 /// triangles of a flip, and the proposer of a flip that lost. `stamp` de-duplicates the list.
 struct CollectNextActive {
   const int32_t* active;
-  const uint8_t* active_mask;
   const int8_t* proposal_edge;
   const int32_t* proposal_nb;
   uint32_t* flip_vote;
   int32_t* partner;
   uint32_t* stamp;
-  uint32_t generation;
+  const uint32_t* generation;
   int32_t* candidates;  // two per active entry, -1 when unused
   uint8_t* candidate_mask;
 
-  GALPHA_HD bool Claim(int32_t t) const {
-    return cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(stamp[t]).exchange(generation) != generation;
+  GALPHA_HD bool Claim(int32_t t, uint32_t now) const {
+    return cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(stamp[t]).exchange(now) != now;
   }
 
   GALPHA_HD void operator()(uint32_t i) const {
     candidates[2 * i] = -1;
     candidates[2 * i + 1] = -1;
     if (proposal_edge[i] < 0) return;
+    const uint32_t now = *generation;
     const int32_t t = active[i], nb = proposal_nb[i];
     flip_vote[t] = kNoFlipVote;
     flip_vote[nb] = kNoFlipVote;
     const bool flipped = proposal_edge[i] == 3;
-    if (Claim(t)) {
+    if (Claim(t, now)) {
       candidates[2 * i] = t;
       // A losing proposer may also have been flipped as another flip's neighbour, and only one
       // of its two claims lands: check every edge so that neither reason is lost.
@@ -161,7 +172,7 @@ struct CollectNextActive {
     if (flipped) {
       partner[t] = kNoPartner;
       partner[nb] = kNoPartner;
-      if (Claim(nb)) {
+      if (Claim(nb, now)) {
         candidates[2 * i + 1] = nb;
         candidate_mask[2 * i + 1] = kCheckFlipOuterEdges;
       }

@@ -61,6 +61,10 @@ struct IsSet {
   GALPHA_HD bool operator()(uint8_t x) const { return x != 0; }
 };
 
+struct IsClear {
+  GALPHA_HD bool operator()(uint8_t x) const { return x == 0; }
+};
+
 struct IsNonNegative {
   GALPHA_HD bool operator()(int32_t x) const { return x >= 0; }
   GALPHA_HD bool operator()(int8_t x) const { return x >= 0; }
@@ -95,12 +99,14 @@ class DelaunayBuilder {
         active_mask_(sys, capacity_),
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
-        flags_(sys, 2) {
+        flags_(sys, 2),
+        counts_(sys, kNumCounts) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
     thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
     thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
     thrust::fill(sys_.policy(), flags_.begin(), flags_.end(), 0);
+    thrust::fill(sys_.policy(), counts_.begin(), counts_.end(), 0u);
   }
 
   /// Frees everything but the mesh once it is final (before the output stage).
@@ -141,19 +147,32 @@ class DelaunayBuilder {
   }
 
   /// Inserts every pending vertex in rounds; `location` starts at a triangle of the mesh.
+  ///
+  /// Each round waits for the device once, for the number of points elected (the mesh's size on
+  /// the host sizes the next launches). The other counts stay on the device: the pending points
+  /// left after a round are counted there, the next round's vote strides over that count, and the
+  /// host learns it with the round's one wait.
   void InsertAll(int32_t* pending, int32_t* location, uint8_t* inserted, uint32_t num_pending) {
     auto pol = sys_.policy();
     const thrust::counting_iterator<uint32_t> first(0);
+    uint32_t* pending_count = counts_.data() + kPendingCount;
+    thrust::fill(pol, pending_count, pending_count + 1, num_pending);
     Relocate(pending, location, inserted, num_pending);
-    while (num_pending > 0) {
+    for (;;) {
       ++rounds_;
       thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
-      thrust::for_each(pol, first, first + num_pending,
-                       VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
-      // Inclusive, so that its last entry is the number of splits: one read, one host sync.
+      sys_.ForEachBelow(pending_count, VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
+      // Inclusive, so that its last entry is the number of splits.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
                                        split_count_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
-      const int32_t num_split = sys_.Read(split_count_or_nb_.data() + num_tri_ - 1);
+      // The round's one wait: splits, pending points, and whether a relocation walk failed.
+      int32_t num_split = 0;
+      int32_t walk_failed = 0;
+      sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
+                     {&num_pending, pending_count, sizeof(uint32_t)},
+                     {&walk_failed, flags_.data(), sizeof(int32_t)}});
+      if (walk_failed != 0) throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
+      if (num_pending == 0) return;
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
@@ -168,8 +187,7 @@ class DelaunayBuilder {
 
       Relocate(pending, location, inserted, num_pending);
       auto zipped = thrust::make_zip_iterator(thrust::make_tuple(pending, location));
-      auto zipped_end = thrust::remove_if(pol, zipped, zipped + num_pending, inserted, IsSet());
-      num_pending = static_cast<uint32_t>(zipped_end - zipped);
+      sys_.SelectFlaggedInPlace(zipped, inserted, num_pending, IsClear(), pending_count);
       thrust::fill(pol, inserted, inserted + num_pending, uint8_t{0});
     }
   }
@@ -286,40 +304,57 @@ class DelaunayBuilder {
     return reinterpret_cast<int32_t*>(tri_vote_.data());
   }
 
+  /// Walks every pending point not inserted to the triangle that holds it now. A walk that fails
+  /// leaves the point's old triangle and raises a flag, read with the round's count.
   void Relocate(const int32_t* pending, int32_t* location, const uint8_t* inserted, uint32_t num_pending) {
     const thrust::counting_iterator<uint32_t> first(0);
     thrust::for_each(sys_.policy(), first, first + num_pending,
                      RelocatePoint{mesh_, pending, inserted, location, flags_.data(), m_ + 16u});
-    if (sys_.Read(flags_.data()) != 0) {
-      throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
-    }
+  }
+
+  /// One parallel Lawson iteration over the `*count` triangles of active_: they propose flips,
+  /// the winners flip and are re-linked, and what must be checked next replaces active_'s
+  /// triangles, counted into `*next_count`. Stream work only (recorded by RestoreDelaunay).
+  void FlipIteration(const uint32_t* count, uint32_t* next_count, bool hull_may_change) {
+    uint32_t* generation = counts_.data() + kGeneration;
+    sys_.RunSingle(StartFlipIteration{next_count, generation});
+    sys_.ForEachBelow(count, ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(),
+                                          split_count_or_nb_.data(), flip_vote_.data(), hull_may_change});
+    sys_.ForEachBelow(count, ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
+                                          flip_vote_.data(), partner_.data()});
+    sys_.ForEachBelow(count,
+                      LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
+    sys_.ForEachBelow(count, CollectNextActive{active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
+                                               flip_vote_.data(), partner_.data(), stamp_.data(), generation,
+                                               candidates(), candidate_mask_.data()});
+    auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates(), candidate_mask_.data()));
+    auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
+    sys_.AppendIf(count, 2, from, candidates(), IsNonNegative(), to, next_count);
   }
 
   /// Parallel Lawson flips from the `count` triangles in active_ until no edge needs a flip.
+  ///
+  /// Two iterations (their counts alternate between two words) are recorded once and replayed:
+  /// the loop's hundreds of small kernels would otherwise be bound by the host's cost of
+  /// launching them. The host stays one replay ahead: it learns a replay's starting count while
+  /// the next one runs, and stops after a replay that started with none.
   void RestoreDelaunay(uint32_t count, bool hull_may_change) {
-    auto pol = sys_.policy();
-    const thrust::counting_iterator<uint32_t> first(0);
-    for (int iteration = 0; count > 0; ++iteration) {
-      if (iteration > (1 << 20)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
-      thrust::for_each(pol, first, first + count,
-                       ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
-                                    flip_vote_.data(), hull_may_change});
-      // No count of the proposals here (one host sync less per iteration): without any, the
-      // passes below change nothing and leave no candidates, which ends the loop.
-      thrust::for_each(pol, first, first + count,
-                       ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
-                                    flip_vote_.data(), partner_.data()});
-      thrust::for_each(pol, first, first + count,
-                       LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
-      ++generation_;
-      thrust::for_each(pol, first, first + count,
-                       CollectNextActive{active_.data(), active_mask_.data(), proposal_edge_.data(),
-                                         split_count_or_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
-                                         generation_, candidates(), candidate_mask_.data()});
-      auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates(), candidate_mask_.data()));
-      auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
-      count = static_cast<uint32_t>(
-          thrust::copy_if(pol, from, from + 2 * count, candidates(), to, IsNonNegative()) - to);
+    if (count == 0) return;
+    uint32_t* even = counts_.data() + kEvenIterationCount;
+    uint32_t* odd = counts_.data() + kOddIterationCount;
+    thrust::fill(sys_.policy(), even, even + 1, count);
+    typename System::Recording& recording = hull_may_change ? insertion_flips_ : repair_flips_;
+    typename System::CountTicket started_with{};
+    for (int replay = 0;; ++replay) {
+      if (replay > (1 << 19)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
+      sys_.Replay(recording, [&] {
+        FlipIteration(even, odd, hull_may_change);
+        FlipIteration(odd, even, hull_may_change);
+      });
+      const typename System::CountTicket next = sys_.ReadCountLater(even);
+      const uint32_t started = replay == 0 ? count : sys_.CountOf(started_with);
+      if (started == 0) return;
+      started_with = next;
     }
   }
 
@@ -342,10 +377,20 @@ class DelaunayBuilder {
   Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
   Buffer<int32_t, System> flags_;  // [0] walk or repair failed, [1] serial repair flips
+  // Counts kept in system memory between the host's waits, and the flip stamps' generation.
+  static constexpr int kPendingCount = 0;
+  static constexpr int kEvenIterationCount = 1;
+  static constexpr int kOddIterationCount = 2;
+  static constexpr int kGeneration = 3;
+  static constexpr int kNumCounts = 4;
+  Buffer<uint32_t, System> counts_;
   MeshView mesh_{};
   int32_t num_tri_ = 0;
   int rounds_ = 0;
-  uint32_t generation_ = 0;
+  // The flip loop's two iterations, recorded once per build for each kind of flipping; declared
+  // last, so that they are destroyed (after the stream's last replay) before the buffers.
+  typename System::Recording insertion_flips_;
+  typename System::Recording repair_flips_;
 };
 
 /// A triangulation in an execution system's memory, named by input indices: what the alpha

@@ -12,6 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include <thrust/copy.h>
+#include <thrust/for_each.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/remove.h>
 #include <thrust/system/omp/execution_policy.h>
 
 #include "gpu/delaunay_backend.hpp"
@@ -54,6 +58,16 @@ class HostTempAllocator {
 
  private:
   MemoryLedger* ledger_;
+};
+
+/// The negation of a predicate (thrust::remove_if drops what its predicate accepts).
+template <class Keep>
+struct Rejects {
+  Keep keep;
+  template <class T>
+  bool operator()(const T& x) const {
+    return !keep(x);
+  }
 };
 
 /// The OpenMP backend: host memory, thrust::omp::par.
@@ -118,6 +132,45 @@ class CpuSystem {
   }
   /// Waits for queued work; the CPU backend runs synchronously.
   void Synchronize() {}
+
+  /// The CUDA system's count read a step late; here the value is there at once.
+  struct CountTicket {
+    uint32_t value;
+  };
+  CountTicket ReadCountLater(const uint32_t* system) { return {*system}; }
+  uint32_t CountOf(CountTicket ticket) { return ticket.value; }
+
+  /// Keeps, in place and in order, the first `n` items of `data` whose flag satisfies `keep`;
+  /// their number goes to `*count`.
+  template <class DataIt, class FlagIt, class Keep>
+  void SelectFlaggedInPlace(DataIt data, FlagIt flags, uint32_t n, Keep keep, uint32_t* count) {
+    *count = static_cast<uint32_t>(thrust::remove_if(policy(), data, data + n, flags, Rejects<Keep>{keep}) - data);
+  }
+  /// Runs f(i) for every i below `*count` (set by earlier work).
+  template <class F>
+  void ForEachBelow(const uint32_t* count, F f) {
+    const thrust::counting_iterator<uint32_t> first(0);
+    thrust::for_each(policy(), first, first + *count, f);
+  }
+  /// Appends the items among the first `per_item * *count` of `in` whose flag satisfies `keep`
+  /// to `out` from position `*out_count` on, in order, and adds their number to `*out_count`.
+  template <class InIt, class FlagIt, class Keep, class OutIt>
+  void AppendIf(const uint32_t* count, uint32_t per_item, InIt in, FlagIt flags, Keep keep, OutIt out,
+                uint32_t* out_count) {
+    const uint32_t n = per_item * *count;
+    *out_count += static_cast<uint32_t>(thrust::copy_if(policy(), in, in + n, flags, out + *out_count, keep) -
+                                        (out + *out_count));
+  }
+  template <class F>
+  void RunSingle(F f) {
+    f(0u);
+  }
+  /// The CUDA system records work once and replays it; here it simply runs again.
+  struct Recording {};
+  template <class Body>
+  void Replay(Recording&, Body&& body) {
+    body();
+  }
 
   using StageMark = std::chrono::steady_clock::time_point;
   StageMark MarkStage() { return std::chrono::steady_clock::now(); }

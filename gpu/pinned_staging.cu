@@ -122,4 +122,67 @@ void PinnedStaging::Upload(const std::vector<HostCopy>& copies, cudaStream_t str
   }
 }
 
+struct PinnedCounters::Block {
+  uint32_t* words = nullptr;
+  cudaEvent_t done[kWords] = {};
+};
+
+namespace {
+
+std::vector<PinnedCounters::Block*>& FreeCounterBlocks() {
+  static auto* free_blocks = new std::vector<PinnedCounters::Block*>();
+  return *free_blocks;
+}
+
+PinnedCounters::Block* NewCounterBlock() {
+  auto* block = new PinnedCounters::Block();
+  try {
+    CheckCuda(cudaHostAlloc(reinterpret_cast<void**>(&block->words), PinnedCounters::kWords * sizeof(uint32_t),
+                            cudaHostAllocDefault),
+              "cudaHostAlloc (pinned counters)");
+    for (cudaEvent_t& e : block->done) CheckCuda(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
+  } catch (...) {
+    if (block->words != nullptr) cudaFreeHost(block->words);
+    for (cudaEvent_t e : block->done) {
+      if (e != nullptr) cudaEventDestroy(e);
+    }
+    delete block;
+    throw;
+  }
+  return block;
+}
+
+}  // namespace
+
+PinnedCounters::PinnedCounters() {
+  {
+    std::lock_guard<std::mutex> lock(pool_mutex);
+    if (!FreeCounterBlocks().empty()) {
+      block_ = FreeCounterBlocks().back();
+      FreeCounterBlocks().pop_back();
+      return;
+    }
+  }
+  block_ = NewCounterBlock();
+}
+
+PinnedCounters::~PinnedCounters() {
+  // A read may still be in flight when an exception unwinds: the block returns only once idle.
+  for (cudaEvent_t e : block_->done) cudaEventSynchronize(e);
+  cudaGetLastError();
+  std::lock_guard<std::mutex> lock(pool_mutex);
+  FreeCounterBlocks().push_back(block_);
+}
+
+void PinnedCounters::StartRead(int i, const uint32_t* device, cudaStream_t stream) {
+  CheckCuda(cudaMemcpyAsync(block_->words + i, device, sizeof(uint32_t), cudaMemcpyDeviceToHost, stream),
+            "cudaMemcpyAsync (count)");
+  CheckCuda(cudaEventRecord(block_->done[i], stream), "cudaEventRecord");
+}
+
+uint32_t PinnedCounters::Finish(int i) {
+  CheckCuda(cudaEventSynchronize(block_->done[i]), "cudaEventSynchronize (count)");
+  return block_->words[i];
+}
+
 }  // namespace galpha::detail
