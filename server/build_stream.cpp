@@ -23,7 +23,7 @@ BuildStreamDecoder::~BuildStreamDecoder() {
 }
 
 void BuildStreamDecoder::ReleasePoints() {
-  std::vector<Point2>().swap(decoded_.points);
+  HostVector<Point2>().swap(decoded_.points);
   if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(reserved_);
   reserved_ = 0;
 }
@@ -78,19 +78,22 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
         return absl::InvalidArgumentError(
             absl::StrCat("the stream carries more points than the ", expected, " its header announced"));
       }
-      for (size_t i = 0; i < count; ++i) {
-        if (!std::isfinite(coordinates[static_cast<int>(i)])) {
-          return absl::InvalidArgumentError(absl::StrCat("point ", before + i / 2, " has a ",
-                                                         std::isnan(coordinates[static_cast<int>(i)]) ? "NaN" : "infinite",
-                                                         " ", i % 2 == 0 ? "x" : "y", " coordinate"));
-        }
+      // One branch-free pass over the chunk (it vectorises); the index only when one is bad.
+      const double* values = coordinates.data();
+      bool all_finite = true;
+      for (size_t i = 0; i < count; ++i) all_finite &= std::isfinite(values[i]);
+      if (!all_finite) {
+        size_t i = 0;
+        while (std::isfinite(values[i])) ++i;
+        return absl::InvalidArgumentError(absl::StrCat("point ", before + i / 2, " has a ",
+                                                       std::isnan(values[i]) ? "NaN" : "infinite", " ",
+                                                       i % 2 == 0 ? "x" : "y", " coordinate"));
       }
       if (expected == 0) {
         if (absl::Status s = Reserve(count * sizeof(double)); !s.ok()) return s;
       }
       decoded_.points.resize(after);
       if (count > 0) std::memcpy(&decoded_.points[before], coordinates.data(), count * sizeof(double));
-      hasher_.AddCoordinates(absl::MakeConstSpan(coordinates.data(), count));
       return absl::OkStatus();
     }
     case galpha::v1::BuildRequest::PART_NOT_SET:
@@ -108,7 +111,9 @@ absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
     return absl::InvalidArgumentError(absl::StrCat("the stream ended after ", decoded_.points.size(),
                                                    " points; its header announced ", expected));
   }
-  decoded_.handle = hasher_.Finish();
+  // Hashed once the points are all here: in parallel (point_set_handle.hpp), ~1 ms at 1M points
+  // on 16 cores.
+  decoded_.handle = PointSetHandle(decoded_.points);
   return &decoded_;
 }
 

@@ -11,6 +11,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/host_vector.hpp"
 #include "core/point.hpp"
 #include "core/point_set_handle.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
@@ -39,7 +40,7 @@ struct BuildStreamLimits {
 /// A decoded stream: the header and the points, and the handle of the points.
 struct DecodedBuild {
   galpha::v1::BuildHeader header;
-  std::vector<Point2> points;
+  HostVector<Point2> points;  // not zeroed as it grows: every byte is then copied in
   std::string handle;
 };
 
@@ -77,7 +78,6 @@ class BuildStreamDecoder {
   size_t reserved_ = 0;
   bool has_header_ = false;
   bool finished_ = false;
-  PointSetHasher hasher_;
   DecodedBuild decoded_;
 };
 

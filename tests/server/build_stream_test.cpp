@@ -252,7 +252,7 @@ absl::StatusOr<std::string> DecodeSplit(const std::vector<Point2>& points, const
   }
   absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
   if (!decoded.ok()) return decoded.status();
-  *decoded_points = (*decoded)->points;
+  decoded_points->assign((*decoded)->points.begin(), (*decoded)->points.end());
   return (*decoded)->handle;
 }
 
@@ -315,7 +315,7 @@ TEST(BuildStreamDecoderTest, PointsAreDecodedBitForBit) {
   ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>(coordinates.begin() + 4, coordinates.end()))).ok());
   const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
   ASSERT_TRUE(decoded.ok()) << decoded.status();
-  const std::vector<Point2>& points = (*decoded)->points;
+  const HostVector<Point2>& points = (*decoded)->points;
   ASSERT_EQ(points.size() * 2, coordinates.size());
   for (size_t i = 0; i < points.size(); ++i) {
     SCOPED_TRACE(i);
@@ -325,7 +325,7 @@ TEST(BuildStreamDecoderTest, PointsAreDecodedBitForBit) {
   EXPECT_TRUE(std::signbit(points[0].x)) << "-0.0 keeps its sign";
   EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
   // -0.0 and 0.0 are equal doubles but different inputs: their handles differ.
-  std::vector<Point2> positive_zero = points;
+  std::vector<Point2> positive_zero(points.begin(), points.end());
   positive_zero[0].x = 0.0;
   EXPECT_NE(PointSetHandle(positive_zero), (*decoded)->handle);
 }

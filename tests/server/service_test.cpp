@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -496,12 +497,28 @@ TEST(ServiceTest, CancellationMidStreamFreesTheUpload) {
 TEST(ServiceTest, DeadlineStopsARunningBuild) {
   auto server = StartServer(TestServerOptions());
   ASSERT_NE(server, nullptr);
+  const std::vector<Point2> points = gen::Uniform(SlowBuildPoints() * 3 / 2, 13);
+  // Unhurried builds (the second one warm) say how long the upload and the build take on this
+  // machine; the deadline then falls a third of the way into the engine's work (a fixed deadline
+  // expired in the upload or after the build, as machines and the engine got faster).
+  double upload_ms = 0, build_ms = 0;
+  for (int warm = 0; warm < 2; ++warm) {
+    auto unhurried = ClientOf(*server);
+    const auto start = std::chrono::steady_clock::now();
+    auto first = unhurried->Build(points);
+    const double total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_TRUE(first.ok()) << first.status();
+    build_ms = 0;
+    for (const auto& stage : first->summary.stage_times()) build_ms += 1e3 * stage.seconds();
+    upload_ms = std::max(0.0, total_ms - build_ms);
+    ASSERT_TRUE(unhurried->Release(first->handle).ok());
+  }
   client::ClientOptions options;
   options.target = "127.0.0.1:" + std::to_string(server->port());
-  options.deadline = std::chrono::milliseconds(300);
+  options.deadline = std::chrono::milliseconds(static_cast<int64_t>(upload_ms + build_ms / 3) + 1);
   auto client = client::AlphaClient::Connect(options);
   ASSERT_TRUE(client.ok());
-  auto built = (*client)->Build(gen::Uniform(SlowBuildPoints() * 3 / 2, 13));
+  auto built = (*client)->Build(points);
   EXPECT_EQ(built.status().code(), absl::StatusCode::kDeadlineExceeded) << built.status();
   // The build stops at its next phase boundary and frees what it held.
   EXPECT_TRUE(WaitFor([&] { return ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 60));
