@@ -14,7 +14,6 @@
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
-#include <thrust/remove.h>
 #include <thrust/scan.h>
 #include <thrust/sequence.h>
 #include <thrust/transform.h>
@@ -23,6 +22,8 @@
 
 #include "core/alpha_ranks.hpp"
 #include "gpu/alpha_functors.cuh"
+#include "gpu/atomic_increment.cuh"
+#include "gpu/delaunay_backend.hpp"
 #include "gpu/engine_system.cuh"
 
 namespace galpha::detail {
@@ -113,20 +114,49 @@ struct ResetBest {
 };
 
 struct RelabelEdge {
+  WeightedEdge* edges;
   const uint32_t* parent;
-  GALPHA_HD void operator()(WeightedEdge& e) const {
+  GALPHA_HD void operator()(uint32_t i) const {
+    WeightedEdge& e = edges[i];
     e.a = parent[e.a];
     e.b = parent[e.b];
   }
 };
 
-struct InsideOneComponent {
-  GALPHA_HD bool operator()(const WeightedEdge& e) const { return e.a == e.b; }
+struct JoinsTwoComponents {
+  GALPHA_HD bool operator()(const WeightedEdge& e) const { return e.a != e.b; }
 };
 
-struct IsHooked {
+struct IsRoot {
   const uint32_t* parent;
-  GALPHA_HD bool operator()(uint32_t c) const { return parent[c] != c; }
+  GALPHA_HD bool operator()(uint32_t c) const { return parent[c] == c; }
+};
+
+template <class T>
+struct CopyItem {
+  const T* from;
+  T* to;
+  GALPHA_HD void operator()(uint32_t i) const { to[i] = from[i]; }
+};
+
+/// The round's bookkeeping after the compactions (one thread): the kept items' counts become the
+/// live counts, and the next compaction's counts start at zero.
+struct TakeKeptCounts {
+  uint32_t* live_edges;
+  uint32_t* live_labels;
+  uint32_t* kept_edges;
+  uint32_t* kept_labels;
+  GALPHA_HD void operator()(uint32_t) const {
+    *live_edges = *kept_edges;
+    *live_labels = *kept_labels;
+    *kept_edges = 0;
+    *kept_labels = 0;
+  }
+};
+
+struct ClearFlag {
+  uint32_t* flag;
+  GALPHA_HD void operator()(uint32_t) const { *flag = 0; }
 };
 
 struct HasRank {
@@ -134,47 +164,76 @@ struct HasRank {
 };
 
 /// Adds to merges_at_rank[r] the number of spanning-forest edges of rank r. `edges` holds one
-/// entry per edge (weights unique; rank kNeverRank for an edge that never appears); nodes are
-/// 0..num_nodes.
+/// entry per edge (weights unique; rank kNeverRank for an edge that never appears) and is used as
+/// working space (clobbered); nodes are 0..num_nodes.
+///
+/// A round's kernels are recorded once and replayed (the host's launch cost bounded the rounds,
+/// as in the triangulation's flip loop): the live edge and label counts stay on the device, and
+/// the host waits once a round, for whether edges were left and whether the pointer jumps
+/// converged.
 template <class System>
-void CountForestEdgesByRank(System& sys, const WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes,
+void CountForestEdgesByRank(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes,
                             uint32_t* merges_at_rank) {
   auto policy = sys.policy();
-  thrust::counting_iterator<uint32_t> zero(0);
   Buffer<WeightedEdge, System> active(sys, num_edges);
-  uint32_t num_active = static_cast<uint32_t>(
+  const uint32_t num_ranked = static_cast<uint32_t>(
       thrust::copy_if(policy, edges, edges + num_edges, active.data(), HasRank{}) - active.data());
-  Buffer<uint32_t, System> labels(sys, num_nodes), parent(sys, num_nodes), target(sys, num_nodes);
+  WeightedEdge* kept = edges;  // the compactions' target from here on
+  Buffer<uint32_t, System> labels(sys, num_nodes), kept_labels(sys, num_nodes), parent(sys, num_nodes),
+      target(sys, num_nodes);
   Buffer<unsigned long long, System> best(sys, num_nodes);
-  Buffer<uint32_t, System> changed(sys, 1);
+  enum Count { kLiveEdges, kLiveLabels, kKeptEdges, kKeptLabels, kJumped, kNumCounts };
+  Buffer<uint32_t, System> counts(sys, kNumCounts);
+  uint32_t* count = counts.data();
   thrust::sequence(policy, labels.data(), labels.data() + num_nodes);
   thrust::sequence(policy, parent.data(), parent.data() + num_nodes);
   thrust::fill_n(policy, best.data(), num_nodes, ~0ull);
-  uint32_t num_labels = num_nodes;
-  while (num_active > 0) {
-    thrust::for_each_n(policy, zero, num_active, OfferLightestEdge{active.data(), best.data()});
-    thrust::for_each_n(policy, zero, num_active, RecordHookTarget{active.data(), best.data(), target.data()});
-    thrust::for_each_n(policy, zero, num_labels,
-                       HookComponent{labels.data(), best.data(), target.data(), parent.data(), merges_at_rank});
-    // Hook trees are shallow on realistic input: a few jumps flatten them. The jumps run in
-    // groups, and only the last of a group reports whether it still moved a pointer, so that a
-    // round waits for the device once instead of once a jump (each wait costs more than a jump).
-    constexpr int kJumpsPerCheck = 3;
-    uint32_t jumped = 1;
-    while (jumped != 0) {
-      for (int j = 0; j + 1 < kJumpsPerCheck; ++j) {
-        thrust::for_each_n(policy, zero, num_labels, JumpOnce{labels.data(), parent.data(), nullptr});
-      }
-      thrust::fill_n(policy, changed.data(), 1, 0u);
-      thrust::for_each_n(policy, zero, num_labels, JumpOnce{labels.data(), parent.data(), changed.data()});
-      jumped = sys.Read(changed.data());
+  const uint32_t initial[kNumCounts] = {num_ranked, num_nodes, 0, 0, 0};
+  sys.FromHost(count, initial, kNumCounts);
+
+  // Hook trees are shallow on realistic input: a few jumps flatten them. The jumps run in groups,
+  // and only the last of a group reports whether it still moved a pointer.
+  constexpr int kJumpsPerCheck = 3;
+  auto jump_group = [&] {
+    for (int j = 0; j + 1 < kJumpsPerCheck; ++j) {
+      sys.ForEachBelow(count + kLiveLabels, JumpOnce{labels.data(), parent.data(), nullptr});
     }
-    thrust::for_each_n(policy, zero, num_labels, ResetBest{labels.data(), best.data()});
-    thrust::for_each_n(policy, active.data(), num_active, RelabelEdge{parent.data()});
-    num_active = static_cast<uint32_t>(
-        thrust::remove_if(policy, active.data(), active.data() + num_active, InsideOneComponent{}) - active.data());
-    num_labels = static_cast<uint32_t>(
-        thrust::remove_if(policy, labels.data(), labels.data() + num_labels, IsHooked{parent.data()}) - labels.data());
+    sys.RunSingle(ClearFlag{count + kJumped});
+    sys.ForEachBelow(count + kLiveLabels, JumpOnce{labels.data(), parent.data(), count + kJumped});
+  };
+  // Declared after the buffers: destroyed (after the stream's last replay) before them.
+  typename System::Recording hook_round, more_jumps, shrink_round;
+  for (int round = 0;; ++round) {
+    // Every component with an edge left merges in a round: at most log2(nodes) + 1 rounds.
+    if (round > 64) throw EngineError(EngineError::Kind::kInternal, "component rounds did not converge");
+    sys.Replay(hook_round, [&] {
+      sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active.data(), best.data()});
+      sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active.data(), best.data(), target.data()});
+      sys.ForEachBelow(count + kLiveLabels, HookComponent{labels.data(), best.data(), target.data(), parent.data(),
+                                                          merges_at_rank});
+      jump_group();
+    });
+    // The round's wait: whether edges were left for it (none: it changed nothing, and the forest
+    // is complete) and whether the jumps converged.
+    uint32_t live_edges = 0, jumped = 0;
+    sys.Download({{&live_edges, count + kLiveEdges, sizeof(uint32_t)}, {&jumped, count + kJumped, sizeof(uint32_t)}});
+    if (live_edges == 0) return;
+    for (int group = 0; jumped != 0; ++group) {
+      if (group > 32) throw EngineError(EngineError::Kind::kInternal, "pointer jumping did not converge");
+      sys.Replay(more_jumps, jump_group);
+      jumped = sys.Read(count + kJumped);
+    }
+    sys.Replay(shrink_round, [&] {
+      sys.ForEachBelow(count + kLiveLabels, ResetBest{labels.data(), best.data()});
+      sys.ForEachBelow(count + kLiveEdges, RelabelEdge{active.data(), parent.data()});
+      sys.AppendIf(count + kLiveEdges, 1, active.data(), active.data(), JoinsTwoComponents{}, kept,
+                   count + kKeptEdges);
+      sys.AppendIf(count + kLiveLabels, 1, labels.data(), labels.data(), IsRoot{parent.data()}, kept_labels.data(),
+                   count + kKeptLabels);
+      sys.ForEachBelow(count + kKeptEdges, CopyItem<WeightedEdge>{kept, active.data()});
+      sys.ForEachBelow(count + kKeptLabels, CopyItem<uint32_t>{kept_labels.data(), labels.data()});
+      sys.RunSingle(TakeKeptCounts{count + kLiveEdges, count + kLiveLabels, count + kKeptEdges, count + kKeptLabels});
+    });
   }
 }
 
