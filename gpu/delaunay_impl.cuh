@@ -154,7 +154,6 @@ class DelaunayBuilder {
   /// host learns it with the round's one wait.
   void InsertAll(int32_t* pending, int32_t* location, uint8_t* inserted, uint32_t num_pending) {
     auto pol = sys_.policy();
-    const thrust::counting_iterator<uint32_t> first(0);
     uint32_t* pending_count = counts_.data() + kPendingCount;
     thrust::fill(pol, pending_count, pending_count + 1, num_pending);
     Relocate(pending, location, inserted, num_pending);
