@@ -14,12 +14,37 @@ struct PinnedStaging::Slots {
 
 namespace {
 
-/// Slot pairs not leased now. Kept for the life of the process: pinning costs milliseconds.
 std::mutex pool_mutex;
-std::vector<PinnedStaging::Slots*>& FreeSlots() {
-  static auto* free_slots = new std::vector<PinnedStaging::Slots*>();
-  return *free_slots;
-}
+
+/// Pinned blocks of one kind not leased now. Kept for the life of the process: pinning costs
+/// milliseconds.
+template <class Block>
+class IdleBlocks {
+ public:
+  /// An idle block, or a new one from `make`.
+  template <class Make>
+  static Block* Take(Make make) {
+    {
+      std::lock_guard<std::mutex> lock(pool_mutex);
+      if (!Idle().empty()) {
+        Block* block = Idle().back();
+        Idle().pop_back();
+        return block;
+      }
+    }
+    return make();
+  }
+  static void Give(Block* block) {
+    std::lock_guard<std::mutex> lock(pool_mutex);
+    Idle().push_back(block);
+  }
+
+ private:
+  static std::vector<Block*>& Idle() {
+    static auto* idle = new std::vector<Block*>();
+    return *idle;
+  }
+};
 
 PinnedStaging::Slots* NewSlots() {
   auto* slots = new PinnedStaging::Slots();
@@ -62,24 +87,13 @@ std::vector<Piece> CutIntoPieces(const std::vector<HostCopy>& copies) {
 
 }  // namespace
 
-PinnedStaging::PinnedStaging() {
-  {
-    std::lock_guard<std::mutex> lock(pool_mutex);
-    if (!FreeSlots().empty()) {
-      slots_ = FreeSlots().back();
-      FreeSlots().pop_back();
-      return;
-    }
-  }
-  slots_ = NewSlots();
-}
+PinnedStaging::PinnedStaging() : slots_(IdleBlocks<Slots>::Take(NewSlots)) {}
 
 PinnedStaging::~PinnedStaging() {
   // A copy may still be in flight when an exception unwinds: the slots return only once idle.
   for (int i = 0; i < 2; ++i) cudaEventSynchronize(slots_->done[i]);
   cudaGetLastError();
-  std::lock_guard<std::mutex> lock(pool_mutex);
-  FreeSlots().push_back(slots_);
+  IdleBlocks<Slots>::Give(slots_);
 }
 
 void PinnedStaging::Download(const std::vector<HostCopy>& copies, cudaStream_t stream) {
@@ -129,11 +143,6 @@ struct PinnedCounters::Block {
 
 namespace {
 
-std::vector<PinnedCounters::Block*>& FreeCounterBlocks() {
-  static auto* free_blocks = new std::vector<PinnedCounters::Block*>();
-  return *free_blocks;
-}
-
 PinnedCounters::Block* NewCounterBlock() {
   auto* block = new PinnedCounters::Block();
   try {
@@ -154,24 +163,13 @@ PinnedCounters::Block* NewCounterBlock() {
 
 }  // namespace
 
-PinnedCounters::PinnedCounters() {
-  {
-    std::lock_guard<std::mutex> lock(pool_mutex);
-    if (!FreeCounterBlocks().empty()) {
-      block_ = FreeCounterBlocks().back();
-      FreeCounterBlocks().pop_back();
-      return;
-    }
-  }
-  block_ = NewCounterBlock();
-}
+PinnedCounters::PinnedCounters() : block_(IdleBlocks<Block>::Take(NewCounterBlock)) {}
 
 PinnedCounters::~PinnedCounters() {
   // A read may still be in flight when an exception unwinds: the block returns only once idle.
   for (cudaEvent_t e : block_->done) cudaEventSynchronize(e);
   cudaGetLastError();
-  std::lock_guard<std::mutex> lock(pool_mutex);
-  FreeCounterBlocks().push_back(block_);
+  IdleBlocks<Block>::Give(block_);
 }
 
 void PinnedCounters::StartRead(int i, const uint32_t* device, cudaStream_t stream) {
