@@ -31,8 +31,8 @@ absl::StatusOr<std::unique_ptr<AlphaClient>> AlphaClient::Connect(const ClientOp
   // Answers are chunked below 4 MiB, but a large Describe or Components answer may exceed it.
   arguments.SetMaxReceiveMessageSize(std::numeric_limits<int>::max());
   // A connection of its own: gRPC otherwise shares one connection among the channels of a process
-  // to the same server, and concurrent uploads of tens of megabytes then queue behind each other
-  // on it (8 clients in one process reached the throughput of two).
+  // to the same server, and the concurrent uploads of tens of megabytes of several clients would
+  // share that connection's flow control.
   arguments.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
   client->channel_ = grpc::CreateCustomChannel(options.target, credentials, arguments);
   client->stub_ = v1::AlphaShapes::NewStub(client->channel_);

@@ -2,9 +2,12 @@
 
 #include <openssl/evp.h>
 
+#include <algorithm>
 #include <cstdint>
-#include <cstring>
+#include <initializer_list>
 #include <new>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace galpha {
