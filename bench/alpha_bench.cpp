@@ -33,10 +33,10 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "bench/bench_options.hpp"
-#include "core/alpha_family.hpp"
-#include "core/point_formats.hpp"
-#include "gpu/alpha_engine.hpp"
-#include "gpu/sort_floor.hpp"
+#include "core/family/alpha_family.hpp"
+#include "core/io/point_formats.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "bench/sort_floor/sort_floor.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "gpu/delaunay.hpp"
+#include "gpu/triangulation/delaunay.hpp"
 
 namespace galpha {
 

@@ -23,8 +23,8 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "bench/bench_options.hpp"
-#include "core/point_io.hpp"
-#include "gpu/delaunay.hpp"
+#include "core/io/point_io.hpp"
+#include "gpu/triangulation/delaunay.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {

@@ -11,12 +11,12 @@ cmake --preset cuda >/dev/null
 cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
-for b in tests/core/predicates_test tests/core/predicates_device_test tests/gpu/delaunay_test \
-         tests/gpu/delaunay_cgal_test tests/gpu/triangulation_checks_test tests/core/radius_test \
-         tests/gpu/alpha_family_cgal_test tests/gpu/alpha_family_test tests/gpu/alpha_bruteforce_test tests/gpu/alpha_backend_identity_test tests/core/shape_test \
-         bench/delaunay_bench bench/alpha_bench client/alphactl \
-         bench/service_bench server/galpha_server tests/server/service_test; do
-  if [ -x "build/cuda/$b" ]; then cp "build/cuda/$b" .carry/bin/; bins+=(".carry/bin/$(basename "$b")"); fi
+# By name, wherever the build tree puts them (it mirrors the source folders).
+for name in predicates_test predicates_device_test delaunay_test delaunay_cgal_test triangulation_checks_test \
+            radius_test alpha_family_cgal_test alpha_family_test alpha_bruteforce_test alpha_backend_identity_test \
+            shape_test delaunay_bench alpha_bench alphactl service_bench galpha_server service_test; do
+  b=$(find build/cuda -name "$name" -type f -perm -u+x -not -path '*/CMakeFiles/*' | head -n 1)
+  if [ -n "$b" ]; then cp "$b" .carry/bin/; bins+=(".carry/bin/$name"); fi
 done
 for b in "${bins[@]}"; do
   # Everything but the C/C++ runtime, OpenMP and the driver, which the GPU machine has (newer).

@@ -29,8 +29,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "client/galpha_client.hpp"
-#include "core/point_set_handle.hpp"
-#include "gpu/alpha_engine.hpp"
+#include "core/io/point_set_handle.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "server/galpha_server.hpp"
 #include "tests/support/point_generators.hpp"
 

@@ -11,8 +11,8 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "absl/types/span.h"
-#include "core/alpha_family.hpp"
-#include "gpu/delaunay.hpp"
+#include "core/family/alpha_family.hpp"
+#include "gpu/triangulation/delaunay.hpp"
 
 namespace galpha::alphactl {
 

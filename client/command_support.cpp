@@ -12,8 +12,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
-#include "core/point_formats.hpp"
-#include "gpu/alpha_engine.hpp"
+#include "core/io/point_formats.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 
 namespace galpha::alphactl {
 

@@ -10,7 +10,7 @@
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
 #include "client/text_output.hpp"
-#include "gpu/delaunay.hpp"
+#include "gpu/triangulation/delaunay.hpp"
 
 namespace galpha::alphactl {
 

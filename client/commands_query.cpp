@@ -12,8 +12,8 @@
 #include "absl/strings/str_cat.h"
 #include "client/commands.hpp"
 #include "client/text_output.hpp"
-#include "core/classification_summary.hpp"
-#include "core/shape.hpp"
+#include "core/family/classification_summary.hpp"
+#include "core/geometry/shape.hpp"
 
 namespace galpha::alphactl {
 

@@ -20,7 +20,7 @@
 #include "client/commands.hpp"
 #include "client/galpha_client.hpp"
 #include "client/text_output.hpp"
-#include "core/point_set_handle.hpp"
+#include "core/io/point_set_handle.hpp"
 
 namespace galpha::alphactl {
 

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "absl/strings/str_cat.h"
-#include "core/point_set_handle.hpp"
+#include "core/io/point_set_handle.hpp"
 
 namespace galpha::client {
 

@@ -12,7 +12,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
-#include "core/point.hpp"
+#include "core/base/point.hpp"
 #include "galpha/v1/alpha_shapes.grpc.pb.h"
 
 namespace galpha::client {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "absl/strings/string_view.h"
-#include "core/alpha_family.hpp"
-#include "core/alpha_ranks.hpp"
+#include "core/family/alpha_family.hpp"
+#include "core/family/alpha_ranks.hpp"
 
 namespace galpha::alphactl {
 

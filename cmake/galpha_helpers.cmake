@@ -26,3 +26,15 @@ function(galpha_add_test)
   add_test(NAME ${ARG_NAME} COMMAND ${ARG_NAME})
   set_tests_properties(${ARG_NAME} PROPERTIES ENVIRONMENT "GALPHA_DATA_DIR=${GALPHA_DATA_DIR}")
 endfunction()
+
+# The engine's libraries: Thrust for the OpenMP backend, and in CUDA builds the CUDA runtime
+# (static) with whole-program compilation of each .cu file.
+function(galpha_engine_library target)
+  galpha_target_flags(${target})
+  galpha_use_cccl(${target})
+  target_link_libraries(${target} PRIVATE OpenMP::OpenMP_CXX)
+  if(GALPHA_CUDA_ENABLED)
+    target_link_libraries(${target} PRIVATE CUDA::cudart_static)
+    set_target_properties(${target} PROPERTIES CUDA_SEPARABLE_COMPILATION OFF POSITION_INDEPENDENT_CODE ON)
+  endif()
+endfunction()

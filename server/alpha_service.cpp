@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/point_set_handle.hpp"
-#include "gpu/alpha_engine.hpp"
+#include "core/io/point_set_handle.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "server/query_answers.hpp"
 
 namespace galpha::server {

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "galpha/v1/alpha_shapes.grpc.pb.h"
-#include "gpu/delaunay.hpp"
-#include "gpu/device_streams.hpp"
+#include "gpu/triangulation/delaunay.hpp"
+#include "gpu/system/device_streams.hpp"
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
 #include "server/family_cache.hpp"

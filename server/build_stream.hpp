@@ -11,9 +11,9 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "core/host_vector.hpp"
-#include "core/point.hpp"
-#include "core/point_set_handle.hpp"
+#include "core/base/host_vector.hpp"
+#include "core/base/point.hpp"
+#include "core/io/point_set_handle.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
 
 namespace galpha::server {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/alpha_family.hpp"
+#include "core/family/alpha_family.hpp"
 
 namespace galpha::server {
 

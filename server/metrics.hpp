@@ -7,7 +7,7 @@
 #include <string_view>
 
 #include "absl/status/statusor.h"
-#include "core/alpha_family.hpp"
+#include "core/family/alpha_family.hpp"
 #include "server/build_scheduler.hpp"
 #include "server/family_cache.hpp"
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/classification_summary.hpp"
+#include "core/family/classification_summary.hpp"
 
 namespace galpha::server {
 

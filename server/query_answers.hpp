@@ -8,8 +8,8 @@
 #include <string>
 
 #include "absl/status/statusor.h"
-#include "core/alpha_family.hpp"
-#include "core/shape.hpp"
+#include "core/family/alpha_family.hpp"
+#include "core/geometry/shape.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "server/cached_family.hpp"
 

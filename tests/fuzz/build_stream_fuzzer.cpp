@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <cstdlib>
 
-#include "core/point_set_handle.hpp"
+#include "core/io/point_set_handle.hpp"
 #include "server/build_stream.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

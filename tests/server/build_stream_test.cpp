@@ -15,7 +15,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/types/span.h"
-#include "core/point_set_handle.hpp"
+#include "core/io/point_set_handle.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/point_generators.hpp"
 

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "gpu/alpha_engine.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "server/cached_family.hpp"
 
 namespace galpha::server::testing {

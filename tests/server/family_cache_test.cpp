@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "gpu/alpha_engine.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
 #include "tests/server/cached_family_fixture.hpp"

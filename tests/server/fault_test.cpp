@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "client/galpha_client.hpp"
-#include "core/point_set_handle.hpp"
+#include "core/io/point_set_handle.hpp"
 #include "service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/server_process.hpp"

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/classification_summary.hpp"
-#include "core/shape.hpp"
-#include "gpu/alpha_engine.hpp"
+#include "core/family/classification_summary.hpp"
+#include "core/geometry/shape.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
 #include "tests/server/cached_family_fixture.hpp"

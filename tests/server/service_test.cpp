@@ -22,9 +22,9 @@
 #include <thread>
 #include <vector>
 
-#include "core/point_set_handle.hpp"
-#include "core/shape.hpp"
-#include "gpu/alpha_engine.hpp"
+#include "core/io/point_set_handle.hpp"
+#include "core/geometry/shape.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "service_test_support.hpp"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"

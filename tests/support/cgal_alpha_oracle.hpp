@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "absl/types/span.h"
-#include "core/point.hpp"
+#include "core/base/point.hpp"
 
 namespace galpha::testing {
 

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/point.hpp"
+#include "core/base/point.hpp"
 #include "gtest/gtest.h"
 
 namespace galpha::testing {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/point.hpp"
+#include "core/base/point.hpp"
 
 namespace galpha::gen {
 

@@ -1,0 +1,37 @@
+# Build-time check of one layer (see galpha_layers.cmake): every project include of every file in
+# FOLDER names a folder in ALLOWED (comma-separated); with NO_CUDA, no CUDA file or header at all.
+# Run as: cmake -DLAYER=.. -DFOLDER=.. -DALLOWED=a,b -DNO_CUDA=0|1 -DSOURCE_DIR=.. -DSTAMP=.. -P
+cmake_minimum_required(VERSION 3.25)
+string(REPLACE "," ";" allowed "${ALLOWED}")
+# Include paths that name a folder of this repository; anything else is a third-party header.
+set(project_roots core gpu server client proto bench tests)
+file(GLOB files ${SOURCE_DIR}/${FOLDER}/*.hpp ${SOURCE_DIR}/${FOLDER}/*.cpp
+                ${SOURCE_DIR}/${FOLDER}/*.cuh ${SOURCE_DIR}/${FOLDER}/*.cu)
+set(errors "")
+foreach(file IN LISTS files)
+  file(RELATIVE_PATH rel ${SOURCE_DIR} ${file})
+  if(NO_CUDA AND rel MATCHES "\\.(cu|cuh)$")
+    string(APPEND errors "\n  ${rel}: a CUDA file in ${FOLDER}, which must not see CUDA")
+  endif()
+  file(STRINGS ${file} lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
+  foreach(line IN LISTS lines)
+    string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*[<\"]([^>\"]+)[>\"].*$" "\\1" header "${line}")
+    if(NO_CUDA AND header MATCHES "^(cuda|thrust/|cub/|cuda/|nv/|curand|cooperative_groups)")
+      string(APPEND errors "\n  ${rel}: includes <${header}>, but ${FOLDER} must not see CUDA")
+      continue()
+    endif()
+    string(REGEX MATCH "^[^/]+" root "${header}")
+    if(NOT root IN_LIST project_roots OR NOT header MATCHES "/")
+      continue()
+    endif()
+    get_filename_component(header_folder "${header}" DIRECTORY)
+    if(NOT header_folder IN_LIST allowed)
+      string(APPEND errors "\n  ${rel}: includes \"${header}\", but ${LAYER} may only use ${ALLOWED}")
+    endif()
+  endforeach()
+endforeach()
+if(errors)
+  message(FATAL_ERROR "Layering violation in ${FOLDER} (declare the dependency in its CMakeLists.txt "
+                      "with galpha_layer(... USES ...) if it is intended):${errors}")
+endif()
+file(WRITE ${STAMP} "ok\n")

@@ -1,0 +1,245 @@
+#include "core/family/alpha_family.hpp"
+
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/exact/radius_rational.hpp"
+
+namespace galpha {
+
+const char* SimplexClassName(SimplexClass c) {
+  switch (c) {
+    case SimplexClass::kExterior:
+      return "EXTERIOR";
+    case SimplexClass::kSingular:
+      return "SINGULAR";
+    case SimplexClass::kRegular:
+      return "REGULAR";
+    case SimplexClass::kInterior:
+      return "INTERIOR";
+  }
+  return "UNKNOWN";
+}
+
+AlphaFamily::AlphaFamily(AlphaFamilyParts parts) : parts_(std::move(parts)) {
+  const AlphaRanks& r = parts_.ranks;
+  const uint32_t num_tri = static_cast<uint32_t>(parts_.triangles.size());
+  // Every point on a triangle from the largest first-triangle rank over the distinct points.
+  if (num_tri > 0) {
+    uint32_t worst = 0;
+    for (uint32_t v = 0; v < parts_.points.size(); ++v) {
+      if (parts_.representative[v] == v) worst = std::max(worst, r.vertex_tri_low[v]);
+    }
+    if (worst != kNeverRank) solid_level_ = worst;
+  }
+}
+
+namespace {
+
+/// sign(exact threshold of `rank` - value), exactly.
+int CompareRankWith(const AlphaFamilyParts& p, int64_t rank, const mpq_class& value) {
+  const uint32_t id = p.ranks.spectrum_simplex[static_cast<size_t>(rank - 1)];
+  Point2 pts[3];
+  int n;
+  const uint32_t num_tri = static_cast<uint32_t>(p.triangles.size());
+  if (id < num_tri) {
+    for (int k = 0; k < 3; ++k) pts[k] = p.points[p.triangles[id][k]];
+    n = 3;
+  } else {
+    pts[0] = p.points[p.edges[id - num_tri][0]];
+    pts[1] = p.points[p.edges[id - num_tri][1]];
+    n = 2;
+  }
+  const std::optional<mpq_class> threshold = RadiusSqRational(pts, n);
+  if (!threshold) return 1;
+  const int c = cmp(*threshold, value);
+  return (c > 0) - (c < 0);
+}
+
+/// Number of ranks whose exact threshold is <= value (binary search; thresholds increase).
+int64_t CountAtMost(const AlphaFamilyParts& p, const mpq_class& value) {
+  int64_t lo = 0, hi = static_cast<int64_t>(p.ranks.spectrum.size());
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo) / 2;  // rank mid + 1
+    if (CompareRankWith(p, mid + 1, value) <= 0) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo;
+}
+
+}  // namespace
+
+absl::StatusOr<int64_t> AlphaFamily::LevelForAlphaSq(double alpha_sq) const {
+  if (std::isnan(alpha_sq)) return absl::InvalidArgumentError("alpha_sq is NaN");
+  if (alpha_sq < 0) return -1;
+  if (std::isinf(alpha_sq)) return max_level();
+  return CountAtMost(parts_, mpq_class(alpha_sq));
+}
+
+absl::StatusOr<int64_t> AlphaFamily::LevelForAlpha(double alpha) const {
+  if (std::isnan(alpha)) return absl::InvalidArgumentError("alpha is NaN");
+  if (alpha < 0) return absl::InvalidArgumentError(absl::StrCat("alpha is a radius and must be >= 0, got ", alpha));
+  if (std::isinf(alpha)) return max_level();
+  const mpq_class radius(alpha);
+  return CountAtMost(parts_, radius * radius);
+}
+
+absl::StatusOr<int64_t> AlphaFamily::LevelForRank(int64_t rank) const {
+  if (rank < 0 || rank > max_level()) {
+    return absl::OutOfRangeError(absl::StrCat("rank ", rank, " is outside 0..", max_level(),
+                                              " (the spectrum has ", max_level(), " values)"));
+  }
+  return rank;
+}
+
+int64_t AlphaFamily::RankLowerBound(double alpha_sq) const {
+  if (std::isnan(alpha_sq) || alpha_sq <= 0) return 1;
+  if (std::isinf(alpha_sq)) return max_level() + 1;
+  // Ranks below the answer are those with threshold < alpha_sq.
+  const mpq_class value(alpha_sq);
+  int64_t lo = 0, hi = max_level();
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo) / 2;
+    if (CompareRankWith(parts_, mid + 1, value) < 0) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  return lo + 1;
+}
+
+SimplexClass AlphaFamily::ClassifyTriangle(uint32_t t, int64_t level) const {
+  const uint32_t rank = parts_.ranks.tri_rank[t];
+  return rank != kNeverRank && level >= static_cast<int64_t>(rank) ? SimplexClass::kInterior : SimplexClass::kExterior;
+}
+
+SimplexClass AlphaFamily::ClassifyEdge(uint32_t e, int64_t level, ClassifyMode mode) const {
+  const AlphaRanks& r = parts_.ranks;
+  const uint32_t birth = EdgeBirthRank(r, e);
+  if (birth == kNeverRank || level < static_cast<int64_t>(birth)) return SimplexClass::kExterior;
+  if (r.edge_mu_low[e] == kNeverRank || level < static_cast<int64_t>(r.edge_mu_low[e])) {
+    return mode == ClassifyMode::kGeneral ? SimplexClass::kSingular : SimplexClass::kExterior;
+  }
+  if (r.edge_mu_high[e] == kNeverRank || level < static_cast<int64_t>(r.edge_mu_high[e])) return SimplexClass::kRegular;
+  return SimplexClass::kInterior;
+}
+
+SimplexClass AlphaFamily::ClassifyVertex(uint32_t v, int64_t level, ClassifyMode mode, VertexRule rule) const {
+  const AlphaRanks& r = parts_.ranks;
+  if (level < 0) return SimplexClass::kExterior;
+  const uint32_t tri_low = r.vertex_tri_low[v];
+  const uint32_t high = r.vertex_mu_high[v];
+  const bool has_triangle = tri_low != kNeverRank && level >= static_cast<int64_t>(tri_low);
+  const bool all_interior = high != kNeverRank && level >= static_cast<int64_t>(high);
+  if (mode == ClassifyMode::kRegularized && !has_triangle) return SimplexClass::kExterior;
+  if (rule == VertexRule::kReport) {
+    const uint32_t low = r.vertex_mu_low[v];
+    if (low == kNeverRank || level < static_cast<int64_t>(low)) return SimplexClass::kSingular;
+  } else if (!has_triangle) {
+    return SimplexClass::kSingular;
+  }
+  return all_interior ? SimplexClass::kInterior : SimplexClass::kRegular;
+}
+
+Classification AlphaFamily::ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const {
+  Classification c;
+  c.vertices.resize(parts_.points.size());
+  c.edges.resize(parts_.edges.size());
+  c.triangles.resize(parts_.triangles.size());
+  // Independent per simplex: the host's cores share the work (a served family answers Classify
+  // calls while other builds run, so the loops stay simple and static).
+  const int64_t nv = static_cast<int64_t>(c.vertices.size()), ne = static_cast<int64_t>(c.edges.size()),
+                nt = static_cast<int64_t>(c.triangles.size());
+#pragma omp parallel
+  {
+#pragma omp for schedule(static) nowait
+    for (int64_t v = 0; v < nv; ++v) c.vertices[v] = ClassifyVertex(static_cast<uint32_t>(v), level, mode, rule);
+#pragma omp for schedule(static) nowait
+    for (int64_t e = 0; e < ne; ++e) c.edges[e] = ClassifyEdge(static_cast<uint32_t>(e), level, mode);
+#pragma omp for schedule(static) nowait
+    for (int64_t t = 0; t < nt; ++t) c.triangles[t] = ClassifyTriangle(static_cast<uint32_t>(t), level);
+  }
+  return c;
+}
+
+absl::Span<const MasterEntry> AlphaFamily::MasterList(int64_t rank) const {
+  const AlphaRanks& r = parts_.ranks;
+  if (rank < 1 || rank > max_level()) return {};
+  const uint32_t b = r.master_begin[static_cast<size_t>(rank)], e = r.master_begin[static_cast<size_t>(rank) + 1];
+  return absl::MakeConstSpan(r.master.data() + b, e - b);
+}
+
+uint32_t AlphaFamily::Components(int64_t level) const {
+  if (level < 0) return 0;
+  return parts_.ranks.components[static_cast<size_t>(std::min(level, max_level()))];
+}
+
+uint32_t AlphaFamily::SolidComponents(int64_t level) const {
+  if (level < 0) return 0;
+  return parts_.ranks.solid_components[static_cast<size_t>(std::min(level, max_level()))];
+}
+
+std::optional<int64_t> AlphaFamily::OptimalLevelRegularized(uint32_t n) const {
+  if (!solid_level_) return std::nullopt;
+  // Solid components are not monotone in alpha: a scan from the level where every point is
+  // covered (O(K), once per query).
+  for (int64_t level = *solid_level_; level <= max_level(); ++level) {
+    if (parts_.ranks.solid_components[static_cast<size_t>(level)] <= n) return level;
+  }
+  return std::nullopt;
+}
+
+std::optional<int64_t> AlphaFamily::OptimalLevelGeneral(uint32_t n) const {
+  // Components never increase with alpha: binary search for the first level with at most n.
+  if (parts_.ranks.components.back() > n) return std::nullopt;
+  const auto it = std::partition_point(parts_.ranks.components.begin(), parts_.ranks.components.end(), [n](uint32_t c) { return c > n; });
+  return static_cast<int64_t>(it - parts_.ranks.components.begin());
+}
+
+ShapeComplex AlphaFamily::ComplexAt(int64_t level, ClassifyMode mode) const {
+  ShapeComplex complex;
+  complex.points = absl::MakeConstSpan(parts_.points);
+  for (uint32_t t = 0; t < parts_.triangles.size(); ++t) {
+    if (ClassifyTriangle(t, level) == SimplexClass::kInterior) complex.triangles.push_back(parts_.triangles[t]);
+  }
+  if (mode == ClassifyMode::kGeneral) {
+    for (uint32_t e = 0; e < parts_.edges.size(); ++e) {
+      if (ClassifyEdge(e, level, mode) == SimplexClass::kSingular) complex.singular_edges.push_back(parts_.edges[e]);
+    }
+    for (uint32_t v = 0; v < parts_.points.size(); ++v) {
+      if (parts_.representative[v] == v &&
+          ClassifyVertex(v, level, mode, VertexRule::kReport) == SimplexClass::kSingular) {
+        complex.isolated_points.push_back(v);
+      }
+    }
+  }
+  return complex;
+}
+
+namespace {
+template <typename T>
+size_t VectorBytes(const HostVector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+}  // namespace
+
+size_t AlphaFamily::HostBytes() const {
+  const AlphaRanks& r = parts_.ranks;
+  return sizeof(*this) + VectorBytes(parts_.points) + VectorBytes(parts_.representative) +
+         VectorBytes(parts_.triangles) + VectorBytes(parts_.edges) + VectorBytes(r.spectrum) +
+         VectorBytes(r.spectrum_simplex) + VectorBytes(r.tri_rank) + VectorBytes(r.edge_rho_rank) +
+         VectorBytes(r.edge_mu_low) + VectorBytes(r.edge_mu_high) + VectorBytes(r.edge_triangles) +
+         VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) + VectorBytes(r.vertex_tri_low) +
+         VectorBytes(r.master_begin) + VectorBytes(r.master) + VectorBytes(r.components) +
+         VectorBytes(r.solid_components);
+}
+
+}  // namespace galpha

@@ -1,0 +1,124 @@
+// AlphaFamily: the immutable, exact family of alpha shapes of one point set, and every query over
+// it (classification, spectrum, master list, components, optimal alpha, the shape as geometry).
+// Built by BuildAlphaFamily (gpu/alpha_engine.hpp); semantics in ../shared/DESIGN.md section 2.
+//
+// Thresholds are resolved to a *level*: the number of spectrum values <= the threshold, compared
+// exactly (level 0: alpha_sq in [0, spectrum[0]); level -1: a negative alpha_sq, where nothing is in).
+// The complex at level L is the complex at every alpha_sq in [spectrum[L-1], spectrum[L]).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/types/span.h"
+#include "core/family/alpha_ranks.hpp"
+#include "core/base/point.hpp"
+#include "core/geometry/shape.hpp"
+#include "core/base/stage_time.hpp"
+
+namespace galpha {
+
+enum class SimplexClass : uint8_t { kExterior = 0, kSingular = 1, kRegular = 2, kInterior = 3 };
+/// "EXTERIOR", "SINGULAR", "REGULAR", "INTERIOR".
+const char* SimplexClassName(SimplexClass c);
+
+/// GENERAL keeps singular simplices; REGULARIZED keeps only what bounds or fills triangles.
+enum class ClassifyMode { kGeneral, kRegularized };
+/// Vertex classes from incident edges (the report's rule) or from incident triangles (CGAL's).
+enum class VertexRule { kReport, kCgal };
+
+/// What a build measured.
+struct BuildReport {
+  std::string backend;
+  std::vector<StageTime> stage_times;
+  ComparisonCounts comparisons;
+  size_t peak_memory_bytes = 0;
+};
+
+/// The raw parts a family is assembled from (moved in by the builder).
+struct AlphaFamilyParts {
+  HostVector<Point2> points;
+  HostVector<uint32_t> representative;
+  uint32_t num_unique = 0;
+  HostVector<std::array<uint32_t, 3>> triangles;  // counter-clockwise, input indices
+  HostVector<std::array<uint32_t, 2>> edges;      // (smaller, larger) input index
+  AlphaRanks ranks;
+  BuildReport report;
+};
+
+/// Classes of every simplex at one level: vertices by input index, edges and triangles by id.
+struct Classification {
+  std::vector<SimplexClass> vertices;
+  std::vector<SimplexClass> edges;
+  std::vector<SimplexClass> triangles;
+};
+
+class AlphaFamily {
+ public:
+  /// Takes the parts (the engine computed the component curves among them).
+  explicit AlphaFamily(AlphaFamilyParts parts);
+
+  const HostVector<Point2>& points() const { return parts_.points; }
+  const HostVector<uint32_t>& representative() const { return parts_.representative; }
+  uint32_t num_unique() const { return parts_.num_unique; }
+  uint32_t num_duplicates() const { return static_cast<uint32_t>(parts_.points.size()) - parts_.num_unique; }
+  const HostVector<std::array<uint32_t, 3>>& triangles() const { return parts_.triangles; }
+  const HostVector<std::array<uint32_t, 2>>& edges() const { return parts_.edges; }
+  const AlphaRanks& ranks() const { return parts_.ranks; }
+  const BuildReport& report() const { return parts_.report; }
+
+  /// Host memory the family holds (its arrays' capacities), in bytes: what a cache charges for it.
+  size_t HostBytes() const;
+
+  /// The spectrum: nearest doubles of the distinct exact thresholds (alpha_sq), ascending.
+  const HostVector<double>& spectrum() const { return parts_.ranks.spectrum; }
+  int64_t max_level() const { return static_cast<int64_t>(parts_.ranks.spectrum.size()); }
+
+  /// Level of alpha_sq = `alpha_sq`, exactly. InvalidArgument for NaN.
+  absl::StatusOr<int64_t> LevelForAlphaSq(double alpha_sq) const;
+  /// Level of the radius `alpha` (alpha^2 compared exactly). InvalidArgument for NaN or alpha < 0.
+  absl::StatusOr<int64_t> LevelForAlpha(double alpha) const;
+  /// Level of a rank (the complex at spectrum[rank - 1]; rank 0: alpha = 0). OutOfRange beyond K.
+  absl::StatusOr<int64_t> LevelForRank(int64_t rank) const;
+  /// CGAL's alpha_lower_bound: the first rank whose exact threshold is >= alpha_sq (K + 1 when
+  /// none is).
+  int64_t RankLowerBound(double alpha_sq) const;
+
+  SimplexClass ClassifyTriangle(uint32_t t, int64_t level) const;
+  SimplexClass ClassifyEdge(uint32_t e, int64_t level, ClassifyMode mode) const;
+  /// `v` is an input index (a duplicate is classified as its first occurrence).
+  SimplexClass ClassifyVertex(uint32_t v, int64_t level, ClassifyMode mode, VertexRule rule) const;
+  Classification ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const;
+
+  /// Master-list entries whose interval has rank `rank` (1..K) as an end point; empty for any
+  /// other rank (rank 0 and kNeverRank are not end points of the list).
+  absl::Span<const MasterEntry> MasterList(int64_t rank) const;
+
+  /// Connected components of the complex at `level` (GENERAL: simplices sharing a vertex connect;
+  /// every vertex is in from level 0). O(1).
+  uint32_t Components(int64_t level) const;
+  /// CGAL's solid components: interior triangles connected through shared edges. O(1).
+  uint32_t SolidComponents(int64_t level) const;
+  /// Smallest level at which every point lies on an interior triangle (CGAL's find_alpha_solid);
+  /// nullopt when no level does (fewer than 3 points or collinear input).
+  std::optional<int64_t> SolidLevel() const { return solid_level_; }
+  /// Smallest level with at most `n` solid components and every point on a triangle (the sense of
+  /// CGAL's find_optimal_alpha, as documented; CGAL's implementation answers one rank later).
+  std::optional<int64_t> OptimalLevelRegularized(uint32_t n) const;
+  /// Smallest level with at most `n` components in the GENERAL sense (binary search).
+  std::optional<int64_t> OptimalLevelGeneral(uint32_t n) const;
+
+  /// The complex at `level` as geometry input: triangles in, singular edges and isolated points
+  /// (GENERAL mode only).
+  ShapeComplex ComplexAt(int64_t level, ClassifyMode mode) const;
+
+ private:
+  AlphaFamilyParts parts_;
+  std::optional<int64_t> solid_level_;
+};
+
+}  // namespace galpha

@@ -1,0 +1,92 @@
+// The rank tables of an alpha-shape family: what the engine computes after the triangulation (the
+// report's chapter 3: spectrum, ranks, intervals, master list). Plain data shared by the engine
+// backends and AlphaFamily. Semantics: ../shared/DESIGN.md section 2.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/base/hd.hpp"
+#include "core/base/host_vector.hpp"
+
+namespace galpha {
+
+/// Rank r in 1..K names spectrum[r - 1]; rank 0 is alpha = 0. kNeverRank marks an interval end that
+/// is never reached (infinity): a hull edge never becomes interior, a triangle of collinear points
+/// is never born.
+constexpr uint32_t kNeverRank = 0xFFFFFFFFu;
+
+enum class SimplexKind : uint8_t { kVertex = 0, kEdge = 1, kTriangle = 2 };
+/// Which end point of a simplex's intervals a master-list entry stands for.
+enum class Endpoint : uint8_t { kRho = 0, kMuLow = 1, kMuHigh = 2 };
+
+/// One master-list entry, packed in 64 bits so that the engine's array is the list itself and its
+/// natural order is the order within a rank: kind (vertex < edge < triangle), then id, then end
+/// point.
+class MasterEntry {
+ public:
+  MasterEntry() = default;
+  GALPHA_HD MasterEntry(uint32_t id, SimplexKind kind, Endpoint endpoint)
+      : packed_((static_cast<uint64_t>(kind) << 34) | (static_cast<uint64_t>(id) << 2) |
+                static_cast<uint64_t>(endpoint)) {}
+  /// Vertex: input index; edge: edge id; triangle: triangle id.
+  GALPHA_HD uint32_t id() const { return static_cast<uint32_t>(packed_ >> 2); }
+  GALPHA_HD SimplexKind kind() const { return static_cast<SimplexKind>(packed_ >> 34); }
+  GALPHA_HD Endpoint endpoint() const { return static_cast<Endpoint>(packed_ & 3); }
+  GALPHA_HD uint64_t packed() const { return packed_; }
+
+ private:
+  uint64_t packed_ = 0;
+};
+static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "master entries are packed");
+
+/// How the exact order of the spectrum was decided, by comparison path (DESIGN.md section 3).
+struct ComparisonCounts {
+  /// Neighbouring pairs of the approximately sorted spectrum ordered by their certified keys alone.
+  uint64_t filter = 0;
+  /// Exact comparisons in bounded expansion arithmetic (the device's path on CUDA).
+  uint64_t bounded_exact = 0;
+  /// Exact comparisons that needed GMP rationals on the CPU (unbounded): the "CPU fallback".
+  uint64_t cpu_fallback = 0;
+};
+
+struct AlphaRanks {
+  /// The spectrum: the doubles nearest to the distinct exact births of triangles and unattached
+  /// edges, strictly increasing in exact value (nearest doubles of neighbours may coincide only
+  /// when both round to the same double).
+  HostVector<double> spectrum;
+  /// For every rank r, a simplex whose exact rho^2 is spectrum[r - 1]: id < #triangles is a
+  /// triangle, otherwise the edge id - #triangles. Used to compare user thresholds exactly.
+  HostVector<uint32_t> spectrum_simplex;
+
+  HostVector<uint32_t> tri_rank;  ///< per triangle: rank of rho (its birth)
+  /// Per edge: rank of rho when unattached, 0 when attached; mu-low (first incident triangle in,
+  /// kNeverRank without triangles); mu-high (both in; kNeverRank on the hull).
+  HostVector<uint32_t> edge_rho_rank, edge_mu_low, edge_mu_high;
+  /// Per edge: its incident triangles (-1 where there is none).
+  HostVector<std::array<int32_t, 2>> edge_triangles;
+  /// Per input index (duplicates repeat their representative's values): mu-low (first incident
+  /// edge in), mu-high (every incident edge interior; kNeverRank on the hull), and the rank at
+  /// which the first incident triangle is in (CGAL's vertex rule and the regularized mode).
+  HostVector<uint32_t> vertex_mu_low, vertex_mu_high, vertex_tri_low;
+
+  /// Master list in CSR form: entries of rank r are master[master_begin[r] .. master_begin[r+1]),
+  /// r in 0..K (rank 0 is always empty), ordered vertex < edge < triangle, then by id and end point.
+  HostVector<uint32_t> master_begin;
+  HostVector<MasterEntry> master;
+
+  /// Per level 0..K: connected components of the complex (GENERAL: simplices sharing a vertex
+  /// connect; every distinct point is in from level 0) and solid components (interior triangles
+  /// connected through shared edges, CGAL's number_of_solid_components).
+  HostVector<uint32_t> components, solid_components;
+
+  ComparisonCounts comparisons;
+};
+
+/// Birth rank of an edge: rho when unattached, else mu-low (its first incident triangle).
+inline uint32_t EdgeBirthRank(const AlphaRanks& r, uint32_t e) {
+  return r.edge_rho_rank[e] != 0 ? r.edge_rho_rank[e] : r.edge_mu_low[e];
+}
+
+}  // namespace galpha

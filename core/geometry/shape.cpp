@@ -1,0 +1,486 @@
+#include "core/geometry/shape.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "core/exact/predicates.hpp"
+#include "core/base/status_macros.hpp"
+
+namespace galpha {
+namespace {
+
+// ---- Validation -------------------------------------------------------------------------------
+
+absl::Status CheckIndex(uint32_t index, size_t num_points, absl::string_view what, size_t item) {
+  if (index >= num_points) {
+    return absl::InvalidArgumentError(absl::StrCat(what, " ", item, " names point index ", index,
+                                                   ", but there are only ", num_points, " points"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status ValidateComplex(const ShapeComplex& complex) {
+  const size_t n = complex.points.size();
+  for (size_t t = 0; t < complex.triangles.size(); ++t) {
+    const auto& tri = complex.triangles[t];
+    for (uint32_t v : tri) GALPHA_RETURN_IF_ERROR(CheckIndex(v, n, "triangle", t));
+    // Ring orientation and the turn at pinch vertices rely on strictly ccw triangles.
+    if (Orient2dSign(complex.points[tri[0]], complex.points[tri[1]], complex.points[tri[2]]) <= 0) {
+      return absl::InvalidArgumentError(absl::StrCat("triangle ", t, " (", tri[0], ", ", tri[1],
+                                                     ", ", tri[2],
+                                                     ") is not strictly counter-clockwise"));
+    }
+  }
+  for (size_t e = 0; e < complex.singular_edges.size(); ++e) {
+    const auto& edge = complex.singular_edges[e];
+    for (uint32_t v : edge) GALPHA_RETURN_IF_ERROR(CheckIndex(v, n, "singular edge", e));
+    if (edge[0] == edge[1]) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("singular edge ", e, " joins point ", edge[0], " to itself"));
+    }
+  }
+  for (size_t i = 0; i < complex.isolated_points.size(); ++i) {
+    GALPHA_RETURN_IF_ERROR(CheckIndex(complex.isolated_points[i], n, "isolated point", i));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status OverlapError(absl::string_view detail) {
+  return absl::InvalidArgumentError(
+      absl::StrCat("the triangles overlap (they are not a subset of one triangulation): ", detail));
+}
+
+// ---- Topology -----------------------------------------------------------------------------------
+
+// Union-find with path halving and union by size, over triangle indices.
+class UnionFind {
+ public:
+  explicit UnionFind(size_t n) : parent_(n), size_(n, 1) {
+    for (size_t i = 0; i < n; ++i) parent_[i] = static_cast<uint32_t>(i);
+  }
+  uint32_t Find(uint32_t x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void Union(uint32_t a, uint32_t b) {
+    a = Find(a);
+    b = Find(b);
+    if (a == b) return;
+    if (size_[a] < size_[b]) std::swap(a, b);
+    parent_[b] = a;
+    size_[a] += size_[b];
+  }
+
+ private:
+  std::vector<uint32_t> parent_;
+  std::vector<uint32_t> size_;
+};
+
+// A directed edge, keyed (from << 32 | to) so that sorting groups the edges leaving each vertex.
+struct DirectedEdge {
+  uint64_t key;
+  uint32_t triangle;
+};
+uint64_t EdgeKey(uint32_t from, uint32_t to) { return (uint64_t{from} << 32) | to; }
+uint32_t EdgeFrom(uint64_t key) { return static_cast<uint32_t>(key >> 32); }
+uint32_t EdgeTo(uint64_t key) { return static_cast<uint32_t>(key); }
+
+// A boundary edge: its twin is not in the set, so its piece lies on its left only.
+struct BoundaryEdge {
+  uint32_t from;
+  uint32_t to;
+  uint32_t piece;
+};
+
+// Whether, around `v` and counter-clockwise from the direction of `ref` (excluded), the direction
+// of `a` comes before that of `b`. Exact: the half-plane left of v->ref (the direction opposite
+// to ref included) comes first, and within a half-plane two directions are less than pi apart, so
+// one orientation orders them. No two edges leave `v` in one direction (triangles do not overlap).
+bool CcwBefore(Point2 v, Point2 ref, Point2 a, Point2 b) {
+  const int half_a = Orient2dSign(v, ref, a) >= 0 ? 0 : 1;
+  const int half_b = Orient2dSign(v, ref, b) >= 0 ? 0 : 1;
+  if (half_a != half_b) return half_a < half_b;
+  return Orient2dSign(v, a, b) > 0;
+}
+
+// A closed walk along boundary edges; `vertices` are the edges' sources in order.
+struct Ring {
+  uint32_t piece;
+  std::vector<uint32_t> vertices;
+};
+
+// Traces every boundary edge into rings. Entering vertex v along u->v, the walk leaves along the
+// boundary edge of the same piece that comes first counter-clockwise from v->u: the ring then hugs
+// one complement region of the piece at v (see shape.hpp for why that makes rings simple). Other
+// pieces' edges are ignored there: a ring of one piece may touch another piece, never itself.
+absl::StatusOr<std::vector<Ring>> TraceRings(absl::Span<const Point2> points,
+                                             const std::vector<BoundaryEdge>& boundary) {
+  std::vector<Ring> rings;
+  std::vector<bool> used(boundary.size(), false);
+  auto out_range = [&boundary](uint32_t v) {
+    const auto lo = std::lower_bound(boundary.begin(), boundary.end(), v,
+                                     [](const BoundaryEdge& e, uint32_t x) { return e.from < x; });
+    auto hi = lo;
+    while (hi != boundary.end() && hi->from == v) ++hi;
+    return std::make_pair(static_cast<size_t>(lo - boundary.begin()),
+                          static_cast<size_t>(hi - boundary.begin()));
+  };
+  for (size_t start = 0; start < boundary.size(); ++start) {
+    if (used[start]) continue;
+    Ring ring{boundary[start].piece, {}};
+    size_t cur = start;
+    while (true) {
+      used[cur] = true;
+      ring.vertices.push_back(boundary[cur].from);
+      const uint32_t u = boundary[cur].from;
+      const uint32_t v = boundary[cur].to;
+      const auto [lo, hi] = out_range(v);
+      size_t next = boundary.size();
+      for (size_t e = lo; e < hi; ++e) {
+        if (boundary[e].piece != ring.piece) continue;
+        if (next == boundary.size() ||
+            CcwBefore(points[v], points[u], points[boundary[e].to], points[boundary[next].to])) {
+          next = e;
+        }
+      }
+      if (next == boundary.size()) {
+        return OverlapError(absl::StrCat("the boundary stops at point ", v));
+      }
+      if (next == start) break;
+      if (used[next]) {
+        return OverlapError(absl::StrCat("the boundary does not close into rings at point ", v));
+      }
+      cur = next;
+    }
+    rings.push_back(std::move(ring));
+  }
+  return rings;
+}
+
+// +1 when the simple ring is counter-clockwise, -1 when clockwise: the turn at its lowest vertex
+// in (x, y) order is convex, so its exact orientation is the ring's. 0 when the ring doubles back
+// there, which simple rings of non-overlapping triangles never do.
+int RingOrientation(absl::Span<const Point2> points, const std::vector<uint32_t>& ring) {
+  const size_t m = ring.size();
+  size_t low = 0;
+  for (size_t i = 1; i < m; ++i) {
+    if (LexLess(points[ring[i]], points[ring[low]])) low = i;
+  }
+  return Orient2dSign(points[ring[(low + m - 1) % m]], points[ring[low]],
+                      points[ring[(low + 1) % m]]);
+}
+
+void RotateToSmallest(std::vector<uint32_t>& ring) {
+  std::rotate(ring.begin(), std::min_element(ring.begin(), ring.end()), ring.end());
+}
+
+// ---- Writers ------------------------------------------------------------------------------------
+
+// Appends a coordinate with 17 significant digits, which reads back as the same double.
+void AppendNumber(std::string& out, double value) {
+  char buffer[32];
+  const int len = std::snprintf(buffer, sizeof buffer, "%.17g", value);
+  out.append(buffer, static_cast<size_t>(len));
+}
+
+void AppendWktPoint(std::string& out, const Point2& p) {
+  AppendNumber(out, p.x);
+  out += ' ';
+  AppendNumber(out, p.y);
+}
+
+void AppendJsonPoint(std::string& out, const Point2& p) {
+  out += '[';
+  AppendNumber(out, p.x);
+  out += ',';
+  AppendNumber(out, p.y);
+  out += ']';
+}
+
+// Appends a ring, closed by repeating its first vertex (both formats ask for that).
+template <typename AppendPoint>
+void AppendRing(std::string& out, const std::vector<uint32_t>& ring,
+                absl::Span<const Point2> points, const char* open, const char* separator,
+                const char* close, AppendPoint append_point) {
+  out += open;
+  for (size_t i = 0; i <= ring.size(); ++i) {
+    if (i > 0) out += separator;
+    append_point(out, points[ring[i % ring.size()]]);
+  }
+  out += close;
+}
+
+}  // namespace
+
+absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
+  GALPHA_RETURN_IF_ERROR(ValidateComplex(complex));
+  const absl::Span<const Point2> points = complex.points;
+  const auto& triangles = complex.triangles;
+  ShapeGeometry shape;
+
+  for (const auto& tri : triangles) {
+    shape.area += 0.5 * Orient2dApprox(points[tri[0]], points[tri[1]], points[tri[2]]);
+  }
+
+  std::vector<DirectedEdge> edges;
+  edges.reserve(3 * triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      edges.push_back(
+          {EdgeKey(triangles[t][k], triangles[t][(k + 1) % 3]), static_cast<uint32_t>(t)});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
+    return a.key < b.key || (a.key == b.key && a.triangle < b.triangle);
+  });
+  for (size_t i = 1; i < edges.size(); ++i) {
+    if (edges[i].key == edges[i - 1].key) {
+      return OverlapError(absl::StrCat("triangles ", edges[i - 1].triangle, " and ",
+                                       edges[i].triangle, " both hold the directed edge ",
+                                       EdgeFrom(edges[i].key), " -> ", EdgeTo(edges[i].key)));
+    }
+  }
+  auto find_edge = [&edges](uint64_t key) -> const DirectedEdge* {
+    const auto it = std::lower_bound(edges.begin(), edges.end(), key,
+                                     [](const DirectedEdge& e, uint64_t k) { return e.key < k; });
+    return it != edges.end() && it->key == key ? &*it : nullptr;
+  };
+
+  // Pieces: triangles joined through shared edges. A piece's interior is connected and distinct
+  // pieces' interiors are disjoint (they meet at most at vertices), so each is one polygon.
+  UnionFind pieces(triangles.size());
+  std::vector<bool> has_twin(edges.size(), false);
+  for (size_t i = 0; i < edges.size(); ++i) {
+    if (const DirectedEdge* twin =
+            find_edge(EdgeKey(EdgeTo(edges[i].key), EdgeFrom(edges[i].key)))) {
+      has_twin[i] = true;
+      pieces.Union(edges[i].triangle, twin->triangle);
+    }
+  }
+  std::vector<BoundaryEdge> boundary;  // sorted by (from, to), as `edges` is
+  for (size_t i = 0; i < edges.size(); ++i) {
+    if (has_twin[i]) continue;
+    boundary.push_back(
+        {EdgeFrom(edges[i].key), EdgeTo(edges[i].key), pieces.Find(edges[i].triangle)});
+  }
+
+  GALPHA_ASSIGN_OR_RETURN(std::vector<Ring> rings, TraceRings(points, boundary));
+
+  // Each piece has exactly one counter-clockwise ring (around the unbounded complement region) and
+  // one clockwise ring per bounded complement region (its holes). Anything else means overlap.
+  constexpr uint32_t kNoPolygon = UINT32_MAX;
+  std::vector<uint32_t> polygon_of_piece(triangles.size(), kNoPolygon);
+  std::vector<int> orientation(rings.size());
+  for (size_t r = 0; r < rings.size(); ++r) {
+    Ring& ring = rings[r];
+    orientation[r] = RingOrientation(points, ring.vertices);
+    if (orientation[r] == 0) {
+      return OverlapError(
+          absl::StrCat("a boundary ring doubles back near point ", ring.vertices[0]));
+    }
+    if (orientation[r] < 0) continue;
+    if (polygon_of_piece[ring.piece] != kNoPolygon) {
+      return OverlapError(
+          absl::StrCat("the piece of triangle ", ring.piece, " has two outer rings"));
+    }
+    polygon_of_piece[ring.piece] = static_cast<uint32_t>(shape.polygons.size());
+    RotateToSmallest(ring.vertices);
+    shape.polygons.push_back({std::move(ring.vertices), {}});
+  }
+  for (size_t r = 0; r < rings.size(); ++r) {
+    if (orientation[r] > 0) continue;
+    const uint32_t polygon = polygon_of_piece[rings[r].piece];
+    if (polygon == kNoPolygon) {
+      return OverlapError(
+          absl::StrCat("the piece of triangle ", rings[r].piece, " has no outer ring"));
+    }
+    RotateToSmallest(rings[r].vertices);
+    shape.polygons[polygon].holes.push_back(std::move(rings[r].vertices));
+  }
+  for (ShapePolygon& polygon : shape.polygons) {
+    std::sort(polygon.holes.begin(), polygon.holes.end());
+  }
+  std::sort(shape.polygons.begin(), shape.polygons.end(),
+            [](const ShapePolygon& a, const ShapePolygon& b) { return a.outer < b.outer; });
+
+  for (const auto& edge : complex.singular_edges) {
+    shape.singular_edges.push_back({std::min(edge[0], edge[1]), std::max(edge[0], edge[1])});
+  }
+  std::sort(shape.singular_edges.begin(), shape.singular_edges.end());
+  shape.singular_edges.erase(std::unique(shape.singular_edges.begin(), shape.singular_edges.end()),
+                             shape.singular_edges.end());
+  shape.isolated_points = complex.isolated_points;
+  std::sort(shape.isolated_points.begin(), shape.isolated_points.end());
+  shape.isolated_points.erase(
+      std::unique(shape.isolated_points.begin(), shape.isolated_points.end()),
+      shape.isolated_points.end());
+  return shape;
+}
+
+std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> points) {
+  if (shape.polygons.empty() && shape.singular_edges.empty() && shape.isolated_points.empty()) {
+    return "GEOMETRYCOLLECTION EMPTY";
+  }
+  std::string out = "GEOMETRYCOLLECTION (";
+  bool first_part = true;
+  auto begin_part = [&](const char* name) {
+    if (!first_part) out += ", ";
+    first_part = false;
+    out += name;
+  };
+  if (!shape.polygons.empty()) {
+    begin_part("MULTIPOLYGON (");
+    for (size_t p = 0; p < shape.polygons.size(); ++p) {
+      out += p > 0 ? ", (" : "(";
+      AppendRing(out, shape.polygons[p].outer, points, "(", ", ", ")", AppendWktPoint);
+      for (const auto& hole : shape.polygons[p].holes) {
+        AppendRing(out, hole, points, ", (", ", ", ")", AppendWktPoint);
+      }
+      out += ')';
+    }
+    out += ')';
+  }
+  if (!shape.singular_edges.empty()) {
+    begin_part("MULTILINESTRING (");
+    for (size_t e = 0; e < shape.singular_edges.size(); ++e) {
+      out += e > 0 ? ", (" : "(";
+      AppendWktPoint(out, points[shape.singular_edges[e][0]]);
+      out += ", ";
+      AppendWktPoint(out, points[shape.singular_edges[e][1]]);
+      out += ')';
+    }
+    out += ')';
+  }
+  if (!shape.isolated_points.empty()) {
+    begin_part("MULTIPOINT (");
+    for (size_t i = 0; i < shape.isolated_points.size(); ++i) {
+      out += i > 0 ? ", (" : "(";
+      AppendWktPoint(out, points[shape.isolated_points[i]]);
+      out += ')';
+    }
+    out += ')';
+  }
+  out += ')';
+  return out;
+}
+
+std::string ShapeToGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points) {
+  std::string out = "{\"type\":\"FeatureCollection\",\"features\":[";
+  bool first_feature = true;
+  auto begin_feature = [&](const char* kind, const char* type, bool with_area) {
+    if (!first_feature) out += ',';
+    first_feature = false;
+    absl::StrAppend(&out, "{\"type\":\"Feature\",\"properties\":{\"kind\":\"", kind, "\"");
+    if (with_area) {
+      out += ",\"area\":";
+      AppendNumber(out, shape.area);
+    }
+    absl::StrAppend(&out, "},\"geometry\":{\"type\":\"", type, "\",\"coordinates\":[");
+  };
+  const char* kEndFeature = "]}}";
+  if (!shape.polygons.empty()) {
+    begin_feature("polygons", "MultiPolygon", true);
+    for (size_t p = 0; p < shape.polygons.size(); ++p) {
+      out += p > 0 ? ",[" : "[";
+      AppendRing(out, shape.polygons[p].outer, points, "[", ",", "]", AppendJsonPoint);
+      for (const auto& hole : shape.polygons[p].holes) {
+        AppendRing(out, hole, points, ",[", ",", "]", AppendJsonPoint);
+      }
+      out += ']';
+    }
+    out += kEndFeature;
+  }
+  if (!shape.singular_edges.empty()) {
+    begin_feature("singular_edges", "MultiLineString", false);
+    for (size_t e = 0; e < shape.singular_edges.size(); ++e) {
+      out += e > 0 ? ",[" : "[";
+      AppendJsonPoint(out, points[shape.singular_edges[e][0]]);
+      out += ',';
+      AppendJsonPoint(out, points[shape.singular_edges[e][1]]);
+      out += ']';
+    }
+    out += kEndFeature;
+  }
+  if (!shape.isolated_points.empty()) {
+    begin_feature("isolated_points", "MultiPoint", false);
+    for (size_t i = 0; i < shape.isolated_points.size(); ++i) {
+      if (i > 0) out += ',';
+      AppendJsonPoint(out, points[shape.isolated_points[i]]);
+    }
+    out += kEndFeature;
+  }
+  out += "]}";
+  return out;
+}
+
+std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points) {
+  double min_x = 0.0, max_x = 0.0, min_y = 0.0, max_y = 0.0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Point2& p = points[i];
+    min_x = i == 0 ? p.x : std::min(min_x, p.x);
+    max_x = i == 0 ? p.x : std::max(max_x, p.x);
+    min_y = i == 0 ? p.y : std::min(min_y, p.y);
+    max_y = i == 0 ? p.y : std::max(max_y, p.y);
+  }
+  // A degenerate box (one point, or points on a line) still gets a visible square around it.
+  double extent = std::max(max_x - min_x, max_y - min_y);
+  if (!(extent > 0.0)) extent = 1.0;
+  const double margin = 0.05 * extent;
+  // Sizes in user units, as fractions of the drawing (renderers differ on non-scaling strokes).
+  const double radius = 0.004 * extent;
+  // Local coordinates: x from the left edge, y from the top edge (SVG's y grows downwards).
+  char buffer[64];
+  auto local = [&](const Point2& p) {
+    const int len = std::snprintf(buffer, sizeof buffer, "%.9g %.9g", p.x - min_x, max_y - p.y);
+    return std::string(buffer, static_cast<size_t>(len));
+  };
+  auto number = [&](double value) {
+    const int len = std::snprintf(buffer, sizeof buffer, "%.9g", value);
+    return std::string(buffer, static_cast<size_t>(len));
+  };
+  const std::string stroke = number(0.0015 * extent);
+  const std::string width = number(max_x - min_x + 2 * margin);
+  const std::string height = number(max_y - min_y + 2 * margin);
+  std::string out =
+      absl::StrCat("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"", number(-margin), " ",
+                   number(-margin), " ", width, " ", height, "\" width=\"800\" height=\"",
+                   number(800.0 * (max_y - min_y + 2 * margin) / (max_x - min_x + 2 * margin)),
+                   "\" preserveAspectRatio=\"xMidYMid meet\">\n",
+                   "<g fill=\"#4a90d9\" fill-opacity=\"0.6\" stroke=\"#1f4e79\" stroke-width=\"",
+                   stroke, "\" stroke-linejoin=\"round\" fill-rule=\"evenodd\">\n");
+  auto append_ring = [&](const std::vector<uint32_t>& ring) {
+    for (size_t i = 0; i < ring.size(); ++i)
+      absl::StrAppend(&out, i == 0 ? "M" : " L", local(points[ring[i]]));
+    out += " Z";
+  };
+  for (const ShapePolygon& polygon : shape.polygons) {
+    out += "<path d=\"";
+    append_ring(polygon.outer);
+    for (const auto& hole : polygon.holes) {
+      out += ' ';
+      append_ring(hole);
+    }
+    out += "\"/>\n";
+  }
+  absl::StrAppend(&out, "</g>\n<g stroke=\"#c0392b\" stroke-width=\"", number(2 * radius / 3),
+                  "\" stroke-linecap=\"round\">\n");
+  for (const auto& edge : shape.singular_edges) {
+    const Point2& a = points[edge[0]];
+    const Point2& b = points[edge[1]];
+    absl::StrAppend(&out, "<line x1=\"", number(a.x - min_x), "\" y1=\"", number(max_y - a.y),
+                    "\" x2=\"", number(b.x - min_x), "\" y2=\"", number(max_y - b.y), "\"/>\n");
+  }
+  out += "</g>\n<g fill=\"#2c3e50\">\n";
+  for (uint32_t v : shape.isolated_points) {
+    absl::StrAppend(&out, "<circle cx=\"", number(points[v].x - min_x), "\" cy=\"",
+                    number(max_y - points[v].y), "\" r=\"", number(radius), "\"/>\n");
+  }
+  out += "</g>\n</svg>\n";
+  return out;
+}
+
+}  // namespace galpha

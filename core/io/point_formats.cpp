@@ -1,0 +1,267 @@
+#include "core/io/point_formats.hpp"
+
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <system_error>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "core/io/point_io.hpp"
+#include "nlohmann/json.hpp"
+
+namespace galpha {
+namespace {
+
+// Up to the first two fields of a line; returns how many it found (0, 1 or 2). A line with a
+// comma, semicolon or tab is split on that delimiter and keeps its empty fields ("1,,2" has an
+// empty y, not y = 2); otherwise runs of spaces separate the fields.
+int FirstTwoFields(absl::string_view line, absl::string_view* x, absl::string_view* y) {
+  const size_t delimiter_at = line.find_first_of(",;\t");
+  std::vector<absl::string_view> fields;
+  if (delimiter_at != absl::string_view::npos) {
+    fields = absl::StrSplit(line, line[delimiter_at]);
+  } else {
+    fields = absl::StrSplit(line, ' ', absl::SkipWhitespace());
+  }
+  const int found = fields.size() >= 2 ? 2 : static_cast<int>(fields.size());
+  if (found >= 1) *x = absl::StripAsciiWhitespace(fields[0]);
+  if (found >= 2) *y = absl::StripAsciiWhitespace(fields[1]);
+  return found;
+}
+
+bool ParseCoordinate(absl::string_view field, double* value) {
+  // SimpleAtod also takes a leading '+', "inf" and "nan": the validation layer rejects the last two
+  // with the point's index.
+  return absl::SimpleAtod(field, value);
+}
+
+// The value of `key` in a .npy header dictionary ("{'descr': '<f8', 'fortran_order': False,
+// 'shape': (3, 2), }"), up to the next top-level comma or the closing brace.
+bool NpyHeaderValue(absl::string_view header, absl::string_view key, absl::string_view* value) {
+  const std::string quoted = absl::StrCat("'", key, "'");
+  size_t at = header.find(quoted);
+  if (at == absl::string_view::npos) return false;
+  at = header.find(':', at + quoted.size());
+  if (at == absl::string_view::npos) return false;
+  size_t end = at + 1;
+  int depth = 0;
+  for (; end < header.size(); ++end) {
+    const char c = header[end];
+    if (c == '(') ++depth;
+    if (c == ')') --depth;
+    if (depth == 0 && (c == ',' || c == '}')) break;
+  }
+  *value = absl::StripAsciiWhitespace(header.substr(at + 1, end - at - 1));
+  return true;
+}
+
+uint64_t LittleEndianUint(absl::string_view bytes, size_t offset, size_t width) {
+  uint64_t v = 0;
+  for (size_t i = 0; i < width; ++i) v |= uint64_t{static_cast<unsigned char>(bytes[offset + i])} << (8 * i);
+  return v;
+}
+
+double DoubleAt(absl::string_view bytes, size_t offset, bool little_endian) {
+  uint64_t bits = 0;
+  for (size_t i = 0; i < 8; ++i) {
+    const size_t byte = little_endian ? i : 7 - i;
+    bits |= uint64_t{static_cast<unsigned char>(bytes[offset + i])} << (8 * byte);
+  }
+  double v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
+// Appends the points of one GeoJSON object (geometry, feature or collection) at `where`.
+absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string& where, const std::string& source,
+                                 std::vector<Point2>* points) {
+  auto error = [&](const std::string& what) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": ", where.empty() ? "the document" : where, ": ", what));
+  };
+  auto position = [&](const nlohmann::json& p, const std::string& at) -> absl::Status {
+    if (!p.is_array() || p.size() < 2 || p.size() > 3 || !p[0].is_number() || !p[1].is_number()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(source, ": ", at, ": a position must be an array of two or three numbers"));
+    }
+    points->push_back({p[0].get<double>(), p[1].get<double>()});
+    return absl::OkStatus();
+  };
+  if (!object.is_object() || !object.contains("type") || !object["type"].is_string()) {
+    return error("expected a GeoJSON object with a \"type\"");
+  }
+  const std::string type = object["type"].get<std::string>();
+  const std::string prefix = where.empty() ? "" : absl::StrCat(where, ".");
+  if (type == "FeatureCollection" || type == "GeometryCollection") {
+    const char* member = type == "FeatureCollection" ? "features" : "geometries";
+    if (!object.contains(member) || !object[member].is_array()) {
+      return error(absl::StrCat(type, " without a \"", member, "\" array"));
+    }
+    const nlohmann::json& items = object[member];
+    for (size_t i = 0; i < items.size(); ++i) {
+      const absl::Status status =
+          AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points);
+      if (!status.ok()) return status;
+    }
+    return absl::OkStatus();
+  }
+  if (type == "Feature") {
+    if (!object.contains("geometry")) return error("Feature without a \"geometry\"");
+    if (object["geometry"].is_null()) return absl::OkStatus();  // an unlocated feature: no point
+    return AppendGeoJsonPoints(object["geometry"], absl::StrCat(prefix, "geometry"), source, points);
+  }
+  if (type == "Point" || type == "MultiPoint") {
+    if (!object.contains("coordinates")) return error(absl::StrCat(type, " without \"coordinates\""));
+    const nlohmann::json& coordinates = object["coordinates"];
+    if (type == "Point") return position(coordinates, absl::StrCat(prefix, "coordinates"));
+    if (!coordinates.is_array()) return error("MultiPoint coordinates must be an array of positions");
+    for (size_t i = 0; i < coordinates.size(); ++i) {
+      const absl::Status status = position(coordinates[i], absl::StrCat(prefix, "coordinates[", i, "]"));
+      if (!status.ok()) return status;
+    }
+    return absl::OkStatus();
+  }
+  return error(absl::StrCat("a ", type, " is not a point geometry (Point or MultiPoint)"));
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source) {
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(text.begin(), text.end());
+  } catch (const nlohmann::json::parse_error& e) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": not valid JSON at byte ", e.byte));
+  } catch (const nlohmann::json::exception& e) {
+    // A number beyond the range of a double (1e400) is valid JSON that nlohmann refuses with
+    // out_of_range; found by the point-format fuzzer.
+    return absl::InvalidArgumentError(absl::StrCat(source, ": JSON the parser cannot represent (", e.what(), ")"));
+  }
+  std::vector<Point2> points;
+  const absl::Status status = AppendGeoJsonPoints(document, "", source, &points);
+  if (!status.ok()) return status;
+  return points;
+}
+
+absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source) {
+  std::vector<Point2> points;
+  bool first_line = true;
+  size_t line_number = 0;
+  for (absl::string_view line : absl::StrSplit(text, '\n')) {
+    ++line_number;
+    line = absl::StripAsciiWhitespace(line);  // also drops the '\r' of CRLF files
+    if (line.empty() || line[0] == '#') continue;
+    absl::string_view xs, ys;
+    Point2 p;
+    const int fields = FirstTwoFields(line, &xs, &ys);
+    const bool x_numeric = fields >= 1 && ParseCoordinate(xs, &p.x);
+    const bool y_numeric = fields >= 2 && ParseCoordinate(ys, &p.y);
+    // A header names its columns: one of its first two fields is not a number.
+    const bool header = first_line && ((fields >= 1 && !x_numeric) || (fields >= 2 && !y_numeric));
+    first_line = false;
+    if (header) continue;
+    if (!x_numeric || !y_numeric) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          source, ":", line_number, ": expected x and y as the first two numeric fields, got '",
+          line.substr(0, 80), "'"));
+    }
+    points.push_back(p);
+  }
+  return points;
+}
+
+absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, const std::string& source) {
+  constexpr absl::string_view kMagic("\x93NUMPY", 6);
+  if (bytes.size() < 10 || bytes.substr(0, 6) != kMagic) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": not a .npy file (no \\x93NUMPY magic)"));
+  }
+  const int major = static_cast<unsigned char>(bytes[6]);
+  if (major < 1 || major > 3) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": unsupported .npy format version ", major));
+  }
+  const size_t length_width = major == 1 ? 2 : 4;
+  if (bytes.size() < 8 + length_width) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": truncated .npy header"));
+  }
+  const uint64_t header_length = LittleEndianUint(bytes, 8, length_width);
+  const uint64_t data_offset = 8 + length_width + header_length;
+  if (data_offset > bytes.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": truncated .npy header"));
+  }
+  const absl::string_view header = bytes.substr(8 + length_width, header_length);
+  absl::string_view descr, fortran, shape;
+  if (!NpyHeaderValue(header, "descr", &descr) || !NpyHeaderValue(header, "fortran_order", &fortran) ||
+      !NpyHeaderValue(header, "shape", &shape)) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": malformed .npy header '", header, "'"));
+  }
+  bool little_endian;
+  if (descr == "'<f8'" || descr == "'=f8'") {
+    little_endian = true;
+  } else if (descr == "'>f8'") {
+    little_endian = false;
+  } else {
+    return absl::InvalidArgumentError(
+        absl::StrCat(source, ": the array's dtype is ", descr, "; float64 ('<f8' or '>f8') is needed"));
+  }
+  if (fortran != "False" && fortran != "True") {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": malformed fortran_order ", fortran));
+  }
+  const bool fortran_order = fortran == "True";
+  // shape: "(N, 2)"
+  uint64_t n = 0, columns = 0;
+  {
+    absl::string_view inside = absl::StripAsciiWhitespace(shape);
+    if (!absl::ConsumePrefix(&inside, "(") || !absl::ConsumeSuffix(&inside, ")")) {
+      return absl::InvalidArgumentError(absl::StrCat(source, ": malformed .npy shape ", shape));
+    }
+    std::vector<absl::string_view> dims = absl::StrSplit(inside, ',', absl::SkipWhitespace());
+    if (dims.size() != 2 || !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[0]), &n) ||
+        !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[1]), &columns) || columns != 2) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(source, ": the array's shape is ", shape, "; (N, 2) is needed"));
+    }
+  }
+  const uint64_t data_bytes = bytes.size() - data_offset;
+  if (n > data_bytes / 16 || data_bytes != n * 16) {
+    return absl::DataLossError(absl::StrCat(source, ": the .npy header announces ", n, " points (",
+                                            n * 16, " bytes) but the file holds ", data_bytes,
+                                            " bytes of data"));
+  }
+  std::vector<Point2> points(n);
+  for (uint64_t i = 0; i < n; ++i) {
+    const uint64_t x_at = fortran_order ? i : 2 * i, y_at = fortran_order ? n + i : 2 * i + 1;
+    points[i].x = DoubleAt(bytes, data_offset + 8 * x_at, little_endian);
+    points[i].y = DoubleAt(bytes, data_offset + 8 * y_at, little_endian);
+  }
+  return points;
+}
+
+absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
+  const std::string extension = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    return absl::NotFoundError(absl::StrCat("points file '", path, "' does not exist"));
+  }
+  // A directory opens as a stream on Linux and fails only when read (by exception).
+  if (std::filesystem::is_directory(path, error)) {
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' is a directory"));
+  }
+  if (extension == ".bin") return ReadPointsBin(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open points file '", path, "'"));
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return absl::DataLossError(absl::StrCat("cannot read points file '", path, "'"));
+  if (extension == ".npy") return ParsePointsNpy(bytes, path);
+  if (extension == ".geojson" || extension == ".json") return ParsePointsGeoJson(bytes, path);
+  return ParsePointsText(bytes, path);
+}
+
+}  // namespace galpha

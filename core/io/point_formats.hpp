@@ -1,0 +1,47 @@
+// Point files in the formats users bring (DESIGN.md section 5), next to the raw `.bin` format of
+// point_io.hpp: delimited text (CSV, TSV, whitespace) and NumPy `.npy` arrays. Nothing is
+// deduplicated or validated for finiteness here: the engine's validation layer does that, naming
+// the point's index (its row among the data rows).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+#include "core/base/point.hpp"
+
+namespace galpha {
+
+/// Parses delimited text: one point per line, x and y the first two fields, fields separated by
+/// the line's first comma, semicolon or tab (empty fields count), or else by runs of spaces. Empty
+/// lines and lines starting with '#' are skipped. The first non-skipped line is a header when one
+/// of its first two fields is not a number. Further fields are ignored. O(size).
+///
+/// Errors: InvalidArgument naming `source` and the 1-based line number of a line that has fewer
+/// than two fields or whose x or y is not a number.
+absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source);
+
+/// Parses the bytes of a NumPy `.npy` file (format versions 1-3) holding a float64 array of shape
+/// (N, 2), in C or Fortran order, either byte order. O(N).
+///
+/// Errors naming `source`: InvalidArgument for a missing magic string, a malformed header, another
+/// dtype or shape; DataLoss when the data is shorter or longer than the header says.
+absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, const std::string& source);
+
+/// Parses GeoJSON (RFC 7946): a FeatureCollection, Feature, GeometryCollection, Point or
+/// MultiPoint; points are taken in document order, the third coordinate (altitude) ignored, features
+/// with a null geometry (unlocated) skipped. O(size).
+///
+/// Errors: InvalidArgument naming `source` and, for content, the place in the document (as
+/// `features[3].geometry`): invalid JSON (with its byte offset), a geometry that is not a Point or
+/// MultiPoint (other geometries are refused rather than skipped, so that no data is lost
+/// silently), a position that is not an array of two or three numbers.
+absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source);
+
+/// Reads a point file, choosing the format by extension: `.bin` (raw, point_io.hpp), `.npy`,
+/// `.geojson` or `.json`, anything else as delimited text. Errors name the file: NotFound when it does not exist, the
+/// errno-derived code when it cannot be read, and the parsers' errors above.
+absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path);
+
+}  // namespace galpha

@@ -1,0 +1,50 @@
+// The seam between BuildAlphaFamily() and the two backends that run the one templated build
+// (triangulation, delaunay_impl.cuh, then the alpha pipeline, alpha_impl.cuh, on the triangulation
+// where it lies). Plain C++ and std types only.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "core/family/alpha_ranks.hpp"
+#include "core/base/host_vector.hpp"
+#include "core/base/point.hpp"
+#include "core/base/stage_time.hpp"
+
+namespace galpha::detail {
+
+/// A triangulation in host memory, borrowed: what the host's exact repairs read.
+struct AlphaInput {
+  const Point2* points = nullptr;
+  const std::array<uint32_t, 3>* triangles = nullptr;
+  uint32_t num_triangles = 0;  // simplex ids below this are triangles, the rest edges
+  const std::array<uint32_t, 2>* edges = nullptr;
+};
+
+/// What a backend's build hands back; BuildAlphaFamily() moves it into an AlphaFamily.
+struct FamilyOutput {
+  HostVector<uint32_t> representative;
+  uint32_t num_unique = 0;
+  HostVector<std::array<uint32_t, 3>> triangles;
+  HostVector<std::array<uint32_t, 2>> edges;
+  AlphaRanks ranks;
+  std::vector<StageTime> stage_times;
+  size_t peak_memory_bytes = 0;
+};
+
+/// Called between the build's phases: after the triangulation, `after_triangulation` runs (it
+/// reports progress and may throw EngineError kCancelled to stop the build).
+struct BuildHooks {
+  std::function<void()> after_triangulation;
+};
+
+/// Builds the family of `n` finite points on the OpenMP backend. Throws EngineError (or a
+/// Thrust/std exception) on failure.
+void BuildFamilyOnCpu(const Point2* points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out);
+
+/// The same on the CUDA backend, on `stream` (a cudaStream_t, or nullptr for one of its own).
+void BuildFamilyOnCuda(const Point2* points, uint32_t n, void* stream, const BuildHooks& hooks, FamilyOutput* out);
+
+}  // namespace galpha::detail

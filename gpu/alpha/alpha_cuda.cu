@@ -1,0 +1,21 @@
+// The CUDA instantiation of the family build: one stream, stream-ordered memory.
+#include <cuda_runtime.h>
+
+#include "gpu/alpha/alpha_backend.hpp"
+#include "gpu/alpha/alpha_impl.cuh"
+#include "gpu/system/cuda_system.cuh"
+
+namespace galpha::detail {
+
+void BuildFamilyOnCuda(const Point2* points, uint32_t n, void* stream, const BuildHooks& hooks, FamilyOutput* out) {
+  if (stream != nullptr) {
+    CudaSystem system(static_cast<cudaStream_t>(stream));
+    RunFamilyBuild(system, points, n, hooks, out);
+    return;
+  }
+  OwnedStream owned;
+  CudaSystem system(owned.get());
+  RunFamilyBuild(system, points, n, hooks, out);
+}
+
+}  // namespace galpha::detail

@@ -1,0 +1,30 @@
+// BuildAlphaFamily: points in, the exact family of alpha shapes out (core/alpha_family.hpp). Runs
+// the triangulation and the alpha pipeline on one backend (CUDA on one stream, or OpenMP).
+#pragma once
+
+#include <functional>
+#include <string_view>
+
+#include "absl/status/statusor.h"
+#include "absl/types/span.h"
+#include "core/family/alpha_family.hpp"
+#include "core/base/point.hpp"
+#include "gpu/triangulation/delaunay.hpp"
+
+namespace galpha {
+
+struct BuildOptions {
+  Backend backend = Backend::kAuto;
+  /// CUDA stream (a cudaStream_t) to run on; nullptr: one of the engine's own.
+  void* cuda_stream = nullptr;
+  /// Called after each phase ("triangulation", "alpha", "components") with the fraction done.
+  std::function<void(std::string_view phase, double fraction)> progress;
+  /// Polled between phases; when it answers true the build stops, frees what it holds and returns
+  /// Cancelled (a server passes its client's cancellation and deadline here).
+  std::function<bool()> cancelled;
+};
+
+/// Builds the family. Errors as Triangulate's (gpu/delaunay.hpp), and Cancelled.
+absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options = {});
+
+}  // namespace galpha

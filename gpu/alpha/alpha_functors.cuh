@@ -1,0 +1,444 @@
+// Host/device functors of the alpha pipeline (alpha_impl.cuh): edge topology, radii and attachment,
+// the exact repair of the approximately sorted spectrum, intervals and the master list. Every
+// decision is exact: keys only order values whose certified intervals are disjoint.
+#pragma once
+
+#include <cstdint>
+
+#include "core/family/alpha_ranks.hpp"
+#include "core/exact/attachment.hpp"
+#include "core/base/hd.hpp"
+#include "core/base/point.hpp"
+#include "core/exact/radius.hpp"
+#include "gpu/system/atomic_increment.cuh"
+
+namespace galpha::detail {
+
+struct TriIdx {
+  uint32_t v[3];
+};
+struct TriNb {
+  int32_t n[3];
+};
+struct EdgeIdx {
+  uint32_t v[2];
+};
+struct EdgeTris {
+  int32_t t[2];
+};
+
+/// Atomic minimum / maximum on both backends (CUDA atomics; GCC builtins on the host).
+GALPHA_HD inline void AtomicMinU32(uint32_t* p, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  atomicMin(p, v);
+#else
+  uint32_t old = __atomic_load_n(p, __ATOMIC_RELAXED);
+  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  }
+#endif
+}
+GALPHA_HD inline void AtomicMaxU32(uint32_t* p, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  atomicMax(p, v);
+#else
+  uint32_t old = __atomic_load_n(p, __ATOMIC_RELAXED);
+  while (v > old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  }
+#endif
+}
+
+/// The triangulation's ownership rule (delaunay_output.cuh): triangle t owns its local edge k (from
+/// vertex k to k+1, opposite vertex k+2) when the indices increase along it or on the hull. Writes
+/// each owned edge's incident triangles.
+struct WriteEdgeTriangles {
+  const TriIdx* tri;
+  const TriNb* nbr;
+  const uint32_t* edge_begin;
+  EdgeTris* edge_tris;
+  GALPHA_HD void operator()(uint32_t t) const {
+    uint32_t slot = edge_begin[t];
+    for (int k = 0; k < 3; ++k) {
+      const int32_t across = nbr[t].n[(k + 2) % 3];
+      if (!(tri[t].v[k] < tri[t].v[(k + 1) % 3] || across < 0)) continue;
+      edge_tris[slot++] = EdgeTris{{static_cast<int32_t>(t), across}};
+    }
+  }
+};
+
+/// The points of simplex `id` (id < num_tri: a triangle; else the edge id - num_tri) into p;
+/// returns the number of points.
+struct SimplexPoints {
+  const Point2* points;
+  const TriIdx* tri;
+  const EdgeIdx* edges;
+  uint32_t num_tri;
+  GALPHA_HD int operator()(uint32_t id, Point2* p) const {
+    if (id < num_tri) {
+      for (int k = 0; k < 3; ++k) p[k] = points[tri[id].v[k]];
+      return 3;
+    }
+    const EdgeIdx e = edges[id - num_tri];
+    p[0] = points[e.v[0]];
+    p[1] = points[e.v[1]];
+    return 2;
+  }
+};
+
+/// Radius key of every triangle (entries 0..T) and edge (entries T..T+E); an attached edge gets
+/// kAttachedKey (it has no spectrum value of its own). Flags uncertified keys.
+constexpr uint64_t kAttachedKey = ~uint64_t{0} - 1;  // below kInfiniteRadiusKey, above every radius
+struct ComputeRadiusKeys {
+  SimplexPoints simplex;
+  const EdgeTris* edge_tris;
+  uint64_t* keys;
+  uint8_t* uncertified;
+  GALPHA_HD void operator()(uint32_t id) const {
+    Point2 p[3];
+    const int n = simplex(id, p);
+    if (n == 2) {
+      const EdgeTris et = edge_tris[id - simplex.num_tri];
+      for (int side = 0; side < 2; ++side) {
+        const int32_t t = et.t[side];
+        if (t < 0) continue;
+        // The triangle's vertex off the edge.
+        uint32_t r = simplex.tri[t].v[0];
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t v = simplex.tri[t].v[k];
+          const Point2 q = simplex.points[v];
+          if (!(q == p[0]) && !(q == p[1])) r = v;
+        }
+        if (InDiametralCircleSign(p[0], p[1], simplex.points[r]) > 0) {
+          keys[id] = kAttachedKey;
+          uncertified[id] = 0;
+          return;
+        }
+      }
+    }
+    const RadiusSqApprox a = ApproxRadiusSq(p, n);
+    keys[id] = a.key;
+    uncertified[id] = a.certified ? 0 : 1;
+  }
+};
+
+/// Whether a spectrum entry (by key) takes part in the spectrum: born at a finite radius and not
+/// an attached edge.
+struct IsSpectrumEntry {
+  const uint64_t* keys;
+  const uint8_t* uncertified;
+  bool want_uncertified;
+  GALPHA_HD bool operator()(uint32_t id) const {
+    if (keys[id] == kAttachedKey || keys[id] == kInfiniteRadiusKey) return false;
+    return (uncertified[id] != 0) == want_uncertified;
+  }
+};
+
+/// link[i]: entries i and i+1 of the sorted spectrum may be tied or out of order.
+struct MayTieWithNext {
+  const uint64_t* sorted_keys;
+  GALPHA_HD uint8_t operator()(uint32_t i) const {
+    return RadiusKeysMayTie(sorted_keys[i], sorted_keys[i + 1]) ? 1 : 0;
+  }
+};
+
+/// A position where a run of entries linked to each other starts (a run of one is a settled value).
+struct IsRunStart {
+  const uint8_t* link;  // n - 1 links
+  GALPHA_HD bool operator()(uint32_t i) const { return i == 0 || link[i - 1] == 0; }
+};
+
+/// Largest run sorted in place by one thread; longer runs go to the host's three-way quicksort.
+constexpr uint32_t kMaxDeviceRun = 16;
+
+/// Sorts one short run of linked entries exactly (insertion sort with the bounded comparison) and
+/// marks where a new exact value starts. A run that the bounded arithmetic cannot decide, or that
+/// is too long, is left for the host (`needs_host`).
+struct RepairRun {
+  SimplexPoints simplex;
+  const uint32_t* run_begin;
+  const uint32_t* run_end;
+  uint32_t* ids;          // sorted spectrum entries
+  uint8_t* new_value;     // 1 where an exact value starts
+  uint8_t* needs_host;    // per run
+  uint32_t* comparisons;  // per run: bounded comparisons done
+  GALPHA_HD void operator()(uint32_t r) const {
+    const uint32_t b = run_begin[r], e = run_end[r];
+    needs_host[r] = 0;
+    comparisons[r] = 0;
+    if (e - b == 1) return;  // a settled value: new_value stays 1
+    if (e - b > kMaxDeviceRun) {
+      needs_host[r] = 1;
+      return;
+    }
+    uint32_t local[kMaxDeviceRun];
+    for (uint32_t i = b; i < e; ++i) local[i - b] = ids[i];
+    const uint32_t n = e - b;
+    uint32_t count = 0;
+    Point2 pa[3], pb[3];
+    for (uint32_t i = 1; i < n; ++i) {
+      const uint32_t x = local[i];
+      const int nx = simplex(x, pa);
+      uint32_t j = i;
+      while (j > 0) {
+        const int ny = simplex(local[j - 1], pb);
+        const int c = CompareRadiusSqBounded(pb, ny, pa, nx);
+        ++count;
+        if (c == kRadiusUndecided) {
+          needs_host[r] = 1;
+          comparisons[r] = count;
+          return;
+        }
+        if (c <= 0) break;
+        local[j] = local[j - 1];
+        --j;
+      }
+      local[j] = x;
+    }
+    new_value[b] = 1;
+    for (uint32_t i = 1; i < n; ++i) {
+      const int na = simplex(local[i - 1], pa);
+      const int nb = simplex(local[i], pb);
+      const int c = CompareRadiusSqBounded(pa, na, pb, nb);
+      ++count;
+      if (c == kRadiusUndecided) {
+        needs_host[r] = 1;
+        comparisons[r] = count;
+        return;
+      }
+      new_value[b + i] = c != 0 ? 1 : 0;
+    }
+    for (uint32_t i = 0; i < n; ++i) ids[b + i] = local[i];
+    comparisons[r] = count;
+  }
+};
+
+/// 1 where a run starts (for numbering runs by a scan).
+struct RunStartAsU32 {
+  const uint8_t* link;
+  GALPHA_HD uint32_t operator()(uint32_t i) const { return i == 0 || link[i - 1] == 0 ? 1u : 0u; }
+};
+
+/// Clears settled[r] unless entry i and its run's first both have rho^2 exactly equal to one
+/// double (ExactDoubleRadiusSq): then the whole run is one exact value. Only runs still needing
+/// repair (settled starts as needs_host) are checked; concurrent writes only ever write 0.
+struct CheckRunOfOneDouble {
+  SimplexPoints simplex;
+  const uint32_t* ids;
+  const uint32_t* run_of;  // inclusive scan of run starts: run index + 1
+  const uint32_t* run_begin;
+  uint8_t* settled;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t r = run_of[i] - 1;
+    if (!settled[r]) return;
+    Point2 p[3], q[3];
+    const int n = simplex(ids[i], p), m = simplex(ids[run_begin[r]], q);
+    double a, b;
+    if (!ExactDoubleRadiusSq(p, n, &a) || !ExactDoubleRadiusSq(q, m, &b) || a != b) settled[r] = 0;
+  }
+};
+
+/// In a settled run, only the first entry starts a value.
+struct SettleRunOfOneDouble {
+  const uint32_t* run_of;
+  const uint32_t* run_begin;
+  const uint8_t* settled;
+  uint8_t* new_value;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t r = run_of[i] - 1;
+    if (settled[r]) new_value[i] = i == run_begin[r] ? 1 : 0;
+  }
+};
+
+/// Equalities a settled run proved: one per entry after its first.
+struct SettledComparisons {
+  const uint32_t* run_begin;
+  const uint8_t* settled;
+  GALPHA_HD uint64_t operator()(uint32_t r) const { return settled[r] ? run_begin[r + 1] - run_begin[r] - 1 : 0; }
+};
+
+struct StillNeedsHost {
+  const uint8_t* needs_host;
+  const uint8_t* settled;
+  GALPHA_HD uint8_t operator()(uint32_t r) const { return needs_host[r] && !settled[r] ? 1 : 0; }
+};
+
+struct ToU32 {
+  GALPHA_HD uint32_t operator()(uint8_t v) const { return v; }
+};
+
+/// Scatters each sorted entry's rank to its simplex and records one simplex per rank.
+struct ScatterRanks {
+  const uint32_t* ids;
+  const uint32_t* rank;  // inclusive scan of new_value: 1..K
+  const uint8_t* new_value;
+  uint32_t num_tri;
+  uint32_t* tri_rank;
+  uint32_t* edge_rho_rank;
+  uint32_t* spectrum_simplex;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t id = ids[i];
+    if (id < num_tri) {
+      tri_rank[id] = rank[i];
+    } else {
+      edge_rho_rank[id - num_tri] = rank[i];
+    }
+    if (new_value[i]) spectrum_simplex[rank[i] - 1] = id;
+  }
+};
+
+/// The nearest double of each spectrum value (bounded arithmetic; failures flagged for the host).
+struct NearestSpectrumValue {
+  SimplexPoints simplex;
+  const uint32_t* spectrum_simplex;
+  double* spectrum;
+  uint8_t* needs_host;
+  GALPHA_HD void operator()(uint32_t r) const {
+    Point2 p[3];
+    const int n = simplex(spectrum_simplex[r], p);
+    needs_host[r] = NearestRadiusSqFast(p, n, &spectrum[r]) || NearestRadiusSqBounded(p, n, &spectrum[r]) ? 0 : 1;
+  }
+};
+
+/// Edge intervals (report Table 2.1) and their contribution to their vertices' intervals.
+struct EdgeIntervals {
+  const EdgeIdx* edges;
+  const EdgeTris* edge_tris;
+  const uint32_t* tri_rank;
+  uint32_t* edge_rho_rank;  // 0 written for attached edges
+  uint32_t* edge_mu_low;
+  uint32_t* edge_mu_high;
+  const uint64_t* keys;     // kAttachedKey marks attached edges
+  uint32_t num_tri;
+  uint32_t* vertex_mu_low;
+  uint32_t* vertex_mu_high;
+  uint32_t* vertex_tri_low;
+  GALPHA_HD void operator()(uint32_t e) const {
+    const EdgeTris et = edge_tris[e];
+    const uint32_t r0 = et.t[0] >= 0 ? tri_rank[et.t[0]] : kNeverRank;
+    const uint32_t r1 = et.t[1] >= 0 ? tri_rank[et.t[1]] : kNeverRank;
+    const uint32_t lo = r0 < r1 ? r0 : r1;
+    const bool interior = et.t[0] >= 0 && et.t[1] >= 0;
+    const uint32_t hi = interior ? (r0 > r1 ? r0 : r1) : kNeverRank;
+    if (keys[num_tri + e] == kAttachedKey) edge_rho_rank[e] = 0;
+    edge_mu_low[e] = lo;
+    edge_mu_high[e] = hi;
+    const uint32_t birth = edge_rho_rank[e] != 0 ? edge_rho_rank[e] : lo;
+    for (int k = 0; k < 2; ++k) {
+      const uint32_t v = edges[e].v[k];
+      AtomicMinU32(&vertex_mu_low[v], birth);
+      AtomicMaxU32(&vertex_mu_high[v], hi);
+      AtomicMinU32(&vertex_tri_low[v], lo);
+    }
+  }
+};
+
+/// Vertices without edges (a single point) are never regular or interior; duplicates repeat their
+/// representative's intervals.
+struct FinishVertexIntervals {
+  const uint32_t* representative;
+  uint32_t* vertex_mu_low;
+  uint32_t* vertex_mu_high;
+  uint32_t* vertex_tri_low;
+  GALPHA_HD void operator()(uint32_t v) const {
+    const uint32_t rep = representative[v];
+    if (rep != v) {
+      // Representatives are finished by the same pass; read theirs raw and apply the same rule.
+      const uint32_t low = vertex_mu_low[rep];
+      vertex_mu_low[v] = low;
+      vertex_mu_high[v] = low == kNeverRank ? kNeverRank : vertex_mu_high[rep];
+      vertex_tri_low[v] = vertex_tri_low[rep];
+      return;
+    }
+    if (vertex_mu_low[v] == kNeverRank) vertex_mu_high[v] = kNeverRank;
+  }
+};
+
+/// A master-list entry packed so that its natural order is the order within a rank: vertex < edge
+/// < triangle, then id, then end point.
+GALPHA_HD inline uint64_t PackMasterEntry(SimplexKind kind, uint32_t id, Endpoint endpoint) {
+  return MasterEntry(id, kind, endpoint).packed();
+}
+
+/// Visits every master-list end point of every simplex (ranks 1..K; 0 and kNeverRank are not end
+/// points in the list): Visitor(rank, packed entry). Items 0..n-1 are vertices, then edges, then
+/// triangles.
+struct MasterEndpoints {
+  const uint32_t* representative;
+  const uint32_t* vertex_mu_low;
+  const uint32_t* vertex_mu_high;
+  const uint32_t* edge_rho;
+  const uint32_t* edge_mu_low;
+  const uint32_t* edge_mu_high;
+  const uint32_t* tri_rank;
+  uint32_t num_points;
+  uint32_t num_edges;
+
+  template <class Visitor>
+  GALPHA_HD void Visit(uint32_t item, Visitor& visit) const {
+    auto real = [](uint32_t r) { return r != 0 && r != kNeverRank; };
+    if (item < num_points) {
+      const uint32_t v = item;
+      if (representative[v] != v) return;
+      if (real(vertex_mu_low[v])) visit(vertex_mu_low[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuLow));
+      if (real(vertex_mu_high[v])) visit(vertex_mu_high[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuHigh));
+      return;
+    }
+    item -= num_points;
+    if (item < num_edges) {
+      const uint32_t e = item;
+      if (real(edge_rho[e])) visit(edge_rho[e], PackMasterEntry(SimplexKind::kEdge, e, Endpoint::kRho));
+      if (real(edge_mu_low[e])) visit(edge_mu_low[e], PackMasterEntry(SimplexKind::kEdge, e, Endpoint::kMuLow));
+      if (real(edge_mu_high[e])) visit(edge_mu_high[e], PackMasterEntry(SimplexKind::kEdge, e, Endpoint::kMuHigh));
+      return;
+    }
+    const uint32_t t = item - num_edges;
+    if (real(tri_rank[t])) visit(tri_rank[t], PackMasterEntry(SimplexKind::kTriangle, t, Endpoint::kRho));
+  }
+};
+
+/// Pass 1: entries per rank.
+struct CountMasterEntries {
+  MasterEndpoints endpoints;
+  uint32_t* count;
+  GALPHA_HD void operator()(uint32_t item) const {
+    auto visit = [this](uint32_t rank, uint64_t) { AtomicIncrement(&count[rank]); };
+    endpoints.Visit(item, visit);
+  }
+};
+
+/// Pass 2: each entry into a free slot of its rank's segment (order fixed by pass 3).
+struct FillMasterEntries {
+  MasterEndpoints endpoints;
+  uint32_t* cursor;
+  uint64_t* entries;
+  GALPHA_HD void operator()(uint32_t item) const {
+    auto visit = [this](uint32_t rank, uint64_t packed) { entries[AtomicIncrement(&cursor[rank])] = packed; };
+    endpoints.Visit(item, visit);
+  }
+};
+
+/// Largest rank segment sorted by one thread; longer ones (exact ties: a grid's congruent
+/// triangles) are sorted by a Thrust call each.
+constexpr uint32_t kMaxThreadSegment = 64;
+
+/// Pass 3: sorts every short rank segment (insertion sort); flags the long ones.
+struct SortMasterSegment {
+  const uint32_t* begin;
+  uint64_t* entries;
+  uint8_t* long_segment;
+  GALPHA_HD void operator()(uint32_t rank) const {
+    const uint32_t b = begin[rank], e = begin[rank + 1];
+    long_segment[rank] = e - b > kMaxThreadSegment ? 1 : 0;
+    if (e - b > kMaxThreadSegment) return;
+    for (uint32_t i = b + 1; i < e; ++i) {
+      const uint64_t x = entries[i];
+      uint32_t j = i;
+      while (j > b && entries[j - 1] > x) {
+        entries[j] = entries[j - 1];
+        --j;
+      }
+      entries[j] = x;
+    }
+  }
+};
+
+}  // namespace galpha::detail

@@ -1,0 +1,200 @@
+#include "gpu/alpha/alpha_host_repair.hpp"
+
+#include <algorithm>
+#include <utility>
+
+#include "core/exact/radius.hpp"
+#include "core/exact/radius_rational.hpp"
+
+namespace galpha::detail {
+namespace {
+
+/// Exact comparison of two spectrum entries by simplex id, counting the path it took.
+class ExactComparator {
+ public:
+  explicit ExactComparator(const AlphaInput& in) : in_(in) {}
+
+  int operator()(uint32_t a, uint32_t b) {
+    Point2 pa[3], pb[3];
+    const int na = Points(a, pa), nb = Points(b, pb);
+    const int c = CompareRadiusSqBounded(pa, na, pb, nb);
+    if (c != kRadiusUndecided) {
+      ++counts_.bounded_exact;
+      return c;
+    }
+    ++counts_.cpu_fallback;
+    return CompareRadiusSqRational(pa, na, pb, nb);
+  }
+
+  int Points(uint32_t id, Point2* p) const {
+    if (id < in_.num_triangles) {
+      for (int k = 0; k < 3; ++k) p[k] = in_.points[in_.triangles[id][k]];
+      return 3;
+    }
+    const std::array<uint32_t, 2>& e = in_.edges[id - in_.num_triangles];
+    p[0] = in_.points[e[0]];
+    p[1] = in_.points[e[1]];
+    return 2;
+  }
+
+  const ComparisonCounts& counts() const { return counts_; }
+
+ private:
+  const AlphaInput& in_;
+  ComparisonCounts counts_;
+};
+
+/// Three-way quicksort (Dijkstra's partition): equal values gather around the pivot and are
+/// never compared again, so exact ties cost one comparison each. Marks value starts.
+void SortThreeWay(uint32_t* a, size_t n, uint8_t* new_value, ExactComparator& cmp) {
+  while (n > 0) {
+    if (n == 1) {
+      new_value[0] = 1;
+      return;
+    }
+    const uint32_t pivot = a[n / 2];
+    size_t lt = 0, i = 0, gt = n;
+    while (i < gt) {
+      const int c = cmp(a[i], pivot);
+      if (c < 0) {
+        std::swap(a[lt++], a[i++]);
+      } else if (c > 0) {
+        std::swap(a[i], a[--gt]);
+      } else {
+        ++i;
+      }
+    }
+    new_value[lt] = 1;
+    for (size_t k = lt + 1; k < gt; ++k) new_value[k] = 0;
+    // Recurse into the smaller side, loop on the larger (bounded stack depth).
+    if (lt < n - gt) {
+      SortThreeWay(a, lt, new_value, cmp);
+      a += gt;
+      new_value += gt;
+      n -= gt;
+    } else {
+      SortThreeWay(a + gt, n - gt, new_value + gt, cmp);
+      n = lt;
+    }
+  }
+}
+
+void Add(ComparisonCounts* total, const ComparisonCounts& part) {
+  total->filter += part.filter;
+  total->bounded_exact += part.bounded_exact;
+  total->cpu_fallback += part.cpu_fallback;
+}
+
+}  // namespace
+
+namespace {
+
+/// Repairs a run whose every value is exactly a double (ExactDoubleRadiusSq: small integer
+/// coordinates, grids): ordered and tied by those doubles alone. False, with nothing changed,
+/// when some value is not.
+bool RepairRunOfExactDoubles(ExactComparator& cmp, uint32_t* ids, uint32_t n, uint8_t* new_value,
+                             ComparisonCounts* counts) {
+  std::vector<std::pair<double, uint32_t>> values(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    Point2 p[3];
+    const int k = cmp.Points(ids[i], p);
+    if (!ExactDoubleRadiusSq(p, k, &values[i].first)) return false;
+    values[i].second = ids[i];
+  }
+  // Congruent simplices (a grid's triangles) are all equal: one pass proves it.
+  const bool all_equal = std::all_of(values.begin(), values.end(), [&](const auto& v) { return v.first == values[0].first; });
+  if (!all_equal) std::sort(values.begin(), values.end());
+  for (uint32_t i = 0; i < n; ++i) {
+    ids[i] = values[i].second;
+    new_value[i] = i == 0 || values[i].first != values[i - 1].first ? 1 : 0;
+  }
+  counts->bounded_exact += n - 1;
+  return true;
+}
+
+}  // namespace
+
+void RepairRunsOnHost(const AlphaInput& in, const std::vector<std::array<uint32_t, 2>>& runs, uint32_t* ids,
+                      uint8_t* new_value, ComparisonCounts* counts) {
+  const long num_runs = static_cast<long>(runs.size());
+#pragma omp parallel
+  {
+    ExactComparator cmp(in);
+    ComparisonCounts shortcut;
+#pragma omp for schedule(dynamic, 1)
+    for (long r = 0; r < num_runs; ++r) {
+      const uint32_t b = runs[r][0], e = runs[r][1];
+      if (!RepairRunOfExactDoubles(cmp, ids + b, e - b, new_value + b, &shortcut)) {
+        SortThreeWay(ids + b, e - b, new_value + b, cmp);
+      }
+    }
+#pragma omp critical
+    Add(counts, shortcut);
+#pragma omp critical
+    Add(counts, cmp.counts());
+  }
+}
+
+void MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, std::vector<uint32_t>* ids,
+                            std::vector<uint8_t>* new_value, ComparisonCounts* counts) {
+  ExactComparator cmp(in);
+  std::vector<uint8_t> odd_new(odd.size());
+  SortThreeWay(odd.data(), odd.size(), odd_new.data(), cmp);
+  // Value groups of the main order: starts of exact values.
+  std::vector<uint32_t> starts;
+  for (uint32_t i = 0; i < ids->size(); ++i) {
+    if ((*new_value)[i]) starts.push_back(i);
+  }
+  std::vector<uint32_t> merged_ids;
+  std::vector<uint8_t> merged_new;
+  merged_ids.reserve(ids->size() + odd.size());
+  merged_new.reserve(ids->size() + odd.size());
+  size_t next_main = 0;  // next main entry to copy
+  size_t lo_group = 0;   // groups before lo_group are below the current odd value
+  for (size_t i = 0; i < odd.size(); ++i) {
+    // First group whose value is >= odd[i] (exact binary search over group representatives).
+    size_t lo = lo_group, hi = starts.size();
+    int at = 1;
+    while (lo < hi) {
+      const size_t mid = lo + (hi - lo) / 2;
+      const int c = cmp((*ids)[starts[mid]], odd[i]);
+      if (c < 0) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    if (lo < starts.size()) at = cmp((*ids)[starts[lo]], odd[i]);
+    // Copy main entries of the groups below, and of an equal group (the odd entry joins it).
+    const size_t copy_end = lo < starts.size() ? (at == 0 ? (lo + 1 < starts.size() ? starts[lo + 1] : ids->size()) : starts[lo])
+                                               : ids->size();
+    for (; next_main < copy_end; ++next_main) {
+      merged_ids.push_back((*ids)[next_main]);
+      merged_new.push_back((*new_value)[next_main]);
+    }
+    const bool joins_main = lo < starts.size() && at == 0;
+    merged_ids.push_back(odd[i]);
+    merged_new.push_back(joins_main ? 0 : odd_new[i]);
+    lo_group = joins_main ? lo + 1 : lo;
+  }
+  for (; next_main < ids->size(); ++next_main) {
+    merged_ids.push_back((*ids)[next_main]);
+    merged_new.push_back((*new_value)[next_main]);
+  }
+  *ids = std::move(merged_ids);
+  *new_value = std::move(merged_new);
+  Add(counts, cmp.counts());
+}
+
+void NearestValuesOnHost(const AlphaInput& in, const std::vector<uint8_t>& needs, AlphaRanks* out) {
+  ExactComparator points(in);
+  for (size_t r = 0; r < needs.size(); ++r) {
+    if (!needs[r]) continue;
+    Point2 p[3];
+    const int n = points.Points(out->spectrum_simplex[r], p);
+    const std::optional<mpq_class> value = RadiusSqRational(p, n);
+    out->spectrum[r] = value ? NearestDouble(*value) : HUGE_VAL;
+  }
+}
+
+}  // namespace galpha::detail

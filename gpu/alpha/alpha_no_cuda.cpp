@@ -1,0 +1,11 @@
+// Builds without nvcc have no CUDA backend: this is the family build's answer there.
+#include "gpu/alpha/alpha_backend.hpp"
+#include "gpu/system/backend.hpp"
+
+namespace galpha::detail {
+
+void BuildFamilyOnCuda(const Point2*, uint32_t, void*, const BuildHooks&, FamilyOutput*) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
+}  // namespace galpha::detail

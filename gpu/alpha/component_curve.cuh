@@ -1,0 +1,310 @@
+// Component curves by Borůvka's minimum spanning forest, one source for both backends.
+//
+// The number of components of a graph whose edges appear at ranks is, at every rank L, the number
+// of nodes present minus the number of edges of rank <= L in a minimum spanning forest (Kruskal's
+// algorithm adds exactly the edges that join two components, in rank order). Borůvka's algorithm
+// finds that forest in parallel rounds: every component picks its lightest outgoing edge (weights
+// made unique by the edge id), hooks to the other side, and pointer jumping flattens the hooks.
+// A union-find in rank order computes the same curve, but sequentially and with a cache miss per
+// step, which made it the slowest stage of a GPU build.
+#pragma once
+
+#include <thrust/copy.h>
+#include <thrust/count.h>
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/scan.h>
+#include <thrust/sequence.h>
+#include <thrust/transform.h>
+
+#include <cstdint>
+
+#include "core/family/alpha_ranks.hpp"
+#include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/system/atomic_increment.cuh"
+#include "gpu/triangulation/delaunay_backend.hpp"
+#include "gpu/system/engine_system.cuh"
+
+namespace galpha::detail {
+
+/// An edge of the graph: its two nodes and its unique weight (rank << 32 | edge id).
+struct WeightedEdge {
+  uint32_t a, b;
+  uint64_t weight;
+};
+
+GALPHA_HD inline void AtomicMinU64(unsigned long long* p, unsigned long long v) {
+#if defined(__CUDA_ARCH__)
+  atomicMin(p, v);
+#else
+  unsigned long long old = __atomic_load_n(p, __ATOMIC_RELAXED);
+  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
+  }
+#endif
+}
+
+// The working edges carry the current component labels of their ends (relabelled every round),
+// and the rounds visit only the live labels and edges: both shrink at least by half a round, so
+// the total work is linear, not (nodes x rounds).
+
+/// Each edge offers its weight to both of its components.
+struct OfferLightestEdge {
+  const WeightedEdge* edges;
+  unsigned long long* best;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const WeightedEdge e = edges[i];
+    AtomicMinU64(&best[e.a], e.weight);
+    AtomicMinU64(&best[e.b], e.weight);
+  }
+};
+
+/// The edge a component chose tells it where to hook.
+struct RecordHookTarget {
+  const WeightedEdge* edges;
+  const unsigned long long* best;
+  uint32_t* target;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const WeightedEdge e = edges[i];
+    if (best[e.a] == e.weight) target[e.a] = e.b;
+    if (best[e.b] == e.weight) target[e.b] = e.a;
+  }
+};
+
+/// A component hooks to the other end of its lightest edge, except the smaller of two components
+/// that chose the same edge (the only cycles Borůvka can form with unique weights); each hooked
+/// edge is a forest edge, counted at its rank.
+struct HookComponent {
+  const uint32_t* labels;
+  const unsigned long long* best;
+  const uint32_t* target;
+  uint32_t* parent;
+  uint32_t* merges_at_rank;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t c = labels[i];
+    if (best[c] == ~0ull) return;  // no edge leaves this component any more
+    const uint32_t other = target[c];
+    if (best[other] == best[c] && c < other) return;  // the other side hooks to us
+    parent[c] = other;
+    AtomicIncrement(&merges_at_rank[static_cast<uint32_t>(best[c] >> 32)]);
+  }
+};
+
+/// One step of pointer jumping over the live labels (the hooks form trees once the two-cycles are
+/// broken): log(depth) steps reach the roots even on long chains (a path whose weights increase
+/// along it hooks every node to the next). Racing writes only move a pointer closer to its root.
+struct JumpOnce {
+  const uint32_t* labels;
+  uint32_t* parent;
+  uint32_t* changed;  // set when a pointer moved; null: not reported
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t c = labels[i];
+    const uint32_t p = parent[c], pp = parent[p];
+    if (p != pp) {
+      parent[c] = pp;
+      if (changed != nullptr) *changed = 1;
+    }
+  }
+};
+
+struct ResetBest {
+  const uint32_t* labels;
+  unsigned long long* best;
+  GALPHA_HD void operator()(uint32_t i) const { best[labels[i]] = ~0ull; }
+};
+
+struct RelabelEdge {
+  WeightedEdge* edges;
+  const uint32_t* parent;
+  GALPHA_HD void operator()(uint32_t i) const {
+    WeightedEdge& e = edges[i];
+    e.a = parent[e.a];
+    e.b = parent[e.b];
+  }
+};
+
+struct JoinsTwoComponents {
+  GALPHA_HD bool operator()(const WeightedEdge& e) const { return e.a != e.b; }
+};
+
+struct IsRoot {
+  const uint32_t* parent;
+  GALPHA_HD bool operator()(uint32_t c) const { return parent[c] == c; }
+};
+
+template <class T>
+struct CopyItem {
+  const T* from;
+  T* to;
+  GALPHA_HD void operator()(uint32_t i) const { to[i] = from[i]; }
+};
+
+/// The round's bookkeeping after the compactions (one thread): the kept items' counts become the
+/// live counts, and the next compaction's counts start at zero.
+struct TakeKeptCounts {
+  uint32_t* live_edges;
+  uint32_t* live_labels;
+  uint32_t* kept_edges;
+  uint32_t* kept_labels;
+  GALPHA_HD void operator()(uint32_t) const {
+    *live_edges = *kept_edges;
+    *live_labels = *kept_labels;
+    *kept_edges = 0;
+    *kept_labels = 0;
+  }
+};
+
+struct ClearFlag {
+  uint32_t* flag;
+  GALPHA_HD void operator()(uint32_t) const { *flag = 0; }
+};
+
+struct HasRank {
+  GALPHA_HD bool operator()(const WeightedEdge& e) const { return static_cast<uint32_t>(e.weight >> 32) != kNeverRank; }
+};
+
+/// Adds to merges_at_rank[r] the number of spanning-forest edges of rank r. `edges` holds one
+/// entry per edge (weights unique; rank kNeverRank for an edge that never appears) and is used as
+/// working space (clobbered); nodes are 0..num_nodes.
+///
+/// A round's kernels are recorded once and replayed (the host's launch cost bounded the rounds,
+/// as in the triangulation's flip loop): the live edge and label counts stay on the device, and
+/// the host waits once a round, for whether edges were left and whether the pointer jumps
+/// converged.
+template <class System>
+void CountForestEdgesByRank(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes,
+                            uint32_t* merges_at_rank) {
+  auto policy = sys.policy();
+  Buffer<WeightedEdge, System> active(sys, num_edges);
+  const uint32_t num_ranked = static_cast<uint32_t>(
+      thrust::copy_if(policy, edges, edges + num_edges, active.data(), HasRank{}) - active.data());
+  WeightedEdge* kept = edges;  // the compactions' target from here on
+  Buffer<uint32_t, System> labels(sys, num_nodes), kept_labels(sys, num_nodes), parent(sys, num_nodes),
+      target(sys, num_nodes);
+  Buffer<unsigned long long, System> best(sys, num_nodes);
+  enum Count { kLiveEdges, kLiveLabels, kKeptEdges, kKeptLabels, kJumped, kNumCounts };
+  Buffer<uint32_t, System> counts(sys, kNumCounts);
+  uint32_t* count = counts.data();
+  thrust::sequence(policy, labels.data(), labels.data() + num_nodes);
+  thrust::sequence(policy, parent.data(), parent.data() + num_nodes);
+  thrust::fill_n(policy, best.data(), num_nodes, ~0ull);
+  const uint32_t initial[kNumCounts] = {num_ranked, num_nodes, 0, 0, 0};
+  sys.FromHost(count, initial, kNumCounts);
+
+  // Hook trees are shallow on realistic input: a few jumps flatten them. The jumps run in groups,
+  // and only the last of a group reports whether it still moved a pointer.
+  constexpr int kJumpsPerCheck = 3;
+  auto jump_group = [&] {
+    for (int j = 0; j + 1 < kJumpsPerCheck; ++j) {
+      sys.ForEachBelow(count + kLiveLabels, JumpOnce{labels.data(), parent.data(), nullptr});
+    }
+    sys.RunSingle(ClearFlag{count + kJumped});
+    sys.ForEachBelow(count + kLiveLabels, JumpOnce{labels.data(), parent.data(), count + kJumped});
+  };
+  // Declared after the buffers: destroyed (after the stream's last replay) before them.
+  typename System::Recording hook_round, more_jumps, shrink_round;
+  for (int round = 0;; ++round) {
+    // Every component with an edge left merges in a round: at most log2(nodes) + 1 rounds.
+    if (round > 64) throw EngineError(EngineError::Kind::kInternal, "component rounds did not converge");
+    sys.Replay(hook_round, [&] {
+      sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active.data(), best.data()});
+      sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active.data(), best.data(), target.data()});
+      sys.ForEachBelow(count + kLiveLabels, HookComponent{labels.data(), best.data(), target.data(), parent.data(),
+                                                          merges_at_rank});
+      jump_group();
+    });
+    // The round's wait: whether edges were left for it (none: it changed nothing, and the forest
+    // is complete) and whether the jumps converged.
+    uint32_t live_edges = 0, jumped = 0;
+    sys.Download({{&live_edges, count + kLiveEdges, sizeof(uint32_t)}, {&jumped, count + kJumped, sizeof(uint32_t)}});
+    if (live_edges == 0) return;
+    for (int group = 0; jumped != 0; ++group) {
+      if (group > 32) throw EngineError(EngineError::Kind::kInternal, "pointer jumping did not converge");
+      sys.Replay(more_jumps, jump_group);
+      jumped = sys.Read(count + kJumped);
+    }
+    sys.Replay(shrink_round, [&] {
+      sys.ForEachBelow(count + kLiveLabels, ResetBest{labels.data(), best.data()});
+      sys.ForEachBelow(count + kLiveEdges, RelabelEdge{active.data(), parent.data()});
+      sys.AppendIf(count + kLiveEdges, 1, active.data(), active.data(), JoinsTwoComponents{}, kept,
+                   count + kKeptEdges);
+      sys.AppendIf(count + kLiveLabels, 1, labels.data(), labels.data(), IsRoot{parent.data()}, kept_labels.data(),
+                   count + kKeptLabels);
+      sys.ForEachBelow(count + kKeptEdges, CopyItem<WeightedEdge>{kept, active.data()});
+      sys.ForEachBelow(count + kKeptLabels, CopyItem<uint32_t>{kept_labels.data(), labels.data()});
+      sys.RunSingle(TakeKeptCounts{count + kLiveEdges, count + kLiveLabels, count + kKeptEdges, count + kKeptLabels});
+    });
+  }
+}
+
+/// The general graph: nodes are input indices, an edge appears at its birth.
+struct GeneralGraphEdge {
+  const EdgeIdx* edges;
+  const uint32_t* rho;
+  const uint32_t* mu_low;
+  GALPHA_HD WeightedEdge operator()(uint32_t e) const {
+    const uint32_t birth = rho[e] != 0 ? rho[e] : mu_low[e];
+    return WeightedEdge{edges[e].v[0], edges[e].v[1], (static_cast<uint64_t>(birth) << 32) | e};
+  }
+};
+
+/// The solid graph: nodes are triangles, an interior edge joins its two when it becomes interior.
+struct SolidGraphEdge {
+  const EdgeTris* edge_tris;
+  const uint32_t* mu_high;
+  GALPHA_HD WeightedEdge operator()(uint32_t e) const {
+    if (mu_high[e] == kNeverRank) return WeightedEdge{0, 0, (static_cast<uint64_t>(kNeverRank) << 32) | e};
+    return WeightedEdge{static_cast<uint32_t>(edge_tris[e].t[0]), static_cast<uint32_t>(edge_tris[e].t[1]),
+                        (static_cast<uint64_t>(mu_high[e]) << 32) | e};
+  }
+};
+
+struct CountTriangleBirth {
+  const uint32_t* tri_rank;
+  uint32_t* births_at_rank;
+  GALPHA_HD void operator()(uint32_t t) const {
+    if (tri_rank[t] != kNeverRank) AtomicIncrement(&births_at_rank[tri_rank[t]]);
+  }
+};
+
+/// curve[L] = base + plus[0..L] - minus[0..L] for L in 0..K (plus may be null: a constant base).
+struct CurveAt {
+  const uint32_t* plus_prefix;
+  const uint32_t* minus_prefix;
+  uint32_t base;
+  GALPHA_HD uint32_t operator()(uint32_t level) const {
+    return base + (plus_prefix != nullptr ? plus_prefix[level] : 0u) - minus_prefix[level];
+  }
+};
+
+/// Both component curves over levels 0..num_ranks: GENERAL components (every distinct point from
+/// level 0, joined by edges at their births) and solid components (triangles from their births,
+/// joined by edges becoming interior).
+template <class System>
+void ComponentCurves(System& sys, uint32_t num_points, uint32_t num_unique, uint32_t num_tri, uint32_t num_edges,
+                     uint32_t num_ranks, const EdgeIdx* edges, const EdgeTris* edge_tris, const uint32_t* tri_rank,
+                     const uint32_t* edge_rho, const uint32_t* edge_mu_low, const uint32_t* edge_mu_high,
+                     uint32_t* components, uint32_t* solid_components) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t levels = num_ranks + 1;
+  Buffer<WeightedEdge, System> graph(sys, num_edges);
+  Buffer<uint32_t, System> merges(sys, levels), births(sys, levels);
+  // General.
+  thrust::transform(policy, zero, zero + num_edges, graph.data(), GeneralGraphEdge{edges, edge_rho, edge_mu_low});
+  thrust::fill_n(policy, merges.data(), levels, 0u);
+  CountForestEdgesByRank(sys, graph.data(), num_edges, num_points, merges.data());
+  thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
+  thrust::transform(policy, zero, zero + levels, components, CurveAt{nullptr, merges.data(), num_unique});
+  // Solid.
+  thrust::transform(policy, zero, zero + num_edges, graph.data(), SolidGraphEdge{edge_tris, edge_mu_high});
+  thrust::fill_n(policy, merges.data(), levels, 0u);
+  CountForestEdgesByRank(sys, graph.data(), num_edges, num_tri, merges.data());
+  thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
+  thrust::fill_n(policy, births.data(), levels, 0u);
+  thrust::for_each_n(policy, zero, num_tri, CountTriangleBirth{tri_rank, births.data()});
+  thrust::inclusive_scan(policy, births.data(), births.data() + levels, births.data());
+  thrust::transform(policy, zero, zero + levels, solid_components, CurveAt{births.data(), merges.data(), 0u});
+}
+
+}  // namespace galpha::detail

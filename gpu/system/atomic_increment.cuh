@@ -1,0 +1,31 @@
+// A counter increment shared by the triangulation's and the alpha pipeline's functors.
+#pragma once
+
+#include <cstdint>
+
+#include "core/base/hd.hpp"
+
+namespace galpha::detail {
+
+/// *p += 1, atomically; returns the value before. On the device the threads of a warp that
+/// increment the same counter combine first (one atomic per distinct counter and warp): a grid's
+/// millions of exactly tied radii all count into two or three ranks, and the flip loop appends
+/// its next active triangles to one list; one atomic per thread on one address would serialise
+/// such a pass.
+GALPHA_HD inline uint32_t AtomicIncrement(uint32_t* p) {
+#if defined(__CUDA_ARCH__)
+  const unsigned active = __activemask();
+  const unsigned peers = __match_any_sync(active, reinterpret_cast<unsigned long long>(p));
+  unsigned lane;
+  asm("mov.u32 %0, %%laneid;" : "=r"(lane));
+  const int leader = __ffs(peers) - 1;
+  uint32_t base = 0;
+  if (static_cast<int>(lane) == leader) base = atomicAdd(p, static_cast<uint32_t>(__popc(peers)));
+  base = __shfl_sync(peers, base, leader);
+  return base + static_cast<uint32_t>(__popc(peers & ((1u << lane) - 1u)));
+#else
+  return __atomic_fetch_add(p, 1u, __ATOMIC_RELAXED);
+#endif
+}
+
+}  // namespace galpha::detail

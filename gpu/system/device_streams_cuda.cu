@@ -1,0 +1,51 @@
+#include <cuda_runtime.h>
+
+#include "absl/status/status.h"
+#include "absl/strings/str_cat.h"
+#include "gpu/system/device_streams.hpp"
+
+namespace galpha {
+
+absl::StatusOr<DeviceMemory> QueryDeviceMemory() {
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess || count == 0) {
+    cudaGetLastError();
+    return absl::UnavailableError("no CUDA device is visible");
+  }
+  DeviceMemory memory;
+  const cudaError_t result = cudaMemGetInfo(&memory.free_bytes, &memory.total_bytes);
+  if (result != cudaSuccess) {
+    cudaGetLastError();
+    return absl::InternalError(absl::StrCat("cudaMemGetInfo: ", cudaGetErrorString(result)));
+  }
+  return memory;
+}
+
+absl::StatusOr<std::unique_ptr<CudaStreamPool>> CudaStreamPool::Create(int count) {
+  int devices = 0;
+  if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
+    cudaGetLastError();
+    return absl::UnavailableError("no CUDA device is visible");
+  }
+  std::unique_ptr<CudaStreamPool> pool(new CudaStreamPool());
+  for (int i = 0; i < count; ++i) {
+    cudaStream_t stream = nullptr;
+    const cudaError_t result = cudaStreamCreateWithFlags(&stream, cudaStreamNonBlocking);
+    if (result != cudaSuccess) {
+      cudaGetLastError();
+      return absl::InternalError(absl::StrCat("cudaStreamCreateWithFlags: ", cudaGetErrorString(result)));
+    }
+    pool->streams_.push_back(stream);
+  }
+  return pool;
+}
+
+CudaStreamPool::~CudaStreamPool() {
+  for (void* stream : streams_) {
+    // Best effort at shutdown: a failure here has no one left to report to.
+    cudaStreamSynchronize(static_cast<cudaStream_t>(stream));
+    cudaStreamDestroy(static_cast<cudaStream_t>(stream));
+  }
+}
+
+}  // namespace galpha

@@ -1,0 +1,75 @@
+// Public, CUDA-free interface of the Delaunay triangulation engine.
+//
+// The algorithm is gDel2D's (Qi, Cao, Tan): points sorted along a Hilbert curve are inserted in
+// rounds (each triangle takes the uninserted point nearest its circumcentre), the Delaunay property
+// is restored with parallel Lawson flips whose conflicts are resolved by voting, and uninserted
+// points are relocated by a visibility walk. The convex hull is handled symbolically with a vertex
+// at infinity; all predicates are exact with Simulation of Simplicity on input indices. The same
+// source runs on the CUDA backend (one stream) and on the OpenMP backend.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/types/span.h"
+#include "core/base/point.hpp"
+#include "core/base/stage_time.hpp"
+#include "gpu/system/backend.hpp"
+
+namespace galpha {
+
+struct TriangulateOptions {
+  Backend backend = Backend::kAuto;
+  /// CUDA stream (a cudaStream_t) to run on; nullptr uses a stream the engine creates. Ignored on
+  /// the CPU backend.
+  void* cuda_stream = nullptr;
+};
+
+/// The Delaunay triangulation of a point set, named by input indices.
+///
+/// Vertices are input indices; an input point that duplicates an earlier one is represented by the
+/// first occurrence (see `representative`). Triangles are counter-clockwise. The edge list follows
+/// the report's ownership rule (section 3.1): triangle t owns its local edge k (from vertex k to
+/// vertex k+1) when the vertex indices increase along it or when it is a hull edge; edges are laid
+/// out triangle by triangle in the order of an exclusive scan of the owned counts.
+struct Triangulation {
+  /// Input points exactly as given (duplicates included).
+  std::vector<Point2> points;
+  /// For every input index, the input index of its first occurrence (itself when not a duplicate).
+  std::vector<uint32_t> representative;
+  /// Number of distinct points.
+  uint32_t num_unique = 0;
+
+  /// Finite triangles: three input indices, counter-clockwise.
+  std::vector<std::array<uint32_t, 3>> triangles;
+  /// neighbors[t][k]: the triangle across the edge opposite vertex k, or kNoNeighbor on the hull.
+  std::vector<std::array<int32_t, 3>> neighbors;
+  /// First owned edge of each triangle in `edges` (exclusive scan of owned counts).
+  std::vector<uint32_t> tri_edge_begin;
+  /// Edges as (smaller input index, larger input index).
+  std::vector<std::array<uint32_t, 2>> edges;
+
+  /// Backend that ran, and the stage times (transfers are their own stages).
+  Backend backend = Backend::kCpu;
+  std::vector<StageTime> stage_times;
+  /// Peak working memory of the build on its backend (device memory on CUDA, host memory on the
+  /// CPU backend), in bytes: the engine's buffers and its algorithms' temporaries, input included,
+  /// the returned host vectors excluded.
+  size_t peak_memory_bytes = 0;
+
+  static constexpr int32_t kNoNeighbor = -1;
+};
+
+/// Triangulates `points`.
+///
+/// Errors: InvalidArgument naming the first index holding NaN or infinity; ResourceExhausted when
+/// there are more points than a 32-bit index allows; Unavailable when the CUDA backend is asked for
+/// and there is none; Internal when a device call fails. 0, 1 or 2 distinct points and collinear
+/// input are valid: no triangles, and the edges join the points in sorted order along their line.
+absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points,
+                                          const TriangulateOptions& options = {});
+
+}  // namespace galpha

@@ -1,0 +1,13 @@
+// The OpenMP instantiation of the triangulation pipeline.
+#include "gpu/triangulation/delaunay_backend.hpp"
+#include "gpu/triangulation/delaunay_impl.cuh"
+#include "gpu/system/engine_system.cuh"
+
+namespace galpha::detail {
+
+void TriangulateOnCpu(const Point2* points, uint32_t n, DelaunayOutput* out) {
+  CpuSystem system;
+  RunTriangulation(system, points, n, out);
+}
+
+}  // namespace galpha::detail

@@ -1,0 +1,21 @@
+// The CUDA instantiation of the triangulation pipeline: one stream, stream-ordered memory.
+#include <cuda_runtime.h>
+
+#include "gpu/system/cuda_system.cuh"
+#include "gpu/triangulation/delaunay_backend.hpp"
+#include "gpu/triangulation/delaunay_impl.cuh"
+
+namespace galpha::detail {
+
+void TriangulateOnCuda(const Point2* points, uint32_t n, void* stream, DelaunayOutput* out) {
+  if (stream != nullptr) {
+    CudaSystem system(static_cast<cudaStream_t>(stream));
+    RunTriangulation(system, points, n, out);
+    return;
+  }
+  OwnedStream owned;
+  CudaSystem system(owned.get());
+  RunTriangulation(system, points, n, out);
+}
+
+}  // namespace galpha::detail

@@ -1,0 +1,332 @@
+// Parallel Lawson flips (gDel2D): every active triangle proposes to flip its first non-Delaunay
+// edge; a proposal wins when it holds the minimum vote on both triangles it touches, so no
+// triangle takes part in two flips at once. Also the repair of hull triangles that are flat
+// in reality but not in the symbolic perturbation.
+#pragma once
+
+#include <cstdint>
+
+#include <cuda/atomic>
+
+#include "core/base/hd.hpp"
+#include "core/exact/predicates.hpp"
+#include "gpu/triangulation/mesh.cuh"
+
+namespace galpha::detail {
+
+constexpr uint32_t kNoFlipVote = ~0u;
+constexpr int32_t kNoPartner = -1;
+
+/// The two triangles of a flip before it happens: t = (r, p, q) with the flipped edge p-q opposite
+/// position k, and nb = (s, q, p) with s at position j. After it: t = (r, p, s), nb = (s, q, r).
+/// Edges (r,p) and (s,q) stay in their slots; edge (p,s) moves from nb to t and (q,r) from t to nb.
+struct FlipPlan {
+  int32_t t, nb;
+  int k, j;
+};
+
+/// Writes the flipped pair; outside neighbours are the old ones (the caller re-links).
+GALPHA_HD inline void WriteFlip(const MeshView& mesh, const FlipPlan& f) {
+  const Tri x = mesh.tri[f.t], y = mesh.tri[f.nb];
+  const TriNbr nx = mesh.nbr[f.t], ny = mesh.nbr[f.nb];
+  const int32_t r = x.v[f.k], p = x.v[Next(f.k)];
+  const int32_t s = y.v[f.j], q = y.v[Next(f.j)];
+  const int32_t across_rp = nx.n[Prev(f.k)], across_qr = nx.n[Next(f.k)];
+  const int32_t across_ps = ny.n[Next(f.j)], across_sq = ny.n[Prev(f.j)];
+  mesh.tri[f.t] = Tri{{r, p, s}};
+  mesh.nbr[f.t] = TriNbr{{across_ps, f.nb, across_rp}};
+  mesh.tri[f.nb] = Tri{{s, q, r}};
+  mesh.nbr[f.nb] = TriNbr{{across_qr, f.t, across_sq}};
+}
+
+/// Edge masks of active triangles: which positions may have stopped being locally Delaunay. After a
+/// 1-to-3 split only a child's outside edge (position 2) can be; after a flip only the four outer
+/// edges of the quadrilateral (positions 0 and 2 of both triangles), never the new diagonal.
+constexpr uint8_t kCheckOutsideEdge = 0b100;
+constexpr uint8_t kCheckFlipOuterEdges = 0b101;
+constexpr uint8_t kCheckAllEdges = 0b111;
+
+/// Each active triangle proposes its first edge that must flip and votes on both triangles.
+struct ProposeFlips {
+  MeshView mesh;
+  const int32_t* active;
+  const uint8_t* active_mask;
+  int8_t* proposal_edge;     // per active entry: k, or -1
+  int32_t* proposal_nb;      // per active entry: the neighbour across that edge
+  uint32_t* flip_vote;       // per triangle, kNoFlipVote when untouched
+  bool hull_may_change;
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = active[i];
+    proposal_edge[i] = -1;
+    const uint8_t mask = active_mask[i];
+    for (int k = 0; k < 3; ++k) {
+      if (((mask >> k) & 1u) && mesh.ShouldFlip(t, k, hull_may_change)) {
+        const int32_t nb = mesh.nbr[t].n[k];
+        proposal_edge[i] = static_cast<int8_t>(k);
+        proposal_nb[i] = nb;
+        cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[t]).fetch_min(static_cast<uint32_t>(t));
+        cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[nb]).fetch_min(static_cast<uint32_t>(t));
+        return;
+      }
+    }
+  }
+};
+
+/// Performs the proposals that won both votes, and records each triangle's flip partner.
+struct ExecuteFlips {
+  MeshView mesh;
+  const int32_t* active;
+  int8_t* proposal_edge;     // set to 3 for a winner (re-linked next), kept for losers
+  const int32_t* proposal_nb;
+  const uint32_t* flip_vote;
+  int32_t* partner;
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    if (proposal_edge[i] < 0) return;
+    const int32_t t = active[i], nb = proposal_nb[i];
+    if (flip_vote[t] != static_cast<uint32_t>(t) || flip_vote[nb] != static_cast<uint32_t>(t)) return;
+    const int k = proposal_edge[i];
+    const Tri x = mesh.tri[t];
+    const int j = mesh.EdgePos(nb, x.v[Prev(k)], x.v[Next(k)]);
+    WriteFlip(mesh, FlipPlan{t, nb, k, j});
+    partner[t] = nb;
+    partner[nb] = t;
+    proposal_edge[i] = 3;
+  }
+};
+
+/// After ExecuteFlips: points each flipped triangle's outside edges at their current owners, and
+/// untouched neighbours of a moved edge back at the flipped triangle. One writer per slot.
+struct LinkFlips {
+  MeshView mesh;
+  const int32_t* active;
+  const int8_t* proposal_edge;
+  const int32_t* proposal_nb;
+  const int32_t* partner;
+
+  GALPHA_HD void Relink(int32_t y, int pos, bool moved) const {
+    const int32_t x = mesh.nbr[y].n[pos];
+    const int32_t a = mesh.tri[y].v[Next(pos)], b = mesh.tri[y].v[Prev(pos)];
+    const int32_t px = partner[x];
+    if (px != kNoPartner) {
+      mesh.nbr[y].n[pos] = mesh.EdgePos(x, b, a) >= 0 ? x : px;
+    } else if (moved) {
+      mesh.nbr[x].n[mesh.EdgePos(x, b, a)] = y;
+    }
+  }
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    if (proposal_edge[i] != 3) return;
+    const int32_t t = active[i], nb = proposal_nb[i];
+    Relink(t, 0, true);
+    Relink(t, 2, false);
+    Relink(nb, 0, true);
+    Relink(nb, 2, false);
+  }
+};
+
+/// Starts a flip iteration: zeroes the count of the next list and moves to a new generation of
+/// stamps. One thread.
+struct StartFlipIteration {
+  uint32_t* next_count;
+  uint32_t* generation;
+  GALPHA_HD void operator()(uint32_t) const {
+    *next_count = 0;
+    *generation += 1;
+  }
+};
+
+/// Clears the votes and partners one iteration used, and lists the triangles to check next: both
+/// triangles of a flip, and the proposer of a flip that lost. `stamp` de-duplicates the list.
+struct CollectNextActive {
+  const int32_t* active;
+  const int8_t* proposal_edge;
+  const int32_t* proposal_nb;
+  uint32_t* flip_vote;
+  int32_t* partner;
+  uint32_t* stamp;
+  const uint32_t* generation;
+  int32_t* candidates;  // two per active entry, -1 when unused
+  uint8_t* candidate_mask;
+
+  GALPHA_HD bool Claim(int32_t t, uint32_t now) const {
+    return cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(stamp[t]).exchange(now) != now;
+  }
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    candidates[2 * i] = -1;
+    candidates[2 * i + 1] = -1;
+    if (proposal_edge[i] < 0) return;
+    const uint32_t now = *generation;
+    const int32_t t = active[i], nb = proposal_nb[i];
+    flip_vote[t] = kNoFlipVote;
+    flip_vote[nb] = kNoFlipVote;
+    const bool flipped = proposal_edge[i] == 3;
+    if (Claim(t, now)) {
+      candidates[2 * i] = t;
+      // A losing proposer may also have been flipped as another flip's neighbour, and only one
+      // of its two claims lands: check every edge so that neither reason is lost.
+      candidate_mask[2 * i] = flipped ? kCheckFlipOuterEdges : kCheckAllEdges;
+    }
+    if (flipped) {
+      partner[t] = kNoPartner;
+      partner[nb] = kNoPartner;
+      if (Claim(nb, now)) {
+        candidates[2 * i + 1] = nb;
+        candidate_mask[2 * i + 1] = kCheckFlipOuterEdges;
+      }
+    }
+  }
+};
+
+/// Whether finite triangle t is flat in reality: three collinear vertices on a hull line, made by
+/// the symbolic perturbation.
+GALPHA_HD inline bool IsFlatTriangle(const MeshView& mesh, int32_t t) {
+  if (mesh.IsInfinite(t)) return false;
+  const Tri& x = mesh.tri[t];
+  return Orient2dSign(mesh.pts[x.v[0]], mesh.pts[x.v[1]], mesh.pts[x.v[2]]) == 0;
+}
+
+/// Position of the vertex of a flat triangle that lies between the other two.
+GALPHA_HD inline int MiddlePosition(const MeshView& mesh, int32_t t) {
+  const Tri& x = mesh.tri[t];
+  for (int k = 0; k < 3; ++k) {
+    const Point2 m = mesh.pts[x.v[k]], a = mesh.pts[x.v[Next(k)]], b = mesh.pts[x.v[Prev(k)]];
+    if ((LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a))) return k;
+  }
+  return -1;
+}
+
+/// The hull repair: flat triangles are removed so that points on a hull edge become hull vertices,
+/// as in CGAL. A flat triangle (m between p and q) flips across its long edge p-q when the triangle
+/// there is infinite (m joins the hull) or properly shaped (m joins that triangle's apex); such a
+/// flip never makes a new flat triangle. When the triangle across is flat too, it waits for that
+/// one's repair. Proposals are voted on and executed like Lawson flips (ExecuteFlips, LinkFlips),
+/// in parallel rounds; a round's depth is the longest chain of flat triangles waiting on each other.
+struct ProposeFlatRepairs {
+  MeshView mesh;
+  const int32_t* flat;    // flat triangles still to repair
+  int8_t* proposal_edge;  // per entry: the long edge's position, or -1 while waiting
+  int32_t* proposal_nb;
+  uint32_t* flip_vote;
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = flat[i];
+    proposal_edge[i] = -1;
+    const int k = MiddlePosition(mesh, t);
+    if (k < 0) return;
+    const int32_t nb = mesh.nbr[t].n[k];
+    if (IsFlatTriangle(mesh, nb)) return;
+    proposal_edge[i] = static_cast<int8_t>(k);
+    proposal_nb[i] = nb;
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[t]).fetch_min(static_cast<uint32_t>(t));
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[nb]).fetch_min(static_cast<uint32_t>(t));
+  }
+};
+
+/// After a repair round: clears votes and partners, lists both triangles of every executed repair
+/// (for the Lawson pass after), and marks the flat triangles that remain.
+struct CollectFlatRepairs {
+  const int32_t* flat;
+  const int8_t* proposal_edge;  // 3 where ExecuteFlips flipped
+  const int32_t* proposal_nb;
+  uint32_t* flip_vote;
+  int32_t* partner;
+  int32_t* flipped_pairs;       // two per entry, -1 when unused
+  uint8_t* still_flat;          // per entry
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = flat[i];
+    flipped_pairs[2 * i] = -1;
+    flipped_pairs[2 * i + 1] = -1;
+    still_flat[i] = proposal_edge[i] != 3;
+    if (proposal_edge[i] < 0) return;
+    const int32_t nb = proposal_nb[i];
+    flip_vote[t] = kNoFlipVote;
+    flip_vote[nb] = kNoFlipVote;
+    if (proposal_edge[i] == 3) {
+      partner[t] = kNoPartner;
+      partner[nb] = kNoPartner;
+      flipped_pairs[2 * i] = t;
+      flipped_pairs[2 * i + 1] = nb;
+    }
+  }
+};
+
+/// The repair of what the parallel rounds leave when flat triangles wait on each other in long
+/// chains (on two parallel lines of points every point is on the hull, and the chains are O(n)
+/// long, so parallel rounds would take O(n) rounds): one thread, depth-first with an explicit
+/// stack, so that each flat triangle is visited O(1) times.
+struct RepairFlatChainsSerially {
+  MeshView mesh;
+  const int32_t* flat;   // the flat triangles left
+  uint32_t num_flat;
+  int32_t* stack;        // num_flat entries
+  uint32_t* on_stack;    // per triangle, kNoFlipVote (the idle flip votes) when not on the stack
+  int32_t* failed;       // set when flat triangles remain (reported as an internal error)
+  int32_t* flips_done;
+  int32_t* touched;      // the two triangles of every repair flip, for the Lawson pass after
+
+  GALPHA_HD void SerialFlip(int32_t t, int k) const {
+    const Tri x = mesh.tri[t];
+    const int32_t nb = mesh.nbr[t].n[k];
+    const int j = mesh.EdgePos(nb, x.v[Prev(k)], x.v[Next(k)]);
+    WriteFlip(mesh, FlipPlan{t, nb, k, j});
+    // The two moved edges: re-point their outside neighbours.
+    for (int32_t y : {t, nb}) {
+      const int32_t o = mesh.nbr[y].n[0];
+      const int32_t a = mesh.tri[y].v[1], b = mesh.tri[y].v[2];
+      mesh.nbr[o].n[mesh.EdgePos(o, b, a)] = y;
+    }
+  }
+
+  /// Repairs flat triangle `first` and, before it, the flat triangles it waits for.
+  GALPHA_HD void RepairFrom(int32_t first, int32_t* flips) const {
+    uint32_t top = 0;
+    stack[top++] = first;
+    on_stack[first] = 0;
+    while (top > 0) {
+      const int32_t t = stack[top - 1];
+      const int k = IsFlatTriangle(mesh, t) ? MiddlePosition(mesh, t) : -1;
+      if (k >= 0) {
+        const int32_t nb = mesh.nbr[t].n[k];
+        if (IsFlatTriangle(mesh, nb)) {
+          if (on_stack[nb] == kNoFlipVote && top < num_flat) {
+            stack[top++] = nb;
+            on_stack[nb] = 0;
+            continue;
+          }
+          // A cycle: t stays flat for now, and a later pass tries again.
+        } else {
+          SerialFlip(t, k);
+          touched[2 * *flips] = t;
+          touched[2 * *flips + 1] = nb;
+          ++*flips;
+        }
+      }
+      on_stack[t] = kNoFlipVote;
+      --top;
+    }
+  }
+
+  GALPHA_HD void operator()(uint32_t) const {
+    int32_t flips = 0;
+    // Passes until every flat triangle is repaired; a pass that repairs none is a failure.
+    for (bool remaining = true; remaining;) {
+      remaining = false;
+      const int32_t before = flips;
+      for (uint32_t i = 0; i < num_flat; ++i) {
+        if (IsFlatTriangle(mesh, flat[i])) RepairFrom(flat[i], &flips);
+        remaining |= IsFlatTriangle(mesh, flat[i]);
+      }
+      if (remaining && flips == before) {
+        *failed = 1;
+        break;
+      }
+    }
+    *flips_done = flips;
+  }
+};
+
+}  // namespace galpha::detail

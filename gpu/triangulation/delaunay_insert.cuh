@@ -1,0 +1,193 @@
+// One insertion round of the gDel2D scheme: every triangle elects the uninserted point nearest its
+// circumcentre (atomic minimum over packed keys), elected points split their triangle 1-to-3, then
+// the split triangles' outside neighbours are re-linked.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+#include <cuda/atomic>
+
+#include "core/base/hd.hpp"
+#include "gpu/triangulation/mesh.cuh"
+
+namespace galpha::detail {
+
+constexpr unsigned long long kNoVote = ~0ull;
+
+/// Maps a float to an unsigned key with the same order (negative values included).
+GALPHA_HD inline uint32_t OrderedFloatKey(float f) {
+  uint32_t bits;
+  memcpy(&bits, &f, sizeof bits);
+  return (bits & 0x80000000u) ? ~bits : (bits | 0x80000000u);
+}
+
+/// Binary exponent of the largest magnitude among the given differences (0 when all are zero).
+/// Scores are computed on coordinates divided by 2^exponent (exact: a power of two), so that
+/// subnormal or huge inputs neither underflow to ties nor overflow.
+GALPHA_HD inline int ScoreExponent(double a, double b, double c, double d) {
+  const double m = fmax(fmax(fabs(a), fabs(b)), fmax(fabs(c), fabs(d)));
+  return m > 0.0 ? ilogb(m) : 0;
+}
+
+/// Each uninserted point votes for itself in the triangle that contains it; the smallest key wins.
+/// Finite triangles prefer the point nearest the circumcentre (gDel2D's choice: it keeps triangles
+/// well shaped); infinite ones the point farthest outside their hull edge. The choice is a
+/// heuristic only, so approximate doubles are fine here; but ties must be rare, or the smallest
+/// index (an end of a run of points along a line, in Hilbert order) wins every round.
+struct VoteForInsertion {
+  MeshView mesh;
+  const int32_t* pending;        // vertex of each uninserted point
+  const int32_t* location;       // triangle containing it
+  unsigned long long* tri_vote;  // per triangle, kNoVote when nobody voted
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    const int32_t t = location[i];
+    const Point2 p = mesh.pts[pending[i]];
+    const Tri x = mesh.tri[t];
+    float score;
+    int inf_pos = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (x.v[k] == mesh.inf) inf_pos = k;
+    }
+    if (inf_pos >= 0) {
+      // Farthest outside first (the hull grows as in quickhull). Points on the hull edge's line
+      // (grids, collinear data) all score 0 that way: among them prefer the one nearest the
+      // edge's midpoint, so a line of n such points is split in halves, O(log n) rounds, not n.
+      const Point2 u = mesh.pts[x.v[Next(inf_pos)]], w = mesh.pts[x.v[Prev(inf_pos)]];
+      const int e = ScoreExponent(w.x - u.x, w.y - u.y, 0.0, 0.0);
+      const double wx = ldexp(w.x - u.x, -e), wy = ldexp(w.y - u.y, -e);
+      const double px = ldexp(p.x - u.x, -e), py = ldexp(p.y - u.y, -e);
+      const double outside = wx * py - wy * px;
+      if (outside > 0.0) {
+        score = -static_cast<float>(outside);
+      } else {
+        const double dx = px - 0.5 * wx, dy = py - 0.5 * wy;
+        score = static_cast<float>(dx * dx + dy * dy);
+      }
+    } else {
+      // Nearest the circumcentre o means the smallest power |p - o|^2 - R^2 (same order), but the
+      // power is computed from coordinates relative to a vertex, without R^2: for a sliver, whose
+      // circumcentre is far away, |p - o|^2 rounds to the same float for every point, and the
+      // index would then pick an end of the sliver (linear rounds on collinear data) instead of
+      // its middle (a point on a chord has power -|p - a| |p - b|, lowest at the midpoint).
+      const Point2 a = mesh.pts[x.v[0]], b = mesh.pts[x.v[1]], c = mesh.pts[x.v[2]];
+      const int e = ScoreExponent(b.x - a.x, b.y - a.y, c.x - a.x, c.y - a.y);
+      const double bx = ldexp(b.x - a.x, -e), by = ldexp(b.y - a.y, -e);
+      const double cx = ldexp(c.x - a.x, -e), cy = ldexp(c.y - a.y, -e);
+      const double px = ldexp(p.x - a.x, -e), py = ldexp(p.y - a.y, -e);
+      const double d = bx * cy - by * cx;
+      const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+      const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
+      score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
+                                                                     : (power < 0 ? -3.0e38f : 3.0e38f);
+    }
+    const unsigned long long key =
+        (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
+    cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(tri_vote[t]);
+    slot.fetch_min(key);
+  }
+};
+
+/// 1 where a triangle won a point this round.
+struct HasWinner {
+  GALPHA_HD int32_t operator()(unsigned long long vote) const { return vote != kNoVote ? 1 : 0; }
+};
+
+/// Where the three children of a split triangle live: child 2 reuses the parent's slot, children
+/// 0 and 1 take two fresh slots after the current triangles. `split_count` is the inclusive scan of
+/// HasWinner, so a split parent is the (split_count - 1)-th split of the round.
+GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_count, int32_t num_tri) {
+  return k == 2 ? parent : num_tri + 2 * (split_count - 1) + k;
+}
+
+/// Splits every elected triangle (a, b, c) around its point w into (b, c, w), (c, a, w), (a, b, w):
+/// child k keeps the parent's edge opposite vertex k. Outside neighbours still name the parent
+/// afterwards; LinkSplitChildren repairs them.
+struct SplitTriangles {
+  MeshView mesh;
+  const unsigned long long* tri_vote;
+  const int32_t* split_count;  // inclusive scan of HasWinner
+  const int32_t* pending;
+  uint8_t* inserted;            // per uninserted point
+  int32_t num_tri;
+
+  GALPHA_HD void operator()(int32_t t) const {
+    const unsigned long long vote = tri_vote[t];
+    if (vote == kNoVote) return;
+    const uint32_t winner = static_cast<uint32_t>(vote & 0xffffffffu);
+    inserted[winner] = 1;
+    const int32_t w = pending[winner];
+    const Tri x = mesh.tri[t];
+    const TriNbr nx = mesh.nbr[t];
+    int32_t child[3];
+    for (int k = 0; k < 3; ++k) child[k] = ChildSlot(t, k, split_count[t], num_tri);
+    for (int k = 0; k < 3; ++k) {
+      mesh.tri[child[k]] = Tri{{x.v[Next(k)], x.v[Prev(k)], w}};
+      mesh.nbr[child[k]] = TriNbr{{child[Next(k)], child[Prev(k)], nx.n[k]}};
+    }
+  }
+};
+
+/// Re-links the outside edge of each child: to the matching child when the neighbour split in the
+/// same round, else by pointing the untouched neighbour back at the child. Each write has one
+/// writer, so the pass is race-free.
+struct LinkSplitChildren {
+  MeshView mesh;
+  const unsigned long long* tri_vote;
+  const int32_t* split_count;  // inclusive scan of HasWinner
+  int32_t num_tri;
+
+  GALPHA_HD void operator()(int32_t t) const {
+    if (tri_vote[t] == kNoVote) return;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t c = ChildSlot(t, k, split_count[t], num_tri);
+      const int32_t p = mesh.tri[c].v[0], q = mesh.tri[c].v[1];
+      const int32_t x = mesh.nbr[c].n[2];
+      if (tri_vote[x] != kNoVote) {
+        for (int j = 0; j < 3; ++j) {
+          const int32_t cx = ChildSlot(x, j, split_count[x], num_tri);
+          if (mesh.tri[cx].v[0] == q && mesh.tri[cx].v[1] == p) mesh.nbr[c].n[2] = cx;
+        }
+      } else {
+        mesh.nbr[x].n[mesh.EdgePos(x, q, p)] = c;
+      }
+    }
+  }
+};
+
+/// Lists the three children of every split triangle: the first triangles to check for flips.
+struct ListSplitChildren {
+  const unsigned long long* tri_vote;
+  const int32_t* split_count;  // inclusive scan of HasWinner
+  int32_t* active;
+  int32_t num_tri;
+
+  GALPHA_HD void operator()(int32_t t) const {
+    if (tri_vote[t] == kNoVote) return;
+    for (int k = 0; k < 3; ++k) active[3 * (split_count[t] - 1) + k] = ChildSlot(t, k, split_count[t], num_tri);
+  }
+};
+
+/// Relocates a point that is still uninserted, walking from the triangle that held it.
+struct RelocatePoint {
+  MeshView mesh;
+  const int32_t* pending;
+  const uint8_t* inserted;
+  int32_t* location;
+  int32_t* walk_failed;
+  uint32_t max_steps;
+
+  GALPHA_HD void operator()(uint32_t i) const {
+    if (inserted[i]) return;
+    const int32_t t = mesh.Locate(location[i], pending[i], max_steps);
+    if (t < 0) {
+      *walk_failed = 1;
+      return;
+    }
+    location[i] = t;
+  }
+};
+
+}  // namespace galpha::detail

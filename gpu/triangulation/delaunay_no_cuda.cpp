@@ -1,0 +1,11 @@
+// Builds without nvcc have no CUDA backend: this is the triangulation's answer there.
+#include "gpu/system/backend.hpp"
+#include "gpu/triangulation/delaunay_backend.hpp"
+
+namespace galpha::detail {
+
+void TriangulateOnCuda(const Point2*, uint32_t, void*, DelaunayOutput*) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
+}  // namespace galpha::detail

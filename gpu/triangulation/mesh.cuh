@@ -1,0 +1,140 @@
+// The triangle-neighbour mesh the triangulation works on, as seen from a functor, with the exact
+// predicates adapted to it.
+//
+// Vertices 0..n-1 are the distinct input points in Hilbert order; vertex n is the symbolic vertex at
+// infinity. Triangles are counter-clockwise vertex triples on the sphere formed with that vertex:
+// a triangle holding it is "infinite" and stands for the outside of one hull edge. nbr[t].n[k] is the
+// triangle across the edge opposite vertex k (the edge from v[k+1] to v[k+2]).
+#pragma once
+
+#include <cstdint>
+
+#include "core/base/hd.hpp"
+#include "core/base/point.hpp"
+#include "core/exact/predicates.hpp"
+
+namespace galpha::detail {
+
+struct Tri {
+  int32_t v[3];
+};
+struct TriNbr {
+  int32_t n[3];
+};
+
+GALPHA_HD inline int Next(int k) { return k == 2 ? 0 : k + 1; }
+GALPHA_HD inline int Prev(int k) { return k == 0 ? 2 : k - 1; }
+
+/// Mutable view of the mesh; copied by value into functors.
+struct MeshView {
+  const Point2* pts;     // vertex coordinates, Hilbert order
+  const uint32_t* sos;   // input index of each vertex: the Simulation-of-Simplicity rank
+  Tri* tri;
+  TriNbr* nbr;
+  int32_t inf;           // id of the vertex at infinity (= number of finite vertices)
+  // The vertices of the first triangle. Their symbolic interior point c = a + e1 (b - a) +
+  // e2 (c - a) (0 < e2 << e1 << 1) lies inside every later hull; rays from it through the hull
+  // vertices split the outside into disjoint sectors, one per infinite triangle, so points
+  // inserted outside the hull in the same round never overlap.
+  int32_t center_a, center_b, center_c;
+
+  /// Sign of orient(center, w, p): orient is affine in its first point, so it is the first
+  /// nonzero of the exact signs with a, b, c in its place (never zero: a, b, c are not collinear).
+  GALPHA_HD int CenterOrient(int32_t w, int32_t p) const {
+    int s = Orient2dSign(pts[center_a], pts[w], pts[p]);
+    if (s == 0) s = Orient2dSign(pts[center_b], pts[w], pts[p]);
+    if (s == 0) s = Orient2dSign(pts[center_c], pts[w], pts[p]);
+    return s;
+  }
+
+  GALPHA_HD bool IsInfinite(int32_t t) const {
+    const Tri& x = tri[t];
+    return x.v[0] == inf || x.v[1] == inf || x.v[2] == inf;
+  }
+
+  /// Exact, never-zero orientation of three finite vertices.
+  GALPHA_HD int Orient(int32_t a, int32_t b, int32_t c) const {
+    return Orient2dSoS(pts[a], sos[a], pts[b], sos[b], pts[c], sos[c]);
+  }
+
+  /// Whether vertex s lies inside the (symbolically perturbed) circumcircle of triangle t. For an
+  /// infinite triangle the "circle" is the open half-plane beyond its hull edge.
+  GALPHA_HD bool InConflict(int32_t t, int32_t s) const {
+    if (s == inf) return false;
+    const Tri& x = tri[t];
+    for (int k = 0; k < 3; ++k) {
+      if (x.v[k] == inf) return Orient(x.v[Next(k)], x.v[Prev(k)], s) > 0;
+    }
+    const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
+    return InCircleSoS(pts[a], sos[a], pts[b], sos[b], pts[c], sos[c], pts[s], sos[s]) > 0;
+  }
+
+  /// Position in triangle t of the edge running from a to b (the edge opposite that position), or -1.
+  GALPHA_HD int EdgePos(int32_t t, int32_t a, int32_t b) const {
+    const Tri& x = tri[t];
+    for (int k = 0; k < 3; ++k) {
+      if (x.v[Next(k)] == a && x.v[Prev(k)] == b) return k;
+    }
+    return -1;
+  }
+
+  /// Visibility walk from triangle t to a triangle containing vertex p: a finite triangle with p
+  /// inside (SoS orientation: never on an edge), or an infinite triangle whose hull edge p sees.
+  /// Terminates on a Delaunay triangulation (Edelsbrunner's acyclicity theorem); returns -1 if it
+  /// exceeds `max_steps`, which the caller reports as an internal error.
+  GALPHA_HD int32_t Locate(int32_t t, int32_t p, uint32_t max_steps) const {
+    for (uint32_t step = 0; step < max_steps; ++step) {
+      const Tri x = tri[t];
+      int inf_pos = -1;
+      for (int k = 0; k < 3; ++k) {
+        if (x.v[k] == inf) inf_pos = k;
+      }
+      if (inf_pos >= 0) {
+        // Hull edge u->w with the outside on its left; its sector is the wedge from ray
+        // center->w counter-clockwise to ray center->u.
+        const int32_t u = x.v[Next(inf_pos)], w = x.v[Prev(inf_pos)];
+        if (CenterOrient(w, p) < 0) {
+          t = nbr[t].n[Next(inf_pos)];  // across the edge (w, inf): the sector clockwise of w
+        } else if (CenterOrient(u, p) > 0) {
+          t = nbr[t].n[Prev(inf_pos)];  // across the edge (inf, u): the sector beyond u
+        } else if (Orient(u, w, p) > 0) {
+          return t;
+        } else {
+          t = nbr[t].n[inf_pos];
+        }
+        continue;
+      }
+      // Start at a rotating edge so that walks through long chains spread over the three choices.
+      const int first = static_cast<int>((static_cast<uint32_t>(p) + step) % 3u);
+      int exit_edge = -1;
+      for (int i = 0; i < 3; ++i) {
+        const int k = (first + i) % 3;
+        if (Orient(x.v[Next(k)], x.v[Prev(k)], p) < 0) {
+          exit_edge = k;
+          break;
+        }
+      }
+      if (exit_edge < 0) return t;
+      t = nbr[t].n[exit_edge];
+    }
+    return -1;
+  }
+
+  /// Whether the edge of t opposite position k must be flipped to restore the (SoS) Delaunay
+  /// property. Edges on the hull between a finite and an infinite triangle never flip; an edge
+  /// between two infinite triangles flips when its finite vertex is not convex (only while the hull
+  /// is still being built: `hull_may_change`).
+  GALPHA_HD bool ShouldFlip(int32_t t, int k, bool hull_may_change) const {
+    const Tri& x = tri[t];
+    const int32_t r = x.v[k], p = x.v[Next(k)], q = x.v[Prev(k)];
+    if (r == inf) return false;
+    const int32_t nb = nbr[t].n[k];
+    const int j = EdgePos(nb, q, p);
+    const int32_t s = tri[nb].v[j];
+    if (s == inf) return false;
+    if ((p == inf || q == inf) && !hull_may_change) return false;
+    return InConflict(t, s);
+  }
+};
+
+}  // namespace galpha::detail

@@ -1,0 +1,121 @@
+// Functors that order the input: exact-duplicate detection (lexicographic sort, first occurrence
+// wins) and the Hilbert curve key that gives the insertion rounds their locality.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "core/base/hd.hpp"
+#include "core/base/point.hpp"
+
+namespace galpha::detail {
+
+/// A 64-bit key with the order of the double (-0.0 and +0.0 get the same key): radix-sortable.
+GALPHA_HD inline uint64_t OrderedDoubleKey(double v) {
+  const double normalized = v + 0.0;  // -0.0 + 0.0 == +0.0
+  uint64_t bits;
+  memcpy(&bits, &normalized, sizeof bits);
+  return (bits >> 63) ? ~bits : (bits | 0x8000000000000000ull);
+}
+
+/// The sort key of coordinate y (kY) or x (kX) of the input point a permutation entry names. Sorting
+/// stably by y, then by x, orders by (x, y) with ties in index order (exact
+/// duplicates adjacent, first occurrence first), with two radix sorts instead of a comparison sort.
+struct CoordinateKey {
+  enum Axis { kX, kY };
+  const Point2* pts;
+  const uint32_t* order;
+  Axis axis;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const Point2 p = pts[order[k]];
+    return OrderedDoubleKey(axis == kX ? p.x : p.y);
+  }
+};
+
+/// Position of the head of the run of equal points that sorted position k belongs to (0 when k is
+/// not a head, for a max-scan).
+struct RunHeadPosition {
+  const Point2* pts;
+  const uint32_t* sorted;
+  GALPHA_HD uint32_t operator()(uint32_t k) const {
+    return (k == 0 || !(pts[sorted[k]] == pts[sorted[k - 1]])) ? k : 0u;
+  }
+};
+
+/// representative[input index] = input index of the run's head.
+struct WriteRepresentative {
+  const uint32_t* sorted;
+  const uint32_t* head;
+  uint32_t* representative;
+  GALPHA_HD void operator()(uint32_t k) const { representative[sorted[k]] = sorted[head[k]]; }
+};
+
+struct IsRunHead {
+  const uint32_t* head;
+  GALPHA_HD bool operator()(uint32_t k) const { return head[k] == k; }
+};
+
+struct BoundingBox {
+  double min_x, min_y, max_x, max_y;
+};
+
+struct PointToBox {
+  GALPHA_HD BoundingBox operator()(const Point2& p) const { return {p.x, p.y, p.x, p.y}; }
+};
+
+struct MergeBoxes {
+  GALPHA_HD BoundingBox operator()(const BoundingBox& a, const BoundingBox& b) const {
+    return {a.min_x < b.min_x ? a.min_x : b.min_x, a.min_y < b.min_y ? a.min_y : b.min_y,
+            a.max_x > b.max_x ? a.max_x : b.max_x, a.max_y > b.max_y ? a.max_y : b.max_y};
+  }
+};
+
+/// Hilbert curve index of a point quantized to a 2^kHilbertOrder grid over the bounding box.
+/// Only the insertion order depends on it, never a topological decision.
+struct HilbertKey {
+  static constexpr int kHilbertOrder = 21;
+  const Point2* pts;
+  const uint32_t* input_index;
+  BoundingBox box;
+
+  GALPHA_HD static uint32_t Quantize(double v, double lo, double hi) {
+    const double span = hi - lo;
+    if (!(span > 0.0)) return 0;
+    double f = (v - lo) / span;
+    f = f < 0.0 ? 0.0 : (f > 1.0 ? 1.0 : f);
+    return static_cast<uint32_t>(f * static_cast<double>((1u << kHilbertOrder) - 1));
+  }
+
+  GALPHA_HD uint64_t operator()(uint32_t i) const {
+    const Point2 p = pts[input_index[i]];
+    uint32_t x = Quantize(p.x, box.min_x, box.max_x);
+    uint32_t y = Quantize(p.y, box.min_y, box.max_y);
+    const uint32_t n = 1u << kHilbertOrder;
+    uint64_t d = 0;
+    for (uint32_t s = n >> 1; s > 0; s >>= 1) {
+      const uint32_t rx = (x & s) ? 1u : 0u;
+      const uint32_t ry = (y & s) ? 1u : 0u;
+      d += static_cast<uint64_t>(s) * s * ((3u * rx) ^ ry);
+      if (ry == 0) {  // rotate the quadrant so the curve stays continuous
+        if (rx == 1) {
+          x = n - 1 - x;
+          y = n - 1 - y;
+        }
+        const uint32_t tmp = x;
+        x = y;
+        y = tmp;
+      }
+    }
+    return d;
+  }
+};
+
+/// Gathers the distinct points into Hilbert order with their input indices (the SoS ranks).
+struct GatherVertex {
+  const Point2* input_points;
+  const uint32_t* input_index;
+  Point2* vertex_points;
+  GALPHA_HD void operator()(uint32_t v) const { vertex_points[v] = input_points[input_index[v]]; }
+};
+
+}  // namespace galpha::detail

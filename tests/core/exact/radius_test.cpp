@@ -1,0 +1,207 @@
+// Squared radii (core/radius.hpp) against exact GMP rationals: the certified key order, the bounded
+// exact comparison, and the nearest double, on random and adversarial simplices: exact ties
+// (congruent grid triangles and edges), near ties a few ulps apart, nearly collinear triangles,
+// huge offsets with small spacing, tiny and subnormal coordinates, mixed magnitudes.
+#include "core/exact/radius.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/exact/radius_rational.hpp"
+
+namespace galpha {
+namespace {
+
+struct Simplex {
+  Point2 p[3];
+  int n;
+};
+
+std::string Show(const Simplex& s) {
+  std::string out;
+  char text[96];
+  for (int i = 0; i < s.n; ++i) {
+    std::snprintf(text, sizeof text, "(%.17g, %.17g) ", s.p[i].x, s.p[i].y);
+    out += text;
+  }
+  return out;
+}
+
+double Ulps(double v, int n) {
+  for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? INFINITY : -INFINITY);
+  return v;
+}
+
+// Simplices of one family: integer-ish shapes placed at `offset`, scaled by 2^scale, optionally
+// nudged by ulps so that exact ties become near ties.
+std::vector<Simplex> Family(const std::string& name, int count, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> small(-6, 6), ulps(-2, 2), coin(0, 1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Simplex> out;
+  double offset = 0.0;
+  int scale = 0;
+  bool nudge = false;
+  if (name == "grid") scale = 0;
+  if (name == "offset1e9") offset = 1e9, scale = -10;
+  if (name == "offset1e15") offset = 1e15, scale = 0;
+  if (name == "tiny") scale = -1000;
+  if (name == "subnormal") scale = -1070;
+  if (name == "nudged") nudge = true, offset = 64.0;  // ulps of normal numbers
+  for (int i = 0; i < count; ++i) {
+    Simplex s;
+    s.n = 2 + coin(rng);
+    if (name == "uniform") {
+      for (int k = 0; k < s.n; ++k) s.p[k] = {unit(rng), unit(rng)};
+    } else if (name == "mixed") {
+      std::uniform_int_distribution<int> e(-300, 300);
+      for (int k = 0; k < s.n; ++k) s.p[k] = {std::ldexp(unit(rng), e(rng)), std::ldexp(unit(rng), e(rng))};
+    } else if (name == "flat") {
+      // Nearly collinear triangles: the third point a few ulps off the segment's midpoint.
+      s.n = 3;
+      const double ax = unit(rng), ay = unit(rng), bx = unit(rng), by = unit(rng);
+      s.p[0] = {ax, ay};
+      s.p[1] = {bx, by};
+      s.p[2] = {Ulps(0.5 * (ax + bx), ulps(rng)), Ulps(0.5 * (ay + by), ulps(rng))};
+    } else {
+      for (int k = 0; k < s.n; ++k) {
+        s.p[k] = {offset + std::ldexp(small(rng), scale), offset + std::ldexp(small(rng), scale)};
+        if (nudge) s.p[k] = {Ulps(s.p[k].x, ulps(rng)), Ulps(s.p[k].y, ulps(rng))};
+      }
+    }
+    bool distinct = true;
+    for (int a = 0; a < s.n; ++a)
+      for (int b = a + 1; b < s.n; ++b) distinct = distinct && !(s.p[a] == s.p[b]);
+    if (distinct) out.push_back(s);
+  }
+  return out;
+}
+
+class RadiusTest : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(RadiusTest, BoundedComparisonIsExactOrUndecided) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 400, 7);
+  ASSERT_GT(simplices.size(), 100u);
+  int decided = 0, ties = 0;
+  for (size_t i = 0; i < simplices.size(); ++i) {
+    for (size_t j = i; j < simplices.size() && j < i + 40; ++j) {
+      const Simplex& a = simplices[i];
+      const Simplex& b = simplices[j];
+      const int expected = CompareRadiusSqRational(a.p, a.n, b.p, b.n);
+      const int got = CompareRadiusSqBounded(a.p, a.n, b.p, b.n);
+      if (got == kRadiusUndecided) continue;
+      ++decided;
+      ties += expected == 0;
+      ASSERT_EQ(got, expected) << Show(a) << " vs " << Show(b);
+    }
+  }
+  // Every family here is within the bounded path's range except the mixed magnitudes.
+  int pairs = 0;
+  for (size_t i = 0; i < simplices.size(); ++i) pairs += static_cast<int>(std::min(simplices.size(), i + 40) - i);
+  if (GetParam() != "mixed") {
+    EXPECT_EQ(decided, pairs);
+  }
+  if (GetParam() == "grid" || GetParam() == "offset1e15") {
+    EXPECT_GT(ties, 0);
+  }
+}
+
+TEST_P(RadiusTest, CertifiedKeysOrderExactValues) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 400, 11);
+  int certified = 0;
+  for (size_t i = 0; i < simplices.size(); ++i) {
+    const RadiusSqApprox a = ApproxRadiusSq(simplices[i].p, simplices[i].n);
+    if (!a.certified) continue;
+    ++certified;
+    // The key's value is within 2^-40 of the exact one.
+    if (!RadiusSqRational(simplices[i].p, simplices[i].n)) {  // collinear: infinite, and keyed so
+      EXPECT_EQ(a.key, kInfiniteRadiusKey) << Show(simplices[i]);
+      continue;
+    }
+    for (size_t j = 0; j < simplices.size(); ++j) {
+      const RadiusSqApprox b = ApproxRadiusSq(simplices[j].p, simplices[j].n);
+      if (!b.certified || a.key > b.key || RadiusKeysMayTie(a.key, b.key)) continue;
+      // Keys far apart: the exact values must be strictly in key order.
+      ASSERT_LT(CompareRadiusSqRational(simplices[i].p, simplices[i].n, simplices[j].p, simplices[j].n), 0)
+          << Show(simplices[i]) << " key " << a.key << " vs " << Show(simplices[j]) << " key " << b.key;
+    }
+  }
+  if (GetParam() != "mixed") {
+    EXPECT_EQ(certified, static_cast<int>(simplices.size()));
+  }
+}
+
+TEST_P(RadiusTest, NearestDoubleMatchesGmp) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 300, 13);
+  int done = 0;
+  for (const Simplex& s : simplices) {
+    double got = 0.0;
+    if (!NearestRadiusSqBounded(s.p, s.n, &got)) continue;
+    ++done;
+    const std::optional<mpq_class> exact = RadiusSqRational(s.p, s.n);
+    if (!exact) {
+      EXPECT_TRUE(std::isinf(got)) << Show(s);
+      continue;
+    }
+    const double expected = NearestDouble(*exact);
+    if (std::fpclassify(expected) == FP_SUBNORMAL || expected == 0.0) {
+      // One extra rounding is allowed below the normal range.
+      EXPECT_LE(std::abs(got - expected), std::ldexp(1.0, -1074)) << Show(s);
+    } else {
+      ASSERT_EQ(got, expected) << Show(s);
+    }
+  }
+  if (GetParam() != "mixed" && GetParam() != "flat") {
+    EXPECT_EQ(done, static_cast<int>(simplices.size()));
+  }
+}
+
+TEST_P(RadiusTest, FastNearestDoubleIsExactWhenItAnswers) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 400, 17);
+  int answered = 0;
+  for (const Simplex& s : simplices) {
+    double got = 0.0;
+    if (!NearestRadiusSqFast(s.p, s.n, &got)) continue;
+    ++answered;
+    const std::optional<mpq_class> exact = RadiusSqRational(s.p, s.n);
+    ASSERT_TRUE(exact.has_value()) << Show(s);
+    ASSERT_EQ(got, NearestDouble(*exact)) << Show(s);
+  }
+  // The fast path answers nearly everything in ordinary ranges.
+  if (GetParam() == "uniform" || GetParam() == "grid" || GetParam() == "offset1e9") {
+    EXPECT_GT(answered, static_cast<int>(simplices.size()) * 9 / 10);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Families, RadiusTest,
+                         ::testing::Values("uniform", "grid", "nudged", "offset1e9", "offset1e15", "tiny",
+                                           "subnormal", "mixed", "flat"));
+
+TEST(RadiusTest, HandComputedValues) {
+  // Unit square's triangle (0,0) (1,0) (1,1): circumradius^2 = 1/2; its side as an edge: 1/4.
+  const Point2 tri[3] = {{0, 0}, {1, 0}, {1, 1}};
+  const Point2 edge[2] = {{0, 0}, {1, 0}};
+  const Point2 diagonal[2] = {{0, 0}, {1, 1}};
+  double v = 0.0;
+  ASSERT_TRUE(NearestRadiusSqBounded(tri, 3, &v));
+  EXPECT_EQ(v, 0.5);
+  ASSERT_TRUE(NearestRadiusSqBounded(edge, 2, &v));
+  EXPECT_EQ(v, 0.25);
+  EXPECT_EQ(CompareRadiusSqBounded(tri, 3, diagonal, 2), 0);  // the hypotenuse is a diameter
+  EXPECT_EQ(CompareRadiusSqBounded(edge, 2, tri, 3), -1);
+  // Collinear: infinite.
+  const Point2 flat[3] = {{0, 0}, {1, 1}, {2, 2}};
+  EXPECT_EQ(ApproxRadiusSq(flat, 3).key, kInfiniteRadiusKey);
+  EXPECT_EQ(CompareRadiusSqBounded(flat, 3, tri, 3), 1);
+  EXPECT_EQ(NearestDouble(mpq_class(1, 3)), 1.0 / 3.0);
+  EXPECT_EQ(NearestDouble(mpq_class(1, 10)), 0.1);
+}
+
+}  // namespace
+}  // namespace galpha
