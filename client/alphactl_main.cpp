@@ -2,7 +2,7 @@
 //
 //   alphactl COMMAND FILE [OPTIONS]      (alphactl --help lists the commands: cli_args.cpp)
 //
-// Output is for scripts (DESIGN.md section 5): JSON on one line, or one simplex or value per line.
+// Output is for scripts (docs/design.md, "Formats"): JSON on one line, or one simplex or value per line.
 // Errors are one line on standard error starting with "alphactl: ", and a non-zero exit status:
 // 2 for a usage error, 1 for a failure (unreadable file, bad input).
 #include <cstdio>

@@ -1,9 +1,10 @@
-// The exact attachment test of the alpha-shape family (report, chapter 2; DESIGN.md section 2): an
-// edge pq is attached when the third vertex r of an incident Delaunay triangle lies strictly inside
-// the edge's diametral circle (the smallest circle through p and q). By Thales' theorem that is
-// the sign of the dot product (p - r) . (q - r): negative inside, zero on the circle (unattached,
-// as in CGAL), positive outside. Same three layers as core/predicates.hpp: a floating filter, then
-// expansion arithmetic; one source for host and device.
+// The exact attachment test of the alpha-shape family (the report "Computing 2D Alpha Shapes Using GPU",
+// chapter 2; docs/design.md, "Semantics"): an edge pq is attached when the third vertex r of an
+// incident Delaunay triangle lies strictly inside the edge's diametral circle (the smallest circle
+// through p and q). By Thales' theorem that is the sign of the dot product (p - r) . (q - r):
+// negative inside, zero on the circle (unattached, as in CGAL), positive outside. Same three layers
+// as core/exact/predicates.hpp: a floating filter, then expansion arithmetic; one source for host
+// and device.
 #pragma once
 
 #include "core/exact/expansion.hpp"
@@ -20,7 +21,7 @@ constexpr int kDiametralExpansionCapacity = 16;
 
 /// (p - r) . (q - r), scaled by a power of two so that nothing underflows or overflows, as a
 /// nonoverlapping expansion of at most kDiametralExpansionCapacity components; returns its length.
-/// Exact over the range of Orient2dSign (core/predicates.hpp): the computation has the same shape.
+/// Exact over the range of Orient2dSign (core/exact/predicates.hpp): the computation has the same shape.
 GALPHA_HD inline int DiametralDotExpansion(Point2 p, Point2 q, Point2 r, double* out) {
   // p - r and q - r, by coordinate
   double d[4][2];

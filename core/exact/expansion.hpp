@@ -25,7 +25,7 @@
 // underflows. Two-Product(a, b) is exact when exponent(a) + exponent(b) >= -970 (no underflow of
 // its tail) and |a|, |b| < 2^996 (Split multiplies by 2^27 + 1). Sums (Two-Sum, Two-Diff) are
 // exact for all finite operands whose sum does not overflow, subnormals included. The predicates
-// (core/predicates.hpp) rescale their inputs by powers of two to stay inside these limits.
+// (core/exact/predicates.hpp) rescale their inputs by powers of two to stay inside these limits.
 //
 // Every function is usable from device code: no exceptions, no allocation, no std:: calls;
 // callers provide fixed-size output arrays whose capacity bounds are stated per function.

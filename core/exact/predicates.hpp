@@ -8,11 +8,11 @@
 //
 // Each sign is computed adaptively (Shewchuk 1997): a floating-point filter with a rigorous error
 // bound decides the common case; only when it cannot, an exact evaluation with expansion
-// arithmetic (core/expansion.hpp) runs. The SoS variants never return 0: they evaluate the exact
+// arithmetic (core/exact/expansion.hpp) runs. The SoS variants never return 0: they evaluate the exact
 // sign first and fall back to the perturbation terms only when it is 0.
 //
-// SUPPORTED COORDINATE RANGE (the guarantee; tests/core/predicates_test.cpp checks it). Let H be
-// the largest |coordinate| and m the smallest nonzero |coordinate| among the points of one call,
+// SUPPORTED COORDINATE RANGE (the guarantee; tests/core/exact/predicates_test.cpp checks it). Let
+// H be the largest |coordinate| and m the smallest nonzero |coordinate| among the points of one call,
 // and m' = max(m, 2^-1022) (subnormals count as 2^-1022). Then:
 //   * Orient2dSign is exact when H < 2^1022 (~4.4e307) and H / m' < 2^930 (~9e279);
 //   * InCircleSign, Orient2dSoS and InCircleSoS are exact when H < 2^1022 and H / m' < 2^437

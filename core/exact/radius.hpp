@@ -2,7 +2,7 @@
 //
 // rho^2 of an edge pq is |q - p|^2 / 4; of a triangle abc it is |b-a|^2 |c-a|^2 |c-b|^2 / (4 D^2)
 // with D = orient2d(a, b, c) (twice the signed area). Both are exact rationals of the input. The
-// alpha spectrum needs them in exact order (DESIGN.md section 3), which this header provides in
+// alpha spectrum needs them in exact order (docs/design.md, "Exactness"), which this header provides in
 // three layers, one source for host and device:
 //   1. RadiusSqApprox: a 64-bit order-preserving key of a double approximation whose relative
 //      error is certified to be below kRadiusSqRelErr (or flagged `certified == false`). Two keys
@@ -11,7 +11,7 @@
 //      device's path). It answers kRadiusUndecided when a buffer would overflow or the operands'
 //      exponent range would make an error-free transformation inexact; the caller then uses
 //      layer 3.
-//   3. core/radius_rational.hpp: GMP rationals on the host, exact and unbounded (the CPU fallback).
+//   3. core/exact/radius_rational.hpp: GMP rationals on the host, exact and unbounded (the CPU fallback).
 // NearestRadiusSqBounded gives the double nearest to an exact rho^2 (the spectrum's published value).
 #pragma once
 
