@@ -1,4 +1,4 @@
-// The service's Prometheus metrics (DESIGN.md section 4), in base units, counters with `_total`,
+// The service's Prometheus metrics (server/README.md, "Metrics"), in base units, counters with `_total`,
 // no handle labels (handles are unbounded). The exporter serves them on its own port.
 #pragma once
 

@@ -1,6 +1,6 @@
 // AlphaFamily: the immutable, exact family of alpha shapes of one point set, and every query over
 // it (classification, spectrum, master list, components, optimal alpha, the shape as geometry).
-// Built by BuildAlphaFamily (gpu/alpha_engine.hpp); semantics in ../shared/DESIGN.md section 2.
+// Built by BuildAlphaFamily (gpu/alpha/alpha_engine.hpp); semantics in docs/design.md, "Semantics".
 //
 // Thresholds are resolved to a *level*: the number of spectrum values <= the threshold, compared
 // exactly (level 0: alpha_sq in [0, spectrum[0]); level -1: a negative alpha_sq, where nothing is in).
@@ -28,7 +28,8 @@ const char* SimplexClassName(SimplexClass c);
 
 /// GENERAL keeps singular simplices; REGULARIZED keeps only what bounds or fills triangles.
 enum class ClassifyMode { kGeneral, kRegularized };
-/// Vertex classes from incident edges (the report's rule) or from incident triangles (CGAL's).
+/// Vertex classes from incident edges (the rule of the report "Computing 2D Alpha Shapes Using GPU") or
+/// from incident triangles (CGAL's).
 enum class VertexRule { kReport, kCgal };
 
 /// What a build measured.

@@ -1,6 +1,7 @@
-// The rank tables of an alpha-shape family: what the engine computes after the triangulation (the
-// report's chapter 3: spectrum, ranks, intervals, master list). Plain data shared by the engine
-// backends and AlphaFamily. Semantics: ../shared/DESIGN.md section 2.
+// The rank tables of an alpha-shape family: what the engine computes after the triangulation
+// (the report "Computing 2D Alpha Shapes Using GPU", chapter 3: spectrum, ranks, intervals, master
+// list). Plain data shared by the engine backends and AlphaFamily. Semantics: docs/design.md,
+// "Semantics".
 #pragma once
 
 #include <array>
@@ -41,7 +42,7 @@ class MasterEntry {
 };
 static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "master entries are packed");
 
-/// How the exact order of the spectrum was decided, by comparison path (DESIGN.md section 3).
+/// How the exact order of the spectrum was decided, by comparison path (docs/design.md, "Exactness").
 struct ComparisonCounts {
   /// Neighbouring pairs of the approximately sorted spectrum ordered by their certified keys alone.
   uint64_t filter = 0;

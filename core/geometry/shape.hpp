@@ -1,4 +1,4 @@
-// The alpha shape as geometry (DESIGN.md section 2, "Shape"): the complex at one threshold turned
+// The alpha shape as geometry (docs/design.md, "Semantics"): the complex at one threshold turned
 // into polygons, line strings and points that GEOS, PostGIS and GeoJSON readers accept as valid,
 // and the writers for WKT, GeoJSON (RFC 7946) and SVG.
 //

@@ -1,5 +1,5 @@
-// Point files in the formats users bring (DESIGN.md section 5), next to the raw `.bin` format of
-// point_io.hpp: delimited text (CSV, TSV, whitespace) and NumPy `.npy` arrays. Nothing is
+// Point files in the formats users bring (docs/design.md, "Formats"), next to the raw `.bin` format
+// of point_io.hpp: delimited text (CSV, TSV, whitespace), NumPy `.npy` arrays and GeoJSON. Nothing is
 // deduplicated or validated for finiteness here: the engine's validation layer does that, naming
 // the point's index (its row among the data rows).
 #pragma once

@@ -1,4 +1,4 @@
-// Reading and writing the raw binary point format (data/README.md, DESIGN.md section 5):
+// Reading and writing the raw binary point format (data/README.md; docs/design.md, "Formats"):
 // little-endian uint64 N, then N pairs of little-endian float64 (x, y). Nothing is deduplicated,
 // rounded or validated for finiteness here: the engine's validation layer does that.
 #pragma once

@@ -1,4 +1,4 @@
-// Content-derived handles of point sets (DESIGN.md section 4): a SHA-256 tree over the points as a
+// Content-derived handles of point sets (docs/design.md, "Formats"): a SHA-256 tree over the points as a
 // client sends them, so that equal inputs get equal handles on every replica and the client can
 // compute a handle before uploading anything (to skip the upload when the server holds the family,
 // and to route the stream to the replica that would hold it).

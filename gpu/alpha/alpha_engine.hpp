@@ -1,4 +1,4 @@
-// BuildAlphaFamily: points in, the exact family of alpha shapes out (core/alpha_family.hpp). Runs
+// BuildAlphaFamily: points in, the exact family of alpha shapes out (core/family/alpha_family.hpp). Runs
 // the triangulation and the alpha pipeline on one backend (CUDA on one stream, or OpenMP).
 #pragma once
 
@@ -24,7 +24,7 @@ struct BuildOptions {
   std::function<bool()> cancelled;
 };
 
-/// Builds the family. Errors as Triangulate's (gpu/delaunay.hpp), and Cancelled.
+/// Builds the family. Errors as Triangulate's (gpu/triangulation/delaunay.hpp), and Cancelled.
 absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options = {});
 
 }  // namespace galpha

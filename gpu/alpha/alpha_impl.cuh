@@ -1,7 +1,8 @@
 // The alpha pipeline after the triangulation, written once over an execution system (CpuSystem or
 // CudaSystem): edge topology, radii and attachment, the exact spectrum (sort by certified keys,
 // exact repair of the runs whose keys may tie, merge of exact ties), ranks, intervals and the
-// master list and the component curves (report chapters 3-4; DESIGN.md sections 2-3).
+// master list and the component curves (the report "Computing 2D Alpha Shapes Using GPU", chapters 3-4;
+// docs/design.md, "Semantics" and "Exactness").
 #pragma once
 
 #include <thrust/copy.h>
@@ -310,7 +311,7 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   timer.EndStage("components");
 
   // The rest of the family, then the downloads started earlier (the host arrays are not zeroed
-  // first: the copies are their first touch, on every core; core/host_vector.hpp).
+  // first: the copies are their first touch, on every core; core/base/host_vector.hpp).
   out->components.resize(static_cast<size_t>(num_ranks) + 1);
   out->solid_components.resize(static_cast<size_t>(num_ranks) + 1);
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);

@@ -32,9 +32,10 @@ struct TriangulateOptions {
 ///
 /// Vertices are input indices; an input point that duplicates an earlier one is represented by the
 /// first occurrence (see `representative`). Triangles are counter-clockwise. The edge list follows
-/// the report's ownership rule (section 3.1): triangle t owns its local edge k (from vertex k to
-/// vertex k+1) when the vertex indices increase along it or when it is a hull edge; edges are laid
-/// out triangle by triangle in the order of an exclusive scan of the owned counts.
+/// the ownership rule of the report "Computing 2D Alpha Shapes Using GPU" (section 3.1): triangle t
+/// owns its local edge k (from vertex k to vertex k+1) when the vertex indices increase along it or
+/// when it is a hull edge; edges are laid out triangle by triangle in the order of an exclusive scan
+/// of the owned counts.
 struct Triangulation {
   /// Input points exactly as given (duplicates included).
   std::vector<Point2> points;

@@ -1,6 +1,6 @@
 // Turns the working mesh (sphere with the vertex at infinity, Hilbert vertex ids) into the output:
-// finite triangles named by input indices, neighbours, and the edge list by the report's ownership
-// rule (section 3.1 / 4.3.1).
+// finite triangles named by input indices, neighbours, and the edge list by the ownership rule of
+// the report "Computing 2D Alpha Shapes Using GPU" (sections 3.1 and 4.3.1).
 #pragma once
 
 #include <cstdint>

@@ -1,10 +1,11 @@
 // An independent, exact validator of galpha::Triangulation, for tests.
 //
 // It re-derives everything the engine promises from the points alone, with the exact predicates of
-// core/predicates.hpp and none of the engine's code: the representatives of duplicates, a
+// core/exact/predicates.hpp and none of the engine's code: the representatives of duplicates, a
 // counter-clockwise manifold triangulation whose boundary is the convex hull (collinear hull points
-// included, as in CGAL), the report's edge ownership layout (section 3.1), Euler's relation, and the
-// Delaunay property under Simulation of Simplicity on input indices.
+// included, as in CGAL), the edge ownership layout of the report "Computing 2D Alpha Shapes Using GPU"
+// (section 3.1), Euler's relation, and the Delaunay property under Simulation of Simplicity on input
+// indices.
 #pragma once
 
 #include "absl/status/status.h"
