@@ -191,8 +191,9 @@ TEST(AlphactlTest, ClassifiesTheSquareAtEveryRank) {
             Lines({"v 0 SINGULAR", "v 1 SINGULAR", "v 2 SINGULAR", "v 3 SINGULAR", "e 0 1 EXTERIOR",
                    "e 0 3 EXTERIOR", "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR",
                    "t 1 2 3 EXTERIOR"}));
-  // alpha_sq = 1/4: the sides are in with no triangle; vertices are REGULAR by the report's rule
-  // (an incident edge is in), SINGULAR by CGAL's (no incident triangle).
+  // alpha_sq = 1/4: the sides are in with no triangle; vertices are REGULAR by the rule of the
+  // report "Computing 2D Alpha Shapes Using GPU" (an incident edge is in), SINGULAR by CGAL's (no
+  // incident triangle).
   const std::string rank1_edges =
       Lines({"e 0 1 SINGULAR", "e 0 3 SINGULAR", "e 1 2 SINGULAR", "e 1 3 EXTERIOR", "e 2 3 SINGULAR",
              "t 0 1 3 EXTERIOR", "t 1 2 3 EXTERIOR"});

@@ -29,7 +29,8 @@
 //       alpha < mid : SINGULAR in GENERAL mode (vertices are never EXTERIOR there; REGULARIZED:
 //                     EXTERIOR);
 //       alpha >= mid: REGULAR if hull vertex or alpha < max, else INTERIOR.
-//     Hence a vertex that only has SINGULAR edges is SINGULAR for CGAL (REGULAR in the report);
+//     Hence a vertex that only has SINGULAR edges is SINGULAR for CGAL (REGULAR in the report
+//     "Computing 2D Alpha Shapes Using GPU");
 //     a hull vertex is never INTERIOR.
 // (d) number_of_solid_components(alpha): connected components of the finite faces with
 //     r2 <= alpha, two faces being connected iff they share an edge (BFS over neighbor());

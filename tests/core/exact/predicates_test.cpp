@@ -1,4 +1,4 @@
-// Tests of core/expansion.hpp and core/predicates.hpp against exact rational arithmetic (GMP).
+// Tests of core/exact/expansion.hpp and core/exact/predicates.hpp against exact rational arithmetic (GMP).
 //
 // Every predicate is compared with the sign computed in mpq_class (doubles convert to mpq exactly)
 // on families of adversarial inputs, inside the coordinate range the header guarantees. The SoS

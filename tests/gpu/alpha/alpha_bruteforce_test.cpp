@@ -1,4 +1,4 @@
-// The alpha family against its definitions (DESIGN.md section 2), computed by brute force with GMP
+// The alpha family against its definitions (docs/design.md, "Semantics"), computed by brute force with GMP
 // rationals, independently of CGAL and of the engine: on small point sets whose Delaunay
 // triangulation is unique, a triple is a Delaunay triangle iff no other point lies inside or on its
 // circumcircle; births, attachment and the spectrum come straight from their definitions; every
@@ -498,7 +498,7 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
     ASSERT_TRUE(IsNearestDouble(d, want)) << "rank " << rank << ": " << d;
   }
 
-  // The rank tables (core/alpha_ranks.hpp), entry by entry.
+  // The rank tables (core/family/alpha_ranks.hpp), entry by entry.
   for (uint32_t t = 0; t < num_tri; ++t) {
     ASSERT_EQ(r.tri_rank[t], b.RankOf(b.tri_birth[tri_map[t]])) << "triangle " << t;
   }
@@ -575,7 +575,7 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
     ASSERT_EQ(f.SolidComponents(level), BruteSolidComponents(b, A)) << "level " << level;
   }
 
-  // Optimal levels, by their definitions in core/alpha_family.hpp, over all levels 0..K.
+  // Optimal levels, by their definitions in core/family/alpha_family.hpp, over all levels 0..K.
   std::optional<int64_t> solid;
   if (!b.tris.empty()) {
     for (int64_t level = 0; level <= k && !solid; ++level) {

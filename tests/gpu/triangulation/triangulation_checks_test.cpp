@@ -21,7 +21,8 @@ Triangulation WithPoints(std::vector<Point2> points) {
 }
 
 // The square (0,0) (2,0) (2,2) (0,2) and its centre 4, four triangles around the centre; neighbours
-// and the owned edges worked out by hand from the report's section 3.1.
+// and the owned edges worked out by hand from the report "Computing 2D Alpha Shapes Using GPU",
+// section 3.1.
 Triangulation SquareWithCentre() {
   Triangulation t = WithPoints({{0, 0}, {2, 0}, {2, 2}, {0, 2}, {1, 1}});
   t.triangles = {{0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
