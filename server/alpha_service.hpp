@@ -19,8 +19,10 @@
 
 namespace galpha::server {
 
-/// Estimated peak working memory of one build, per point (measured peaks: 508 B/pt on an H100,
-/// 580 B/pt on the CPU backend; bench/README.md), with headroom.
+/// Estimated peak working memory of one build, per point, with headroom over the engine's measured
+/// peaks (bench/README.md): 520 B/pt of device memory on an H100 (uniform, gaussian and clustered
+/// points) and 584 B/pt of host memory on the CPU backend. Admission charges this plus the point
+/// itself (16 bytes): 656 B/pt.
 inline constexpr size_t kBuildBytesPerPoint = 640;
 
 struct ServiceOptions {
