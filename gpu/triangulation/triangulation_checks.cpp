@@ -267,9 +267,9 @@ absl::Status CheckConnected(const Context& c) {
   return absl::OkStatus();
 }
 
-// Report section 3.1: triangle t owns its local edge e (vertex e to vertex e+1) when the indices
-// increase along it or it is a hull edge; owned edges are laid out triangle by triangle, in local
-// order, starting at the exclusive scan of the owned counts.
+// The report "Computing 2D Alpha Shapes Using GPU", section 3.1: triangle t owns its local edge e
+// (vertex e to vertex e+1) when the indices increase along it or it is a hull edge; owned edges are
+// laid out triangle by triangle, in local order, starting at the exclusive scan of the owned counts.
 absl::Status CheckEdgeList(const Context& c) {
   const Triangulation& t = c.t;
   size_t next = 0;
