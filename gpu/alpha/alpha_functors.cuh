@@ -298,7 +298,8 @@ struct NearestSpectrumValue {
   }
 };
 
-/// Edge intervals (report Table 2.1) and their contribution to their vertices' intervals.
+/// Edge intervals (Table 2.1 of the report "Computing 2D Alpha Shapes Using GPU") and their
+/// contribution to their vertices' intervals.
 struct EdgeIntervals {
   const EdgeIdx* edges;
   const EdgeTris* edge_tris;
