@@ -1,6 +1,7 @@
 // Exact squared radii as GMP rationals: the CPU fallback of the spectrum's exact comparisons
-// (core/exact/radius.hpp's bounded path answers "undecided" beyond its buffers and exponent range)
-// and the exact comparison of user thresholds with the spectrum. Host only; exact and unbounded.
+// (core/exact/radius_compare.hpp's bounded path answers Order::kUndecided beyond its buffers and
+// exponent range) and the exact comparison of user thresholds with the spectrum. Host only; exact
+// and unbounded.
 #pragma once
 
 #include <gmpxx.h>

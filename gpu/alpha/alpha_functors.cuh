@@ -9,7 +9,10 @@
 #include "core/exact/attachment.hpp"
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
-#include "core/exact/radius.hpp"
+#include "core/exact/order.hpp"
+#include "core/exact/radius_compare.hpp"
+#include "core/exact/radius_key.hpp"
+#include "core/exact/radius_nearest.hpp"
 #include "gpu/system/atomic_increment.cuh"
 
 namespace galpha::detail {
@@ -180,14 +183,14 @@ struct RepairRun {
       uint32_t j = i;
       while (j > 0) {
         const int ny = simplex(local[j - 1], pb);
-        const int c = CompareRadiusSqBounded(pb, ny, pa, nx);
+        const Order c = CompareRadiusSqBounded(pb, ny, pa, nx);
         ++count;
-        if (c == kRadiusUndecided) {
+        if (c == Order::kUndecided) {
           needs_host[r] = 1;
           comparisons[r] = count;
           return;
         }
-        if (c <= 0) break;
+        if (c != Order::kGreater) break;
         local[j] = local[j - 1];
         --j;
       }
@@ -197,14 +200,14 @@ struct RepairRun {
     for (uint32_t i = 1; i < n; ++i) {
       const int na = simplex(local[i - 1], pa);
       const int nb = simplex(local[i], pb);
-      const int c = CompareRadiusSqBounded(pa, na, pb, nb);
+      const Order c = CompareRadiusSqBounded(pa, na, pb, nb);
       ++count;
-      if (c == kRadiusUndecided) {
+      if (c == Order::kUndecided) {
         needs_host[r] = 1;
         comparisons[r] = count;
         return;
       }
-      new_value[b + i] = c != 0 ? 1 : 0;
+      new_value[b + i] = c != Order::kEqual ? 1 : 0;
     }
     for (uint32_t i = 0; i < n; ++i) ids[b + i] = local[i];
     comparisons[r] = count;

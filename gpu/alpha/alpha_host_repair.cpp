@@ -1,9 +1,11 @@
 #include "gpu/alpha/alpha_host_repair.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
-#include "core/exact/radius.hpp"
+#include "core/exact/order.hpp"
+#include "core/exact/radius_compare.hpp"
 #include "core/exact/radius_rational.hpp"
 
 namespace galpha::detail {
@@ -17,10 +19,10 @@ class ExactComparator {
   int operator()(uint32_t a, uint32_t b) {
     Point2 pa[3], pb[3];
     const int na = Points(a, pa), nb = Points(b, pb);
-    const int c = CompareRadiusSqBounded(pa, na, pb, nb);
-    if (c != kRadiusUndecided) {
+    const Order c = CompareRadiusSqBounded(pa, na, pb, nb);
+    if (c != Order::kUndecided) {
       ++counts_.bounded_exact;
-      return c;
+      return SignOf(c);
     }
     ++counts_.cpu_fallback;
     return CompareRadiusSqRational(pa, na, pb, nb);

@@ -1,9 +1,7 @@
-// Squared radii (core/radius.hpp) against exact GMP rationals: the certified key order, the bounded
+// Squared radii (core/exact/radius_*.hpp) against exact GMP rationals: the certified key order, the bounded
 // exact comparison, and the nearest double, on random and adversarial simplices: exact ties
 // (congruent grid triangles and edges), near ties a few ulps apart, nearly collinear triangles,
 // huge offsets with small spacing, tiny and subnormal coordinates, mixed magnitudes.
-#include "core/exact/radius.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "core/exact/order.hpp"
+#include "core/exact/radius_compare.hpp"
+#include "core/exact/radius_key.hpp"
+#include "core/exact/radius_nearest.hpp"
 #include "core/exact/radius_rational.hpp"
 
 namespace galpha {
@@ -94,11 +96,11 @@ TEST_P(RadiusTest, BoundedComparisonIsExactOrUndecided) {
       const Simplex& a = simplices[i];
       const Simplex& b = simplices[j];
       const int expected = CompareRadiusSqRational(a.p, a.n, b.p, b.n);
-      const int got = CompareRadiusSqBounded(a.p, a.n, b.p, b.n);
-      if (got == kRadiusUndecided) continue;
+      const Order got = CompareRadiusSqBounded(a.p, a.n, b.p, b.n);
+      if (got == Order::kUndecided) continue;
       ++decided;
       ties += expected == 0;
-      ASSERT_EQ(got, expected) << Show(a) << " vs " << Show(b);
+      ASSERT_EQ(SignOf(got), expected) << Show(a) << " vs " << Show(b);
     }
   }
   // Every family here is within the bounded path's range except the mixed magnitudes.
@@ -193,12 +195,12 @@ TEST(RadiusTest, HandComputedValues) {
   EXPECT_EQ(v, 0.5);
   ASSERT_TRUE(NearestRadiusSqBounded(edge, 2, &v));
   EXPECT_EQ(v, 0.25);
-  EXPECT_EQ(CompareRadiusSqBounded(tri, 3, diagonal, 2), 0);  // the hypotenuse is a diameter
-  EXPECT_EQ(CompareRadiusSqBounded(edge, 2, tri, 3), -1);
+  EXPECT_EQ(CompareRadiusSqBounded(tri, 3, diagonal, 2), Order::kEqual);  // the hypotenuse is a diameter
+  EXPECT_EQ(CompareRadiusSqBounded(edge, 2, tri, 3), Order::kLess);
   // Collinear: infinite.
   const Point2 flat[3] = {{0, 0}, {1, 1}, {2, 2}};
   EXPECT_EQ(ApproxRadiusSq(flat, 3).key, kInfiniteRadiusKey);
-  EXPECT_EQ(CompareRadiusSqBounded(flat, 3, tri, 3), 1);
+  EXPECT_EQ(CompareRadiusSqBounded(flat, 3, tri, 3), Order::kGreater);
   EXPECT_EQ(NearestDouble(mpq_class(1, 3)), 1.0 / 3.0);
   EXPECT_EQ(NearestDouble(mpq_class(1, 10)), 0.1);
 }

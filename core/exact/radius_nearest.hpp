@@ -1,0 +1,183 @@
+// The double nearest to an exact squared radius: the alpha spectrum's published values. A fast
+// double-double path with a certified error bound decides almost every rounding; the rest are
+// rounded exactly on the expansion terms (radius_terms.hpp), and what the bounded buffers cannot
+// hold goes to the host's GMP fallback (radius_rational.hpp). Host and device alike.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/base/hd.hpp"
+#include "core/base/point.hpp"
+#include "core/exact/expansion.hpp"
+#include "core/exact/order.hpp"
+#include "core/exact/radius_terms.hpp"
+
+namespace galpha {
+
+namespace radius_detail {
+
+/// The order of Num against 4 m Den for m = c + h (h a power of two, a half gap to a neighbour of
+/// c, so that (c, h) is a nonoverlapping pair): the exact value against m. Order::kUndecided on
+/// overflow.
+GALPHA_HD inline Order CompareToScaled(const ExactRadiusTerms& t, double c, double h) {
+  double m[2];
+  const int mn = TwoToExpansion(Mul(c, 4.0), Mul(h, 4.0), m);
+  double prod[kBoundedCapacity], diff[kBoundedCapacity];
+  int prodn, diffn;
+  if (!BoundedProduct(mn, m, t.denn, t.den, prod, &prodn)) return Order::kUndecided;
+  if (!BoundedSum(t.numn, t.num, prodn, prod, true, diff, &diffn)) return Order::kUndecided;
+  return OrderOfSign(ExpansionSign(diffn, diff));
+}
+
+GALPHA_HD GALPHA_FORCEINLINE double NextUp(double c) { return BitsToDouble(DoubleBits(c) + 1); }
+GALPHA_HD GALPHA_FORCEINLINE double NextDown(double c) { return BitsToDouble(DoubleBits(c) - 1); }
+
+}  // namespace radius_detail
+
+/// The double nearest to rho^2 of the simplex p[0..n) (ties to even), into *out: exact rounding
+/// whenever the result is a normal double (in the subnormal range the correctly rounded
+/// significand is scaled with one more rounding). Collinear triangles give +infinity. False when
+/// the bounded buffers or the exponent range do not suffice (use the CPU fallback).
+GALPHA_HD inline bool NearestRadiusSqBounded(const Point2* p, int n, double* out) {
+  using namespace radius_detail;
+  double dmax = 0.0;
+  int lowest = 1 << 20;
+  int s = 0;
+  ExactRadiusTerms t;
+  if (!DifferenceRange(p, n, &dmax, &lowest) || !ExactScaleFor(dmax, lowest, n == 2 ? 2 : 6, &s) ||
+      !ExactTerms(p, n, s, &t)) {
+    return false;
+  }
+  if (t.denn == 0) {
+    *out = BitsToDouble(uint64_t{0x7ff} << 52);
+    return true;
+  }
+  // In scaled units v = Num / (4 Den) = q * 2^shift with q in (1/4, 4) and c its first guess. The
+  // largest scaled difference is about 2^96 and rho is at least half the longest edge, so shift
+  // >= 188; a shift above 700 (a triangle whose radius exceeds its edges by 2^250) goes to the
+  // fallback, which keeps m * Den below and above the limits of Two-Product.
+  const double num = t.num[t.numn - 1], den = t.den[t.denn - 1];
+  const int num_exp = ExponentOf(num), den_exp = ExponentOf(den);
+  const int shift = num_exp - den_exp - 2;
+  if (shift > 700 || shift < 100) return false;
+  const double scale = Pow2(shift);
+  double c = ScaleByPow2(num, -num_exp) / ScaleByPow2(den, -den_exp);
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    // Midpoints to the neighbours: c + up and c - down (up, down: half gaps, powers of two).
+    const double up = Mul(Sub(NextUp(c), c), 0.5);
+    const double down = Mul(Sub(c, NextDown(c)), 0.5);
+    const Order above = CompareToScaled(t, Mul(c, scale), Mul(up, scale));
+    const Order below = CompareToScaled(t, Mul(c, scale), -Mul(down, scale));
+    if (above == Order::kUndecided || below == Order::kUndecided) return false;
+    const bool even = (DoubleBits(c) & 1) == 0;
+    if (above == Order::kGreater || (above == Order::kEqual && !even)) {
+      c = NextUp(c);
+    } else if (below == Order::kLess || (below == Order::kEqual && !even)) {
+      c = NextDown(c);
+    } else {
+      *out = ldexp(c, shift - 2 * s);
+      return true;
+    }
+  }
+  return false;
+}
+
+namespace radius_detail {
+
+/// Double-double value h + l (|l| <= half an ulp of h after TwoSum).
+struct DoubleDouble {
+  double h, l;
+};
+
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble Normalize(double h, double l) {
+  DoubleDouble r;
+  TwoSum(h, l, r.h, r.l);
+  return r;
+}
+/// Relative error below 2^-102 (the dropped l*l term and three roundings of the tail).
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDMul(DoubleDouble a, DoubleDouble b) {
+  double p, e;
+  TwoProduct(a.h, b.h, p, e);
+  return Normalize(p, Add(e, Add(Mul(a.h, b.l), Mul(a.l, b.h))));
+}
+/// Absolute error below 2^-102 (|a| + |b|).
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDAdd(DoubleDouble a, DoubleDouble b) {
+  double s, e;
+  TwoSum(a.h, b.h, s, e);
+  return Normalize(s, Add(e, Add(a.l, b.l)));
+}
+/// Relative error below 2^-100 for positive operands.
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDDiv(DoubleDouble a, DoubleDouble b) {
+  const double q1 = a.h / b.h;
+  const DoubleDouble qb = DDMul(b, DoubleDouble{q1, 0.0});
+  const DoubleDouble r = DDAdd(a, DoubleDouble{-qb.h, -qb.l});
+  return Normalize(q1, r.h / b.h);
+}
+/// Exact scaled difference as a double-double.
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDDiff(double u, double v, int s) {
+  double hi, lo;
+  TwoDiff(u, v, hi, lo);
+  return DoubleDouble{ScaleByPow2(hi, s), ScaleByPow2(lo, s)};
+}
+
+}  // namespace radius_detail
+
+/// The double nearest to rho^2 of p[0..n) by double-double arithmetic with a certified error
+/// bound (about 2^-95 relative): decides the rounding unless the value lies within that bound of a
+/// midpoint between two doubles or outside the normal range, where it returns false and the
+/// exact NearestRadiusSqBounded decides. The fast path of the published spectrum.
+GALPHA_HD inline bool NearestRadiusSqFast(const Point2* p, int n, double* out) {
+  using namespace radius_detail;
+  const int from[3] = {0, 0, 1}, to[3] = {1, 2, 2};
+  const int m = n == 2 ? 1 : 3;
+  double maxabs = 0.0;
+  for (int k = 0; k < m; ++k) {
+    const double dx = Abs(Sub(p[to[k]].x, p[from[k]].x)), dy = Abs(Sub(p[to[k]].y, p[from[k]].y));
+    if (!Finite(dx) || !Finite(dy)) return false;
+    maxabs = dx > maxabs ? dx : maxabs;
+    maxabs = dy > maxabs ? dy : maxabs;
+  }
+  if (maxabs == 0.0) return false;
+  const int s = -ExactExponentOf(maxabs);
+  DoubleDouble d[3][2];
+  for (int k = 0; k < m; ++k) {
+    d[k][0] = DDDiff(p[to[k]].x, p[from[k]].x, s);
+    d[k][1] = DDDiff(p[to[k]].y, p[from[k]].y, s);
+    for (int c = 0; c < 2; ++c) {
+      // Tiny differences beside large ones could underflow in products: the exact path takes them.
+      if (d[k][c].h != 0.0 && Abs(d[k][c].h) < 0x1p-300) return false;
+    }
+  }
+  DoubleDouble len[3];
+  for (int k = 0; k < m; ++k) len[k] = DDAdd(DDMul(d[k][0], d[k][0]), DDMul(d[k][1], d[k][1]));
+  DoubleDouble value;
+  double bound = 0x1p-95;
+  if (n == 2) {
+    value = DoubleDouble{Mul(len[0].h, 0.25), Mul(len[0].l, 0.25)};
+  } else {
+    const DoubleDouble left = DDMul(d[0][0], d[1][1]), right = DDMul(d[0][1], d[1][0]);
+    const DoubleDouble area = DDAdd(left, DoubleDouble{-right.h, -right.l});
+    const double sum = Add(Abs(left.h), Abs(right.h));
+    if (Abs(area.h) < 0x1p-500 || Abs(area.h) < Mul(sum, 0x1p-31)) return false;
+    // D's relative error: 2^-101 (|left| + |right|) / |D| <= 2^-70; rho^2 gets four times that.
+    bound = Add(bound, Mul(Mul(sum / Abs(area.h), 0x1p-101), 4.0));
+    const DoubleDouble num = DDMul(DDMul(len[0], len[1]), len[2]);
+    const DoubleDouble den = DDMul(area, area);
+    value = DDDiv(num, DoubleDouble{Mul(den.h, 4.0), Mul(den.l, 4.0)});
+  }
+  // Unscale (exact while normal), then decide the rounding: the exact value lies within
+  // bound * value of h + l; h is its nearest double if that interval stays strictly inside
+  // h's rounding interval.
+  const double h = ldexp(value.h, -2 * s);
+  const double l = ldexp(value.l, -2 * s);
+  if (!(h >= 0x1p-900 && h <= 0x1p1000)) return false;  // l and the bound stay normal
+  const double err = Mul(Mul(h, bound), 1.0 + 0x1p-20);
+  const double up = Mul(Sub(NextUp(h), h), 0.5);
+  const double down = Mul(Sub(h, NextDown(h)), 0.5);
+  if (!(Add(l, err) < up && Sub(l, err) > -down)) return false;
+  *out = h;
+  return true;
+}
+
+}  // namespace galpha
