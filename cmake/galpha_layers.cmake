@@ -10,8 +10,9 @@ set(GALPHA_LAYER_CHECK_SCRIPT ${CMAKE_CURRENT_LIST_DIR}/check_layering.cmake)
 #   <target>  the library target of the calling folder (defined before this call).
 #   USES      the layers it is built on; their folders (and theirs, transitively) may be included,
 #             and the target links them PUBLIC.
-#   NO_CUDA   the folder must not see CUDA: no .cu/.cuh files and no CUDA, Thrust, CUB or libcu++
-#             include (core/).
+#   NO_CUDA   the folder must not see CUDA: no .cu/.cuh files, no include of a .cuh header and no
+#             CUDA, Thrust, CUB or libcu++ include (core/, server/, client/: they see the engine
+#             through its CUDA-free .hpp headers only).
 function(galpha_layer target)
   cmake_parse_arguments(ARG "NO_CUDA" "" "USES" ${ARGN})
   file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
