@@ -51,9 +51,9 @@ int Failure(const absl::Status& status) {
 absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
                                        absl::Span<const absl::string_view> allowed) {
   std::vector<absl::string_view> names(allowed.begin(), allowed.end());
-  names.push_back("backend");
-  names.push_back("server");
-  names.push_back("tls-ca");
+  names.emplace_back("backend");
+  names.emplace_back("server");
+  names.emplace_back("tls-ca");
   auto line = ParseCommandLine(command, args, names);
   if (!line.ok()) return line.status();
   CommonArgs common;

@@ -24,6 +24,7 @@ test_packages=(
   openssl                # the TLS tests make a self-signed certificate
   curl                   # the README's service walk-through scrapes /metrics
   clang libclang-rt-14-dev  # libFuzzer: the fuzz targets run briefly in CI
+  clang-format clang-tidy   # scripts/lint.sh: the format check and static analysis, as errors
 )
 
 profile=all

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The README's second command, and what CI runs: installs what is needed, builds every target
 # (the CUDA backend too when nvcc is present, for one architecture) and runs the whole test suite.
-# Tests that need a GPU skip themselves on machines without one. Then the fuzz targets run briefly,
-# the Kubernetes manifests are validated and the container image's build steps run.
+# Tests that need a GPU skip themselves on machines without one. Then the format check and
+# clang-tidy (scripts/lint.sh), the sanitizer builds of the CPU backend (scripts/sanitize.sh), the
+# fuzz targets briefly, the Kubernetes manifests' validation and the container image's build steps.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -11,6 +12,10 @@ if [ -x /usr/local/cuda/bin/nvcc ] || command -v nvcc >/dev/null; then preset=cu
 cmake --preset "$preset"
 cmake --build --preset "$preset" -j"$(nproc)"
 ctest --preset "$preset"
+# Formatting and static analysis, as errors (.clang-format, .clang-tidy).
+scripts/lint.sh --build-dir "build/$preset"
+# AddressSanitizer + UBSan and ThreadSanitizer on the CPU build (a chosen subset: CI's time budget).
+scripts/sanitize.sh
 # The fuzz targets, briefly (20 s each): parsers of untrusted input must not crash.
 tests/fuzz/run.sh 20
 # The API's style (buf lint).

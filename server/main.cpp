@@ -2,7 +2,7 @@
 // cuts the drain notice short). Prints one "listening" line per port on stdout so that scripts
 // started with port 0 learn the ports.
 #include <pthread.h>
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX sigwait and signal masks
 
 #include <chrono>
 #include <cstdio>

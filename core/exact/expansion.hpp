@@ -284,7 +284,7 @@ GALPHA_HD inline int ScaleExpansionZeroElim(int elen, const double* e, double b,
 template <int kMaxE, int kMaxF>
 GALPHA_HD inline int ExpansionProduct(int elen, const double* e, int flen, const double* f,
                                       double* h) {
-  constexpr int kMaxLong = kMaxE > kMaxF ? kMaxE : kMaxF;
+  constexpr int kMaxLong = kMaxE > kMaxF ? kMaxE : kMaxF;  // NOLINT(bugprone-branch-clone): a max
   constexpr int kMaxOut = 2 * kMaxE * kMaxF;
   static_assert(kMaxE > 0 && kMaxF > 0, "expansion capacities must be positive");
   const double* longer = e;

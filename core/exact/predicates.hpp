@@ -183,7 +183,7 @@ GALPHA_HD inline bool ScaledDifferences(const double (&u)[4], const double (&v)[
   double hi[4], lo[4];
   for (int i = 0; i < 4; ++i) TwoDiff(u[i], v[i], hi[i], lo[i]);
   double maxabs = 0.0;
-  for (int i = 0; i < 4; ++i) maxabs = Abs(hi[i]) > maxabs ? Abs(hi[i]) : maxabs;
+  for (const double h : hi) maxabs = Abs(h) > maxabs ? Abs(h) : maxabs;
   if (maxabs == 0.0) return false;  // hi == 0 means the difference was exact, so lo == 0 too
   const int s = kOrientScaleTarget - ExponentOf(maxabs);
   for (int i = 0; i < 4; ++i) dl[i] = TwoToExpansion(ScaleByPow2(hi[i], s), ScaleByPow2(lo[i], s), d[i]);

@@ -107,7 +107,7 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
     }
     const nlohmann::json& items = object[member];
     for (size_t i = 0; i < items.size(); ++i) {
-      const absl::Status status =
+      absl::Status status =
           AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points);
       if (!status.ok()) return status;
     }
@@ -124,7 +124,7 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
     if (type == "Point") return position(coordinates, absl::StrCat(prefix, "coordinates"));
     if (!coordinates.is_array()) return error("MultiPoint coordinates must be an array of positions");
     for (size_t i = 0; i < coordinates.size(); ++i) {
-      const absl::Status status = position(coordinates[i], absl::StrCat(prefix, "coordinates[", i, "]"));
+      absl::Status status = position(coordinates[i], absl::StrCat(prefix, "coordinates[", i, "]"));
       if (!status.ok()) return status;
     }
     return absl::OkStatus();

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Formatting and static analysis, as errors; called by scripts/test.sh (and so by CI) after the
+# CPU or CUDA build has written compile_commands.json.
+#   format  clang-format (.clang-format) on every tracked C++ and CUDA file: any difference fails.
+#   tidy    clang-tidy (.clang-tidy, warnings are errors) on every C++ translation unit of the
+#           project in the build's compile_commands.json; the headers they include (.hpp and the
+#           engine's .cuh, which the OpenMP backend compiles as C++) are checked through them.
+#           CUDA translation units (.cu) are nvcc's alone: clang-tidy does not parse them.
+# Usage: scripts/lint.sh [format|tidy]... [--build-dir DIR]   (default: both, build/cpu or build/cuda)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+build_dir=""
+steps=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build-dir) build_dir=$2; shift 2 ;;
+    format|tidy) steps+=("$1"); shift ;;
+    *) echo "usage: scripts/lint.sh [format|tidy]... [--build-dir DIR]" >&2; exit 2 ;;
+  esac
+done
+[ ${#steps[@]} -gt 0 ] || steps=(format tidy)
+if [ -z "$build_dir" ]; then
+  for candidate in build/cpu build/cuda; do
+    if [ -f "$candidate/compile_commands.json" ]; then build_dir=$candidate; break; fi
+  done
+fi
+
+for step in "${steps[@]}"; do
+  case "$step" in
+    format)
+      mapfile -t files < <(git ls-files '*.cpp' '*.hpp' '*.cu' '*.cuh')
+      clang-format --dry-run --Werror "${files[@]}"
+      echo "lint: clang-format: ${#files[@]} files formatted"
+      ;;
+    tidy)
+      if [ -z "$build_dir" ] || [ ! -f "$build_dir/compile_commands.json" ]; then
+        echo "lint: no compile_commands.json (build first, or pass --build-dir)" >&2
+        exit 2
+      fi
+      # Our translation units only: not the generated protobuf code under the build folder.
+      root=$(pwd)
+      run-clang-tidy -p "$build_dir" -quiet -j"$(nproc)" "^${root}/(core|gpu|server|client|bench|tests)/.*\\.cpp\$" \
+        > "$build_dir/clang-tidy.log" 2>&1 || {
+        grep -E 'error:|warning:' "$build_dir/clang-tidy.log" | sort -u
+        echo "lint: clang-tidy found problems (whole log: $build_dir/clang-tidy.log)" >&2
+        exit 1
+      }
+      echo "lint: clang-tidy: clean"
+      ;;
+  esac
+done

@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Sanitizer runs of the CPU build, called by scripts/test.sh (and so by CI). The presets are in
+# CMakePresets.json:
+#   asan  AddressSanitizer + UndefinedBehaviorSanitizer (leaks included) on the exact arithmetic,
+#         the point parsers, the family build and its queries, and the upload decoder: the code
+#         that handles untrusted input and raw indices.
+#   tsan  ThreadSanitizer on the service's threaded parts (build scheduler, family cache, upload
+#         streams). OpenMP runs one thread there (OMP_NUM_THREADS=1 in the preset): Debian's
+#         libgomp is not instrumented, and its own threads would only report its internals.
+# Only these tests, not the whole suite: both builds and runs must fit in CI's budget on 2 cores.
+# Usage: scripts/sanitize.sh [asan|tsan]...   (default: both)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+asan_tests=(predicates_test attachment_test radius_test point_formats_test point_set_handle_test
+            alpha_family_test alpha_bruteforce_test build_stream_test family_cache_test)
+tsan_tests=(build_scheduler_test family_cache_test build_stream_test)
+
+run_preset() {
+  local preset=$1
+  shift
+  local tests=("$@")
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset" -j"$(nproc)" --target "${tests[@]}"
+  local regex
+  regex="^($(IFS='|'; echo "${tests[*]}"))\$"
+  ctest --preset "$preset" -R "$regex" -j"$(nproc)"
+}
+
+presets=("$@")
+[ ${#presets[@]} -gt 0 ] || presets=(asan tsan)
+for preset in "${presets[@]}"; do
+  case "$preset" in
+    asan) run_preset asan "${asan_tests[@]}" ;;
+    tsan) run_preset tsan "${tsan_tests[@]}" ;;
+    *) echo "usage: scripts/sanitize.sh [asan|tsan]..." >&2; exit 2 ;;
+  esac
+done
