@@ -53,9 +53,9 @@ absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, bool accept_c
       }
       explicit_generated = true;
     } else if (arg == "--data" && i + 1 < argc) {
-      options.data_files.push_back(argv[++i]);
+      options.data_files.emplace_back(argv[++i]);
     } else if (const char* v = value_of("--data")) {
-      options.data_files.push_back(v);
+      options.data_files.emplace_back(v);
     } else {
       return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
     }

@@ -215,14 +215,17 @@ int Run(const Options& options) {
   double single_rate = 0;
   for (const int c : options.clients) {
     std::vector<std::vector<Point2>> inputs;
+    inputs.reserve(static_cast<size_t>(c));
     for (int i = 0; i < c; ++i) inputs.push_back(gen::Uniform(options.points, 1000 + static_cast<uint64_t>(i)));
     // Connected before the clock starts (each client has a connection of its own); best of the
     // repeats, the families released between them.
     std::vector<std::unique_ptr<client::AlphaClient>> clients;
+    clients.reserve(static_cast<size_t>(c));
     for (int i = 0; i < c; ++i) clients.push_back(Client(port));
     double wall = std::numeric_limits<double>::infinity();
     for (int r = 0; r < options.repeat; ++r) {
       std::vector<std::thread> threads;
+      threads.reserve(static_cast<size_t>(c));
       const auto start = Clock::now();
       for (int i = 0; i < c; ++i) {
         threads.emplace_back([&, i] { TimedBuild(*clients[static_cast<size_t>(i)], inputs[static_cast<size_t>(i)], nullptr); });
@@ -242,6 +245,7 @@ int Run(const Options& options) {
   std::mutex mutex;
   std::atomic<bool> stop{false};
   std::vector<std::thread> threads;
+  threads.reserve(static_cast<size_t>(options.query_clients));
   for (int q = 0; q < options.query_clients; ++q) {
     threads.emplace_back([&, q] {
       auto own = Client(port);

@@ -133,7 +133,7 @@ absl::StatusOr<int64_t> ParseInteger(absl::string_view option, const std::string
 absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line) {
   std::vector<absl::string_view> given;
   for (const auto& [name, value] : line.options) {
-    if (name == "alpha-sq" || name == "alpha" || name == "rank") given.push_back(name);
+    if (name == "alpha-sq" || name == "alpha" || name == "rank") given.emplace_back(name);
   }
   if (given.empty()) {
     return absl::InvalidArgumentError("missing threshold: give one of --alpha-sq A, --alpha R or --rank K");

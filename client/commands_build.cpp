@@ -102,6 +102,7 @@ int RunBench(Args args) {
 
   const BuildReport& report = family->report();
   std::vector<std::pair<std::string, std::string>> rows;
+  rows.reserve(best.size() + 3);
   for (const auto& [stage, seconds] : best) rows.emplace_back(stage, absl::StrFormat("%.3f", seconds * 1e3));
   rows.emplace_back("total", absl::StrFormat("%.3f", best_total * 1e3));
   rows.emplace_back("peak_memory_bytes", absl::StrCat(report.peak_memory_bytes));

@@ -353,6 +353,7 @@ int RemoteBench(const CommonArgs& common, int64_t repeat) {
     best_rpc = run == 0 ? rpc : std::min(best_rpc, rpc);
   }
   std::vector<std::pair<std::string, std::string>> rows;
+  rows.reserve(best.size() + 3);
   for (const auto& [stage, seconds] : best) rows.emplace_back(stage, absl::StrFormat("%.3f", seconds * 1e3));
   rows.emplace_back("total", absl::StrFormat("%.3f", best_engine * 1e3));
   rows.emplace_back("rpc_total", absl::StrFormat("%.3f", best_rpc * 1e3));
