@@ -1,0 +1,173 @@
+// Refined keys of squared radii: rho^2 to about 150 bits with a certified error, for ordering the
+// spectrum's long runs of near ties (the 64-bit keys of radius_key.hpp separate values only
+// 2^-38 apart, and a lattice perturbed by single ulps puts millions of radii closer than that;
+// their first- and second-order differences are 2^-40 to 2^-120 of the value). Sorting by these
+// keys orders every pair of values more than 2^-146 apart exactly, so that the exact comparisons
+// left are those of adjacent entries whose keys cannot separate them: O(n) of them, most of them
+// exact ties, which RadiusTermsIdentical proves without arithmetic when the two simplices are
+// translates of each other. Host and device alike.
+//
+// Why the error is certified (rho^2 = Num / (4 Den) * 2^(-2s), exact expansions from
+// radius_terms.hpp, both positive, each compressed; Q = Num / Den):
+//  1. The top component of a compressed (nonoverlapping) expansion is within 2^-51.99 of its
+//     value, relatively: the rest is below one unit in its last place.
+//  2. q0 = fl(num_top / den_top) is Q (1 + z) with |z| <= 2^-50.4 (two inputs within 2^-51.99 and
+//     one rounding of 2^-53).
+//  3. R1 = Num - q0 Den is exact (a scaled expansion and a difference, no rounding), so
+//     Q = q0 + R1/Den with |R1/Den| = |z| Q <= 2^-50.4 Q. q1 = fl(R1_top / den_top) is
+//     R1/Den (1 + y1) with |y1| <= 2^-50.4, as in 2.
+//  4. R2 = R1 - q1 Den is exact, Q = q0 + q1 + R2/Den, |R2/Den| = |y1| |R1/Den| <= 2^-100.8 Q, and
+//     q2 = fl(R2_top / den_top) errs by |y2| |R2/Den| <= 2^-151.2 Q.
+//  5. q0 + q1 + q2 is carried exactly into (hi, mid, lo) by error-free sums; scaling by powers of
+//     two is exact, except that mid or lo may underflow to a subnormal when hi is scaled to
+//     [1, 2): an absolute error below 2^-1073, nothing against the 2^-151.2 above.
+// So a refined key (hi + mid + lo) 2^e is within kRefinedRelErr = 2^-150 of rho^2, relatively. The
+// components need not be normalized for that: the separation test subtracts the keys exactly.
+#pragma once
+
+#include <cstdint>
+
+#include "core/base/hd.hpp"
+#include "core/base/point.hpp"
+#include "core/exact/expansion.hpp"
+#include "core/exact/radius_terms.hpp"
+
+namespace galpha {
+
+/// Relative error bound of a refined key (derivation above).
+constexpr double kRefinedRelErr = 0x1p-150;
+/// Refined values closer than this (at a common exponent where both are below 4) are not
+/// separated by their keys; farther ones are (RefinedKeysSeparated).
+constexpr double kRefinedSeparation = 0x1p-146;
+
+/// rho^2 ~ (hi + mid + lo) 2^exponent with hi in [1, 2) and |mid| + |lo| below 2^-50, certified
+/// within kRefinedRelErr; `ok` is false when the exact terms do not fit the bounded buffers or their
+/// exponent range (the caller then orders the simplex by exact comparisons), and `infinite` marks
+/// a collinear triangle.
+struct RefinedRadiusSq {
+  int32_t exponent = 0;
+  double hi = 0.0;
+  double mid = 0.0;
+  double lo = 0.0;
+  bool ok = false;
+  bool infinite = false;
+};
+
+namespace radius_detail {
+
+/// Puts the vertices of a simplex in lexicographic order (x, then y). The order is translation
+/// invariant, so two simplices that are exact translates of each other get the same differences
+/// and, through the same operations, bit-identical exact terms (RadiusTermsIdentical).
+GALPHA_HD inline void LexOrderVertices(Point2* p, int n) {
+  for (int i = 1; i < n; ++i) {
+    const Point2 x = p[i];
+    int j = i;
+    while (j > 0 && LexLess(x, p[j - 1])) {
+      p[j] = p[j - 1];
+      --j;
+    }
+    p[j] = x;
+  }
+}
+
+/// The exact terms of a simplex in canonical vertex order, and the scale they were built at.
+/// False when they do not fit (bounded buffers, exponent range).
+GALPHA_HD inline bool CanonicalExactTerms(const Point2* points, int n, ExactRadiusTerms* terms, int* scale) {
+  Point2 p[3];
+  for (int i = 0; i < n; ++i) p[i] = points[i];
+  LexOrderVertices(p, n);
+  double dmax = 0.0;
+  int lowest = 1 << 20;
+  return DifferenceRange(p, n, &dmax, &lowest) && ExactScaleFor(dmax, lowest, n == 2 ? 2 : 6, scale) &&
+         ExactTerms(p, n, *scale, terms);
+}
+
+}  // namespace radius_detail
+
+/// The refined key of the edge (n = 2) or triangle (n = 3) p[0..n).
+GALPHA_HD inline RefinedRadiusSq RefineRadiusSq(const Point2* p, int n) {
+  using namespace radius_detail;
+  RefinedRadiusSq out;
+  ExactRadiusTerms terms;
+  int s = 0;
+  if (!CanonicalExactTerms(p, n, &terms, &s) || terms.numn == 0) return out;
+  if (terms.denn == 0) {  // collinear triangle
+    out.ok = true;
+    out.infinite = true;
+    return out;
+  }
+  const double num_top = terms.num[terms.numn - 1], den_top = terms.den[terms.denn - 1];
+  // Num and Den are positive (squares), so are their top components. Their quotient must stay
+  // well inside the double range, and q0 * Den must be splittable (below 2^996).
+  const int quotient_exponent = ExponentOf(num_top) - ExponentOf(den_top);
+  if (quotient_exponent > 900 || quotient_exponent < -900) return out;
+  const double q0 = num_top / den_top;
+  // R1 = Num - q0 Den, then R2 = R1 - q1 Den, exactly.
+  double product[kBoundedCapacity], residual[kBoundedCapacity], next[kBoundedCapacity];
+  if (terms.numn + 2 * terms.denn > kBoundedCapacity) return out;
+  int productn = ScaleExpansionZeroElim(terms.denn, terms.den, q0, product);
+  int residualn = Compress(ExpansionDiffZeroElim(terms.numn, terms.num, productn, product, residual), residual);
+  const double q1 = residualn == 0 ? 0.0 : residual[residualn - 1] / den_top;
+  double q2 = 0.0;
+  if (q1 != 0.0) {
+    if (residualn + 2 * terms.denn > kBoundedCapacity) return out;
+    productn = ScaleExpansionZeroElim(terms.denn, terms.den, q1, product);
+    const int nextn = Compress(ExpansionDiffZeroElim(residualn, residual, productn, product, next), next);
+    q2 = nextn == 0 ? 0.0 : next[nextn - 1] / den_top;
+  }
+  // q0 + q1 + q2 into (hi, mid, lo) without rounding: |q2| << |q1| << |q0|.
+  double s12, e12, hi, e0;
+  TwoSum(q1, q2, s12, e12);
+  FastTwoSum(q0, s12, hi, e0);
+  double mid, lo;
+  TwoSum(e0, e12, mid, lo);
+  const int k = ExponentOf(hi);
+  out.hi = ScaleByPow2(hi, -k);
+  out.mid = ScaleByPow2(mid, -k);
+  out.lo = ScaleByPow2(lo, -k);
+  out.exponent = k - 2 * s - 2;  // rho^2 = Num / (4 Den) at scale 2^s
+  out.ok = true;
+  return out;
+}
+
+/// Whether b's exact value is certainly above a's, given refined keys with a before b in key
+/// order: at a common exponent (where both are below 4) the exact difference of the keys exceeds
+/// kRefinedSeparation = 2^-146, and their certified errors sum to under 6 * 2^-150 < 2^-147, so
+/// the exact values differ by more than 2^-147 in b's favour.
+GALPHA_HD inline bool RefinedKeysSeparated(const RefinedRadiusSq& a, const RefinedRadiusSq& b) {
+  using namespace exact;
+  if (a.infinite || b.infinite) return !a.infinite && b.infinite;  // only an infinite b is above a finite a
+  const int64_t gap = static_cast<int64_t>(b.exponent) - a.exponent;
+  if (gap >= 2) return true;  // b >= 4 (1 - 2^-50) > 2 (1 + 2^-50) > a, errors included
+  if (gap < 0) return false;
+  const double scale = gap == 1 ? 2.0 : 1.0;  // exact
+  // b - a - 2^-146 by Grow-Expansion only, which keeps an expansion nonoverlapping (Shewchuk 1997,
+  // Theorem 10) so that its most significant component carries the sign; every step is exact.
+  const double terms[7] = {Mul(b.lo, scale), Mul(b.mid, scale), Mul(b.hi, scale), -a.lo, -a.mid, -a.hi,
+                           -kRefinedSeparation};
+  double e[8];
+  int en = 0;
+  for (const double t : terms) en = GrowExpansionZeroElim(en, e, t, e);
+  return ExpansionSign(en, e) > 0;
+}
+
+/// Whether rho^2(a) and rho^2(b) are equal because their exact terms, built in canonical vertex
+/// order at the same scale, are bit for bit the same (translates of each other, for instance).
+/// False proves nothing.
+GALPHA_HD inline bool RadiusTermsIdentical(const Point2* a, int na, const Point2* b, int nb) {
+  using namespace radius_detail;
+  if (na != nb) return false;
+  ExactRadiusTerms ta, tb;
+  int sa = 0, sb = 0;
+  if (!CanonicalExactTerms(a, na, &ta, &sa) || !CanonicalExactTerms(b, nb, &tb, &sb)) return false;
+  if (sa != sb || ta.numn != tb.numn || ta.denn != tb.denn) return false;
+  for (int i = 0; i < ta.numn; ++i) {
+    if (ta.num[i] != tb.num[i]) return false;
+  }
+  for (int i = 0; i < ta.denn; ++i) {
+    if (ta.den[i] != tb.den[i]) return false;
+  }
+  return true;
+}
+
+}  // namespace galpha
