@@ -21,6 +21,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "gpu/triangulation/delaunay.hpp"
+#include "tests/support/geos.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {
@@ -29,65 +30,7 @@ namespace {
 using Tri = std::array<uint32_t, 3>;
 using Edge = std::array<uint32_t, 2>;
 
-// ---- GEOS, through its reentrant C API ----------------------------------------------------------
-
-class Geos {
- public:
-  struct Deleter {
-    GEOSContextHandle_t ctx;
-    void operator()(GEOSGeometry* g) const { GEOSGeom_destroy_r(ctx, g); }
-  };
-  using Geom = std::unique_ptr<GEOSGeometry, Deleter>;
-
-  Geos() : ctx_(GEOS_init_r()) {}
-  ~Geos() { GEOS_finish_r(ctx_); }
-  Geos(const Geos&) = delete;
-  Geos& operator=(const Geos&) = delete;
-
-  GEOSContextHandle_t ctx() const { return ctx_; }
-  Geom Own(GEOSGeometry* g) const { return Geom(g, Deleter{ctx_}); }
-
-  Geom ReadWkt(const std::string& wkt) const {
-    GEOSWKTReader* reader = GEOSWKTReader_create_r(ctx_);
-    GEOSGeometry* g = GEOSWKTReader_read_r(ctx_, reader, wkt.c_str());
-    GEOSWKTReader_destroy_r(ctx_, reader);
-    return Own(g);
-  }
-
-  // The union of the triangles, each built from its coordinates (not through our WKT).
-  Geom UnionOfTriangles(absl::Span<const Point2> points, const std::vector<Tri>& tris) const {
-    std::vector<GEOSGeometry*> polygons;
-    for (const Tri& t : tris) {
-      GEOSCoordSequence* seq = GEOSCoordSeq_create_r(ctx_, 4, 2);
-      for (unsigned k = 0; k < 4; ++k) {
-        const Point2& p = points[t[k % 3]];
-        GEOSCoordSeq_setXY_r(ctx_, seq, k, p.x, p.y);
-      }
-      polygons.push_back(
-          GEOSGeom_createPolygon_r(ctx_, GEOSGeom_createLinearRing_r(ctx_, seq), nullptr, 0));
-    }
-    Geom collection = Own(GEOSGeom_createCollection_r(
-        ctx_, GEOS_GEOMETRYCOLLECTION, polygons.data(), static_cast<unsigned>(polygons.size())));
-    return Own(GEOSUnaryUnion_r(ctx_, collection.get()));
-  }
-
-  std::string ValidReason(const GEOSGeometry* g) const {
-    char* reason = GEOSisValidReason_r(ctx_, g);
-    std::string out = reason ? reason : "(no reason)";
-    GEOSFree_r(ctx_, reason);
-    return out;
-  }
-
-  // Whether the ring is counter-clockwise, by GEOS's own robust test.
-  bool IsCcw(const GEOSGeometry* ring) const {
-    char ccw = 0;
-    GEOSCoordSeq_isCCW_r(ctx_, GEOSGeom_getCoordSeq_r(ctx_, ring), &ccw);
-    return ccw == 1;
-  }
-
- private:
-  GEOSContextHandle_t ctx_;
-};
+using testing::Geos;
 
 // ---- Independent facts about a set of triangles ------------------------------------------------
 

@@ -17,6 +17,7 @@
 #include "gpu/triangulation/delaunay.hpp"
 #include "gpu/triangulation/triangulation_checks.hpp"
 #include "gtest/gtest.h"
+#include "tests/support/backend_fixture.hpp"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
 
@@ -77,15 +78,10 @@ bool BitwiseEqual(const std::vector<Point2>& a, absl::Span<const Point2> b) {
          (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Point2)) == 0);
 }
 
-// Fixture parameterised by backend; the CUDA instance skips where this build or machine has none.
-class DelaunayTest : public ::testing::TestWithParam<Backend> {
+// The backend fixture (the CUDA instance skips where this build or machine has none) that
+// triangulates on its backend.
+class DelaunayTest : public testing::BackendTest {
  protected:
-  void SetUp() override {
-    if (GetParam() == Backend::kCuda && !CudaBackendAvailable()) {
-      GTEST_SKIP() << "no CUDA backend in this build, or no visible GPU";
-    }
-  }
-
   absl::StatusOr<Triangulation> Run(absl::Span<const Point2> points) {
     TriangulateOptions options;
     options.backend = GetParam();
@@ -311,10 +307,7 @@ TEST_P(DelaunayTest, InfinityIsRejectedWithItsIndex) {
   EXPECT_NE(result.status().message().find("13"), absl::string_view::npos) << result.status();
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, DelaunayTest, ::testing::Values(Backend::kCpu, Backend::kCuda),
-                         [](const ::testing::TestParamInfo<Backend>& info) {
-                           return std::string(BackendName(info.param));
-                         });
+GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(DelaunayTest);
 
 TEST(DelaunayBackendTest, CudaWithoutGpuIsUnavailable) {
   if (CudaBackendAvailable()) GTEST_SKIP() << "a GPU is visible";
