@@ -1,45 +1,24 @@
 #include "server/alpha_service.hpp"
 
-#include <malloc.h>
 #include <unistd.h>
 
-#include <chrono>
+#include <memory>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/point_set_handle.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
+#include "server/build_reactor.hpp"
+#include "server/grpc_status.hpp"
 #include "server/query_answers.hpp"
+#include "server/rpc_record.hpp"
 
 namespace galpha::server {
 
 namespace v1 = galpha::v1;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-grpc::Status ToGrpc(const absl::Status& status) {
-  if (status.ok()) return grpc::Status::OK;
-  // absl's canonical codes are gRPC's, number for number.
-  return grpc::Status(static_cast<grpc::StatusCode>(status.code()), std::string(status.message()));
-}
-
-/// Times one RPC and records its method and status code when it finishes.
-class RpcRecord {
- public:
-  RpcRecord(ServerMetrics* metrics, const char* method) : metrics_(metrics), method_(method), start_(Clock::now()) {}
-  void Done(const grpc::Status& status) const {
-    const std::string code = absl::StatusCodeToString(static_cast<absl::StatusCode>(status.error_code()));
-    metrics_->RecordRpc(method_, code, std::chrono::duration<double>(Clock::now() - start_).count());
-  }
-
- private:
-  ServerMetrics* metrics_;
-  const char* method_;
-  Clock::time_point start_;
-};
 
 /// A server-streamed answer written chunk by chunk as the client takes them (a slow reader slows
 /// the writer; nothing is buffered beyond one message).
@@ -51,7 +30,7 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
     WriteNext();
   }
   /// An answer that is only an error.
-  ChunkWriter(RpcRecord record, const absl::Status& error) : record_(record) { Done(ToGrpc(error)); }
+  ChunkWriter(RpcRecord record, const absl::Status& error) : record_(record) { Done(ToGrpcStatus(error)); }
 
   void OnWriteDone(bool ok) override {
     if (!ok) {
@@ -81,12 +60,60 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
   Message message_;
 };
 
-/// Gives freed heap memory back to the system: a build frees hundreds of bytes per point at once,
-/// and without this glibc keeps it, so the process would sit at its peak forever.
-void ReturnFreedMemory() {
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
+/// Finishes a unary RPC with `status`, recorded first.
+grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context, const RpcRecord& record,
+                                      const absl::Status& status) {
+  const grpc::Status result = ToGrpcStatus(status);
+  record.Done(result);
+  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  reactor->Finish(result);
+  return reactor;
+}
+
+// Runs a unary RPC whose `answer` fills the response itself and returns an absl::Status; the
+// reactor finishes with it.
+template <typename Answer>
+grpc::ServerUnaryReactor* AnswerUnary(grpc::CallbackServerContext* context, ServerMetrics* metrics,
+                                      const char* method, Answer answer) {
+  RpcRecord record(metrics, method);
+  return FinishUnary(context, record, answer());
+}
+
+/// The reply of a unary query (AlphaService::AnswerQuery): the answer becomes the response, or its
+/// error the RPC's status.
+template <typename Response>
+class UnaryReply {
+ public:
+  UnaryReply(grpc::CallbackServerContext* context, Response* response) : context_(context), response_(response) {}
+  grpc::ServerUnaryReactor* operator()(const RpcRecord& record, absl::StatusOr<Response> answer) const {
+    if (!answer.ok()) return FinishUnary(context_, record, answer.status());
+    *response_ = *std::move(answer);
+    return FinishUnary(context_, record, absl::OkStatus());
+  }
+
+ private:
+  grpc::CallbackServerContext* context_;
+  Response* response_;
+};
+
+/// The reply of a streamed query (AlphaService::AnswerQuery): a ChunkWriter over the answer's
+/// chunks, or one that only finishes with its error.
+template <typename Message>
+struct StreamedReply {
+  grpc::ServerWriteReactor<Message>* operator()(const RpcRecord& record,
+                                                absl::StatusOr<std::unique_ptr<ChunkSource<Message>>> source) const {
+    if (!source.ok()) return new ChunkWriter<Message>(record, source.status());
+    return new ChunkWriter<Message>(record, *std::move(source));
+  }
+};
+
+/// A unary answer of query_answers.hpp reads the family only while it answers; the streamed ones
+/// take the cached family itself, to keep it while their chunks are written.
+template <typename Answer>
+auto FromAlphaFamily(Answer answer) {
+  return [answer](std::shared_ptr<const CachedFamily> cached, const auto& request) {
+    return answer(cached->family(), request);
+  };
 }
 
 size_t DefaultMemoryBudget(Backend backend) {
@@ -100,136 +127,6 @@ size_t DefaultMemoryBudget(Backend backend) {
 }
 
 }  // namespace
-
-// ---- Build ------------------------------------------------------------------------------------------
-
-/// One Build call: reads the stream through a decoder, then hands the build to the scheduler, whose
-/// worker finishes the call. Deletes itself when gRPC is done with the call.
-class BuildReactor final : public grpc::ServerReadReactor<v1::BuildRequest> {
- public:
-  BuildReactor(AlphaService* service, grpc::CallbackServerContext* context, v1::BuildResponse* response,
-               absl::StatusOr<std::string> tenant)
-      : service_(service),
-        context_(context),
-        response_(response),
-        record_(service->metrics_, "Build"),
-        decoder_(BuildStreamLimits{service->options_.max_points_per_build}, &service->in_flight_) {
-    if (!tenant.ok()) {
-      Respond(tenant.status());
-      return;
-    }
-    tenant_ = *std::move(tenant);
-    if (service_->draining_) {
-      Respond(absl::UnavailableError("the server is draining and accepts no new builds"));
-      return;
-    }
-    StartRead(&request_);
-  }
-
-  void OnReadDone(bool ok) override {
-    if (!ok) {
-      EndOfStream();
-      return;
-    }
-    if (absl::Status status = decoder_.Add(request_); !status.ok()) {
-      if (absl::IsResourceExhausted(status)) service_->metrics_->RecordRejectedBuild("limits");
-      Respond(status);
-      return;
-    }
-    StartRead(&request_);
-  }
-
-  void OnCancel() override { cancelled_ = true; }
-  void OnDone() override { delete this; }
-
- private:
-  void EndOfStream() {
-    if (context_->IsCancelled() || cancelled_) {
-      Respond(absl::CancelledError("the client cancelled the build during the upload"));
-      return;
-    }
-    auto decoded = decoder_.Finish();
-    if (!decoded.ok()) {
-      Respond(decoded.status());
-      return;
-    }
-    build_ = *decoded;
-    if (auto cached = service_->cache_->Find(tenant_, build_->handle)) {
-      Succeed(*cached, /*was_cached=*/true);
-      return;
-    }
-    const size_t need = build_->points.size() * (kBuildBytesPerPoint + sizeof(Point2));
-    absl::Status submitted =
-        service_->scheduler_->Submit(need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
-    if (!submitted.ok()) {
-      service_->metrics_->RecordRejectedBuild(absl::IsUnavailable(submitted) ? "draining" : "queue_or_memory");
-      Respond(submitted);
-    }
-  }
-
-  void Run(const BuildSlot& slot, bool draining) {
-    if (draining) {
-      Respond(absl::UnavailableError("the server is shutting down; the build had not started"));
-      return;
-    }
-    if (cancelled_) {
-      Respond(absl::CancelledError("the client went away while the build was queued"));
-      return;
-    }
-    BuildOptions options;
-    options.backend = service_->backend_;
-    options.cuda_stream = slot.cuda_stream;
-    options.cancelled = [this] { return cancelled_.load(); };
-    const auto start = Clock::now();
-    absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(build_->points, options);
-    const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    decoder_.ReleasePoints();
-    if (!family.ok()) {
-      ReturnFreedMemory();
-      Respond(family.status());
-      return;
-    }
-    service_->metrics_->RecordBuild(family->report(), seconds);
-    // The last owner of a family (the cache, or a query still streaming from it after a release
-    // or an eviction) frees hundreds of megabytes: give them back to the system right then.
-    std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family), build_->header.name()),
-                                               [](const CachedFamily* f) {
-                                                 delete f;
-                                                 ReturnFreedMemory();
-                                               });
-    auto inserted = service_->cache_->Insert(tenant_, build_->handle, std::move(cached));
-    ReturnFreedMemory();  // the engine's working memory and the points
-    if (!inserted.ok()) {
-      Respond(inserted.status());
-      return;
-    }
-    Succeed(**inserted, /*was_cached=*/false);
-  }
-
-  void Succeed(const CachedFamily& family, bool was_cached) {
-    response_->set_handle(build_->handle);
-    response_->set_cached(was_cached);
-    FillBuildSummary(family, response_->mutable_summary());
-    Respond(absl::OkStatus());
-  }
-
-  // The last thing any path does: after Finish, gRPC may delete this at any moment.
-  void Respond(const absl::Status& status) {
-    const grpc::Status result = ToGrpc(status);
-    record_.Done(result);
-    Finish(result);
-  }
-
-  AlphaService* const service_;
-  grpc::CallbackServerContext* const context_;
-  v1::BuildResponse* const response_;
-  RpcRecord record_;
-  std::string tenant_;
-  v1::BuildRequest request_;
-  BuildStreamDecoder decoder_;
-  DecodedBuild* build_ = nullptr;
-  std::atomic<bool> cancelled_{false};
-};
 
 // ---- The service ------------------------------------------------------------------------------------
 
@@ -307,19 +204,16 @@ grpc::ServerReadReactor<v1::BuildRequest>* AlphaService::Build(grpc::CallbackSer
   return new BuildReactor(this, context, response, Authenticate(context));
 }
 
-namespace {
-// Runs a unary query: `answer` returns an absl::Status; the reactor finishes with it.
-template <typename Answer>
-grpc::ServerUnaryReactor* AnswerUnary(grpc::CallbackServerContext* context, ServerMetrics* metrics,
-                                      const char* method, Answer answer) {
-  RpcRecord record(metrics, method);
-  const grpc::Status status = ToGrpc(answer());
-  record.Done(status);
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  reactor->Finish(status);
-  return reactor;
+template <typename Request, typename Answer, typename Reply>
+auto AlphaService::AnswerQuery(grpc::CallbackServerContext* context, const char* method, const Request& request,
+                               Answer answer, Reply reply) {
+  RpcRecord record(metrics_, method);
+  auto family = Lookup(context, request.handle());
+  if (!family.ok()) return reply(record, family.status());
+  // Answered before the reply, so that a unary answer's family reference ends before the RPC.
+  auto answered = answer(*std::move(family), request);
+  return reply(record, std::move(answered));
 }
-}  // namespace
 
 grpc::ServerUnaryReactor* AlphaService::Describe(grpc::CallbackServerContext* context,
                                                  const v1::DescribeRequest* request, v1::DescribeResponse* response) {
@@ -334,40 +228,21 @@ grpc::ServerUnaryReactor* AlphaService::Describe(grpc::CallbackServerContext* co
 
 grpc::ServerUnaryReactor* AlphaService::Spectrum(grpc::CallbackServerContext* context,
                                                  const v1::SpectrumRequest* request, v1::SpectrumResponse* response) {
-  return AnswerUnary(context, metrics_, "Spectrum", [&]() -> absl::Status {
-    auto family = Lookup(context, request->handle());
-    if (!family.ok()) return family.status();
-    auto answer = AnswerSpectrum((*family)->family(), *request);
-    if (!answer.ok()) return answer.status();
-    *response = *std::move(answer);
-    return absl::OkStatus();
-  });
+  return AnswerQuery(context, "Spectrum", *request, FromAlphaFamily(AnswerSpectrum), UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::Components(grpc::CallbackServerContext* context,
                                                    const v1::ComponentsRequest* request,
                                                    v1::ComponentsResponse* response) {
-  return AnswerUnary(context, metrics_, "Components", [&]() -> absl::Status {
-    auto family = Lookup(context, request->handle());
-    if (!family.ok()) return family.status();
-    auto answer = AnswerComponents((*family)->family(), *request);
-    if (!answer.ok()) return answer.status();
-    *response = *std::move(answer);
-    return absl::OkStatus();
-  });
+  return AnswerQuery(context, "Components", *request, FromAlphaFamily(AnswerComponents),
+                     UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::OptimalAlpha(grpc::CallbackServerContext* context,
                                                      const v1::OptimalAlphaRequest* request,
                                                      v1::OptimalAlphaResponse* response) {
-  return AnswerUnary(context, metrics_, "OptimalAlpha", [&]() -> absl::Status {
-    auto family = Lookup(context, request->handle());
-    if (!family.ok()) return family.status();
-    auto answer = AnswerOptimalAlpha((*family)->family(), *request);
-    if (!answer.ok()) return answer.status();
-    *response = *std::move(answer);
-    return absl::OkStatus();
-  });
+  return AnswerQuery(context, "OptimalAlpha", *request, FromAlphaFamily(AnswerOptimalAlpha),
+                     UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* context,
@@ -383,32 +258,17 @@ grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* con
 
 grpc::ServerWriteReactor<v1::ClassifyResponse>* AlphaService::Classify(grpc::CallbackServerContext* context,
                                                                        const v1::ClassifyRequest* request) {
-  RpcRecord record(metrics_, "Classify");
-  auto family = Lookup(context, request->handle());
-  if (!family.ok()) return new ChunkWriter<v1::ClassifyResponse>(record, family.status());
-  auto source = MakeClassifySource(*std::move(family), *request);
-  if (!source.ok()) return new ChunkWriter<v1::ClassifyResponse>(record, source.status());
-  return new ChunkWriter<v1::ClassifyResponse>(record, *std::move(source));
+  return AnswerQuery(context, "Classify", *request, MakeClassifySource, StreamedReply<v1::ClassifyResponse>());
 }
 
 grpc::ServerWriteReactor<v1::MasterListResponse>* AlphaService::MasterList(grpc::CallbackServerContext* context,
                                                                            const v1::MasterListRequest* request) {
-  RpcRecord record(metrics_, "MasterList");
-  auto family = Lookup(context, request->handle());
-  if (!family.ok()) return new ChunkWriter<v1::MasterListResponse>(record, family.status());
-  auto source = MakeMasterListSource(*std::move(family), *request);
-  if (!source.ok()) return new ChunkWriter<v1::MasterListResponse>(record, source.status());
-  return new ChunkWriter<v1::MasterListResponse>(record, *std::move(source));
+  return AnswerQuery(context, "MasterList", *request, MakeMasterListSource, StreamedReply<v1::MasterListResponse>());
 }
 
 grpc::ServerWriteReactor<v1::ShapeResponse>* AlphaService::Shape(grpc::CallbackServerContext* context,
                                                                  const v1::ShapeRequest* request) {
-  RpcRecord record(metrics_, "Shape");
-  auto family = Lookup(context, request->handle());
-  if (!family.ok()) return new ChunkWriter<v1::ShapeResponse>(record, family.status());
-  auto source = MakeShapeSource(*std::move(family), *request);
-  if (!source.ok()) return new ChunkWriter<v1::ShapeResponse>(record, source.status());
-  return new ChunkWriter<v1::ShapeResponse>(record, *std::move(source));
+  return AnswerQuery(context, "Shape", *request, MakeShapeSource, StreamedReply<v1::ShapeResponse>());
 }
 
 }  // namespace galpha::server

@@ -91,6 +91,13 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   /// The cached family of (tenant, handle), or NotFound / InvalidArgument.
   absl::StatusOr<std::shared_ptr<const CachedFamily>> Lookup(grpc::CallbackServerContext* context,
                                                              const std::string& handle);
+  /// One query on a built family, the same for the unary and the streamed ones: times the RPC as
+  /// `method`, looks the family up by the request's handle, answers from it with `answer` (a
+  /// query_answers.hpp function of the family and the request) and finishes the RPC with `reply`
+  /// (of the record and the answer, or the lookup's error). Returns the reply's reactor.
+  template <typename Request, typename Answer, typename Reply>
+  auto AnswerQuery(grpc::CallbackServerContext* context, const char* method, const Request& request, Answer answer,
+                   Reply reply);
 
   ServiceOptions options_;
   ServerMetrics* metrics_;
