@@ -208,6 +208,37 @@ std::vector<Point2> Tiny(size_t n, uint64_t seed) {
   return points;
 }
 
+std::vector<Point2> UlpLattice(size_t n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> nudge(-2, 2);
+  auto moved = [&](double v) {
+    const int ulps = nudge(rng);
+    for (int i = 0; i < std::abs(ulps); ++i) v = std::nextafter(v, ulps > 0 ? INFINITY : -INFINITY);
+    return v;
+  };
+  const auto width = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+  std::vector<Point2> points;
+  points.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double x = 1000.0 + 0.1 * static_cast<double>(i % std::max<size_t>(width, 1));
+    const double y = 2000.0 + 0.1 * static_cast<double>(i / std::max<size_t>(width, 1));
+    points.push_back({moved(x), moved(y)});
+  }
+  std::shuffle(points.begin(), points.end(), rng);
+  return points;
+}
+
+std::vector<Point2> LidarCentimetres(size_t n, uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int64_t> centimetres(0, 20000);  // a 200 m tile
+  std::vector<Point2> points(n);
+  for (Point2& p : points) {
+    p.x = static_cast<double>(centimetres(rng)) * 0.01 + 500000.0;
+    p.y = static_cast<double>(centimetres(rng)) * 0.01 + 4000000.0;
+  }
+  return points;
+}
+
 std::vector<NamedGenerator> AllDistributions() {
   return {
       {"uniform", Uniform, true},
@@ -223,6 +254,8 @@ std::vector<NamedGenerator> AllDistributions() {
       {"huge_offset_1e15", [](size_t n, uint64_t seed) { return HugeOffset(n, seed, 1e15); },
        false},
       {"tiny", Tiny, false},
+      {"ulp_lattice", UlpLattice, false},
+      {"lidar_cm", LidarCentimetres, false},
   };
 }
 

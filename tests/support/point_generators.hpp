@@ -54,6 +54,16 @@ std::vector<Point2> HugeOffset(size_t n, uint64_t seed, double offset);
 /// floating-point filters and naive expansions must survive.
 std::vector<Point2> Tiny(size_t n, uint64_t seed);
 
+/// A lattice as reprojection or unit conversion leaves it: the first n cells (row-major) of a
+/// ceil(sqrt(n))-wide lattice of spacing 0.1 at offset (1000, 2000), each coordinate computed in
+/// doubles and then moved by -2..2 units in the last place, shuffled. Millions of squared radii
+/// agree to 40 bits and more: the spectrum's hardest near ties.
+std::vector<Point2> UlpLattice(size_t n, uint64_t seed);
+
+/// Airborne LiDAR as stored in LAS files: integer centimetres times 0.01 plus a UTM-like offset
+/// (500000, 4000000), uniform over a 200 m tile (so exact repeats occur), computed in doubles.
+std::vector<Point2> LidarCentimetres(size_t n, uint64_t seed);
+
 /// A generator with the name tests print (SCOPED_TRACE) and benchmarks select by.
 struct NamedGenerator {
   std::string name;
