@@ -20,7 +20,9 @@
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
+#include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/family/alpha_ranks.hpp"
@@ -33,209 +35,424 @@
 
 namespace galpha::detail {
 
-/// Runs the alpha pipeline on the triangulation `t` (in `sys`'s memory, with its points kept) and
-/// downloads the family into `out`: triangles, edges, duplicate map and rank tables. `host_points`
-/// is the same input in host memory (the host's exact repairs read it).
+// The pipeline reads the triangulation's arrays as the alpha functors' types, and the family's host
+// arrays receive them as std::arrays: one layout throughout.
+static_assert(sizeof(TriIdx) == sizeof(std::array<uint32_t, 3>), "layout of the host triangles");
+static_assert(sizeof(TriNb) == sizeof(std::array<int32_t, 3>), "layout of the host neighbours");
+static_assert(sizeof(EdgeIdx) == sizeof(std::array<uint32_t, 2>), "layout of the host edges");
+static_assert(sizeof(EdgeTris) == sizeof(std::array<int32_t, 2>), "layout of the edge triangles");
+static_assert(sizeof(TriIdx) == sizeof(Tri) && sizeof(TriNb) == sizeof(TriNbr) && sizeof(EdgeIdx) == sizeof(EdgePair),
+              "the triangulation's layout is the pipeline's");
+
+// ---- The state passed between the stages --------------------------------------------------------------
+
+/// The triangulation as the stages read it: arrays in the system's memory, sizes on the host.
+struct PipelineMesh {
+  const Point2* points;
+  const TriIdx* tri;
+  const EdgeIdx* edges;
+  const uint32_t* representative;  // per input point, its first occurrence
+  uint32_t n;                      // input points, duplicates included
+  uint32_t num_unique;
+  uint32_t num_tri;
+  uint32_t num_edges;
+
+  /// Spectrum entries are simplex ids: triangles first, then edges.
+  uint32_t num_simplices() const { return num_tri + num_edges; }
+  SimplexPoints simplex() const { return SimplexPoints{points, tri, edges, num_tri}; }
+};
+
 template <class System>
-void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points, StageTimer<System>& timer,
-                      FamilyOutput* family) {
-  static_assert(sizeof(TriIdx) == sizeof(std::array<uint32_t, 3>), "layout of the host triangles");
-  static_assert(sizeof(TriNb) == sizeof(std::array<int32_t, 3>), "layout of the host neighbours");
-  static_assert(sizeof(EdgeIdx) == sizeof(std::array<uint32_t, 2>), "layout of the host edges");
-  static_assert(sizeof(EdgeTris) == sizeof(std::array<int32_t, 2>), "layout of the edge triangles");
-  static_assert(sizeof(TriIdx) == sizeof(Tri) && sizeof(TriNb) == sizeof(TriNbr) && sizeof(EdgeIdx) == sizeof(EdgePair),
-                "the triangulation's layout is the pipeline's");
-  AlphaRanks* out = &family->ranks;
-  auto policy = sys.policy();
-  const uint32_t n = static_cast<uint32_t>(t.points.size());
-  const uint32_t num_tri = static_cast<uint32_t>(t.tri.size()), num_edges = static_cast<uint32_t>(t.edges.size());
-  const uint32_t num_simplices = num_tri + num_edges;
-  thrust::counting_iterator<uint32_t> zero(0);
+PipelineMesh PipelineMeshOf(SystemTriangulation<System>& t) {
+  PipelineMesh mesh;
+  mesh.points = t.points.data();
+  mesh.tri = reinterpret_cast<const TriIdx*>(t.tri.data());
+  mesh.edges = reinterpret_cast<const EdgeIdx*>(t.edges.data());
+  mesh.representative = t.representative.data();
+  mesh.n = static_cast<uint32_t>(t.points.size());
+  mesh.num_unique = t.num_unique;
+  mesh.num_tri = static_cast<uint32_t>(t.tri.size());
+  mesh.num_edges = static_cast<uint32_t>(t.edges.size());
+  return mesh;
+}
 
-  Buffer<uint32_t, System>& representative = t.representative;
-  auto& points = t.points;
-  const TriIdx* tri_data = reinterpret_cast<const TriIdx*>(t.tri.data());
-  const TriNb* nbr_data = reinterpret_cast<const TriNb*>(t.nbr.data());
-  const EdgeIdx* edge_data = reinterpret_cast<const EdgeIdx*>(t.edges.data());
+/// A download running beside the pipeline (CudaSystem's waits when destroyed: declare it after the
+/// buffers it reads).
+template <class System>
+using PendingDownloadOf = decltype(std::declval<System&>().DownloadAsync(std::vector<HostCopy>{}));
 
-  // The triangulation's arrays the family keeps go to the host beside the pipeline, from now on
-  // (the host arrays are sized at once: sizing a HostVector touches no memory).
-  family->triangles.resize(num_tri);
-  family->edges.resize(num_edges);
-  family->representative.resize(n);
+/// The mesh on its way to the host, where the family keeps it; the rare exact repairs on the host
+/// read it there.
+template <class System>
+struct HostMesh {
+  PendingDownloadOf<System> download;
+  AlphaInput input;
+
+  /// The mesh on the host, once it has arrived.
+  const AlphaInput& Get() {
+    download.Wait();
+    return input;
+  }
+};
+
+/// One certified radius key per simplex (kAttachedKey for attached edges), and the keys the
+/// filter could not certify.
+template <class System>
+struct SimplexKeys {
+  Buffer<uint64_t, System> key;
+  Buffer<uint8_t, System> uncertified;
+};
+
+/// The spectrum's entries (triangles and unattached edges) sorted by certified key, and apart the
+/// few whose keys are not certified.
+template <class System>
+struct SortedSpectrum {
+  Buffer<uint32_t, System> ids;  // simplex ids, by key
+  Buffer<uint32_t, System> odd_ids;
+  Buffer<uint64_t, System> sorted_keys;  // the keys of `ids`, in order
+  uint32_t num_entries;
+  uint32_t num_odd;
+};
+
+/// The spectrum's entries in exact order, with the starts of the distinct exact values.
+template <class System>
+struct ExactSpectrum {
+  Buffer<uint32_t, System> ids;
+  Buffer<uint8_t, System> new_value;  // 1 where an exact value starts, 0 inside a tie
+  uint32_t num_entries;
+};
+
+/// The sorted entries whose keys may tie with their neighbour's, grouped in runs.
+template <class System>
+struct TiedRuns {
+  Buffer<uint8_t, System> link;        // link[i]: entries i and i + 1 may tie (num_entries - 1)
+  Buffer<uint32_t, System> run_begin;  // each run's first entry, then num_entries (num_runs + 1)
+  uint32_t num_runs;
+  uint64_t num_links;
+};
+
+/// The rank of every simplex's value (1..K, in exact order) and the first simplex of every rank.
+template <class System>
+struct SpectrumRanks {
+  Buffer<uint32_t, System> tri_rank;       // kNeverRank for collinear triangles
+  Buffer<uint32_t, System> edge_rho_rank;  // 0 for attached edges
+  Buffer<uint32_t, System> spectrum_simplex;
+  uint32_t num_ranks;
+};
+
+/// The published spectrum values: the nearest doubles, except where the system could not round
+/// (`needs_host`: rounded on the host after the download).
+template <class System>
+struct SpectrumValues {
+  Buffer<double, System> spectrum;
+  Buffer<uint8_t, System> needs_host;
+  bool any_needs_host;
+};
+
+/// The intervals of edges and vertices (report Table 2.1), as ranks.
+template <class System>
+struct IntervalRanks {
+  Buffer<uint32_t, System> edge_mu_low;
+  Buffer<uint32_t, System> edge_mu_high;
+  Buffer<uint32_t, System> vertex_mu_low;
+  Buffer<uint32_t, System> vertex_mu_high;
+  Buffer<uint32_t, System> vertex_tri_low;
+};
+
+/// The master list in CSR form: rank r's entries are entries[begin[r], begin[r + 1]).
+template <class System>
+struct MasterListCsr {
+  Buffer<uint32_t, System> begin;
+  Buffer<uint64_t, System> entries;  // packed MasterEntry values
+  uint32_t num_master;
+};
+
+/// The component curves: the number of components at every level 0..K.
+template <class System>
+struct ComponentCounts {
+  Buffer<uint32_t, System> components;
+  Buffer<uint32_t, System> solid_components;
+};
+
+// ---- The stages, in order ---------------------------------------------------------------------------------
+
+/// The triangulation's arrays the family keeps go to the host beside the pipeline, from now on
+/// (the host arrays are sized at once: sizing a HostVector touches no memory).
+template <class System>
+HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, const PipelineMesh& mesh,
+                                   const Point2* host_points, FamilyOutput* family) {
+  family->triangles.resize(mesh.num_tri);
+  family->edges.resize(mesh.num_edges);
+  family->representative.resize(mesh.n);
   family->num_unique = t.num_unique;
-  auto mesh_download = sys.DownloadAsync(
-      {{family->triangles.data(), t.tri.data(), size_t{num_tri} * sizeof(TriIdx)},
-       {family->edges.data(), t.edges.data(), size_t{num_edges} * sizeof(EdgeIdx)},
-       {family->representative.data(), representative.data(), size_t{n} * sizeof(uint32_t)}});
-  AlphaInput host_input;
-  host_input.points = host_points;
-  host_input.triangles = family->triangles.data();
-  host_input.num_triangles = num_tri;
-  host_input.edges = family->edges.data();
-  // The rare host repairs read the mesh on the host.
-  auto host_mesh = [&]() -> const AlphaInput& {
-    mesh_download.Wait();
-    return host_input;
-  };
+  HostMesh<System> host{
+      sys.DownloadAsync(
+          {{family->triangles.data(), t.tri.data(), size_t{mesh.num_tri} * sizeof(TriIdx)},
+           {family->edges.data(), t.edges.data(), size_t{mesh.num_edges} * sizeof(EdgeIdx)},
+           {family->representative.data(), t.representative.data(), size_t{mesh.n} * sizeof(uint32_t)}}),
+      AlphaInput{}};
+  host.input.points = host_points;
+  host.input.triangles = family->triangles.data();
+  host.input.num_triangles = mesh.num_tri;
+  host.input.edges = family->edges.data();
+  return host;
+}
 
-  // Edge topology: the incident triangles of every edge (none for a collinear chain).
-  Buffer<EdgeTris, System> edge_tris(sys, num_edges);
-  thrust::fill_n(policy, edge_tris.data(), num_edges, EdgeTris{{-1, -1}});
-  thrust::for_each_n(policy, zero, num_tri, WriteEdgeTriangles{tri_data, nbr_data, t.edge_begin.data(), edge_tris.data()});
-  t.nbr.Reset();
-  t.edge_begin.Reset();
-  timer.EndStage("edge_topology");
+/// Edge topology: the incident triangles of every edge (none for a collinear chain). The
+/// triangulation's neighbours and edge offsets are not needed after it.
+template <class System>
+Buffer<EdgeTris, System> EdgeTriangles(System& sys, const PipelineMesh& mesh, SystemTriangulation<System>* t) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const TriNb* nbr_data = reinterpret_cast<const TriNb*>(t->nbr.data());
+  Buffer<EdgeTris, System> edge_tris(sys, mesh.num_edges);
+  thrust::fill_n(policy, edge_tris.data(), mesh.num_edges, EdgeTris{{-1, -1}});
+  thrust::for_each_n(policy, zero, mesh.num_tri,
+                     WriteEdgeTriangles{mesh.tri, nbr_data, t->edge_begin.data(), edge_tris.data()});
+  t->nbr.Reset();
+  t->edge_begin.Reset();
+  return edge_tris;
+}
 
-  // Radii and attachment: one certified key per simplex.
-  const SimplexPoints simplex{points.data(), tri_data, edge_data, num_tri};
-  Buffer<uint64_t, System> keys(sys, num_simplices);
-  Buffer<uint8_t, System> uncertified(sys, num_simplices);
-  thrust::for_each_n(policy, zero, num_simplices,
-                     ComputeRadiusKeys{simplex, edge_tris.data(), keys.data(), uncertified.data()});
-  timer.EndStage("radii_attachment");
+/// Radii and attachment: one certified key per simplex.
+template <class System>
+SimplexKeys<System> KeySimplices(System& sys, const PipelineMesh& mesh, const Buffer<EdgeTris, System>& edge_tris) {
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t num_simplices = mesh.num_simplices();
+  SimplexKeys<System> keys{Buffer<uint64_t, System>(sys, num_simplices), Buffer<uint8_t, System>(sys, num_simplices)};
+  thrust::for_each_n(sys.policy(), zero, num_simplices,
+                     ComputeRadiusKeys{mesh.simplex(), edge_tris.data(), keys.key.data(), keys.uncertified.data()});
+  return keys;
+}
 
-  // The spectrum's entries: triangles and unattached edges with certified keys, sorted by key;
-  // the few uncertified ones are placed by the host with exact comparisons.
+/// The spectrum's entries: triangles and unattached edges with certified keys, sorted by key;
+/// the few uncertified ones are placed by the host with exact comparisons (RepairSpectrum).
+template <class System>
+SortedSpectrum<System> SortSpectrum(System& sys, const PipelineMesh& mesh, SimplexKeys<System>* keys) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t num_simplices = mesh.num_simplices();
   Buffer<uint32_t, System> ids(sys, num_simplices);
   const uint32_t num_entries = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_simplices, ids.data(), IsSpectrumEntry{keys.data(), uncertified.data(), false}) -
+      thrust::copy_if(policy, zero, zero + num_simplices, ids.data(),
+                      IsSpectrumEntry{keys->key.data(), keys->uncertified.data(), false}) -
       ids.data());
   Buffer<uint32_t, System> odd_ids(sys, num_simplices - num_entries);
   const uint32_t num_odd = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_simplices, odd_ids.data(), IsSpectrumEntry{keys.data(), uncertified.data(), true}) -
+      thrust::copy_if(policy, zero, zero + num_simplices, odd_ids.data(),
+                      IsSpectrumEntry{keys->key.data(), keys->uncertified.data(), true}) -
       odd_ids.data());
-  uncertified.Reset();
+  keys->uncertified.Reset();
   Buffer<uint64_t, System> sorted_keys(sys, num_entries);
-  thrust::gather(policy, ids.data(), ids.data() + num_entries, keys.data(), sorted_keys.data());
+  thrust::gather(policy, ids.data(), ids.data() + num_entries, keys->key.data(), sorted_keys.data());
   thrust::sort_by_key(policy, sorted_keys.data(), sorted_keys.data() + num_entries, ids.data());
-  timer.EndStage("spectrum_sort");
+  return {std::move(ids), std::move(odd_ids), std::move(sorted_keys), num_entries, num_odd};
+}
 
-  // Runs of entries whose keys may tie: sorted exactly; short runs in parallel on the system,
-  // long or undecided runs on the host.
-  Buffer<uint8_t, System> new_value(sys, num_entries);
-  thrust::fill_n(policy, new_value.data(), num_entries, uint8_t{1});
+/// The runs of sorted entries linked by keys that may tie (num_entries > 1).
+template <class System>
+TiedRuns<System> FindTiedRuns(System& sys, const Buffer<uint64_t, System>& sorted_keys, uint32_t num_entries) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<uint8_t, System> link(sys, num_entries - 1);
+  thrust::transform(policy, zero, zero + (num_entries - 1), link.data(), MayTieWithNext{sorted_keys.data()});
+  const uint64_t num_links = thrust::count(policy, link.data(), link.data() + (num_entries - 1), uint8_t{1});
+  Buffer<uint32_t, System> run_begin(sys, num_entries + 1);
+  const uint32_t num_runs = static_cast<uint32_t>(
+      thrust::copy_if(policy, zero, zero + num_entries, run_begin.data(), IsRunStart{link.data()}) - run_begin.data());
+  sys.FromHost(run_begin.data() + num_runs, &num_entries, 1);
+  return {std::move(link), std::move(run_begin), num_runs, num_links};
+}
+
+/// Long runs whose values are all exactly one double (a grid's congruent simplices) are settled
+/// here, in parallel: every entry checks itself against its run's first. Clears their
+/// `needs_host`; returns the number of runs still left for the host.
+template <class System>
+uint32_t SettleRunsOfOneDouble(System& sys, const PipelineMesh& mesh, const TiedRuns<System>& runs,
+                               ExactSpectrum<System>* spectrum, Buffer<uint8_t, System>* needs_host,
+                               ComparisonCounts* counts) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t num_entries = spectrum->num_entries;
+  const uint32_t num_runs = runs.num_runs;
+  Buffer<uint32_t, System> run_of(sys, num_entries);
+  const auto starts = thrust::make_transform_iterator(zero, RunStartAsU32{runs.link.data()});
+  thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
+  Buffer<uint8_t, System> settled(sys, num_runs);
+  thrust::copy_n(policy, needs_host->data(), num_runs, settled.data());
+  thrust::for_each_n(policy, zero, num_entries,
+                     CheckRunOfOneDouble{mesh.simplex(), spectrum->ids.data(), run_of.data(), runs.run_begin.data(),
+                                         settled.data()});
+  thrust::for_each_n(policy, zero, num_entries,
+                     SettleRunOfOneDouble{run_of.data(), runs.run_begin.data(), settled.data(),
+                                          spectrum->new_value.data()});
+  counts->bounded_exact += thrust::transform_reduce(policy, zero, zero + num_runs,
+                                                    SettledComparisons{runs.run_begin.data(), settled.data()},
+                                                    uint64_t{0}, thrust::plus<uint64_t>());
+  thrust::transform(policy, zero, zero + num_runs, needs_host->data(),
+                    StillNeedsHost{needs_host->data(), settled.data()});
+  return static_cast<uint32_t>(thrust::count(policy, needs_host->data(), needs_host->data() + num_runs, uint8_t{1}));
+}
+
+/// Brings the whole order to the host once (rare: long runs of near or exact ties, such as a
+/// grid's congruent triangles) and repairs there the runs marked in `needs_host`.
+template <class System>
+void RepairRunsOnHostOnce(System& sys, HostMesh<System>& host_mesh, const TiedRuns<System>& runs,
+                          const Buffer<uint8_t, System>& needs_host, ExactSpectrum<System>* spectrum,
+                          ComparisonCounts* counts) {
+  const uint32_t num_entries = spectrum->num_entries;
+  const uint32_t num_runs = runs.num_runs;
+  std::vector<uint32_t> host_ids = spectrum->ids.ToHostVector(num_entries);
+  std::vector<uint8_t> host_new = spectrum->new_value.ToHostVector(num_entries);
+  std::vector<uint32_t> host_begin = runs.run_begin.ToHostVector(num_runs + 1);
+  std::vector<uint8_t> host_needs = needs_host.ToHostVector(num_runs);
+  std::vector<std::array<uint32_t, 2>> host_runs;
+  for (uint32_t r = 0; r < num_runs; ++r) {
+    if (host_needs[r]) host_runs.push_back({host_begin[r], host_begin[r + 1]});
+  }
+  RepairRunsOnHost(host_mesh.Get(), host_runs, host_ids.data(), host_new.data(), counts);
+  sys.FromHost(spectrum->ids.data(), host_ids.data(), num_entries);
+  sys.FromHost(spectrum->new_value.data(), host_new.data(), num_entries);
+}
+
+/// Runs of entries whose keys may tie: sorted exactly; short runs in parallel on the system,
+/// long or undecided runs on the host. Returns the number of links (neighbours whose keys alone
+/// did not order them).
+template <class System>
+uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>& host_mesh,
+                        const Buffer<uint64_t, System>& sorted_keys, ExactSpectrum<System>* spectrum,
+                        ComparisonCounts* counts) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  TiedRuns<System> runs = FindTiedRuns(sys, sorted_keys, spectrum->num_entries);
+  const uint32_t num_runs = runs.num_runs;
+  const uint32_t* run_end = runs.run_begin.data() + 1;
+  Buffer<uint8_t, System> needs_host(sys, num_runs);
+  Buffer<uint32_t, System> run_comparisons(sys, num_runs);
+  thrust::for_each_n(policy, zero, num_runs,
+                     RepairRun{mesh.simplex(), runs.run_begin.data(), run_end, spectrum->ids.data(),
+                               spectrum->new_value.data(), needs_host.data(), run_comparisons.data()});
+  counts->bounded_exact +=
+      thrust::reduce(policy, run_comparisons.data(), run_comparisons.data() + num_runs, uint64_t{0});
+  uint32_t host_runs =
+      static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
+  if (host_runs > 0) host_runs = SettleRunsOfOneDouble(sys, mesh, runs, spectrum, &needs_host, counts);
+  runs.link.Reset();
+  if (host_runs > 0) RepairRunsOnHostOnce(sys, host_mesh, runs, needs_host, spectrum, counts);
+  return runs.num_links;
+}
+
+/// Entries whose keys are not certified (extreme exponent ranges inside one simplex): merged into
+/// the exact order on the host.
+template <class System>
+void MergeUncertified(System& sys, HostMesh<System>& host_mesh, const Buffer<uint32_t, System>& odd_ids,
+                      uint32_t num_odd, ExactSpectrum<System>* spectrum, ComparisonCounts* counts) {
+  std::vector<uint32_t> host_ids = spectrum->ids.ToHostVector(spectrum->num_entries);
+  std::vector<uint8_t> host_new = spectrum->new_value.ToHostVector(spectrum->num_entries);
+  std::vector<uint32_t> odd = odd_ids.ToHostVector(num_odd);
+  MergeUncertifiedOnHost(host_mesh.Get(), odd, &host_ids, &host_new, counts);
+  const uint32_t total_entries = static_cast<uint32_t>(host_ids.size());
+  spectrum->ids = Buffer<uint32_t, System>(sys, total_entries);
+  spectrum->new_value = Buffer<uint8_t, System>(sys, total_entries);
+  sys.FromHost(spectrum->ids.data(), host_ids.data(), total_entries);
+  sys.FromHost(spectrum->new_value.data(), host_new.data(), total_entries);
+  spectrum->num_entries = total_entries;
+}
+
+/// The exact spectrum from the key order: the runs of entries whose keys may tie are sorted
+/// exactly, then the uncertified entries are merged in.
+template <class System>
+ExactSpectrum<System> RepairSpectrum(System& sys, const PipelineMesh& mesh, HostMesh<System>& host_mesh,
+                                     SortedSpectrum<System>* sorted, ComparisonCounts* counts) {
+  const uint32_t num_entries = sorted->num_entries;
+  ExactSpectrum<System> spectrum{std::move(sorted->ids), Buffer<uint8_t, System>(sys, num_entries), num_entries};
+  thrust::fill_n(sys.policy(), spectrum.new_value.data(), num_entries, uint8_t{1});
   uint64_t num_links = 0;
-  if (num_entries > 1) {
-    Buffer<uint8_t, System> link(sys, num_entries - 1);
-    thrust::transform(policy, zero, zero + (num_entries - 1), link.data(), MayTieWithNext{sorted_keys.data()});
-    num_links = thrust::count(policy, link.data(), link.data() + (num_entries - 1), uint8_t{1});
-    Buffer<uint32_t, System> run_begin(sys, num_entries + 1);
-    const uint32_t num_runs = static_cast<uint32_t>(
-        thrust::copy_if(policy, zero, zero + num_entries, run_begin.data(), IsRunStart{link.data()}) - run_begin.data());
-    sys.FromHost(run_begin.data() + num_runs, &num_entries, 1);
-    const uint32_t* run_end = run_begin.data() + 1;
-    Buffer<uint8_t, System> needs_host(sys, num_runs);
-    Buffer<uint32_t, System> run_comparisons(sys, num_runs);
-    thrust::for_each_n(policy, zero, num_runs,
-                       RepairRun{simplex, run_begin.data(), run_end, ids.data(), new_value.data(), needs_host.data(),
-                                 run_comparisons.data()});
-    out->comparisons.bounded_exact +=
-        thrust::reduce(policy, run_comparisons.data(), run_comparisons.data() + num_runs, uint64_t{0});
-    uint32_t host_runs = static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
-    if (host_runs > 0) {
-      // Long runs whose values are all exactly one double (a grid's congruent simplices) are
-      // settled here, in parallel: every entry checks itself against its run's first.
-      Buffer<uint32_t, System> run_of(sys, num_entries);
-      const auto starts = thrust::make_transform_iterator(zero, RunStartAsU32{link.data()});
-      thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
-      Buffer<uint8_t, System> settled(sys, num_runs);
-      thrust::copy_n(policy, needs_host.data(), num_runs, settled.data());
-      thrust::for_each_n(policy, zero, num_entries,
-                         CheckRunOfOneDouble{simplex, ids.data(), run_of.data(), run_begin.data(), settled.data()});
-      thrust::for_each_n(policy, zero, num_entries,
-                         SettleRunOfOneDouble{run_of.data(), run_begin.data(), settled.data(), new_value.data()});
-      out->comparisons.bounded_exact += thrust::transform_reduce(
-          policy, zero, zero + num_runs, SettledComparisons{run_begin.data(), settled.data()}, uint64_t{0},
-          thrust::plus<uint64_t>());
-      thrust::transform(policy, zero, zero + num_runs, needs_host.data(), StillNeedsHost{needs_host.data(), settled.data()});
-      host_runs = static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
-    }
-    link.Reset();
-    if (host_runs > 0) {
-      // Bring the whole order to the host once (rare: long runs of near or exact ties, such as a
-      // grid's congruent triangles) and repair there.
-      std::vector<uint32_t> host_ids = ids.ToHostVector(num_entries);
-      std::vector<uint8_t> host_new = new_value.ToHostVector(num_entries);
-      std::vector<uint32_t> host_begin = run_begin.ToHostVector(num_runs + 1);
-      std::vector<uint8_t> host_needs = needs_host.ToHostVector(num_runs);
-      std::vector<std::array<uint32_t, 2>> runs;
-      for (uint32_t r = 0; r < num_runs; ++r) {
-        if (host_needs[r]) runs.push_back({host_begin[r], host_begin[r + 1]});
-      }
-      RepairRunsOnHost(host_mesh(), runs, host_ids.data(), host_new.data(), &out->comparisons);
-      sys.FromHost(ids.data(), host_ids.data(), num_entries);
-      sys.FromHost(new_value.data(), host_new.data(), num_entries);
-    }
-  }
-  out->comparisons.filter += num_entries > 0 ? (num_entries - 1) - num_links : 0;
-  sorted_keys.Reset();
+  if (num_entries > 1) num_links = RepairTiedRuns(sys, mesh, host_mesh, sorted->sorted_keys, &spectrum, counts);
+  counts->filter += num_entries > 0 ? (num_entries - 1) - num_links : 0;
+  sorted->sorted_keys.Reset();
+  if (sorted->num_odd > 0) MergeUncertified(sys, host_mesh, sorted->odd_ids, sorted->num_odd, &spectrum, counts);
+  sorted->odd_ids.Reset();
+  return spectrum;
+}
 
-  // Entries whose keys are not certified (extreme exponent ranges inside one simplex): merged
-  // into the exact order on the host.
-  uint32_t total_entries = num_entries;
-  if (num_odd > 0) {
-    std::vector<uint32_t> host_ids = ids.ToHostVector(num_entries);
-    std::vector<uint8_t> host_new = new_value.ToHostVector(num_entries);
-    std::vector<uint32_t> odd = odd_ids.ToHostVector(num_odd);
-    MergeUncertifiedOnHost(host_mesh(), odd, &host_ids, &host_new, &out->comparisons);
-    total_entries = static_cast<uint32_t>(host_ids.size());
-    ids = Buffer<uint32_t, System>(sys, total_entries);
-    new_value = Buffer<uint8_t, System>(sys, total_entries);
-    sys.FromHost(ids.data(), host_ids.data(), total_entries);
-    sys.FromHost(new_value.data(), host_new.data(), total_entries);
-  }
-  odd_ids.Reset();
-  timer.EndStage("spectrum_repair");
-
-  // Ranks: an inclusive scan of the value starts numbers the distinct exact values 1..K.
+/// Ranks: an inclusive scan of the value starts numbers the distinct exact values 1..K. The exact
+/// order is not needed after it.
+template <class System>
+SpectrumRanks<System> RankSpectrum(System& sys, const PipelineMesh& mesh, ExactSpectrum<System>* spectrum) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t total_entries = spectrum->num_entries;
   Buffer<uint32_t, System> rank(sys, total_entries);
   // (Scanned as uint32: Thrust may accumulate in the input's type, and uint8 would wrap.)
-  const auto as_u32 = thrust::make_transform_iterator(new_value.data(), ToU32{});
+  const auto as_u32 = thrust::make_transform_iterator(spectrum->new_value.data(), ToU32{});
   thrust::inclusive_scan(policy, as_u32, as_u32 + total_entries, rank.data());
   const uint32_t num_ranks = total_entries > 0 ? sys.Read(rank.data() + (total_entries - 1)) : 0;
-  Buffer<uint32_t, System> tri_rank(sys, num_tri);
-  Buffer<uint32_t, System> edge_rho_rank(sys, num_edges);
-  thrust::fill_n(policy, tri_rank.data(), num_tri, kNeverRank);  // collinear triangles: never born
-  thrust::fill_n(policy, edge_rho_rank.data(), num_edges, uint32_t{0});
+  Buffer<uint32_t, System> tri_rank(sys, mesh.num_tri);
+  Buffer<uint32_t, System> edge_rho_rank(sys, mesh.num_edges);
+  thrust::fill_n(policy, tri_rank.data(), mesh.num_tri, kNeverRank);  // collinear triangles: never born
+  thrust::fill_n(policy, edge_rho_rank.data(), mesh.num_edges, uint32_t{0});
   Buffer<uint32_t, System> spectrum_simplex(sys, num_ranks);
   thrust::for_each_n(policy, zero, total_entries,
-                     ScatterRanks{ids.data(), rank.data(), new_value.data(), num_tri, tri_rank.data(),
-                                  edge_rho_rank.data(), spectrum_simplex.data()});
+                     ScatterRanks{spectrum->ids.data(), rank.data(), spectrum->new_value.data(), mesh.num_tri,
+                                  tri_rank.data(), edge_rho_rank.data(), spectrum_simplex.data()});
   rank.Reset();
-  ids.Reset();
-  new_value.Reset();
-  timer.EndStage("ranks");
+  spectrum->ids.Reset();
+  spectrum->new_value.Reset();
+  return {std::move(tri_rank), std::move(edge_rho_rank), std::move(spectrum_simplex), num_ranks};
+}
 
-  // Published spectrum values: the nearest doubles. (Downloaded with the rest at the end, so that
-  // this stage's time is the computation's; the rare values the device cannot round are rounded
-  // on the host after the download.)
-  Buffer<double, System> spectrum(sys, num_ranks);
-  Buffer<uint8_t, System> needs_host(sys, num_ranks);
+/// Published spectrum values: the nearest doubles. (Downloaded with the rest at the end, so that
+/// this stage's time is the computation's; the rare values the device cannot round are rounded
+/// on the host after the download.)
+template <class System>
+SpectrumValues<System> RoundSpectrumValues(System& sys, const PipelineMesh& mesh, const SpectrumRanks<System>& ranks) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t num_ranks = ranks.num_ranks;
+  SpectrumValues<System> values{Buffer<double, System>(sys, num_ranks), Buffer<uint8_t, System>(sys, num_ranks), false};
   thrust::for_each_n(policy, zero, num_ranks,
-                     NearestSpectrumValue{simplex, spectrum_simplex.data(), spectrum.data(), needs_host.data()});
-  const bool any_needs_host = thrust::count(policy, needs_host.data(), needs_host.data() + num_ranks, uint8_t{1}) > 0;
-  timer.EndStage("spectrum_values");
+                     NearestSpectrumValue{mesh.simplex(), ranks.spectrum_simplex.data(), values.spectrum.data(),
+                                          values.needs_host.data()});
+  values.any_needs_host =
+      thrust::count(policy, values.needs_host.data(), values.needs_host.data() + num_ranks, uint8_t{1}) > 0;
+  return values;
+}
 
-  // Intervals (report Table 2.1) for edges and vertices.
-  Buffer<uint32_t, System> edge_mu_low(sys, num_edges), edge_mu_high(sys, num_edges);
-  Buffer<uint32_t, System> vertex_mu_low(sys, n), vertex_mu_high(sys, n), vertex_tri_low(sys, n);
-  thrust::fill_n(policy, vertex_mu_low.data(), n, kNeverRank);
-  thrust::fill_n(policy, vertex_mu_high.data(), n, uint32_t{0});
-  thrust::fill_n(policy, vertex_tri_low.data(), n, kNeverRank);
-  thrust::for_each_n(policy, zero, num_edges,
-                     EdgeIntervals{edge_data, edge_tris.data(), tri_rank.data(), edge_rho_rank.data(),
-                                   edge_mu_low.data(), edge_mu_high.data(), keys.data(), num_tri,
-                                   vertex_mu_low.data(), vertex_mu_high.data(), vertex_tri_low.data()});
+/// Intervals (report Table 2.1) for edges and vertices; attached edges get edge_rho_rank 0. The
+/// keys are not needed after them.
+template <class System>
+IntervalRanks<System> ComputeIntervals(System& sys, const PipelineMesh& mesh, const Buffer<EdgeTris, System>& edge_tris,
+                                   SpectrumRanks<System>* ranks, SimplexKeys<System>* keys) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t n = mesh.n;
+  IntervalRanks<System> iv{Buffer<uint32_t, System>(sys, mesh.num_edges), Buffer<uint32_t, System>(sys, mesh.num_edges),
+                       Buffer<uint32_t, System>(sys, n), Buffer<uint32_t, System>(sys, n),
+                       Buffer<uint32_t, System>(sys, n)};
+  thrust::fill_n(policy, iv.vertex_mu_low.data(), n, kNeverRank);
+  thrust::fill_n(policy, iv.vertex_mu_high.data(), n, uint32_t{0});
+  thrust::fill_n(policy, iv.vertex_tri_low.data(), n, kNeverRank);
+  thrust::for_each_n(policy, zero, mesh.num_edges,
+                     EdgeIntervals{mesh.edges, edge_tris.data(), ranks->tri_rank.data(), ranks->edge_rho_rank.data(),
+                                   iv.edge_mu_low.data(), iv.edge_mu_high.data(), keys->key.data(), mesh.num_tri,
+                                   iv.vertex_mu_low.data(), iv.vertex_mu_high.data(), iv.vertex_tri_low.data()});
   // Representatives first (their own values), then duplicates copy them.
   thrust::for_each_n(policy, zero, n,
-                     FinishVertexIntervals{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
-                                           vertex_tri_low.data()});
-  keys.Reset();
-  timer.EndStage("intervals");
+                     FinishVertexIntervals{mesh.representative, iv.vertex_mu_low.data(), iv.vertex_mu_high.data(),
+                                           iv.vertex_tri_low.data()});
+  keys->key.Reset();
+  return iv;
+}
 
-  // The spectrum, the ranks and the intervals are final: they go to the host beside the master
-  // list and the component curves (which only read them).
+/// The spectrum, the ranks and the intervals are final: they go to the host beside the master
+/// list and the component curves (which only read them).
+template <class System>
+PendingDownloadOf<System> StartTablesDownload(System& sys, const PipelineMesh& mesh,
+                                              const Buffer<EdgeTris, System>& edge_tris,
+                                              const SpectrumRanks<System>& ranks, const SpectrumValues<System>& values,
+                                              const IntervalRanks<System>& iv, AlphaRanks* out) {
+  const uint32_t n = mesh.n, num_tri = mesh.num_tri, num_edges = mesh.num_edges, num_ranks = ranks.num_ranks;
   out->spectrum.resize(num_ranks);
   out->spectrum_simplex.resize(num_ranks);
   out->tri_rank.resize(num_tri);
@@ -246,24 +463,63 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   out->vertex_mu_low.resize(n);
   out->vertex_mu_high.resize(n);
   out->vertex_tri_low.resize(n);
-  auto tables_download = sys.DownloadAsync(
-      {{out->spectrum.data(), spectrum.data(), size_t{num_ranks} * sizeof(double)},
-       {out->spectrum_simplex.data(), spectrum_simplex.data(), size_t{num_ranks} * sizeof(uint32_t)},
-       {out->tri_rank.data(), tri_rank.data(), size_t{num_tri} * sizeof(uint32_t)},
-       {out->edge_rho_rank.data(), edge_rho_rank.data(), size_t{num_edges} * sizeof(uint32_t)},
-       {out->edge_mu_low.data(), edge_mu_low.data(), size_t{num_edges} * sizeof(uint32_t)},
-       {out->edge_mu_high.data(), edge_mu_high.data(), size_t{num_edges} * sizeof(uint32_t)},
+  return sys.DownloadAsync(
+      {{out->spectrum.data(), values.spectrum.data(), size_t{num_ranks} * sizeof(double)},
+       {out->spectrum_simplex.data(), ranks.spectrum_simplex.data(), size_t{num_ranks} * sizeof(uint32_t)},
+       {out->tri_rank.data(), ranks.tri_rank.data(), size_t{num_tri} * sizeof(uint32_t)},
+       {out->edge_rho_rank.data(), ranks.edge_rho_rank.data(), size_t{num_edges} * sizeof(uint32_t)},
+       {out->edge_mu_low.data(), iv.edge_mu_low.data(), size_t{num_edges} * sizeof(uint32_t)},
+       {out->edge_mu_high.data(), iv.edge_mu_high.data(), size_t{num_edges} * sizeof(uint32_t)},
        {out->edge_triangles.data(), edge_tris.data(), size_t{num_edges} * sizeof(EdgeTris)},
-       {out->vertex_mu_low.data(), vertex_mu_low.data(), size_t{n} * sizeof(uint32_t)},
-       {out->vertex_mu_high.data(), vertex_mu_high.data(), size_t{n} * sizeof(uint32_t)},
-       {out->vertex_tri_low.data(), vertex_tri_low.data(), size_t{n} * sizeof(uint32_t)}});
+       {out->vertex_mu_low.data(), iv.vertex_mu_low.data(), size_t{n} * sizeof(uint32_t)},
+       {out->vertex_mu_high.data(), iv.vertex_mu_high.data(), size_t{n} * sizeof(uint32_t)},
+       {out->vertex_tri_low.data(), iv.vertex_tri_low.data(), size_t{n} * sizeof(uint32_t)}});
+}
 
-  // Master list in CSR form: count the end points per rank, scan, place each entry in its rank's
-  // segment, then sort every segment (O(entries): no global sort).
-  const MasterEndpoints endpoints{representative.data(), vertex_mu_low.data(), vertex_mu_high.data(),
-                                  edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(),
-                                  tri_rank.data(), n, num_edges};
-  const uint32_t num_items = n + num_edges + num_tri;
+/// Sorts every rank segment of the master list: short ones by one thread each, long ones (exact
+/// ties: a grid's congruent simplices) afterwards.
+template <class System>
+void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t num_items, uint32_t num_ranks,
+                        const Buffer<uint32_t, System>& master_begin, Buffer<uint64_t, System>* master_entries) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<uint8_t, System> long_segment(sys, static_cast<size_t>(num_ranks) + 1);
+  thrust::for_each_n(policy, zero, num_ranks + 1,
+                     SortMasterSegment{master_begin.data(), master_entries->data(), long_segment.data()});
+  if (thrust::count(policy, long_segment.data(), long_segment.data() + (num_ranks + 1), uint8_t{1}) > 0) {
+    const std::vector<uint8_t> host_long = long_segment.ToHostVector(num_ranks + 1);
+    const std::vector<uint32_t> host_begin = master_begin.ToHostVector(num_ranks + 2);
+    if constexpr (System::kHostMemory) {
+      // One pass over the simplices in order writes the long segments already sorted (items
+      // come by kind, then id, each with its end points in order): no sort of exact ties.
+      std::vector<uint32_t> cursor(host_begin.begin(), host_begin.end() - 1);
+      uint64_t* entries = master_entries->data();
+      auto place = [&](uint32_t rank, uint64_t packed) {
+        if (host_long[rank]) entries[cursor[rank]++] = packed;
+      };
+      for (uint32_t item = 0; item < num_items; ++item) endpoints.Visit(item, place);
+    } else {
+      for (uint32_t r = 0; r <= num_ranks; ++r) {
+        if (host_long[r]) {
+          thrust::sort(policy, master_entries->data() + host_begin[r], master_entries->data() + host_begin[r + 1]);
+        }
+      }
+    }
+  }
+}
+
+/// Master list in CSR form: count the end points per rank, scan, place each entry in its rank's
+/// segment, then sort every segment (O(entries): no global sort).
+template <class System>
+MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, const SpectrumRanks<System>& ranks,
+                                   const IntervalRanks<System>& iv) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t num_ranks = ranks.num_ranks;
+  const MasterEndpoints endpoints{mesh.representative,        iv.vertex_mu_low.data(), iv.vertex_mu_high.data(),
+                                  ranks.edge_rho_rank.data(), iv.edge_mu_low.data(),   iv.edge_mu_high.data(),
+                                  ranks.tri_rank.data(),      mesh.n,                  mesh.num_edges};
+  const uint32_t num_items = mesh.n + mesh.num_edges + mesh.num_tri;
   Buffer<uint32_t, System> master_begin(sys, static_cast<size_t>(num_ranks) + 2);
   thrust::fill_n(policy, master_begin.data(), num_ranks + 2, uint32_t{0});
   thrust::for_each_n(policy, zero, num_items, CountMasterEntries{endpoints, master_begin.data()});
@@ -275,55 +531,80 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
     thrust::copy_n(policy, master_begin.data(), num_ranks + 2, cursor.data());
     thrust::for_each_n(policy, zero, num_items, FillMasterEntries{endpoints, cursor.data(), master_entries.data()});
   }
-  {
-    Buffer<uint8_t, System> long_segment(sys, static_cast<size_t>(num_ranks) + 1);
-    thrust::for_each_n(policy, zero, num_ranks + 1,
-                       SortMasterSegment{master_begin.data(), master_entries.data(), long_segment.data()});
-    if (thrust::count(policy, long_segment.data(), long_segment.data() + (num_ranks + 1), uint8_t{1}) > 0) {
-      const std::vector<uint8_t> host_long = long_segment.ToHostVector(num_ranks + 1);
-      const std::vector<uint32_t> host_begin = master_begin.ToHostVector(num_ranks + 2);
-      if constexpr (System::kHostMemory) {
-        // One pass over the simplices in order writes the long segments already sorted (items
-        // come by kind, then id, each with its end points in order): no sort of exact ties.
-        std::vector<uint32_t> cursor(host_begin.begin(), host_begin.end() - 1);
-        uint64_t* entries = master_entries.data();
-        auto place = [&](uint32_t rank, uint64_t packed) {
-          if (host_long[rank]) entries[cursor[rank]++] = packed;
-        };
-        for (uint32_t item = 0; item < num_items; ++item) endpoints.Visit(item, place);
-      } else {
-        for (uint32_t r = 0; r <= num_ranks; ++r) {
-          if (host_long[r]) {
-            thrust::sort(policy, master_entries.data() + host_begin[r], master_entries.data() + host_begin[r + 1]);
-          }
-        }
-      }
-    }
-  }
-  timer.EndStage("master_list");
+  SortMasterSegments(sys, endpoints, num_items, num_ranks, master_begin, &master_entries);
+  return {std::move(master_begin), std::move(master_entries), num_master};
+}
 
-  // Component curves over all levels (Borůvka spanning forests, component_curve.cuh).
-  Buffer<uint32_t, System> components(sys, static_cast<size_t>(num_ranks) + 1);
-  Buffer<uint32_t, System> solid_components(sys, static_cast<size_t>(num_ranks) + 1);
-  ComponentCurves(sys, n, t.num_unique, num_tri, num_edges, num_ranks, edge_data, edge_tris.data(), tri_rank.data(),
-                  edge_rho_rank.data(), edge_mu_low.data(), edge_mu_high.data(), components.data(),
-                  solid_components.data());
-  timer.EndStage("components");
+/// Component curves over all levels (Borůvka spanning forests, component_curve.cuh).
+template <class System>
+ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
+                                        const Buffer<EdgeTris, System>& edge_tris, const SpectrumRanks<System>& ranks,
+                                        const IntervalRanks<System>& iv) {
+  const uint32_t num_ranks = ranks.num_ranks;
+  ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, static_cast<size_t>(num_ranks) + 1),
+                                 Buffer<uint32_t, System>(sys, static_cast<size_t>(num_ranks) + 1)};
+  ComponentCurves(sys, mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, num_ranks, mesh.edges, edge_tris.data(),
+                  ranks.tri_rank.data(), ranks.edge_rho_rank.data(), iv.edge_mu_low.data(), iv.edge_mu_high.data(),
+                  counts.components.data(), counts.solid_components.data());
+  return counts;
+}
 
-  // The rest of the family, then the downloads started earlier (the host arrays are not zeroed
-  // first: the copies are their first touch, on every core; core/base/host_vector.hpp).
+/// The rest of the family, then the downloads started earlier (the host arrays are not zeroed
+/// first: the copies are their first touch, on every core; core/base/host_vector.hpp), then the
+/// values the system could not round.
+template <class System>
+void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const SpectrumValues<System>& values,
+                    const MasterListCsr<System>& master, const ComponentCounts<System>& counts,
+                    PendingDownloadOf<System>* tables_download, HostMesh<System>* host_mesh, AlphaRanks* out) {
+  const uint32_t num_ranks = ranks.num_ranks;
   out->components.resize(static_cast<size_t>(num_ranks) + 1);
   out->solid_components.resize(static_cast<size_t>(num_ranks) + 1);
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
-  out->master.resize(num_master);
-  sys.Download({{out->components.data(), components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
-                {out->solid_components.data(), solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
-                {out->master_begin.data(), master_begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
-                {out->master.data(), master_entries.data(), size_t{num_master} * sizeof(uint64_t)}});
-  tables_download.Wait();
-  mesh_download.Wait();
-  if (any_needs_host) NearestValuesOnHost(host_input, needs_host.ToHostVector(num_ranks), out);
+  out->master.resize(master.num_master);
+  sys.Download({{out->components.data(), counts.components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+                {out->solid_components.data(), counts.solid_components.data(),
+                 (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+                {out->master_begin.data(), master.begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
+                {out->master.data(), master.entries.data(), size_t{master.num_master} * sizeof(uint64_t)}});
+  tables_download->Wait();
+  const AlphaInput& host_input = host_mesh->Get();
+  if (values.any_needs_host) NearestValuesOnHost(host_input, values.needs_host.ToHostVector(num_ranks), out);
+}
+
+// ---- The pipeline -------------------------------------------------------------------------------------------
+
+/// Runs the alpha pipeline on the triangulation `t` (in `sys`'s memory, with its points kept) and
+/// downloads the family into `out`: triangles, edges, duplicate map and rank tables. `host_points`
+/// is the same input in host memory (the host's exact repairs read it). One stage a call; the
+/// buffers a stage no longer needs are freed by the stage that reads them last.
+template <class System>
+void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points, StageTimer<System>& timer,
+                      FamilyOutput* family) {
+  AlphaRanks* out = &family->ranks;
+  const PipelineMesh mesh = PipelineMeshOf(t);
+  HostMesh<System> host_mesh = StartMeshDownload(sys, t, mesh, host_points, family);
+  Buffer<EdgeTris, System> edge_tris = EdgeTriangles(sys, mesh, &t);
+  timer.EndStage("edge_topology");
+  SimplexKeys<System> keys = KeySimplices(sys, mesh, edge_tris);
+  timer.EndStage("radii_attachment");
+  SortedSpectrum<System> sorted = SortSpectrum(sys, mesh, &keys);
+  timer.EndStage("spectrum_sort");
+  ExactSpectrum<System> exact = RepairSpectrum(sys, mesh, host_mesh, &sorted, &out->comparisons);
+  timer.EndStage("spectrum_repair");
+  SpectrumRanks<System> ranks = RankSpectrum(sys, mesh, &exact);
+  timer.EndStage("ranks");
+  SpectrumValues<System> values = RoundSpectrumValues(sys, mesh, ranks);
+  timer.EndStage("spectrum_values");
+  IntervalRanks<System> intervals = ComputeIntervals(sys, mesh, edge_tris, &ranks, &keys);
+  timer.EndStage("intervals");
+  // Declared after the buffers it reads: on an early exit it waits for its copies before they go.
+  PendingDownloadOf<System> tables_download = StartTablesDownload(sys, mesh, edge_tris, ranks, values, intervals, out);
+  MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
+  timer.EndStage("master_list");
+  ComponentCounts<System> components = CountComponents(sys, mesh, edge_tris, ranks, intervals);
+  timer.EndStage("components");
+  FinishDownload(sys, ranks, values, master, components, &tables_download, &host_mesh, out);
   timer.EndStage("download");
 }
 

@@ -1,0 +1,360 @@
+// The Delaunay mesh under construction, written once over an execution system (CpuSystem or
+// CudaSystem): insertion rounds with Lawson flips, then the repair of the hull. Its own header so
+// that the pipeline around it (delaunay_impl.cuh) reads as its stages.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <thrust/copy.h>
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/zip_iterator.h>
+#include <thrust/scan.h>
+#include <thrust/sort.h>
+#include <thrust/transform_scan.h>
+#include <thrust/unique.h>
+
+#include "core/exact/predicates.hpp"
+#include "gpu/system/engine_system.cuh"
+#include "gpu/triangulation/delaunay_flip.cuh"
+#include "gpu/triangulation/delaunay_insert.cuh"
+#include "gpu/triangulation/mesh.cuh"
+
+namespace galpha::detail {
+
+struct IsSet {
+  GALPHA_HD bool operator()(uint8_t x) const { return x != 0; }
+};
+
+struct IsClear {
+  GALPHA_HD bool operator()(uint8_t x) const { return x == 0; }
+};
+
+struct IsNonNegative {
+  GALPHA_HD bool operator()(int32_t x) const { return x >= 0; }
+  GALPHA_HD bool operator()(int8_t x) const { return x >= 0; }
+};
+
+struct IsFlatFiniteTriangle {
+  MeshView mesh;
+  GALPHA_HD bool operator()(int32_t t) const { return IsFlatTriangle(mesh, t); }
+};
+
+/// The working state of one triangulation and the steps that change it.
+template <class System>
+class DelaunayBuilder {
+ public:
+  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m, int32_t a, int32_t b, int32_t c)
+      : sys_(sys),
+        m_(m),
+        capacity_(2 * m),
+        tri_(sys, capacity_),
+        nbr_(sys, capacity_),
+        tri_vote_(sys, capacity_),
+        split_count_or_nb_(sys, capacity_),
+        flip_vote_(sys, capacity_),
+        partner_(sys, capacity_),
+        stamp_(sys, capacity_),
+        active_(sys, capacity_),
+        active_mask_(sys, capacity_),
+        candidate_mask_(sys, 2 * capacity_),
+        proposal_edge_(sys, capacity_),
+        flags_(sys, 2),
+        counts_(sys, kNumCounts) {
+    mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
+    thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
+    thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
+    thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
+    thrust::fill(sys_.policy(), flags_.begin(), flags_.end(), 0);
+    thrust::fill(sys_.policy(), counts_.begin(), counts_.end(), 0u);
+  }
+
+  /// Frees everything but the mesh once it is final (before the output stage).
+  void ReleaseWorkspace() {
+    tri_vote_.Reset();
+    split_count_or_nb_.Reset();
+    flip_vote_.Reset();
+    partner_.Reset();
+    stamp_.Reset();
+    active_.Reset();
+    active_mask_.Reset();
+    candidate_mask_.Reset();
+    proposal_edge_.Reset();
+  }
+
+  int32_t num_triangles() const { return num_tri_; }
+  const MeshView& mesh() const { return mesh_; }
+  int rounds() const { return rounds_; }
+
+  /// Starts from the triangle (a, b, c), counter-clockwise, and its three infinite neighbours.
+  void Start(int32_t a, int32_t b, int32_t c) {
+    const int32_t inf = mesh_.inf;
+    const Tri init[4] = {{{a, b, c}}, {{b, a, inf}}, {{c, b, inf}}, {{a, c, inf}}};
+    TriNbr links[4];
+    for (int t = 0; t < 4; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const int32_t p = init[t].v[Next(k)], q = init[t].v[Prev(k)];
+        for (int u = 0; u < 4; ++u) {
+          for (int j = 0; j < 3; ++j) {
+            if (u != t && init[u].v[Next(j)] == q && init[u].v[Prev(j)] == p) links[t].n[k] = u;
+          }
+        }
+      }
+    }
+    sys_.FromHost(tri_.data(), init, 4);
+    sys_.FromHost(nbr_.data(), links, 4);
+    num_tri_ = 4;
+  }
+
+  /// Inserts every pending vertex in rounds; `location` starts at a triangle of the mesh.
+  ///
+  /// Each round waits for the device once, for the number of points elected (the mesh's size on
+  /// the host sizes the next launches). The other counts stay on the device: the pending points
+  /// left after a round are counted there, the next round's vote strides over that count, and the
+  /// host learns it with the round's one wait.
+  void InsertAll(int32_t* pending, int32_t* location, uint8_t* inserted, uint32_t num_pending) {
+    auto pol = sys_.policy();
+    uint32_t* pending_count = counts_.data() + kPendingCount;
+    thrust::fill(pol, pending_count, pending_count + 1, num_pending);
+    Relocate(pending, location, inserted, num_pending);
+    for (;;) {
+      ++rounds_;
+      thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
+      sys_.ForEachBelow(pending_count, VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
+      // Inclusive, so that its last entry is the number of splits.
+      thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
+                                       split_count_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
+      // The round's one wait: splits, pending points, and whether a relocation walk failed.
+      int32_t num_split = 0;
+      int32_t walk_failed = 0;
+      sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
+                     {&num_pending, pending_count, sizeof(uint32_t)},
+                     {&walk_failed, flags_.data(), sizeof(int32_t)}});
+      if (walk_failed != 0) throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
+      if (num_pending == 0) return;
+      if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
+      const thrust::counting_iterator<int32_t> tfirst(0);
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       SplitTriangles{mesh_, tri_vote_.data(), split_count_or_nb_.data(), pending, inserted, num_tri_});
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       LinkSplitChildren{mesh_, tri_vote_.data(), split_count_or_nb_.data(), num_tri_});
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       ListSplitChildren{tri_vote_.data(), split_count_or_nb_.data(), active_.data(), num_tri_});
+      num_tri_ += 2 * num_split;
+      thrust::fill(pol, active_mask_.data(), active_mask_.data() + 3 * num_split, kCheckOutsideEdge);
+      RestoreDelaunay(static_cast<uint32_t>(3 * num_split), /*hull_may_change=*/true);
+
+      Relocate(pending, location, inserted, num_pending);
+      auto zipped = thrust::make_zip_iterator(thrust::make_tuple(pending, location));
+      sys_.SelectFlaggedInPlace(zipped, inserted, num_pending, IsClear(), pending_count);
+      thrust::fill(pol, inserted, inserted + num_pending, uint8_t{0});
+    }
+  }
+
+  /// Removes symbolically flat hull triangles, then re-flips the finite triangles to Delaunay
+  /// with the hull fixed. Returns the number of repair flips.
+  int32_t RepairHull() {
+    auto pol = sys_.policy();
+    const thrust::counting_iterator<int32_t> tfirst(0);
+    const thrust::counting_iterator<uint32_t> first(0);
+    // Found in the (larger, idle) candidate buffer, then moved to one of their own size.
+    uint32_t num_flat = static_cast<uint32_t>(
+        thrust::copy_if(pol, tfirst, tfirst + num_tri_, candidates(), IsFlatFiniteTriangle{mesh_}) - candidates());
+    if (num_flat == 0) return 0;
+    Buffer<int32_t, System> flat_now(sys_, num_flat);
+    thrust::copy(pol, candidates(), candidates() + num_flat, flat_now.begin());
+    // Each flat triangle is repaired by one flip of two triangles.
+    Buffer<int32_t, System> flat_next(sys_, num_flat);
+    Buffer<uint8_t, System> still_flat(sys_, num_flat);
+    Buffer<int32_t, System> touched(sys_, 2 * static_cast<size_t>(num_flat));
+    int32_t* flat = flat_now.data();
+    int32_t* next = flat_next.data();
+    uint32_t num_touched = 0;
+    while (num_flat > 0) {
+      thrust::for_each(pol, first, first + num_flat,
+                       ProposeFlatRepairs{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(),
+                                          flip_vote_.data()});
+      thrust::for_each(pol, first, first + num_flat,
+                       ExecuteFlips{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
+                                    partner_.data()});
+      thrust::for_each(pol, first, first + num_flat,
+                       LinkFlips{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
+      thrust::for_each(pol, first, first + num_flat,
+                       CollectFlatRepairs{flat, proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
+                                          partner_.data(), candidates(), still_flat.data()});
+      num_touched = static_cast<uint32_t>(thrust::copy_if(pol, candidates(), candidates() + 2 * num_flat,
+                                                          touched.data() + num_touched, IsNonNegative()) -
+                                          touched.data());
+      const uint32_t remaining = static_cast<uint32_t>(
+          thrust::copy_if(pol, flat, flat + num_flat, still_flat.data(), next, IsSet()) - next);
+      std::swap(flat, next);
+      // The smallest proposer always wins both of its votes, so every round repairs at least
+      // one. Flat triangles wait on each other in chains and a round repairs one per chain: when a
+      // round repairs fewer than one round costs in steps of the one-thread walk, that thread
+      // walks the chains instead, depth-first, in time linear in what is left.
+      const bool chains = num_flat - remaining < System::kRepairStepsPerRound;
+      num_flat = remaining;
+      if (num_flat > 0 && chains) {
+        num_touched += RepairChainsSerially(flat, num_flat, next, touched.data() + num_touched);
+        num_flat = 0;
+      }
+    }
+    flat_now.Reset();
+    flat_next.Reset();
+    // Only triangles a repair flip changed can hold an edge that is no longer locally Delaunay.
+    // A triangle may appear twice (two repair flips): de-duplicate before flipping in parallel.
+    thrust::sort(pol, touched.begin(), touched.begin() + num_touched);
+    const uint32_t num_active = static_cast<uint32_t>(
+        thrust::unique_copy(pol, touched.begin(), touched.begin() + num_touched, active_.data()) - active_.data());
+    thrust::fill(pol, active_mask_.data(), active_mask_.data() + num_active, kCheckAllEdges);
+    RestoreDelaunay(num_active, /*hull_may_change=*/false);
+    return static_cast<int32_t>(num_touched / 2);
+  }
+
+ private:
+  /// Runs RepairFlatChainsSerially over the `num_flat` flat triangles left; returns the number of
+  /// entries it wrote to `touched`. One device thread walks at global-memory latency (~4 us a
+  /// triangle on an H100), so when the chains are long compared with the mesh (every point on the
+  /// hull: parallel lines), the mesh goes to the host, is repaired there by the same functor, and
+  /// comes back (~100 bytes a point each way, ~20 ns a point).
+  uint32_t RepairChainsSerially(const int32_t* flat, uint32_t num_flat, int32_t* stack, int32_t* touched) {
+    constexpr uint32_t kPointsPerDeviceWalkStep = 200;
+    int32_t flips = 0;
+    if constexpr (!System::kHostMemory) {
+      if (num_flat > m_ / kPointsPerDeviceWalkStep) {
+        std::vector<Tri> tri(num_tri_);
+        std::vector<TriNbr> nbr(num_tri_);
+        std::vector<Point2> pts(m_);
+        std::vector<int32_t> host_flat(num_flat), host_stack(num_flat), host_touched(2 * size_t{num_flat});
+        std::vector<uint32_t> on_stack(num_tri_, kNoFlipVote);
+        sys_.ToHost(tri.data(), tri_.data(), tri.size());
+        sys_.ToHost(nbr.data(), nbr_.data(), nbr.size());
+        sys_.ToHost(pts.data(), mesh_.pts, pts.size());
+        sys_.ToHost(host_flat.data(), flat, num_flat);
+        MeshView host_mesh = mesh_;
+        host_mesh.pts = pts.data();
+        host_mesh.sos = nullptr;  // the repair decides by exact orientation only, never by SoS
+        host_mesh.tri = tri.data();
+        host_mesh.nbr = nbr.data();
+        int32_t failed = 0;
+        RepairFlatChainsSerially{host_mesh,        host_flat.data(), num_flat, host_stack.data(), on_stack.data(),
+                                 &failed,          &flips,           host_touched.data()}(0);
+        if (failed != 0) throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+        sys_.FromHost(tri_.data(), tri.data(), tri.size());
+        sys_.FromHost(nbr_.data(), nbr.data(), nbr.size());
+        sys_.FromHost(touched, host_touched.data(), 2 * static_cast<size_t>(flips));
+        return 2 * static_cast<uint32_t>(flips);
+      }
+    }
+    auto pol = sys_.policy();
+    thrust::fill(pol, flags_.begin(), flags_.end(), 0);
+    thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(1),
+                     RepairFlatChainsSerially{mesh_, flat, num_flat, stack, flip_vote_.data(), flags_.data(),
+                                              flags_.data() + 1, touched});
+    if (sys_.Read(flags_.data()) != 0) {
+      throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
+    }
+    flips = sys_.Read(flags_.data() + 1);
+    return 2 * static_cast<uint32_t>(flips);
+  }
+
+  int32_t* candidates() {
+    static_assert(sizeof(unsigned long long) == 2 * sizeof(int32_t), "candidates share the vote buffer");
+    return reinterpret_cast<int32_t*>(tri_vote_.data());
+  }
+
+  /// Walks every pending point not inserted to the triangle that holds it now. A walk that fails
+  /// leaves the point's old triangle and raises a flag, read with the round's count.
+  void Relocate(const int32_t* pending, int32_t* location, const uint8_t* inserted, uint32_t num_pending) {
+    const thrust::counting_iterator<uint32_t> first(0);
+    thrust::for_each(sys_.policy(), first, first + num_pending,
+                     RelocatePoint{mesh_, pending, inserted, location, flags_.data(), m_ + 16u});
+  }
+
+  /// One parallel Lawson iteration over the `*count` triangles of active_: they propose flips,
+  /// the winners flip and are re-linked, and what must be checked next replaces active_'s
+  /// triangles, counted into `*next_count`. Stream work only (recorded by RestoreDelaunay).
+  void FlipIteration(const uint32_t* count, uint32_t* next_count, bool hull_may_change) {
+    uint32_t* generation = counts_.data() + kGeneration;
+    sys_.RunSingle(StartFlipIteration{next_count, generation});
+    sys_.ForEachBelow(count, ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(),
+                                          split_count_or_nb_.data(), flip_vote_.data(), hull_may_change});
+    sys_.ForEachBelow(count, ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
+                                          flip_vote_.data(), partner_.data()});
+    sys_.ForEachBelow(count,
+                      LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
+    sys_.ForEachBelow(count, CollectNextActive{active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
+                                               flip_vote_.data(), partner_.data(), stamp_.data(), generation,
+                                               candidates(), candidate_mask_.data()});
+    auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates(), candidate_mask_.data()));
+    auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
+    sys_.AppendIf(count, 2, from, candidates(), IsNonNegative(), to, next_count);
+  }
+
+  /// Parallel Lawson flips from the `count` triangles in active_ until no edge needs a flip.
+  ///
+  /// Two iterations (their counts alternate between two words) are recorded once and replayed:
+  /// the loop's hundreds of small kernels would otherwise be bound by the host's cost of
+  /// launching them. The host stays one replay ahead: it learns a replay's starting count while
+  /// the next one runs, and stops after a replay that started with none.
+  void RestoreDelaunay(uint32_t count, bool hull_may_change) {
+    if (count == 0) return;
+    uint32_t* even = counts_.data() + kEvenIterationCount;
+    uint32_t* odd = counts_.data() + kOddIterationCount;
+    thrust::fill(sys_.policy(), even, even + 1, count);
+    typename System::Recording& recording = hull_may_change ? insertion_flips_ : repair_flips_;
+    typename System::CountTicket started_with{};
+    for (int replay = 0;; ++replay) {
+      if (replay > (1 << 19)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
+      sys_.Replay(recording, [&] {
+        FlipIteration(even, odd, hull_may_change);
+        FlipIteration(odd, even, hull_may_change);
+      });
+      const typename System::CountTicket next = sys_.ReadCountLater(even);
+      const uint32_t started = replay == 0 ? count : sys_.CountOf(started_with);
+      if (started == 0) return;
+      started_with = next;
+    }
+  }
+
+  System& sys_;
+  uint32_t m_;
+  uint32_t capacity_;
+  Buffer<Tri, System> tri_;
+  Buffer<TriNbr, System> nbr_;
+  // Insertion votes while splitting; while flipping, the same bytes hold 2 * capacity_ flip
+  // candidates (int32): the two are never live at once, and sharing them saves 8 bytes a point.
+  Buffer<unsigned long long, System> tri_vote_;
+  // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while
+  // flipping: never both at once, so one buffer serves both.
+  Buffer<int32_t, System> split_count_or_nb_;
+  Buffer<uint32_t, System> flip_vote_;
+  Buffer<int32_t, System> partner_;
+  Buffer<uint32_t, System> stamp_;
+  Buffer<int32_t, System> active_;
+  Buffer<uint8_t, System> active_mask_;
+  Buffer<uint8_t, System> candidate_mask_;
+  Buffer<int8_t, System> proposal_edge_;
+  Buffer<int32_t, System> flags_;  // [0] walk or repair failed, [1] serial repair flips
+  // Counts kept in system memory between the host's waits, and the flip stamps' generation.
+  static constexpr int kPendingCount = 0;
+  static constexpr int kEvenIterationCount = 1;
+  static constexpr int kOddIterationCount = 2;
+  static constexpr int kGeneration = 3;
+  static constexpr int kNumCounts = 4;
+  Buffer<uint32_t, System> counts_;
+  MeshView mesh_{};
+  int32_t num_tri_ = 0;
+  int rounds_ = 0;
+  // The flip loop's two iterations, recorded once per build for each kind of flipping; declared
+  // last, so that they are destroyed (after the stream's last replay) before the buffers.
+  typename System::Recording insertion_flips_;
+  typename System::Recording repair_flips_;
+};
+
+}  // namespace galpha::detail
