@@ -17,6 +17,7 @@
 #include "core/exact/radius_rational.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
+#include "tests/support/backend_fixture.hpp"
 #include "tests/support/cgal_alpha_oracle.hpp"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
@@ -171,10 +172,9 @@ std::vector<Case> GeneratedCases() {
   };
 }
 
-class AlphaCgalTest : public ::testing::TestWithParam<Backend> {};
+using AlphaCgalTest = testing::BackendTest;
 
 TEST_P(AlphaCgalTest, Generators) {
-  if (GetParam() == Backend::kCuda && !CudaBackendAvailable()) GTEST_SKIP() << "no GPU";
   for (const Case& c : GeneratedCases()) {
     SCOPED_TRACE(c.name);
     CompareWithCgal(c.points, c.name, GetParam(), 40);
@@ -183,7 +183,6 @@ TEST_P(AlphaCgalTest, Generators) {
 }
 
 TEST_P(AlphaCgalTest, RealDataSets) {
-  if (GetParam() == Backend::kCuda && !CudaBackendAvailable()) GTEST_SKIP() << "no GPU";
   const std::vector<std::string> files = testdata::PointFiles();
   ASSERT_FALSE(files.empty());
   for (const std::string& file : files) {
@@ -195,8 +194,7 @@ TEST_P(AlphaCgalTest, RealDataSets) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, AlphaCgalTest, ::testing::Values(Backend::kCpu, Backend::kCuda),
-                         [](const ::testing::TestParamInfo<Backend>& info) { return BackendName(info.param); });
+GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(AlphaCgalTest);
 
 }  // namespace
 }  // namespace galpha
