@@ -1,0 +1,259 @@
+// The Classify stream against ClassifyAll of the in-process AlphaFamily: every simplex once, in
+// canonical order, in chunks of at most kSimplicesPerChunk, after a summary with the counts,
+// components and area; non-exterior-only and summary-only requests; bad thresholds refused.
+#include "server/query_answers.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "core/geometry/shape.hpp"
+#include "gtest/gtest.h"
+#include "server/cached_family.hpp"
+#include "tests/server/query_answers_fixture.hpp"
+
+namespace galpha::server {
+namespace {
+
+namespace v1 = galpha::v1;
+using testing::Drain;
+using testing::Families;
+using testing::LargeFamily;
+using testing::NamedFamily;
+using testing::Rank;
+using testing::Thresholds;
+
+// ---- Classify -------------------------------------------------------------------------------------
+
+// One simplex as the stream names it: kind, sorted vertex indices, class byte.
+using StreamedSimplex = std::tuple<int, std::vector<uint32_t>, int>;
+
+int ClassByte(SimplexClass c) { return static_cast<int>(c) + 1; }
+
+// What the Classify stream must carry after its summary, from ClassifyAll.
+std::vector<StreamedSimplex> ExpectedSimplices(const AlphaFamily& family, const Classification& classes,
+                                               bool non_exterior_only) {
+  auto sent = [&](SimplexClass c) { return !(non_exterior_only && c == SimplexClass::kExterior); };
+  std::vector<StreamedSimplex> out;
+  for (uint32_t v = 0; v < family.points().size(); ++v) {
+    if (family.representative()[v] == v && sent(classes.vertices[v])) {
+      out.emplace_back(v1::SIMPLEX_KIND_VERTEX, std::vector<uint32_t>{v}, ClassByte(classes.vertices[v]));
+    }
+  }
+  std::vector<std::pair<std::array<uint32_t, 2>, SimplexClass>> edges;
+  for (uint32_t e = 0; e < family.edges().size(); ++e) {
+    const auto& edge = family.edges()[e];
+    edges.push_back({{std::min(edge[0], edge[1]), std::max(edge[0], edge[1])}, classes.edges[e]});
+  }
+  std::sort(edges.begin(), edges.end());
+  for (const auto& [edge, c] : edges) {
+    if (sent(c)) out.emplace_back(v1::SIMPLEX_KIND_EDGE, std::vector<uint32_t>{edge[0], edge[1]}, ClassByte(c));
+  }
+  std::vector<std::pair<std::array<uint32_t, 3>, SimplexClass>> triangles;
+  for (uint32_t t = 0; t < family.triangles().size(); ++t) {
+    std::array<uint32_t, 3> triangle = family.triangles()[t];
+    std::sort(triangle.begin(), triangle.end());
+    triangles.push_back({triangle, classes.triangles[t]});
+  }
+  std::sort(triangles.begin(), triangles.end());
+  for (const auto& [triangle, c] : triangles) {
+    if (sent(c)) {
+      out.emplace_back(v1::SIMPLEX_KIND_TRIANGLE, std::vector<uint32_t>{triangle[0], triangle[1], triangle[2]},
+                       ClassByte(c));
+    }
+  }
+  return out;
+}
+
+// Counts per class of ClassifyAll, as ClassCounts (vertices: distinct points only).
+v1::ClassCounts Count(const std::vector<SimplexClass>& classes, const HostVector<uint32_t>* representative) {
+  std::array<uint64_t, 4> counts{};
+  for (uint32_t i = 0; i < classes.size(); ++i) {
+    if (representative == nullptr || (*representative)[i] == i) ++counts[static_cast<size_t>(classes[i])];
+  }
+  v1::ClassCounts out;
+  out.set_exterior(counts[0]);
+  out.set_singular(counts[1]);
+  out.set_regular(counts[2]);
+  out.set_interior(counts[3]);
+  return out;
+}
+
+void ExpectCountsEqual(const v1::ClassCounts& got, const v1::ClassCounts& expected) {
+  EXPECT_EQ(got.exterior(), expected.exterior());
+  EXPECT_EQ(got.singular(), expected.singular());
+  EXPECT_EQ(got.regular(), expected.regular());
+  EXPECT_EQ(got.interior(), expected.interior());
+}
+
+// Runs one Classify request against the family and checks every message.
+void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::ClassifyRequest& request,
+                   size_t* chunks_out = nullptr) {
+  SCOPED_TRACE(request.ShortDebugString());
+  const AlphaFamily& family = cached->family();
+  auto source = MakeClassifySource(cached, request);
+  ASSERT_TRUE(source.ok()) << source.status();
+  const std::vector<v1::ClassifyResponse> messages = Drain(**source);
+  ASSERT_FALSE(messages.empty());
+
+  const int64_t level = ResolveLevel(family, request.threshold())->level;
+  const ClassifyMode mode = ToClassifyMode(request.mode());
+  const Classification classes = family.ClassifyAll(level, mode, ToVertexRule(request.vertex_rule()));
+
+  ASSERT_EQ(messages[0].part_case(), v1::ClassifyResponse::kSummary);
+  const v1::ClassifySummary& summary = messages[0].summary();
+  EXPECT_EQ(summary.level(), level);
+  EXPECT_EQ(summary.alpha_sq(), ResolveLevel(family, request.threshold())->alpha_sq);
+  ExpectCountsEqual(summary.vertices(), Count(classes.vertices, &family.representative()));
+  ExpectCountsEqual(summary.edges(), Count(classes.edges, nullptr));
+  ExpectCountsEqual(summary.triangles(), Count(classes.triangles, nullptr));
+  EXPECT_EQ(summary.components(), family.Components(level));
+  EXPECT_EQ(summary.solid_components(), family.SolidComponents(level));
+  const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, mode));
+  ASSERT_TRUE(shape.ok()) << shape.status();
+  EXPECT_EQ(summary.interior_area(), shape->area) << "the interior area is the shape's area";
+
+  if (request.summary_only()) {
+    EXPECT_EQ(messages.size(), 1u);
+    return;
+  }
+  std::vector<StreamedSimplex> streamed;
+  std::array<size_t, 4> chunks_of_kind{};
+  int last_kind = v1::SIMPLEX_KIND_VERTEX;
+  for (size_t m = 1; m < messages.size(); ++m) {
+    ASSERT_EQ(messages[m].part_case(), v1::ClassifyResponse::kChunk) << "message " << m;
+    const v1::SimplexChunk& chunk = messages[m].chunk();
+    const int kind = chunk.kind();
+    ASSERT_GE(kind, last_kind) << "kinds come in order vertex, edge, triangle";
+    ASSERT_LE(kind, v1::SIMPLEX_KIND_TRIANGLE);
+    last_kind = kind;
+    ++chunks_of_kind[static_cast<size_t>(kind)];
+    const size_t arity = static_cast<size_t>(kind);  // SIMPLEX_KIND_VERTEX = 1, EDGE = 2, TRIANGLE = 3
+    const size_t simplices = chunk.classes().size();
+    EXPECT_GT(simplices, 0u) << "no empty chunks";
+    EXPECT_LE(simplices, kSimplicesPerChunk);
+    ASSERT_EQ(static_cast<size_t>(chunk.vertex_indices_size()), arity * simplices);
+    for (size_t i = 0; i < simplices; ++i) {
+      std::vector<uint32_t> indices(chunk.vertex_indices().begin() + static_cast<int>(i * arity),
+                                    chunk.vertex_indices().begin() + static_cast<int>((i + 1) * arity));
+      streamed.emplace_back(kind, std::move(indices), static_cast<int>(chunk.classes()[i]));
+    }
+  }
+  if (chunks_out != nullptr) *chunks_out = messages.size() - 1;
+  const std::vector<StreamedSimplex> expected = ExpectedSimplices(family, classes, request.non_exterior_only());
+  // Every chunk but the last of its kind is full.
+  std::array<size_t, 4> expected_of_kind{};
+  for (const StreamedSimplex& simplex : expected) ++expected_of_kind[static_cast<size_t>(std::get<0>(simplex))];
+  for (size_t kind = 1; kind <= 3; ++kind) {
+    EXPECT_EQ(chunks_of_kind[kind], (expected_of_kind[kind] + kSimplicesPerChunk - 1) / kSimplicesPerChunk)
+        << "chunks of kind " << kind;
+  }
+  ASSERT_EQ(streamed.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) {
+    if (streamed[i] != expected[i]) {
+      ADD_FAILURE() << "simplex " << i << " differs: kind " << std::get<0>(streamed[i]) << " vs "
+                    << std::get<0>(expected[i]) << ", class " << std::get<2>(streamed[i]) << " vs "
+                    << std::get<2>(expected[i]);
+      break;
+    }
+  }
+}
+
+TEST(QueryAnswersTest, ClassifyStreamsEverySimplexInOrder) {
+  for (const NamedFamily& f : Families()) {
+    SCOPED_TRACE(f.name);
+    ASSERT_NE(f.cached, nullptr);
+    for (const v1::Threshold& threshold : Thresholds(f.cached->family())) {
+      for (const v1::ClassifyMode mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
+        for (const v1::VertexRule rule : {v1::VERTEX_RULE_REPORT, v1::VERTEX_RULE_CGAL}) {
+          for (const bool non_exterior_only : {false, true}) {
+            v1::ClassifyRequest request;
+            *request.mutable_threshold() = threshold;
+            request.set_mode(mode);
+            request.set_vertex_rule(rule);
+            request.set_non_exterior_only(non_exterior_only);
+            CheckClassify(f.cached, request);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(QueryAnswersTest, ClassifyNonExteriorOnlyDropsExactlyTheExterior) {
+  const std::shared_ptr<const CachedFamily>& cached = Families()[0].cached;
+  ASSERT_NE(cached, nullptr);
+  v1::ClassifyRequest request;
+  *request.mutable_threshold() = Rank(cached->family().max_level() / 3);
+  auto all = MakeClassifySource(cached, request);
+  request.set_non_exterior_only(true);
+  auto some = MakeClassifySource(cached, request);
+  ASSERT_TRUE(all.ok() && some.ok());
+  const auto all_messages = Drain(**all);
+  const auto some_messages = Drain(**some);
+  size_t all_sent = 0, exterior = 0, some_sent = 0;
+  for (size_t m = 1; m < all_messages.size(); ++m) {
+    for (const char c : all_messages[m].chunk().classes()) {
+      ++all_sent;
+      exterior += c == v1::SIMPLEX_CLASS_EXTERIOR;
+    }
+  }
+  for (size_t m = 1; m < some_messages.size(); ++m) {
+    for (const char c : some_messages[m].chunk().classes()) {
+      ++some_sent;
+      EXPECT_NE(c, v1::SIMPLEX_CLASS_EXTERIOR);
+    }
+  }
+  EXPECT_GT(exterior, 0u) << "the test needs exterior simplices at this rank";
+  EXPECT_EQ(some_sent, all_sent - exterior);
+  EXPECT_EQ(all_messages[0].SerializeAsString(), some_messages[0].SerializeAsString())
+      << "the summary still counts every class";
+}
+
+TEST(QueryAnswersTest, ClassifySummaryOnlySendsOneMessage) {
+  for (const NamedFamily& f : Families()) {
+    SCOPED_TRACE(f.name);
+    ASSERT_NE(f.cached, nullptr);
+    for (const v1::Threshold& threshold : Thresholds(f.cached->family())) {
+      v1::ClassifyRequest request;
+      *request.mutable_threshold() = threshold;
+      request.set_summary_only(true);
+      CheckClassify(f.cached, request);
+    }
+  }
+}
+
+TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
+  const std::shared_ptr<const CachedFamily>& cached = Families()[0].cached;
+  ASSERT_NE(cached, nullptr);
+  v1::ClassifyRequest request;
+  EXPECT_TRUE(absl::IsInvalidArgument(MakeClassifySource(cached, request).status()));
+  *request.mutable_threshold() = Rank(cached->family().max_level() + 1);
+  EXPECT_TRUE(absl::IsInvalidArgument(MakeClassifySource(cached, request).status()));
+}
+
+TEST(QueryAnswersTest, ClassifyChunksNeverExceedTheLimit) {
+  const std::shared_ptr<const CachedFamily> cached = LargeFamily();
+  ASSERT_NE(cached, nullptr);
+  ASSERT_GT(cached->family().edges().size(), size_t{kSimplicesPerChunk}) << "the test needs several edge chunks";
+  for (const int64_t rank : {cached->family().max_level() / 2, cached->family().max_level()}) {
+    for (const bool non_exterior_only : {false, true}) {
+      v1::ClassifyRequest request;
+      *request.mutable_threshold() = Rank(rank);
+      request.set_non_exterior_only(non_exterior_only);
+      size_t chunks = 0;
+      CheckClassify(cached, request, &chunks);
+      // Every simplex is sent, or (at rank K) none is exterior: edges take two chunks.
+      if (!non_exterior_only || rank == cached->family().max_level()) {
+        EXPECT_GE(chunks, 4u) << "vertices, edges in two chunks, triangles";
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace galpha::server

@@ -1,0 +1,117 @@
+// Thresholds resolved to the family's levels (the in-process AlphaFamily is the oracle), the
+// refusal of bad thresholds, the enum conversions and the build summary.
+#include "server/query_answers.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "absl/strings/str_cat.h"
+#include "gtest/gtest.h"
+#include "tests/server/query_answers_fixture.hpp"
+
+namespace galpha::server {
+namespace {
+
+namespace v1 = galpha::v1;
+using testing::Alpha;
+using testing::AlphaSq;
+using testing::Families;
+using testing::NamedFamily;
+using testing::Rank;
+using testing::Thresholds;
+
+// ---- ResolveLevel ---------------------------------------------------------------------------------
+
+TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
+  for (const NamedFamily& f : Families()) {
+    SCOPED_TRACE(f.name);
+    ASSERT_NE(f.cached, nullptr);
+    const AlphaFamily& family = f.cached->family();
+    const int64_t k = family.max_level();
+    for (int64_t rank = 0; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
+      const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(family, Rank(rank));
+      ASSERT_TRUE(resolved.ok()) << resolved.status();
+      EXPECT_EQ(resolved->level, *family.LevelForRank(rank));
+      EXPECT_EQ(resolved->alpha_sq, rank == 0 ? 0.0 : family.spectrum()[static_cast<size_t>(rank - 1)]);
+    }
+    for (const v1::Threshold& threshold : Thresholds(family)) {
+      SCOPED_TRACE(threshold.ShortDebugString());
+      const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(family, threshold);
+      ASSERT_TRUE(resolved.ok()) << resolved.status();
+      switch (threshold.value_case()) {
+        case v1::Threshold::kRank:
+          EXPECT_EQ(resolved->level, *family.LevelForRank(threshold.rank()));
+          break;
+        case v1::Threshold::kAlphaSq:
+          EXPECT_EQ(resolved->level, *family.LevelForAlphaSq(threshold.alpha_sq()));
+          EXPECT_EQ(resolved->alpha_sq, threshold.alpha_sq());
+          break;
+        case v1::Threshold::kAlpha:
+          EXPECT_EQ(resolved->level, *family.LevelForAlpha(threshold.alpha()));
+          EXPECT_EQ(resolved->alpha_sq, threshold.alpha() * threshold.alpha());
+          break;
+        case v1::Threshold::VALUE_NOT_SET:
+          FAIL();
+      }
+    }
+    // Every spectrum value, as alpha_sq, resolves to its own rank (exact comparison).
+    for (int64_t rank = 1; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
+      const absl::StatusOr<ResolvedLevel> resolved =
+          ResolveLevel(family, AlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
+      ASSERT_TRUE(resolved.ok());
+      EXPECT_EQ(resolved->level, *family.LevelForAlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
+    }
+  }
+}
+
+TEST(QueryAnswersTest, ResolveLevelRefusesBadThresholds) {
+  for (const NamedFamily& f : Families()) {
+    SCOPED_TRACE(f.name);
+    ASSERT_NE(f.cached, nullptr);
+    const AlphaFamily& family = f.cached->family();
+    const int64_t k = family.max_level();
+    const absl::StatusOr<ResolvedLevel> none = ResolveLevel(family, v1::Threshold());
+    EXPECT_TRUE(absl::IsInvalidArgument(none.status())) << none.status();
+    const absl::StatusOr<ResolvedLevel> beyond = ResolveLevel(family, Rank(k + 1));
+    EXPECT_TRUE(absl::IsInvalidArgument(beyond.status())) << beyond.status();
+    EXPECT_NE(beyond.status().message().find(absl::StrCat(k + 1)), absl::string_view::npos) << beyond.status();
+    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, Rank(-1)).status()));
+    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, AlphaSq(std::nan(""))).status()));
+    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, Alpha(std::nan(""))).status()));
+    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, Alpha(-1.0)).status()));
+  }
+}
+
+TEST(QueryAnswersTest, EnumConversions) {
+  EXPECT_EQ(ToClassifyMode(v1::CLASSIFY_MODE_UNSPECIFIED), ClassifyMode::kGeneral);
+  EXPECT_EQ(ToClassifyMode(v1::CLASSIFY_MODE_GENERAL), ClassifyMode::kGeneral);
+  EXPECT_EQ(ToClassifyMode(v1::CLASSIFY_MODE_REGULARIZED), ClassifyMode::kRegularized);
+  EXPECT_EQ(ToVertexRule(v1::VERTEX_RULE_UNSPECIFIED), VertexRule::kReport);
+  EXPECT_EQ(ToVertexRule(v1::VERTEX_RULE_REPORT), VertexRule::kReport);
+  EXPECT_EQ(ToVertexRule(v1::VERTEX_RULE_CGAL), VertexRule::kCgal);
+}
+
+TEST(QueryAnswersTest, BuildSummaryDescribesTheFamily) {
+  for (const NamedFamily& f : Families()) {
+    SCOPED_TRACE(f.name);
+    ASSERT_NE(f.cached, nullptr);
+    const AlphaFamily& family = f.cached->family();
+    v1::BuildSummary summary;
+    FillBuildSummary(*f.cached, &summary);
+    EXPECT_EQ(summary.name(), f.name);
+    EXPECT_EQ(summary.points(), family.points().size());
+    EXPECT_EQ(summary.distinct_points(), family.num_unique());
+    EXPECT_EQ(summary.duplicates(), family.num_duplicates());
+    EXPECT_EQ(summary.distinct_points() + summary.duplicates(), summary.points());
+    EXPECT_EQ(summary.triangles(), family.triangles().size());
+    EXPECT_EQ(summary.edges(), family.edges().size());
+    EXPECT_EQ(summary.spectrum_size(), family.spectrum().size());
+    EXPECT_EQ(summary.backend(), family.report().backend);
+    EXPECT_EQ(summary.family_bytes(), f.cached->bytes());
+    EXPECT_EQ(static_cast<size_t>(summary.stage_times_size()), family.report().stage_times.size());
+  }
+}
+
+}  // namespace
+}  // namespace galpha::server

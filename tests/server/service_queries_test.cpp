@@ -1,0 +1,249 @@
+// The real server, started in-process on loopback ports and driven through the client library:
+// every RPC against the local engine as the oracle (Build, Spectrum, Classify, MasterList,
+// Components, OptimalAlpha, Shape), on generated inputs and a real data set; Describe, Release and
+// the cache.
+#include <gtest/gtest.h>
+#include <grpcpp/grpcpp.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/geometry/shape.hpp"
+#include "core/io/point_set_handle.hpp"
+#include "tests/server/service_test_calls.hpp"
+#include "tests/server/service_test_support.hpp"
+#include "tests/support/data_files.hpp"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha::server {
+namespace {
+
+namespace v1 = galpha::v1;
+using testing::ClientOf;
+using testing::LocalFamily;
+using testing::SpectrumRemote;
+using testing::StartServer;
+using testing::TestServerOptions;
+
+/// The Classify stream of `request` as (kind, indices..., class) rows, and its summary.
+struct ClassifyAnswer {
+  v1::ClassifySummary summary;
+  std::vector<std::vector<uint32_t>> rows;  // arity indices then the class byte
+};
+
+absl::StatusOr<ClassifyAnswer> ClassifyRemote(client::AlphaClient& client, const v1::ClassifyRequest& request) {
+  ClassifyAnswer answer;
+  absl::Status status = client.Classify(request, [&](const v1::ClassifyResponse& message) {
+    if (message.has_summary()) answer.summary = message.summary();
+    if (message.has_chunk()) {
+      const auto& chunk = message.chunk();
+      const int arity = static_cast<int>(chunk.kind());
+      for (size_t i = 0; i < chunk.classes().size(); ++i) {
+        std::vector<uint32_t> row;
+        for (int k = 0; k < arity; ++k) row.push_back(chunk.vertex_indices(static_cast<int>(i) * arity + k));
+        row.push_back(static_cast<uint8_t>(chunk.classes()[i]));
+        answer.rows.push_back(row);
+      }
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return status;
+  return answer;
+}
+
+/// The same rows from the local engine, in the service's order.
+std::vector<std::vector<uint32_t>> ClassifyLocal(const AlphaFamily& family, int64_t level, ClassifyMode mode,
+                                                 VertexRule rule) {
+  const Classification classes = family.ClassifyAll(level, mode, rule);
+  std::vector<std::vector<uint32_t>> rows;
+  for (uint32_t v = 0; v < family.points().size(); ++v) {
+    if (family.representative()[v] == v) rows.push_back({v, static_cast<uint32_t>(classes.vertices[v]) + 1});
+  }
+  std::vector<std::vector<uint32_t>> edges, triangles;
+  for (uint32_t e = 0; e < family.edges().size(); ++e) {
+    const auto& edge = family.edges()[e];
+    edges.push_back({std::min(edge[0], edge[1]), std::max(edge[0], edge[1]), static_cast<uint32_t>(classes.edges[e]) + 1});
+  }
+  for (uint32_t t = 0; t < family.triangles().size(); ++t) {
+    std::array<uint32_t, 3> tri = family.triangles()[t];
+    std::sort(tri.begin(), tri.end());
+    triangles.push_back({tri[0], tri[1], tri[2], static_cast<uint32_t>(classes.triangles[t]) + 1});
+  }
+  std::sort(edges.begin(), edges.end());
+  std::sort(triangles.begin(), triangles.end());
+  rows.insert(rows.end(), edges.begin(), edges.end());
+  rows.insert(rows.end(), triangles.begin(), triangles.end());
+  return rows;
+}
+
+/// Compares everything the service answers about `points` with the local engine.
+void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Point2>& points, const std::string& label) {
+  SCOPED_TRACE(label);
+  const AlphaFamily local = LocalFamily(points);
+  client::BuildCallOptions call;
+  call.name = label;
+  auto built = client.Build(points, call);
+  ASSERT_TRUE(built.ok()) << built.status();
+  EXPECT_EQ(built->handle, PointSetHandle(points));
+  const v1::BuildSummary& summary = built->summary;
+  EXPECT_EQ(summary.points(), points.size());
+  EXPECT_EQ(summary.distinct_points(), local.num_unique());
+  EXPECT_EQ(summary.duplicates(), local.num_duplicates());
+  EXPECT_EQ(summary.triangles(), local.triangles().size());
+  EXPECT_EQ(summary.edges(), local.edges().size());
+  EXPECT_EQ(summary.spectrum_size(), local.spectrum().size());
+  EXPECT_EQ(summary.backend(), testing::TestBackend());
+  EXPECT_GT(summary.family_bytes(), 0u);
+
+  EXPECT_EQ(SpectrumRemote(client, built->handle, 1000), local.spectrum());
+
+  const int64_t k = local.max_level();
+  for (const int64_t rank : {int64_t{0}, k / 3, k / 2, k}) {
+    for (const auto mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
+      v1::ClassifyRequest request;
+      request.set_handle(built->handle);
+      request.mutable_threshold()->set_rank(rank);
+      request.set_mode(mode);
+      request.set_vertex_rule(v1::VERTEX_RULE_CGAL);
+      auto answer = ClassifyRemote(client, request);
+      ASSERT_TRUE(answer.ok()) << answer.status();
+      const ClassifyMode local_mode = mode == v1::CLASSIFY_MODE_GENERAL ? ClassifyMode::kGeneral : ClassifyMode::kRegularized;
+      EXPECT_EQ(answer->rows, ClassifyLocal(local, rank, local_mode, VertexRule::kCgal)) << "rank " << rank;
+      EXPECT_EQ(answer->summary.level(), rank);
+      EXPECT_EQ(answer->summary.components(), local.Components(rank));
+      EXPECT_EQ(answer->summary.solid_components(), local.SolidComponents(rank));
+    }
+  }
+
+  if (k > 0) {
+    v1::MasterListRequest request;
+    request.set_handle(built->handle);
+    request.set_first_rank(1);
+    request.set_last_rank(k);
+    std::vector<uint64_t> ranks;
+    std::string kinds;
+    absl::Status status = client.MasterList(request, [&](const v1::MasterListResponse& message) {
+      ranks.insert(ranks.end(), message.ranks().begin(), message.ranks().end());
+      kinds += message.kinds();
+      return absl::OkStatus();
+    });
+    ASSERT_TRUE(status.ok()) << status;
+    std::vector<uint64_t> local_ranks;
+    std::string local_kinds;
+    for (int64_t r = 1; r <= k; ++r) {
+      for (const MasterEntry& entry : local.MasterList(r)) {
+        local_ranks.push_back(static_cast<uint64_t>(r));
+        local_kinds += static_cast<char>(static_cast<int>(entry.kind()) + 1);
+      }
+    }
+    EXPECT_EQ(ranks, local_ranks);
+    EXPECT_EQ(kinds, local_kinds);
+  }
+
+  v1::ComponentsRequest components;
+  components.set_handle(built->handle);
+  components.mutable_ranks()->set_first(0);
+  components.mutable_ranks()->set_last(k);
+  auto curve = client.Components(components);
+  ASSERT_TRUE(curve.ok()) << curve.status();
+  ASSERT_EQ(curve->components_size(), k + 1);
+  for (int64_t level = 0; level <= k; ++level) {
+    EXPECT_EQ(curve->components(static_cast<int>(level)), local.Components(level));
+    EXPECT_EQ(curve->solid_components(static_cast<int>(level)), local.SolidComponents(level));
+  }
+
+  v1::OptimalAlphaRequest optimal;
+  optimal.set_handle(built->handle);
+  optimal.set_max_components(1);
+  auto best = client.OptimalAlpha(optimal);
+  ASSERT_TRUE(best.ok()) << best.status();
+  EXPECT_EQ(best->has_regularized(), local.OptimalLevelRegularized(1).has_value());
+  if (best->has_regularized()) {
+    EXPECT_EQ(best->regularized().rank(), *local.OptimalLevelRegularized(1));
+  }
+  EXPECT_EQ(best->has_general(), local.OptimalLevelGeneral(1).has_value());
+  if (best->has_general()) {
+    EXPECT_EQ(best->general().rank(), *local.OptimalLevelGeneral(1));
+  }
+
+  v1::ShapeRequest shape;
+  shape.set_handle(built->handle);
+  shape.mutable_threshold()->set_rank(k / 2);
+  shape.set_format(v1::SHAPE_FORMAT_GEOJSON);
+  std::string text;
+  absl::Status status = client.Shape(shape, [&](const v1::ShapeResponse& message) {
+    text += message.text();
+    return absl::OkStatus();
+  });
+  ASSERT_TRUE(status.ok()) << status;
+  auto local_shape = AssembleShape(local.ComplexAt(k / 2, ClassifyMode::kGeneral));
+  ASSERT_TRUE(local_shape.ok());
+  EXPECT_EQ(text, ShapeToGeoJson(*local_shape, local.points()));
+}
+
+TEST(ServiceTest, EveryQueryMatchesTheLocalEngine) {
+  auto server = StartServer(TestServerOptions());
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  ExpectServiceMatchesLocal(*client, gen::Uniform(3000, 1), "uniform");
+  ExpectServiceMatchesLocal(*client, gen::Grid(2500, 2), "grid");
+  ExpectServiceMatchesLocal(*client, gen::WithDuplicates(2000, 3), "duplicates");
+  ExpectServiceMatchesLocal(*client, gen::TwoLines(400, 4), "two lines");
+  ExpectServiceMatchesLocal(*client, {{0.5, 0.25}}, "one point");
+  ExpectServiceMatchesLocal(*client, {}, "no points");
+  // A real data set, as users send them.
+  const std::string file = testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
+  std::ifstream in(file, std::ios::binary);
+  uint64_t n = 0;
+  in.read(reinterpret_cast<char*>(&n), sizeof n);
+  std::vector<Point2> gps(n);
+  in.read(reinterpret_cast<char*>(gps.data()), static_cast<std::streamsize>(n * sizeof(Point2)));
+  ASSERT_TRUE(in.good()) << file;
+  ExpectServiceMatchesLocal(*client, gps, "gps tracks");
+}
+
+TEST(ServiceTest, DescribeReleaseAndTheCache) {
+  auto server = StartServer(TestServerOptions());
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  const std::vector<Point2> points = gen::Uniform(1000, 7);
+  client::BuildCallOptions no_skip;
+  no_skip.name = "first";
+  no_skip.skip_upload_if_cached = false;
+  auto first = client->Build(points, no_skip);
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_FALSE(first->cached);
+  EXPECT_TRUE(first->uploaded);
+  // The same points again: a cache hit, nothing recomputed (the summary is the first build's).
+  auto again = client->Build(points, no_skip);
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_TRUE(again->cached);
+  EXPECT_EQ(again->handle, first->handle);
+  EXPECT_EQ(again->summary.SerializeAsString(), first->summary.SerializeAsString());
+  // The client hashes locally and skips the upload.
+  client::BuildCallOptions skip;
+  skip.name = "third";
+  auto skipped = client->Build(points, skip);
+  ASSERT_TRUE(skipped.ok()) << skipped.status();
+  EXPECT_TRUE(skipped->cached);
+  EXPECT_FALSE(skipped->uploaded);
+  auto described = client->Describe(first->handle);
+  ASSERT_TRUE(described.ok()) << described.status();
+  EXPECT_EQ(described->summary().name(), "first");
+  EXPECT_EQ(server->service().cache().GetStats().entries, 1u);
+
+  auto released = client->Release(first->handle);
+  ASSERT_TRUE(released.ok());
+  EXPECT_TRUE(released->released());
+  EXPECT_TRUE(absl::IsNotFound(client->Describe(first->handle).status()));
+  auto released_again = client->Release(first->handle);
+  ASSERT_TRUE(released_again.ok());
+  EXPECT_FALSE(released_again->released());
+}
+
+}  // namespace
+}  // namespace galpha::server
