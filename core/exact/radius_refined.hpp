@@ -4,8 +4,8 @@
 // their first- and second-order differences are 2^-40 to 2^-120 of the value). Sorting by these
 // keys orders every pair of values more than 2^-146 apart exactly, so that the exact comparisons
 // left are those of adjacent entries whose keys cannot separate them: O(n) of them, most of them
-// exact ties, which RadiusTermsIdentical proves without arithmetic when the two simplices are
-// translates of each other. Host and device alike.
+// exact ties, which RadiusCongruent proves without arithmetic when the two simplices are
+// congruent by a lattice symmetry (translation, rotation by quarter turns, mirror). Host and device alike.
 //
 // Why the error is certified (rho^2 = Num / (4 Den) * 2^(-2s), exact expansions from
 // radius_terms.hpp, both positive, each compressed; Q = Num / Den):
@@ -56,8 +56,9 @@ struct RefinedRadiusSq {
 namespace radius_detail {
 
 /// Puts the vertices of a simplex in lexicographic order (x, then y). The order is translation
-/// invariant, so two simplices that are exact translates of each other get the same differences
-/// and, through the same operations, bit-identical exact terms (RadiusTermsIdentical).
+/// invariant, so two simplices that are exact translates of each other list corresponding
+/// vertices in the same places, and their refined keys come out bit for bit the same (the sort's
+/// cheapest tie).
 GALPHA_HD inline void LexOrderVertices(Point2* p, int n) {
   for (int i = 1; i < n; ++i) {
     const Point2 x = p[i];
@@ -151,21 +152,97 @@ GALPHA_HD inline bool RefinedKeysSeparated(const RefinedRadiusSq& a, const Refin
   return ExpansionSign(en, e) > 0;
 }
 
-/// Whether rho^2(a) and rho^2(b) are equal because their exact terms, built in canonical vertex
-/// order at the same scale, are bit for bit the same (translates of each other, for instance).
+namespace radius_detail {
+
+/// An edge vector in error-free form (Two-Diff heads and tails, unique for a real number), with
+/// its sign normalized so that the vector and its negation compare equal.
+struct ExactEdgeVector {
+  double x_head, x_tail, y_head, y_tail;
+};
+
+GALPHA_HD inline ExactEdgeVector EdgeVectorUpToSign(const Point2& from, const Point2& to) {
+  using namespace exact;
+  ExactEdgeVector v;
+  TwoDiff(to.x, from.x, v.x_head, v.x_tail);
+  TwoDiff(to.y, from.y, v.y_head, v.y_tail);
+  // A head has its difference's sign and is zero only when the difference is.
+  if (v.x_head < 0.0 || (v.x_head == 0.0 && v.y_head < 0.0)) {
+    v = {-v.x_head, -v.x_tail, -v.y_head, -v.y_tail};
+  }
+  return v;
+}
+
+GALPHA_HD inline bool EdgeVectorLess(const ExactEdgeVector& a, const ExactEdgeVector& b) {
+  if (a.x_head != b.x_head) return a.x_head < b.x_head;
+  if (a.x_tail != b.x_tail) return a.x_tail < b.x_tail;
+  if (a.y_head != b.y_head) return a.y_head < b.y_head;
+  return a.y_tail < b.y_tail;
+}
+
+GALPHA_HD inline bool EdgeVectorEqual(const ExactEdgeVector& a, const ExactEdgeVector& b) {
+  return a.x_head == b.x_head && a.x_tail == b.x_tail && a.y_head == b.y_head && a.y_tail == b.y_tail;
+}
+
+/// The edge vectors of a simplex up to sign, sorted (one for an edge, three for a triangle), after
+/// the symmetry `t` of the square (bit 0: negate x, bit 1: negate y, bit 2: swap x and y).
+GALPHA_HD inline void TransformedEdgeVectors(const ExactEdgeVector* raw, int m, int t, ExactEdgeVector* out) {
+  for (int i = 0; i < m; ++i) {
+    ExactEdgeVector v = raw[i];
+    if (t & 1) v = {-v.x_head, -v.x_tail, v.y_head, v.y_tail};
+    if (t & 2) v = {v.x_head, v.x_tail, -v.y_head, -v.y_tail};
+    if (t & 4) v = {v.y_head, v.y_tail, v.x_head, v.x_tail};
+    if (v.x_head < 0.0 || (v.x_head == 0.0 && v.y_head < 0.0)) v = {-v.x_head, -v.x_tail, -v.y_head, -v.y_tail};
+    int j = i;
+    while (j > 0 && EdgeVectorLess(v, out[j - 1])) {
+      out[j] = out[j - 1];
+      --j;
+    }
+    out[j] = v;
+  }
+}
+
+/// The canonical edge vectors of a simplex: the least, in lexicographic order, of its sorted edge
+/// vectors up to sign under the eight symmetries of the square. Simplices related by those
+/// symmetries, by translations and by half-turns get the same ones.
+GALPHA_HD inline int CanonicalEdgeVectors(const Point2* p, int n, ExactEdgeVector* out) {
+  const int m = n == 2 ? 1 : 3;
+  ExactEdgeVector raw[3] = {};
+  raw[0] = EdgeVectorUpToSign(p[0], p[1]);
+  if (n == 3) {
+    raw[1] = EdgeVectorUpToSign(p[0], p[2]);
+    raw[2] = EdgeVectorUpToSign(p[1], p[2]);
+  }
+  TransformedEdgeVectors(raw, m, 0, out);
+  for (int t = 1; t < 8; ++t) {
+    ExactEdgeVector candidate[3] = {};
+    TransformedEdgeVectors(raw, m, t, candidate);
+    int k = 0;
+    while (k < m && EdgeVectorEqual(candidate[k], out[k])) ++k;
+    if (k < m && EdgeVectorLess(candidate[k], out[k])) {
+      for (int i = 0; i < m; ++i) out[i] = candidate[i];
+    }
+  }
+  return m;
+}
+
+}  // namespace radius_detail
+
+/// Whether rho^2(a) and rho^2(b) are equal because the simplices are congruent by a symmetry of
+/// the square lattice: translations, half-turns, quarter-turns and mirrors in the axes and
+/// diagonals (a lattice's cells in every orientation). rho^2 is a function of the multiset of edge
+/// vectors up to sign alone (the squared lengths do not see a sign, and |D|, twice the area, is
+/// |cross(u, v)| for any two of a triangle's three edge vectors, whatever their signs), and is
+/// invariant under the symmetries; so equal canonical edge vectors mean equal values. The vectors
+/// are compared exactly in error-free form; an overflowing difference compares unequal (NaN).
 /// False proves nothing.
-GALPHA_HD inline bool RadiusTermsIdentical(const Point2* a, int na, const Point2* b, int nb) {
+GALPHA_HD inline bool RadiusCongruent(const Point2* a, int na, const Point2* b, int nb) {
   using namespace radius_detail;
   if (na != nb) return false;
-  ExactRadiusTerms ta, tb;
-  int sa = 0, sb = 0;
-  if (!CanonicalExactTerms(a, na, &ta, &sa) || !CanonicalExactTerms(b, nb, &tb, &sb)) return false;
-  if (sa != sb || ta.numn != tb.numn || ta.denn != tb.denn) return false;
-  for (int i = 0; i < ta.numn; ++i) {
-    if (ta.num[i] != tb.num[i]) return false;
-  }
-  for (int i = 0; i < ta.denn; ++i) {
-    if (ta.den[i] != tb.den[i]) return false;
+  ExactEdgeVector va[3] = {}, vb[3] = {};
+  const int m = CanonicalEdgeVectors(a, na, va);
+  CanonicalEdgeVectors(b, nb, vb);
+  for (int k = 0; k < m; ++k) {
+    if (!EdgeVectorEqual(va[k], vb[k])) return false;
   }
   return true;
 }

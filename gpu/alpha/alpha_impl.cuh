@@ -30,6 +30,7 @@
 #include "gpu/alpha/alpha_functors.cuh"
 #include "gpu/alpha/alpha_host_repair.hpp"
 #include "gpu/alpha/component_curve.cuh"
+#include "gpu/alpha/spectrum_refine.cuh"
 #include "gpu/triangulation/delaunay_impl.cuh"
 #include "gpu/system/engine_system.cuh"
 
@@ -249,6 +250,19 @@ SortedSpectrum<System> SortSpectrum(System& sys, const PipelineMesh& mesh, Simpl
   return {std::move(ids), std::move(odd_ids), std::move(sorted_keys), num_entries, num_odd};
 }
 
+/// The start of every run of linked entries, then num_entries, into `run_begin` (num_entries + 1
+/// long); returns the number of runs.
+template <class System>
+uint32_t ListRunStarts(System& sys, const Buffer<uint8_t, System>& link, uint32_t num_entries,
+                       Buffer<uint32_t, System>* run_begin) {
+  thrust::counting_iterator<uint32_t> zero(0);
+  const auto num_runs = static_cast<uint32_t>(
+      thrust::copy_if(sys.policy(), zero, zero + num_entries, run_begin->data(), IsRunStart{link.data()}) -
+      run_begin->data());
+  sys.FromHost(run_begin->data() + num_runs, &num_entries, 1);
+  return num_runs;
+}
+
 /// The runs of sorted entries linked by keys that may tie (num_entries > 1).
 template <class System>
 TiedRuns<System> FindTiedRuns(System& sys, const Buffer<uint64_t, System>& sorted_keys, uint32_t num_entries) {
@@ -258,9 +272,7 @@ TiedRuns<System> FindTiedRuns(System& sys, const Buffer<uint64_t, System>& sorte
   thrust::transform(policy, zero, zero + (num_entries - 1), link.data(), MayTieWithNext{sorted_keys.data()});
   const uint64_t num_links = thrust::count(policy, link.data(), link.data() + (num_entries - 1), uint8_t{1});
   Buffer<uint32_t, System> run_begin(sys, num_entries + 1);
-  const uint32_t num_runs = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_entries, run_begin.data(), IsRunStart{link.data()}) - run_begin.data());
-  sys.FromHost(run_begin.data() + num_runs, &num_entries, 1);
+  const uint32_t num_runs = ListRunStarts(sys, link, num_entries, &run_begin);
   return {std::move(link), std::move(run_begin), num_runs, num_links};
 }
 
@@ -325,6 +337,12 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   TiedRuns<System> runs = FindTiedRuns(sys, sorted_keys, spectrum->num_entries);
+  // Runs too long for one thread are ordered by refined keys first (spectrum_refine.cuh); what
+  // they settle is cut out of the runs, and what is left is repaired below like any run.
+  if (RefineLongRuns(sys, mesh.simplex(), runs.link.data(), runs.run_begin.data(), runs.num_runs,
+                     spectrum->ids.data(), spectrum->new_value.data(), spectrum->num_entries, counts) > 0) {
+    runs.num_runs = ListRunStarts(sys, runs.link, spectrum->num_entries, &runs.run_begin);
+  }
   const uint32_t num_runs = runs.num_runs;
   const uint32_t* run_end = runs.run_begin.data() + 1;
   Buffer<uint8_t, System> needs_host(sys, num_runs);

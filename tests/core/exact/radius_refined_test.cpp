@@ -1,6 +1,6 @@
 // Refined keys of squared radii (core/exact/radius_refined.hpp) against exact GMP rationals: the
 // certified error bound on every simplex, the soundness of the separation test on near ties (the
-// ulp-perturbed lattices it exists for), and the identity proof of translated simplices.
+// ulp-perturbed lattices it exists for), and the equality proof of translated simplices.
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
@@ -189,7 +189,7 @@ TEST(RefinedRadiusSqTest, TiesAreNeverSeparated) {
   EXPECT_FALSE(RefinedKeysSeparated(infinite, infinite));
 }
 
-TEST(RefinedRadiusSqTest, TranslatesHaveIdenticalTerms) {
+TEST(RefinedRadiusSqTest, TranslatesAreProvenEqual) {
   std::mt19937_64 rng(11);
   std::uniform_int_distribution<int> step(0, 1000);
   int identical = 0;
@@ -210,7 +210,7 @@ TEST(RefinedRadiusSqTest, TranslatesHaveIdenticalTerms) {
       exact_translate = exact_translate && mpq_class(moved[i].x) - mpq_class(from.x) == mpq_class(tx) &&
                         mpq_class(moved[i].y) - mpq_class(from.y) == mpq_class(ty);
     }
-    const bool same = RadiusTermsIdentical(first, 3, moved, 3);
+    const bool same = RadiusCongruent(first, 3, moved, 3);
     if (same) {
       ASSERT_EQ(CompareRadiusSqRational(first, 3, moved, 3), 0);
       ++identical;
@@ -223,8 +223,38 @@ TEST(RefinedRadiusSqTest, TranslatesHaveIdenticalTerms) {
   // Different values are never called identical.
   const Point2 t1[3] = {{0, 0}, {1, 0}, {0, 1}};
   const Point2 t2[3] = {{0, 0}, {1, 0}, {0, Ulps(1.0, 1)}};
-  EXPECT_FALSE(RadiusTermsIdentical(t1, 3, t2, 3));
-  EXPECT_TRUE(RadiusTermsIdentical(t1, 3, t1, 3));
+  EXPECT_FALSE(RadiusCongruent(t1, 3, t2, 3));
+  EXPECT_TRUE(RadiusCongruent(t1, 3, t1, 3));
+  // A half-turn: a lattice's upper cell triangle against its lower one.
+  const Point2 lower[3] = {{1000.0, 2000.0}, {Ulps(1000.125, 1), 2000.0}, {1000.0, Ulps(2000.125, -1)}};
+  const Point2 upper[3] = {{Ulps(1000.125, 1), Ulps(2000.125, -1)}, {1000.0, Ulps(2000.125, -1)},
+                           {Ulps(1000.125, 1), 2000.0}};
+  // lower's edge vectors negated: (a + b + c) - lower, exact here, is upper's vertex list.
+  EXPECT_EQ(RadiusCongruent(lower, 3, upper, 3), CompareRadiusSqRational(lower, 3, upper, 3) == 0);
+  const Point2 sheared[3] = {{1000.0, 2000.0}, {Ulps(1000.125, 1), 2000.0}, {Ulps(1000.0, 1), Ulps(2000.125, -1)}};
+  EXPECT_FALSE(RadiusCongruent(lower, 3, sheared, 3));
+  // Edges: equal length alone is not claimed; the lattice's symmetries are.
+  const Point2 e1[2] = {{0, 0}, {3, 4}}, e2[2] = {{0, 0}, {5, 0}}, e3[2] = {{7, 7}, {4, 3}}, e4[2] = {{1, 1}, {5, -2}};
+  EXPECT_FALSE(RadiusCongruent(e1, 2, e2, 2));
+  EXPECT_TRUE(RadiusCongruent(e1, 2, e3, 2));
+  EXPECT_TRUE(RadiusCongruent(e1, 2, e4, 2));  // (4, -3): (3, 4) turned a quarter
+  // Mirrors and quarter turns of a perturbed triangle, against GMP; and a shape that is no symmetry
+  // of it (a shear that keeps one edge) is never claimed, equal or not.
+  const Point2 tri[3] = {{Ulps(1000.0, 1), 2000.0}, {1000.125, Ulps(2000.0, -2)}, {Ulps(1000.0, -1), 2000.25}};
+  for (int t = 0; t < 8; ++t) {
+    Point2 image[3];
+    for (int i = 0; i < 3; ++i) {
+      double x = tri[i].x - 1000.0, y = tri[i].y - 2000.0;  // exact: Sterbenz
+      if (t & 1) x = -x;
+      if (t & 2) y = -y;
+      if (t & 4) std::swap(x, y);
+      image[i] = {x + 5000.0, y + 7000.0};  // may round: then the image is not an exact copy
+    }
+    const bool claimed = RadiusCongruent(tri, 3, image, 3);
+    if (claimed) {
+      EXPECT_EQ(CompareRadiusSqRational(tri, 3, image, 3), 0) << t;
+    }
+  }
 }
 
 }  // namespace

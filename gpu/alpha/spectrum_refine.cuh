@@ -1,0 +1,254 @@
+// The spectrum's long runs of near ties, ordered by refined keys (core/exact/radius_refined.hpp)
+// instead of by exact comparisons inside each run. Runs longer than kMaxDeviceRun used to go to
+// the host whole (a three-way quicksort with exact comparisons: 44 s for a 1000 x 1000 lattice
+// perturbed by single ulps); here every entry of such a run gets a key certified within 2^-150,
+// the entries are sorted by (run, exact key value, id), and only adjacent entries the keys cannot
+// separate are compared exactly: O(n) comparisons, all in parallel, on the backend's cores.
+//
+// Why the result is exact:
+//  - Two adjacent entries whose keys are separated (RefinedKeysSeparated) have exact values in
+//    that order, and since the keys are sorted by their exact values and each is within its
+//    certified error of its entry's value, every entry before the pair is below every entry after
+//    it: a separated pair is a certified boundary.
+//  - Between boundaries lie clusters of entries whose keys may tie. A cluster whose adjacent pairs
+//    all compare Less or Equal exactly is in exact order (order is transitive); its links are cut
+//    and the equal pairs marked as one value. A cluster with a pair out of order or undecided
+//    keeps its links and becomes a run of its own for the existing exact repair (insertion sort on
+//    the device, or the host), which may reorder it freely since its boundaries are certified.
+//  - A run with an entry whose key cannot be refined (exact terms beyond the bounded buffers) is
+//    left whole to the existing repair.
+#pragma once
+
+#include <thrust/copy.h>
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
+#include <thrust/reduce.h>
+#include <thrust/scan.h>
+#include <thrust/sort.h>
+
+#include <cstdint>
+
+#include "core/base/hd.hpp"
+#include "core/base/point.hpp"
+#include "core/exact/expansion.hpp"
+#include "core/exact/order.hpp"
+#include "core/exact/radius_compare.hpp"
+#include "core/exact/radius_refined.hpp"
+#include "core/family/alpha_ranks.hpp"
+#include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/system/engine_system.cuh"
+
+namespace galpha::detail {
+
+/// One entry of a long run with its refined key.
+struct RefinedEntry {
+  uint32_t run;  // the run's index in the run list
+  uint32_t id;   // the simplex
+  RefinedRadiusSq key;
+};
+
+/// Exact order of two refined keys' values: the sign of b - a, by Grow-Expansion (exact, and
+/// nonoverlapping so that the top component carries the sign), after the cheap cases.
+GALPHA_HD inline int CompareRefinedValues(const RefinedRadiusSq& a, const RefinedRadiusSq& b) {
+  using namespace exact;
+  if (a.infinite || b.infinite) return (b.infinite ? 1 : 0) - (a.infinite ? 1 : 0);
+  const int64_t gap = static_cast<int64_t>(b.exponent) - a.exponent;
+  if (gap >= 2) return 1;  // heads in [1, 2) and tails below 2^-50: the values differ by a binade
+  if (gap <= -2) return -1;
+  if (gap == 0 && a.hi == b.hi && a.mid == b.mid && a.lo == b.lo) return 0;  // translates, mostly
+  if (gap == 0) {
+    // Each value is within ulp(hi) / 2 + 2^-100 of its head: heads two ulps apart decide.
+    if (b.hi - a.hi > 0x1p-51) return 1;
+    if (a.hi - b.hi > 0x1p-51) return -1;
+  }
+  const double bs = gap == 1 ? 2.0 : 1.0, as = gap == -1 ? 2.0 : 1.0;  // to a common exponent
+  const double terms[6] = {Mul(b.lo, bs), Mul(b.mid, bs), Mul(b.hi, bs),
+                           -Mul(a.lo, as), -Mul(a.mid, as), -Mul(a.hi, as)};
+  double e[7];
+  int en = 0;
+  for (const double t : terms) en = GrowExpansionZeroElim(en, e, t, e);
+  return ExpansionSign(en, e);
+}
+
+/// Sort order of refined entries: by run, then exact key value, then simplex id (a strict total
+/// order, so both backends produce the same permutation).
+struct RefinedEntryLess {
+  GALPHA_HD bool operator()(const RefinedEntry& a, const RefinedEntry& b) const {
+    if (a.run != b.run) return a.run < b.run;
+    const int c = CompareRefinedValues(a.key, b.key);
+    if (c != 0) return c > 0;
+    return a.id < b.id;
+  }
+};
+
+/// 1 for the entries of runs longer than kMaxDeviceRun (the runs the device cannot sort itself).
+struct InLongRun {
+  const uint32_t* run_of;  // inclusive scan of run starts: 1-based run index of each entry
+  const uint32_t* run_begin;
+  GALPHA_HD bool operator()(uint32_t i) const {
+    const uint32_t r = run_of[i] - 1;
+    return run_begin[r + 1] - run_begin[r] > kMaxDeviceRun;
+  }
+};
+
+/// The refined key of the entry at `position`; marks its run unrefinable when it has none.
+struct ComputeRefinedEntry {
+  SimplexPoints simplex;
+  const uint32_t* positions;
+  const uint32_t* run_of;
+  const uint32_t* ids;
+  RefinedEntry* entries;
+  uint8_t* run_unrefinable;  // per run; only ever set to 1
+  GALPHA_HD void operator()(uint32_t k) const {
+    const uint32_t i = positions[k];
+    RefinedEntry entry;
+    entry.run = run_of[i] - 1;
+    entry.id = ids[i];
+    Point2 p[3];
+    const int n = simplex(entry.id, p);
+    entry.key = RefineRadiusSq(p, n);
+    if (!entry.key.ok) run_unrefinable[entry.run] = 1;
+    entries[k] = entry;
+  }
+};
+
+/// Puts the sorted entries back at their run's positions (positions ascend, and sorting by run
+/// first keeps every run's entries over its own positions).
+struct ScatterRefinedIds {
+  const uint32_t* positions;
+  const RefinedEntry* entries;
+  uint32_t* ids;
+  GALPHA_HD void operator()(uint32_t k) const { ids[positions[k]] = entries[k].id; }
+};
+
+/// Verdict on sorted entries k - 1 and k of the same refinable run: kPairSeparated (a certified
+/// boundary), kPairLess / kPairEqual (decided exactly), or kPairBad (out of order or undecided).
+/// The first entry of a run gets kPairSeparated: runs are apart by their 64-bit keys.
+constexpr uint8_t kPairSeparated = 0, kPairLess = 1, kPairEqual = 2, kPairBad = 3;
+
+struct JudgeRefinedPair {
+  SimplexPoints simplex;
+  const RefinedEntry* entries;
+  const uint8_t* run_unrefinable;
+  uint8_t* verdict;
+  uint32_t* comparisons;  // per entry: bounded exact comparisons done (0 or 1)
+  GALPHA_HD void operator()(uint32_t k) const {
+    comparisons[k] = 0;
+    if (k == 0 || entries[k - 1].run != entries[k].run || run_unrefinable[entries[k].run]) {
+      verdict[k] = kPairSeparated;
+      return;
+    }
+    const RefinedEntry& a = entries[k - 1];
+    const RefinedEntry& b = entries[k];
+    if (RefinedKeysSeparated(a.key, b.key)) {
+      verdict[k] = kPairSeparated;
+      return;
+    }
+    Point2 pa[3], pb[3];
+    const int na = simplex(a.id, pa), nb = simplex(b.id, pb);
+    if (RadiusCongruent(pa, na, pb, nb)) {
+      verdict[k] = kPairEqual;
+      return;
+    }
+    comparisons[k] = 1;
+    const Order order = CompareRadiusSqBounded(pa, na, pb, nb);
+    verdict[k] = order == Order::kLess ? kPairLess : order == Order::kEqual ? kPairEqual : kPairBad;
+  }
+};
+
+/// 1 where a cluster starts: at a separated pair (or a run's first entry).
+struct ClusterStartAsU32 {
+  const uint8_t* verdict;
+  GALPHA_HD uint32_t operator()(uint32_t k) const { return verdict[k] == kPairSeparated ? 1u : 0u; }
+};
+
+/// Marks the clusters that hold a bad pair; concurrent writes only ever write 1.
+struct MarkBadCluster {
+  const uint8_t* verdict;
+  const uint32_t* cluster_of;  // 1-based
+  uint8_t* cluster_bad;
+  GALPHA_HD void operator()(uint32_t k) const {
+    if (verdict[k] == kPairBad) cluster_bad[cluster_of[k] - 1] = 1;
+  }
+};
+
+/// Writes the verdicts into the spectrum: entries of a good cluster become runs of one (links
+/// cut), with new_value 0 for an entry equal to the one before; a bad cluster keeps its links;
+/// every separated pair is cut and starts a new value. Runs left unrefinable are not touched.
+struct ApplyRefinedVerdicts {
+  const uint32_t* positions;
+  const RefinedEntry* entries;
+  const uint8_t* run_unrefinable;
+  const uint8_t* verdict;
+  const uint32_t* cluster_of;
+  const uint8_t* cluster_bad;
+  uint8_t* link;       // link[i]: entries i and i + 1 may tie
+  uint8_t* new_value;  // 1 where an exact value starts
+  GALPHA_HD void operator()(uint32_t k) const {
+    if (run_unrefinable[entries[k].run]) return;
+    const uint32_t i = positions[k];
+    if (verdict[k] == kPairSeparated) {
+      if (k > 0 && entries[k - 1].run == entries[k].run) link[i - 1] = 0;
+      new_value[i] = 1;  // a run's first entry, or above everything before it
+      return;
+    }
+    if (cluster_bad[cluster_of[k] - 1]) return;  // the cluster stays one run for the exact repair
+    link[i - 1] = 0;
+    new_value[i] = verdict[k] == kPairEqual ? 0 : 1;
+  }
+};
+
+/// Orders the entries of runs longer than kMaxDeviceRun by refined keys (see the file comment),
+/// cutting `link` where the order is settled; returns the number of entries refined. The caller
+/// rebuilds its run list from `link`. `ids` and `new_value` hold num_entries entries, `link`
+/// num_entries - 1, `run_begin` num_runs + 1.
+template <class System>
+uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link, const uint32_t* run_begin,
+                        uint32_t num_runs, uint32_t* ids, uint8_t* new_value, uint32_t num_entries,
+                        ComparisonCounts* counts) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<uint32_t, System> run_of(sys, num_entries);
+  const auto starts = thrust::make_transform_iterator(zero, RunStartAsU32{link});
+  thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
+  Buffer<uint32_t, System> positions(sys, num_entries);
+  const auto num_refined = static_cast<uint32_t>(
+      thrust::copy_if(policy, zero, zero + num_entries, positions.data(), InLongRun{run_of.data(), run_begin}) -
+      positions.data());
+  if (num_refined == 0) return 0;
+
+  Buffer<RefinedEntry, System> entries(sys, num_refined);
+  Buffer<uint8_t, System> run_unrefinable(sys, num_runs);
+  thrust::fill_n(policy, run_unrefinable.data(), num_runs, uint8_t{0});
+  thrust::for_each_n(policy, zero, num_refined,
+                     ComputeRefinedEntry{simplex, positions.data(), run_of.data(), ids, entries.data(),
+                                         run_unrefinable.data()});
+  run_of.Reset();
+  thrust::sort(policy, entries.data(), entries.data() + num_refined, RefinedEntryLess{});
+  thrust::for_each_n(policy, zero, num_refined, ScatterRefinedIds{positions.data(), entries.data(), ids});
+
+  Buffer<uint8_t, System> verdict(sys, num_refined);
+  Buffer<uint32_t, System> comparisons(sys, num_refined);
+  thrust::for_each_n(policy, zero, num_refined,
+                     JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(),
+                                      comparisons.data()});
+  counts->bounded_exact += thrust::reduce(policy, comparisons.data(), comparisons.data() + num_refined, uint64_t{0});
+  comparisons.Reset();
+
+  Buffer<uint32_t, System> cluster_of(sys, num_refined);
+  const auto cluster_starts = thrust::make_transform_iterator(zero, ClusterStartAsU32{verdict.data()});
+  thrust::inclusive_scan(policy, cluster_starts, cluster_starts + num_refined, cluster_of.data());
+  uint32_t num_clusters = 0;
+  sys.ToHost(&num_clusters, cluster_of.data() + (num_refined - 1), 1);
+  Buffer<uint8_t, System> cluster_bad(sys, num_clusters);
+  thrust::fill_n(policy, cluster_bad.data(), num_clusters, uint8_t{0});
+  thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict.data(), cluster_of.data(), cluster_bad.data()});
+  thrust::for_each_n(policy, zero, num_refined,
+                     ApplyRefinedVerdicts{positions.data(), entries.data(), run_unrefinable.data(), verdict.data(),
+                                          cluster_of.data(), cluster_bad.data(), link, new_value});
+  return num_refined;
+}
+
+}  // namespace galpha::detail
