@@ -2,10 +2,11 @@
 // with exact constructions (Exact_predicates_exact_constructions_kernel, GENERAL mode) in the same
 // run, over distributions x sizes (and real .bin files). Prints a markdown table with both times,
 // the ratio, both memory peaks per point, the time of one classification of every simplex and
-// galpha's stage times. A plain harness, kept out of ctest.
+// galpha's stage times; then, for hard inputs, each row's pipeline against uniform input of the same
+// size and the stage that dominates it. A plain harness, kept out of ctest.
 //
 //   alpha_bench [--backend=auto|cpu|cuda] [--repeat=3] [--sizes=100000,1000000]
-//               [--dists=uniform,gaussian,clustered,grid] [--seed=1] [--cgal-max=1000000]
+//               [--dists=NAME,...(default: every generator)] [--seed=1] [--cgal-max=1000000]
 //               [--data FILE.bin]...
 //
 // Memory: the peak resident set of the process during the call minus the resident set before it
@@ -233,6 +234,39 @@ void PrintStages(const std::vector<BenchResult>& results) {
   }
 }
 
+/// Hard inputs against easy ones: each row's pipeline over the uniform row of the same size (when
+/// there is one), over CGAL's time, and its largest stage.
+void PrintHardness(const std::vector<BenchResult>& results) {
+  std::printf("\n| input | n | pipeline ms | pipeline / uniform's | CGAL / pipeline | dominant stage (ms) |\n"
+              "|---|---:|---:|---:|---:|---|\n");
+  for (const BenchResult& r : results) {
+    if (!r.error.empty()) continue;
+    std::string vs_uniform = "-", vs_cgal = "-", dominant = "-";
+    char text[96];
+    for (const BenchResult& u : results) {
+      if (u.error.empty() && u.name == "uniform" && u.n == r.n && u.pipeline_ms > 0) {
+        std::snprintf(text, sizeof text, "%.2fx", r.pipeline_ms / u.pipeline_ms);
+        vs_uniform = text;
+      }
+    }
+    if (r.cgal_ms >= 0 && r.pipeline_ms > 0) {
+      std::snprintf(text, sizeof text, "%.0fx", r.cgal_ms / r.pipeline_ms);
+      vs_cgal = text;
+    }
+    const StageTime* top = nullptr;
+    for (const StageTime& s : r.stages) {
+      if (IsTransferStage(s.stage) || IsHostStage(s.stage)) continue;
+      if (top == nullptr || s.seconds > top->seconds) top = &s;
+    }
+    if (top != nullptr) {
+      std::snprintf(text, sizeof text, "%s (%.1f)", top->stage.c_str(), top->seconds * 1e3);
+      dominant = text;
+    }
+    std::printf("| %s | %zu | %.1f | %s | %s | %s |\n", r.name.c_str(), r.n, r.pipeline_ms, vs_uniform.c_str(),
+                vs_cgal.c_str(), dominant.c_str());
+  }
+}
+
 int Main(int argc, char** argv) {
   const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, true);
   if (!options.ok()) {
@@ -264,6 +298,7 @@ int Main(int argc, char** argv) {
     run(file.substr(file.find_last_of('/') + 1), *points);
   }
   PrintStages(results);
+  PrintHardness(results);
   return failed ? 1 : 0;
 }
 

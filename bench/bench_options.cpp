@@ -9,6 +9,7 @@ namespace galpha {
 
 absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, bool accept_cgal_max) {
   BenchOptions options;
+  for (const gen::NamedGenerator& generator : gen::AllDistributions()) options.distributions.push_back(generator.name);
   bool explicit_generated = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];

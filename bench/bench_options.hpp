@@ -15,7 +15,8 @@ struct BenchOptions {
   Backend backend = Backend::kAuto;
   int repeat = 3;
   std::vector<size_t> sizes = {100000, 1000000};
-  std::vector<std::string> distributions = {"uniform", "gaussian", "clustered", "grid"};
+  /// Every generator of tests/support/point_generators.hpp unless --dists names some.
+  std::vector<std::string> distributions;
   uint64_t seed = 1;
   std::vector<std::string> data_files;
   /// Largest input CGAL runs on (alpha_bench only: CGAL's alpha shapes take tens of seconds at 1M).

@@ -10,6 +10,9 @@
 #           its first run (the benchmark distributions)
 #   alpha   alpha_bench: the whole family, CUDA and CPU backends, CGAL Alpha_shape_2 in the same run,
 #           the floor sort of the spectrum's pairs, and 100M uniform points on the GPU
+#   hard    alpha_bench over every generator (the hard ones: lattices, circles, lines, offsets,
+#           ulp-perturbed lattices, centimetre LiDAR) at 100K and 1M with CGAL at 100K, at 10M on
+#           the GPU alone, and the CPU backend at 1M on this machine's cores
 #   identity the CUDA/CPU identity test alone
 #   profile Nsight Systems (nsys, when the machine has it) over one 1M-point family build: the
 #           kernels and the CUDA API calls (waits) by total time
@@ -91,6 +94,13 @@ for phase in "${phases[@]}"; do
         --format csv --output "$out/family_1m" "$out/family_1m.nsys-rep"
       rm -f "$out/family_1m.nsys-rep" "$out/family_1m.sqlite"
       for f in "$out"/family_1m_*.csv; do echo "== $f"; head -n 16 "$f"; done
+      ;;
+    hard)
+      [ -x .carry/bin/alpha_bench ] || { echo "no alpha_bench in .carry"; status=1; continue; }
+      run_step hard 420 .carry/bin/alpha_bench --backend=cuda --sizes=100000,1000000 --repeat=3 --cgal-max=100000
+      run_step hard 300 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --repeat=1 --cgal-max=0
+      run_step hard 400 .carry/bin/alpha_bench --backend=cpu --sizes=1000000 --repeat=1 --cgal-max=0
+      grep -E '^\|' "$out/hard.log" | grep -vE 'stages of the best run|^\| [a-z_0-9]+ \| [0-9]+ \| (validate|upload)'
       ;;
     identity)
       # The CUDA/CPU identity test alone (every generator and data set): the quick correctness
