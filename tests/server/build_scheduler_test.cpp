@@ -19,9 +19,13 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
+
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 
 // Long enough never to fire on a healthy run; only a broken scheduler waits this long.
 constexpr std::chrono::seconds kDeadlock{20};
@@ -126,18 +130,18 @@ TEST(BuildSchedulerTest, JobsRunOnTheSlotsWithTheirStreams) {
     std::atomic<int> started{0};
     Gate all_started, release;
     for (size_t i = 0; i < runs.size(); ++i) {
-      ASSERT_TRUE(scheduler
-                      .Submit(1, [&, i](const BuildSlot& slot, bool draining) {
-                        runs[i].slot = slot;
-                        runs[i].draining = draining;
-                        ++runs[i].calls;
-                        if (++started == 3) all_started.Open();
-                        release.Wait();
-                      })
-                      .ok());
+      ASSERT_THAT(scheduler.Submit(1,
+                                   [&, i](const BuildSlot& slot, bool draining) {
+                                     runs[i].slot = slot;
+                                     runs[i].draining = draining;
+                                     ++runs[i].calls;
+                                     if (++started == 3) all_started.Open();
+                                     release.Wait();
+                                   }),
+                  IsOk());
     }
     ASSERT_TRUE(all_started.Wait());
-    EXPECT_EQ(scheduler.Submit(1, [](const BuildSlot&, bool) {}).code(), absl::StatusCode::kResourceExhausted)
+    EXPECT_THAT(scheduler.Submit(1, [](const BuildSlot&, bool) {}), StatusIs(absl::StatusCode::kResourceExhausted))
         << "every slot busy and no queue";
     release.Open();
   }
@@ -162,22 +166,22 @@ TEST(BuildSchedulerTest, FullQueueRefusesWithResourceExhausted) {
   JobRun second;
   {
     BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/1, /*memory_budget_bytes=*/0, &recorder);
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot&, bool) {
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot&, bool) {
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot& slot, bool draining) {
-                      second = JobRun{slot, draining, second.calls + 1};
-                      second_done.Open();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot& slot, bool draining) {
+                                   second = JobRun{slot, draining, second.calls + 1};
+                                   second_done.Open();
+                                 }),
+                IsOk());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.queued == 1 && l.running == 1; }));
     const absl::Status refused = scheduler.Submit(0, [&](const BuildSlot&, bool) { ++third_calls; });
-    EXPECT_TRUE(absl::IsResourceExhausted(refused)) << refused;
+    EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted));
     EXPECT_NE(refused.message().find("queue"), absl::string_view::npos) << refused;
 
     release_first.Open();
@@ -189,7 +193,7 @@ TEST(BuildSchedulerTest, FullQueueRefusesWithResourceExhausted) {
     // The queue has room again once the second job left it.
     Gate fourth_done;
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 0; }));
-    ASSERT_TRUE(scheduler.Submit(0, [&](const BuildSlot&, bool) { fourth_done.Open(); }).ok());
+    ASSERT_THAT(scheduler.Submit(0, [&](const BuildSlot&, bool) { fourth_done.Open(); }), IsOk());
     ASSERT_TRUE(fourth_done.Wait());
   }
   EXPECT_EQ(third_calls.load(), 0) << "a refused job never runs";
@@ -203,23 +207,23 @@ TEST(BuildSchedulerTest, JobsRunInSubmissionOrder) {
   std::vector<int> order;
   {
     BuildScheduler scheduler({nullptr}, /*max_queue=*/8, /*memory_budget_bytes=*/0, nullptr);
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot&, bool) {
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot&, bool) {
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
     for (int i = 1; i <= 5; ++i) {
-      ASSERT_TRUE(scheduler
-                      .Submit(0, [&, i](const BuildSlot& slot, bool draining) {
-                        EXPECT_FALSE(draining);
-                        EXPECT_EQ(slot.cuda_stream, nullptr);
-                        std::lock_guard<std::mutex> lock(mutex);
-                        order.push_back(i);
-                        if (order.size() == 5) all_done.Open();
-                      })
-                      .ok());
+      ASSERT_THAT(scheduler.Submit(0,
+                                   [&, i](const BuildSlot& slot, bool draining) {
+                                     EXPECT_FALSE(draining);
+                                     EXPECT_EQ(slot.cuda_stream, nullptr);
+                                     std::lock_guard<std::mutex> lock(mutex);
+                                     order.push_back(i);
+                                     if (order.size() == 5) all_done.Open();
+                                   }),
+                  IsOk());
     }
     release_first.Open();
     ASSERT_TRUE(all_done.Wait());  // before the destructor's Stop would drain what is left
@@ -247,32 +251,32 @@ TEST(BuildSchedulerTest, MemoryAdmissionKeepsBuildsWithinTheBudget) {
     BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/4, /*memory_budget_bytes=*/100,
                              &recorder);
     const absl::Status too_big = scheduler.Submit(101, [](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
-    EXPECT_TRUE(absl::IsResourceExhausted(too_big)) << too_big;
+    EXPECT_THAT(too_big, StatusIs(absl::StatusCode::kResourceExhausted));
     EXPECT_NE(too_big.message().find("101"), absl::string_view::npos) << too_big;
 
-    ASSERT_TRUE(scheduler
-                    .Submit(60, [&](const BuildSlot&, bool draining) {
-                      EXPECT_FALSE(draining);
-                      track();
-                      first_started.Open();
-                      release_first.Wait();
-                      finish();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(60,
+                                 [&](const BuildSlot&, bool draining) {
+                                   EXPECT_FALSE(draining);
+                                   track();
+                                   first_started.Open();
+                                   release_first.Wait();
+                                   finish();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
     // The second needs 60 (60 + 60 > 100); the third needs only 10 but queues behind the second.
     for (const size_t need : {size_t{60}, size_t{10}}) {
-      ASSERT_TRUE(scheduler
-                      .Submit(need, [&](const BuildSlot&, bool draining) {
-                        EXPECT_FALSE(draining);
-                        track();
-                        later_started.Open();
-                        // 60 + 10 fit in 100: the two must be able to run side by side.
-                        if (++later == 2) both_later_started.Open();
-                        EXPECT_TRUE(both_later_started.Wait()) << "the 60 and the 10 never ran together";
-                        finish();
-                      })
-                      .ok());
+      ASSERT_THAT(scheduler.Submit(need,
+                                   [&](const BuildSlot&, bool draining) {
+                                     EXPECT_FALSE(draining);
+                                     track();
+                                     later_started.Open();
+                                     // 60 + 10 fit in 100: the two must be able to run side by side.
+                                     if (++later == 2) both_later_started.Open();
+                                     EXPECT_TRUE(both_later_started.Wait()) << "the 60 and the 10 never ran together";
+                                     finish();
+                                   }),
+                  IsOk());
     }
     EXPECT_FALSE(later_started.WaitFor(kWatch)) << "a job started while the first held 60 of 100 bytes";
     EXPECT_EQ(recorder.last().admitted_bytes, 60u);
@@ -295,18 +299,17 @@ TEST(BuildSchedulerTest, TwoBuildsOfSixtyNeverOverlap) {
                              &recorder);
     constexpr int kJobs = 6;
     for (int i = 0; i < kJobs; ++i) {
-      ASSERT_TRUE(scheduler
-                      .Submit(60, [&](const BuildSlot&, bool) {
-                        const int now = ++current;
-                        int seen = max_concurrent.load();
-                        while (now > seen && !max_concurrent.compare_exchange_weak(seen, now)) {
-                        }
-                        // Give a second job every chance to start now, if admission let it.
-                        all_done.WaitFor(std::chrono::milliseconds(10));
-                        --current;
-                        if (++done == kJobs) all_done.Open();
-                      })
-                      .ok());
+      ASSERT_THAT(scheduler.Submit(60,
+                                   [&](const BuildSlot&, bool) {
+                                     const int now = ++current;
+                                     int seen = max_concurrent.load();
+                                     while (now > seen && !max_concurrent.compare_exchange_weak(seen, now)) {}
+                                     // Give a second job every chance to start now, if admission let it.
+                                     all_done.WaitFor(std::chrono::milliseconds(10));
+                                     --current;
+                                     if (++done == kJobs) all_done.Open();
+                                   }),
+                  IsOk());
     }
     ASSERT_TRUE(all_done.Wait());
   }
@@ -326,18 +329,18 @@ TEST(BuildSchedulerTest, JobsWaitingForMemoryCountAsQueued) {
   {
     BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/1, /*memory_budget_bytes=*/100,
                              &recorder);
-    ASSERT_TRUE(scheduler
-                    .Submit(60, [&](const BuildSlot&, bool) {
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(60,
+                                 [&](const BuildSlot&, bool) {
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 1; }));
-    ASSERT_TRUE(scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; }).ok());
+    ASSERT_THAT(scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; }), IsOk());
     EXPECT_EQ(recorder.last().queued, 1u) << "the second job waits for memory, so it is queued";
     const absl::Status third = scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; });
-    EXPECT_TRUE(absl::IsResourceExhausted(third)) << "max_queue 1, one job already waiting: " << third;
+    EXPECT_THAT(third, StatusIs(absl::StatusCode::kResourceExhausted)) << "max_queue 1, one job already waiting";
     release_first.Open();
   }
   ExpectIdle(recorder);
@@ -348,12 +351,12 @@ TEST(BuildSchedulerTest, ZeroBudgetAdmitsEverything) {
   std::atomic<int> started{0};
   BuildScheduler scheduler({nullptr, nullptr}, /*max_queue=*/0, /*memory_budget_bytes=*/0, nullptr);
   for (int i = 0; i < 2; ++i) {
-    ASSERT_TRUE(scheduler
-                    .Submit(size_t{1} << 50, [&](const BuildSlot&, bool) {
-                      if (++started == 2) both_started.Open();
-                      both_started.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(size_t{1} << 50,
+                                 [&](const BuildSlot&, bool) {
+                                   if (++started == 2) both_started.Open();
+                                   both_started.Wait();
+                                 }),
+                IsOk());
   }
   EXPECT_TRUE(both_started.Wait()) << "with no budget, two huge builds run side by side";
 }
@@ -367,35 +370,36 @@ TEST(BuildSchedulerTest, StopDrainsQueuedJobsAndRefusesNewOnes) {
   std::atomic<int> late_calls{0};
   {
     BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/2, /*memory_budget_bytes=*/0, &recorder);
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot& slot, bool draining) {
-                      first = JobRun{slot, draining, first.calls + 1};
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot& slot, bool draining) {
+                                   first = JobRun{slot, draining, first.calls + 1};
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot& slot, bool draining) {
-                      second = JobRun{slot, draining, second.calls + 1};
-                    })
-                    .ok());
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot& slot, bool draining) {
-                      third = JobRun{slot, draining, third.calls + 1};
-                      third_done.set_value();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot& slot, bool draining) {
+                                   second = JobRun{slot, draining, second.calls + 1};
+                                 }),
+                IsOk());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot& slot, bool draining) {
+                                   third = JobRun{slot, draining, third.calls + 1};
+                                   third_done.set_value();
+                                 }),
+                IsOk());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.queued == 2 && l.running == 1; }));
 
     scheduler.Stop();  // returns at once, with the first job still running
     const absl::Status refused = scheduler.Submit(0, [&](const BuildSlot&, bool) { ++late_calls; });
-    EXPECT_TRUE(absl::IsUnavailable(refused)) << refused;
+    EXPECT_THAT(refused, StatusIs(absl::StatusCode::kUnavailable));
     EXPECT_EQ(first.calls, 1);
 
     release_first.Open();
     ASSERT_EQ(third_done_future.wait_for(kDeadlock), std::future_status::ready);
-    EXPECT_TRUE(absl::IsUnavailable(scheduler.Submit(0, [&](const BuildSlot&, bool) { ++late_calls; })));
+    EXPECT_THAT(scheduler.Submit(0, [&](const BuildSlot&, bool) { ++late_calls; }),
+                StatusIs(absl::StatusCode::kUnavailable));
   }
   EXPECT_EQ(first.calls, 1);
   EXPECT_FALSE(first.draining) << "the running job finishes normally";
@@ -417,20 +421,20 @@ TEST(BuildSchedulerTest, StopWakesJobsWaitingForMemory) {
   {
     BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/2, /*memory_budget_bytes=*/100,
                              &recorder);
-    ASSERT_TRUE(scheduler
-                    .Submit(60, [&](const BuildSlot&, bool draining) {
-                      EXPECT_FALSE(draining);
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(60,
+                                 [&](const BuildSlot&, bool draining) {
+                                   EXPECT_FALSE(draining);
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
-    ASSERT_TRUE(scheduler
-                    .Submit(60, [&](const BuildSlot& slot, bool draining) {
-                      EXPECT_NE(slot.cuda_stream, nullptr);
-                      second_draining.set_value(draining);
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(60,
+                                 [&](const BuildSlot& slot, bool draining) {
+                                   EXPECT_NE(slot.cuda_stream, nullptr);
+                                   second_draining.set_value(draining);
+                                 }),
+                IsOk());
     scheduler.Stop();
     ASSERT_EQ(second_future.wait_for(kDeadlock), std::future_status::ready)
         << "a queued job must be drained without waiting for the running one";
@@ -448,16 +452,16 @@ TEST(BuildSchedulerTest, DestructorRunsEveryAcceptedJobOnce) {
   Gate first_started, release_first;
   {
     BuildScheduler scheduler({nullptr}, /*max_queue=*/kJobs, /*memory_budget_bytes=*/0, &recorder);
-    ASSERT_TRUE(scheduler
-                    .Submit(0, [&](const BuildSlot&, bool) {
-                      ++calls[0];
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(0,
+                                 [&](const BuildSlot&, bool) {
+                                   ++calls[0];
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
     for (int i = 1; i < kJobs; ++i) {
-      ASSERT_TRUE(scheduler.Submit(0, [&, i](const BuildSlot&, bool) { ++calls[static_cast<size_t>(i)]; }).ok());
+      ASSERT_THAT(scheduler.Submit(0, [&, i](const BuildSlot&, bool) { ++calls[static_cast<size_t>(i)]; }), IsOk());
     }
     release_first.Open();
   }
@@ -470,15 +474,15 @@ TEST(BuildSchedulerTest, ObserverSeesTheLoadRiseAndFall) {
   Gate first_started, release_first, second_done;
   {
     BuildScheduler scheduler({nullptr}, /*max_queue=*/1, /*memory_budget_bytes=*/1000, &recorder);
-    ASSERT_TRUE(scheduler
-                    .Submit(300, [&](const BuildSlot&, bool) {
-                      first_started.Open();
-                      release_first.Wait();
-                    })
-                    .ok());
+    ASSERT_THAT(scheduler.Submit(300,
+                                 [&](const BuildSlot&, bool) {
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
     ASSERT_TRUE(first_started.Wait());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 1 && l.admitted_bytes == 300; }));
-    ASSERT_TRUE(scheduler.Submit(200, [&](const BuildSlot&, bool) { second_done.Open(); }).ok());
+    ASSERT_THAT(scheduler.Submit(200, [&](const BuildSlot&, bool) { second_done.Open(); }), IsOk());
     ASSERT_TRUE(recorder.WaitFor(
         [](const Load& l) { return l.queued == 1 && l.running == 1 && l.admitted_bytes == 300; }));
     release_first.Open();

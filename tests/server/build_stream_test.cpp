@@ -18,9 +18,13 @@
 #include "core/io/point_set_handle.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
+
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 
 namespace v1 = galpha::v1;
 
@@ -63,13 +67,13 @@ uint64_t Bits(double value) {
 TEST(BuildStreamDecoderTest, DecodesHeaderAndChunks) {
   const std::vector<Point2> points = gen::Uniform(10, 1);
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(10, "ten points")).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(absl::MakeConstSpan(points).subspan(0, 4))).ok());
+  ASSERT_THAT(decoder.Add(Header(10, "ten points")), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(absl::MakeConstSpan(points).subspan(0, 4))), IsOk());
   EXPECT_EQ(decoder.points_received(), 4u);
-  ASSERT_TRUE(decoder.Add(Chunk(absl::MakeConstSpan(points).subspan(4))).ok());
+  ASSERT_THAT(decoder.Add(Chunk(absl::MakeConstSpan(points).subspan(4))), IsOk());
   EXPECT_EQ(decoder.points_received(), 10u);
   absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
-  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ASSERT_THAT(decoded, IsOk());
   EXPECT_EQ((*decoded)->header.name(), "ten points");
   EXPECT_EQ((*decoded)->header.expected_points(), 10u);
   EXPECT_EQ((*decoded)->points, points);
@@ -80,31 +84,31 @@ TEST(BuildStreamDecoderTest, DecodesHeaderAndChunks) {
 TEST(BuildStreamDecoderTest, HeaderMustComeFirst) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
   const absl::Status status = decoder.Add(Chunk(std::vector<double>{1.0, 2.0}));
-  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("header"), absl::string_view::npos) << status;
   EXPECT_EQ(decoder.points_received(), 0u);
 }
 
 TEST(BuildStreamDecoderTest, EmptyChunkBeforeHeaderIsRefused) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  EXPECT_TRUE(absl::IsInvalidArgument(decoder.Add(EmptyChunk())));
+  EXPECT_THAT(decoder.Add(EmptyChunk()), StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 TEST(BuildStreamDecoderTest, SecondHeaderIsRefused) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})).ok());
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})), IsOk());
   const absl::Status status = decoder.Add(Header(0));
-  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("second header"), absl::string_view::npos) << status;
 }
 
 TEST(BuildStreamDecoderTest, OddNumberOfDoublesIsRefused) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})).ok());
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})), IsOk());
   const absl::Status status = decoder.Add(Chunk(std::vector<double>{3.0, 4.0, 5.0}));
-  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(status.message().find("odd"), absl::string_view::npos) << status;
   EXPECT_EQ(decoder.points_received(), 1u) << "a refused chunk adds nothing";
 }
@@ -118,12 +122,12 @@ TEST(BuildStreamDecoderTest, NanNamesTheGlobalPointIndex) {
   // The NaN is the y of the 5th point (index 4) of the second chunk; the first chunk holds 3
   // points, so the point's index in the stream is 3 + 4 = 7.
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(3, 2))).ok());
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(3, 2))), IsOk());
   std::vector<Point2> second = gen::Uniform(6, 3);
   second[4].y = std::numeric_limits<double>::quiet_NaN();
   const absl::Status status = decoder.Add(Chunk(second));
-  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(NamesPoint(status.message(), 7)) << status;
   EXPECT_NE(status.message().find("NaN"), absl::string_view::npos) << status;
   EXPECT_NE(status.message().find(" y "), absl::string_view::npos) << status;
@@ -134,13 +138,13 @@ TEST(BuildStreamDecoderTest, InfinityNamesTheGlobalPointIndex) {
   for (const double bad : {std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()}) {
     SCOPED_TRACE(bad);
     BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-    ASSERT_TRUE(decoder.Add(Header(20)).ok());
-    ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(5, 4))).ok());
-    ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(2, 5))).ok());
+    ASSERT_THAT(decoder.Add(Header(20)), IsOk());
+    ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(5, 4))), IsOk());
+    ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(2, 5))), IsOk());
     std::vector<Point2> third = gen::Uniform(4, 6);
     third[0].x = bad;  // index 5 + 2 + 0 = 7
     const absl::Status status = decoder.Add(Chunk(third));
-    EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+    EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_TRUE(NamesPoint(status.message(), 7)) << status;
     EXPECT_NE(status.message().find("infinite"), absl::string_view::npos) << status;
     EXPECT_NE(status.message().find(" x "), absl::string_view::npos) << status;
@@ -149,23 +153,23 @@ TEST(BuildStreamDecoderTest, InfinityNamesTheGlobalPointIndex) {
 
 TEST(BuildStreamDecoderTest, NanInTheFirstPoint) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
   const absl::Status status =
       decoder.Add(Chunk(std::vector<double>{std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0, 1.0}));
-  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_TRUE(NamesPoint(status.message(), 0)) << status;
 }
 
 TEST(BuildStreamDecoderTest, MessageWithNeitherHeaderNorPointsIsRefused) {
   {
     BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-    EXPECT_TRUE(absl::IsInvalidArgument(decoder.Add(v1::BuildRequest())));
+    EXPECT_THAT(decoder.Add(v1::BuildRequest()), StatusIs(absl::StatusCode::kInvalidArgument));
   }
   {
     BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-    ASSERT_TRUE(decoder.Add(Header(0)).ok());
+    ASSERT_THAT(decoder.Add(Header(0)), IsOk());
     const absl::Status status = decoder.Add(v1::BuildRequest());
-    EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+    EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(status.message().find("neither"), absl::string_view::npos) << status;
   }
 }
@@ -175,65 +179,65 @@ TEST(BuildStreamDecoderTest, AnnouncedCountOverTheLimitIsRefusedAtTheHeader) {
   limits.max_points = 100;
   BuildStreamDecoder decoder(limits, nullptr);
   const absl::Status status = decoder.Add(Header(101));
-  EXPECT_TRUE(absl::IsResourceExhausted(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_NE(status.message().find("100"), absl::string_view::npos) << status;
 
   BuildStreamDecoder at_limit(limits, nullptr);
-  EXPECT_TRUE(at_limit.Add(Header(100)).ok());
+  EXPECT_THAT(at_limit.Add(Header(100)), IsOk());
 }
 
 TEST(BuildStreamDecoderTest, UnannouncedCountOverTheLimitIsRefusedAtTheChunk) {
   BuildStreamLimits limits;
   limits.max_points = 5;
   BuildStreamDecoder decoder(limits, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(3, 7))).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(2, 8))).ok()) << "exactly the limit is allowed";
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(3, 7))), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(2, 8))), IsOk()) << "exactly the limit is allowed";
   const absl::Status status = decoder.Add(Chunk(gen::Uniform(1, 9)));
-  EXPECT_TRUE(absl::IsResourceExhausted(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_EQ(decoder.points_received(), 5u);
 }
 
 TEST(BuildStreamDecoderTest, FewerPointsThanAnnouncedIsRefusedAtFinish) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(10)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(9, 10))).ok());
+  ASSERT_THAT(decoder.Add(Header(10)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(9, 10))), IsOk());
   const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
-  EXPECT_TRUE(absl::IsInvalidArgument(decoded.status())) << decoded.status();
+  EXPECT_THAT(decoded.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(decoded.status().message().find("9"), absl::string_view::npos) << decoded.status();
 }
 
 TEST(BuildStreamDecoderTest, MorePointsThanAnnouncedIsRefusedAtTheChunk) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(10)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(gen::Uniform(8, 11))).ok());
+  ASSERT_THAT(decoder.Add(Header(10)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(8, 11))), IsOk());
   const absl::Status status = decoder.Add(Chunk(gen::Uniform(3, 12)));
-  EXPECT_TRUE(absl::IsInvalidArgument(status)) << status;
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_EQ(decoder.points_received(), 8u);
 }
 
 TEST(BuildStreamDecoderTest, EmptyStreamIsRefused) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
   const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
-  EXPECT_TRUE(absl::IsInvalidArgument(decoded.status())) << decoded.status();
+  EXPECT_THAT(decoded.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(decoded.status().message().find("empty"), absl::string_view::npos) << decoded.status();
 }
 
 TEST(BuildStreamDecoderTest, HeaderWithZeroPointsIsAnEmptyPointSet) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
   const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
-  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ASSERT_THAT(decoded, IsOk());
   EXPECT_TRUE((*decoded)->points.empty());
   EXPECT_EQ((*decoded)->handle, PointSetHandle({}));
 }
 
 TEST(BuildStreamDecoderTest, NothingIsAcceptedAfterFinish) {
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(0)).ok());
-  ASSERT_TRUE(decoder.Finish().ok());
-  EXPECT_TRUE(absl::IsFailedPrecondition(decoder.Add(Chunk(std::vector<double>{1.0, 2.0}))));
-  EXPECT_TRUE(absl::IsFailedPrecondition(decoder.Finish().status()));
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Finish(), IsOk());
+  EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{1.0, 2.0})), StatusIs(absl::StatusCode::kFailedPrecondition));
+  EXPECT_THAT(decoder.Finish().status(), StatusIs(absl::StatusCode::kFailedPrecondition));
 }
 
 // Decodes `points` split at `cuts` (ascending point counts; a repeated cut is an empty chunk).
@@ -272,7 +276,7 @@ TEST(BuildStreamDecoderTest, HandleDoesNotDependOnTheSplit) {
       SCOPED_TRACE(absl::StrCat("announce ", announce, ", cuts ", cuts.size(), " first ", cuts.empty() ? 0 : cuts[0]));
       std::vector<Point2> decoded_points;
       const absl::StatusOr<std::string> handle = DecodeSplit(points, cuts, announce, &decoded_points);
-      ASSERT_TRUE(handle.ok()) << handle.status();
+      ASSERT_THAT(handle, IsOk());
       EXPECT_EQ(*handle, expected);
       EXPECT_EQ(decoded_points, points);
     }
@@ -282,7 +286,7 @@ TEST(BuildStreamDecoderTest, HandleDoesNotDependOnTheSplit) {
   for (size_t i = 1; i < points.size(); ++i) every.push_back(i);
   std::vector<Point2> decoded_points;
   const absl::StatusOr<std::string> handle = DecodeSplit(points, every, true, &decoded_points);
-  ASSERT_TRUE(handle.ok()) << handle.status();
+  ASSERT_THAT(handle, IsOk());
   EXPECT_EQ(*handle, expected);
 }
 
@@ -292,7 +296,8 @@ TEST(BuildStreamDecoderTest, DifferentPointsGiveDifferentHandles) {
   const absl::StatusOr<std::string> a = DecodeSplit(points, {}, false, &decoded_points);
   std::swap(points[0], points[1]);  // order matters: answers name points by index
   const absl::StatusOr<std::string> b = DecodeSplit(points, {}, false, &decoded_points);
-  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_THAT(a, IsOk());
+  ASSERT_THAT(b, IsOk());
   EXPECT_NE(*a, *b);
 }
 
@@ -310,11 +315,11 @@ TEST(BuildStreamDecoderTest, PointsAreDecodedBitForBit) {
                                            1.0 / 3.0,
                                            -12345.678901234567};
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_TRUE(decoder.Add(Header(coordinates.size() / 2)).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>(coordinates.begin(), coordinates.begin() + 4))).ok());
-  ASSERT_TRUE(decoder.Add(Chunk(std::vector<double>(coordinates.begin() + 4, coordinates.end()))).ok());
+  ASSERT_THAT(decoder.Add(Header(coordinates.size() / 2)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(std::vector<double>(coordinates.begin(), coordinates.begin() + 4))), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(std::vector<double>(coordinates.begin() + 4, coordinates.end()))), IsOk());
   const absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
-  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ASSERT_THAT(decoded, IsOk());
   const HostVector<Point2>& points = (*decoded)->points;
   ASSERT_EQ(points.size() * 2, coordinates.size());
   for (size_t i = 0; i < points.size(); ++i) {
@@ -354,19 +359,19 @@ TEST(InFlightBytesTest, ZeroLimitAdmitsEverything) {
 TEST(InFlightBytesTest, AnnouncedStreamOverTheLimitIsRefusedAndReleasePointsFreesTheBytes) {
   InFlightBytes in_flight(100 * sizeof(Point2));
   auto first = std::make_unique<BuildStreamDecoder>(BuildStreamLimits{}, &in_flight);
-  ASSERT_TRUE(first->Add(Header(60)).ok());
+  ASSERT_THAT(first->Add(Header(60)), IsOk());
   EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "the announced size is reserved up front";
 
   BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
   const absl::Status refused = second.Add(Header(60));
-  EXPECT_TRUE(absl::IsResourceExhausted(refused)) << refused;
+  EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2));
 
   const std::vector<Point2> points = gen::Uniform(60, 15);
-  ASSERT_TRUE(first->Add(Chunk(points)).ok());
+  ASSERT_THAT(first->Add(Chunk(points)), IsOk());
   EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "announced chunks reserve nothing more";
   const absl::StatusOr<DecodedBuild*> decoded = first->Finish();
-  ASSERT_TRUE(decoded.ok()) << decoded.status();
+  ASSERT_THAT(decoded, IsOk());
   EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "Finish keeps the reservation";
   first->ReleasePoints();
   EXPECT_EQ(in_flight.held(), 0u);
@@ -375,10 +380,10 @@ TEST(InFlightBytesTest, AnnouncedStreamOverTheLimitIsRefusedAndReleasePointsFree
   EXPECT_EQ(in_flight.held(), 0u) << "the destructor does not release twice";
 
   BuildStreamDecoder third(BuildStreamLimits{}, &in_flight);
-  ASSERT_TRUE(third.Add(Header(60)).ok());
-  ASSERT_TRUE(third.Add(Chunk(points)).ok());
+  ASSERT_THAT(third.Add(Header(60)), IsOk());
+  ASSERT_THAT(third.Add(Chunk(points)), IsOk());
   const absl::StatusOr<DecodedBuild*> third_decoded = third.Finish();
-  ASSERT_TRUE(third_decoded.ok()) << third_decoded.status();
+  ASSERT_THAT(third_decoded, IsOk());
   EXPECT_EQ((*third_decoded)->handle, PointSetHandle(points));
 }
 
@@ -386,38 +391,38 @@ TEST(InFlightBytesTest, DestructorFreesTheBytes) {
   InFlightBytes in_flight(100 * sizeof(Point2));
   {
     BuildStreamDecoder first(BuildStreamLimits{}, &in_flight);
-    ASSERT_TRUE(first.Add(Header(70)).ok());
-    ASSERT_TRUE(first.Add(Chunk(gen::Uniform(70, 16))).ok());
-    ASSERT_TRUE(first.Finish().ok());
+    ASSERT_THAT(first.Add(Header(70)), IsOk());
+    ASSERT_THAT(first.Add(Chunk(gen::Uniform(70, 16))), IsOk());
+    ASSERT_THAT(first.Finish(), IsOk());
     BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
-    EXPECT_TRUE(absl::IsResourceExhausted(second.Add(Header(70))));
+    EXPECT_THAT(second.Add(Header(70)), StatusIs(absl::StatusCode::kResourceExhausted));
     EXPECT_EQ(in_flight.held(), 70 * sizeof(Point2));
   }
   EXPECT_EQ(in_flight.held(), 0u);
   BuildStreamDecoder third(BuildStreamLimits{}, &in_flight);
-  EXPECT_TRUE(third.Add(Header(70)).ok());
+  EXPECT_THAT(third.Add(Header(70)), IsOk());
 }
 
 TEST(InFlightBytesTest, UnannouncedChunksReserveAsTheyArrive) {
   InFlightBytes in_flight(100 * sizeof(Point2));
   BuildStreamDecoder first(BuildStreamLimits{}, &in_flight);
-  ASSERT_TRUE(first.Add(Header(0)).ok());
+  ASSERT_THAT(first.Add(Header(0)), IsOk());
   EXPECT_EQ(in_flight.held(), 0u);
-  ASSERT_TRUE(first.Add(Chunk(gen::Uniform(30, 17))).ok());
+  ASSERT_THAT(first.Add(Chunk(gen::Uniform(30, 17))), IsOk());
   EXPECT_EQ(in_flight.held(), 30 * sizeof(Point2));
-  ASSERT_TRUE(first.Add(Chunk(gen::Uniform(30, 18))).ok());
+  ASSERT_THAT(first.Add(Chunk(gen::Uniform(30, 18))), IsOk());
   EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2));
 
   BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
-  ASSERT_TRUE(second.Add(Header(0)).ok());
-  ASSERT_TRUE(second.Add(Chunk(gen::Uniform(40, 19))).ok()) << "exactly the limit";
+  ASSERT_THAT(second.Add(Header(0)), IsOk());
+  ASSERT_THAT(second.Add(Chunk(gen::Uniform(40, 19))), IsOk()) << "exactly the limit";
   const absl::Status refused = second.Add(Chunk(gen::Uniform(1, 20)));
-  EXPECT_TRUE(absl::IsResourceExhausted(refused)) << refused;
+  EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_EQ(in_flight.held(), 100 * sizeof(Point2));
 
   first.ReleasePoints();
   EXPECT_EQ(in_flight.held(), 40 * sizeof(Point2));
-  EXPECT_TRUE(second.Add(Chunk(gen::Uniform(1, 20))).ok()) << "the released bytes are available again";
+  EXPECT_THAT(second.Add(Chunk(gen::Uniform(1, 20))), IsOk()) << "the released bytes are available again";
   EXPECT_EQ(second.points_received(), 41u);
   second.ReleasePoints();
   EXPECT_EQ(in_flight.held(), 0u);

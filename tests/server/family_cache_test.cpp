@@ -19,9 +19,13 @@
 #include "server/cached_family.hpp"
 #include "tests/server/cached_family_fixture.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
+
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 
 std::shared_ptr<const CachedFamily> MakeFamily(const std::vector<Point2>& points, const std::string& name) {
   return testing::MakeCachedFamily(points, name);
@@ -77,7 +81,7 @@ TEST_F(FamilyCacheTest, FindCountsMissesAndHits) {
 
   EXPECT_EQ(cache.Find("", "h-a"), nullptr);
   auto inserted = cache.Insert("", "h-a", a_);
-  ASSERT_TRUE(inserted.ok()) << inserted.status();
+  ASSERT_THAT(inserted, IsOk());
   EXPECT_EQ(inserted->get(), a_.get());
   EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
   EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
@@ -95,10 +99,10 @@ TEST_F(FamilyCacheTest, FindCountsMissesAndHits) {
 TEST_F(FamilyCacheTest, EvictsTheLeastRecentlyUsed) {
   RecordingObserver observer;
   FamilyCache cache(two_fit_, &observer);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
   EXPECT_EQ(cache.GetStats().entries, 2u);
-  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
 
   const FamilyCache::Stats stats = cache.GetStats();
   EXPECT_EQ(stats.evictions, 1u);
@@ -114,10 +118,10 @@ TEST_F(FamilyCacheTest, EvictsTheLeastRecentlyUsed) {
 TEST_F(FamilyCacheTest, FindMakesAFamilyTheMostRecentlyUsed) {
   RecordingObserver observer;
   FamilyCache cache(two_fit_, &observer);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
   ASSERT_EQ(cache.Find("", "h-a").get(), a_.get());  // now b is the least recently used
-  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
 
   EXPECT_EQ(cache.GetStats().evictions, 1u);
   EXPECT_EQ(cache.GetStats().bytes, a_->bytes() + c_->bytes());
@@ -129,11 +133,11 @@ TEST_F(FamilyCacheTest, FindMakesAFamilyTheMostRecentlyUsed) {
 
 TEST_F(FamilyCacheTest, ReinsertMakesAFamilyTheMostRecentlyUsed) {
   FamilyCache cache(two_fit_, nullptr);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());  // an existing key is touched, not added
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());  // an existing key is touched, not added
   EXPECT_EQ(cache.GetStats().entries, 2u);
-  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
   EXPECT_EQ(cache.Find("", "h-b"), nullptr);
   EXPECT_NE(cache.Find("", "h-a"), nullptr);
 }
@@ -145,9 +149,9 @@ TEST_F(FamilyCacheTest, EvictsAsManyAsNeeded) {
   ASSERT_LT(budget, b_->bytes() + c_->bytes());
   RecordingObserver observer;
   FamilyCache cache(budget, &observer);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
   EXPECT_EQ(cache.GetStats().evictions, 2u);
   EXPECT_EQ(cache.GetStats().entries, 1u);
   EXPECT_EQ(cache.GetStats().bytes, c_->bytes());
@@ -157,9 +161,9 @@ TEST_F(FamilyCacheTest, EvictsAsManyAsNeeded) {
 TEST_F(FamilyCacheTest, FamilyLargerThanTheBudgetIsRefused) {
   RecordingObserver observer;
   FamilyCache cache(c_->bytes() - 1, &observer);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
   const auto refused = cache.Insert("", "h-c", c_);
-  EXPECT_TRUE(absl::IsResourceExhausted(refused.status())) << refused.status();
+  EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kResourceExhausted));
   const FamilyCache::Stats stats = cache.GetStats();
   EXPECT_EQ(stats.evictions, 0u) << "a refused family evicts nothing";
   EXPECT_EQ(stats.entries, 1u);
@@ -169,18 +173,18 @@ TEST_F(FamilyCacheTest, FamilyLargerThanTheBudgetIsRefused) {
   ExpectObserverAgrees(observer, cache);
 
   FamilyCache exact(c_->bytes(), nullptr);
-  EXPECT_TRUE(exact.Insert("", "h-c", c_).ok()) << "a family exactly the budget fits";
+  EXPECT_THAT(exact.Insert("", "h-c", c_), IsOk()) << "a family exactly the budget fits";
 }
 
 TEST_F(FamilyCacheTest, TenantsAreIsolated) {
   FamilyCache cache(size_t{1} << 30, nullptr);
-  ASSERT_TRUE(cache.Insert("alice", "h", a_).ok());
+  ASSERT_THAT(cache.Insert("alice", "h", a_), IsOk());
   EXPECT_EQ(cache.Find("bob", "h"), nullptr);
   EXPECT_EQ(cache.Find("", "h"), nullptr);
   EXPECT_EQ(cache.Find("alice", "h").get(), a_.get());
 
   const auto bobs = cache.Insert("bob", "h", b_);
-  ASSERT_TRUE(bobs.ok());
+  ASSERT_THAT(bobs, IsOk());
   EXPECT_EQ(bobs->get(), b_.get()) << "the same handle under another tenant is another entry";
   EXPECT_EQ(cache.GetStats().entries, 2u);
   EXPECT_EQ(cache.GetStats().bytes, a_->bytes() + b_->bytes());
@@ -195,7 +199,7 @@ TEST_F(FamilyCacheTest, TenantsAreIsolated) {
 TEST_F(FamilyCacheTest, TenantAndHandleDoNotRunTogether) {
   // A key built by plain concatenation would confuse ("ab", "c") with ("a", "bc").
   FamilyCache cache(size_t{1} << 30, nullptr);
-  ASSERT_TRUE(cache.Insert("ab", "c", a_).ok());
+  ASSERT_THAT(cache.Insert("ab", "c", a_), IsOk());
   EXPECT_EQ(cache.Find("a", "bc"), nullptr);
   EXPECT_EQ(cache.Find("abc", ""), nullptr);
 }
@@ -204,13 +208,13 @@ TEST_F(FamilyCacheTest, InsertOfAnExistingKeyReturnsTheCachedFamily) {
   RecordingObserver observer;
   FamilyCache cache(size_t{1} << 30, &observer);
   const auto first = cache.Insert("", "h", a_);
-  ASSERT_TRUE(first.ok());
+  ASSERT_THAT(first, IsOk());
   // A second build of the same points races with the first: its family is another object.
   const std::shared_ptr<const CachedFamily> again = MakeFamily(gen::Uniform(40, 1), "a again");
   ASSERT_NE(again, nullptr);
   ASSERT_NE(again.get(), a_.get());
   const auto second = cache.Insert("", "h", again);
-  ASSERT_TRUE(second.ok());
+  ASSERT_THAT(second, IsOk());
   EXPECT_EQ(second->get(), a_.get());
   EXPECT_EQ(cache.Find("", "h").get(), a_.get());
   EXPECT_EQ(cache.GetStats().entries, 1u);
@@ -221,8 +225,8 @@ TEST_F(FamilyCacheTest, InsertOfAnExistingKeyReturnsTheCachedFamily) {
 TEST_F(FamilyCacheTest, Erase) {
   RecordingObserver observer;
   FamilyCache cache(size_t{1} << 30, &observer);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
   EXPECT_FALSE(cache.Erase("", "h-c"));
   EXPECT_FALSE(cache.Erase("other", "h-a"));
   EXPECT_TRUE(cache.Erase("", "h-a"));
@@ -240,7 +244,7 @@ TEST_F(FamilyCacheTest, Erase) {
   EXPECT_EQ(cache.GetStats().bytes, 0u);
   EXPECT_EQ(cache.GetStats().entries, 0u);
   ExpectObserverAgrees(observer, cache);
-  ASSERT_TRUE(cache.Insert("", "h-a", a_).ok()) << "an erased key can be cached again";
+  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk()) << "an erased key can be cached again";
   EXPECT_EQ(cache.Find("", "h-a").get(), a_.get());
 }
 
@@ -252,7 +256,7 @@ TEST_F(FamilyCacheTest, StatsAndObserverAgreeThroughAMixedSequence) {
     for (size_t i = 0; i < families.size(); ++i) {
       const std::string handle = absl::StrCat("h", i);
       if (cache.Find("", handle) == nullptr) {
-        ASSERT_TRUE(cache.Insert("", handle, families[i]).ok());
+        ASSERT_THAT(cache.Insert("", handle, families[i]), IsOk());
       }
       ExpectObserverAgrees(observer, cache);
       EXPECT_LE(cache.GetStats().bytes, cache.byte_budget());
@@ -268,13 +272,13 @@ TEST_F(FamilyCacheTest, StatsAndObserverAgreeThroughAMixedSequence) {
 
 TEST_F(FamilyCacheTest, FamilyHeldByACallerOutlivesItsEviction) {
   FamilyCache cache(two_fit_, nullptr);
-  ASSERT_TRUE(cache.Insert("", "h-a", MakeFamily(gen::Uniform(40, 1), "held")).ok());
+  ASSERT_THAT(cache.Insert("", "h-a", MakeFamily(gen::Uniform(40, 1), "held")), IsOk());
   std::shared_ptr<const CachedFamily> held = cache.Find("", "h-a");
   ASSERT_NE(held, nullptr);
   const size_t points = held->family().points().size();
   const size_t triangles = held->family().triangles().size();
-  ASSERT_TRUE(cache.Insert("", "h-b", b_).ok());
-  ASSERT_TRUE(cache.Insert("", "h-c", c_).ok());
+  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
+  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
   ASSERT_EQ(cache.Find("", "h-a"), nullptr) << "evicted";
   EXPECT_EQ(held.use_count(), 1) << "the caller's reference is the only one left";
   EXPECT_EQ(held->name(), "held");

@@ -24,14 +24,18 @@
 #include "service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/server_process.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
 using galpha::testing::ServerProcess;
 using galpha::testing::SpawnShell;
+using galpha::testing::StatusIs;
 using galpha::testing::WaitChild;
+using ::testing::Not;
 using testing::WaitFor;
 
 std::unique_ptr<client::AlphaClient> ClientOf(const ServerProcess& server) {
@@ -72,12 +76,12 @@ size_t WarmBaseline(const ServerProcess& server) {
   auto client = ClientOf(server);
   const auto points = gen::Uniform(300000, 77);
   auto built = client->Build(points, Upload());
-  EXPECT_TRUE(built.ok()) << built.status();
+  EXPECT_THAT(built, IsOk());
   v1::ClassifyRequest classify;
   classify.set_handle(PointSetHandle(points));
   classify.mutable_threshold()->set_rank(1);
-  EXPECT_TRUE(client->Classify(classify, [](const v1::ClassifyResponse&) { return absl::OkStatus(); }).ok());
-  EXPECT_TRUE(client->Release(PointSetHandle(points)).ok());
+  EXPECT_THAT(client->Classify(classify, [](const v1::ClassifyResponse&) { return absl::OkStatus(); }), IsOk());
+  EXPECT_THAT(client->Release(PointSetHandle(points)), IsOk());
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   return server.ResidentBytes();
 }
@@ -94,9 +98,9 @@ TEST(FaultTest, SigtermDuringABuildFinishesItAndRefusesNewWork) {
   auto other = ClientOf(server);
   EXPECT_TRUE(WaitFor([&] { return testing::HealthOf(other->channel(), "") == "NOT_SERVING"; }, 1.0));
   const auto refused = other->Build(gen::Uniform(100, 2), Upload());
-  EXPECT_TRUE(absl::IsUnavailable(refused.status())) << refused.status();
+  EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kUnavailable));
   builder.join();
-  EXPECT_TRUE(running.ok()) << "the build running at SIGTERM must finish: " << running.status();
+  EXPECT_THAT(running, IsOk()) << "the build running at SIGTERM must finish";
   const int status = server.Signal(0, 90);
   EXPECT_EQ(status, 0) << server.log();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -113,7 +117,7 @@ TEST(FaultTest, SigtermWithAShortGraceCancelsTheBuildCleanly) {
   const int status = server.Signal(SIGTERM, 60);
   builder.join();
   EXPECT_EQ(status, 0) << server.log();
-  EXPECT_FALSE(running.ok()) << "a build cut by the grace period fails; it does not hang";
+  EXPECT_THAT(running, Not(IsOk())) << "a build cut by the grace period fails; it does not hang";
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   // The build stops at its next phase boundary, so the exit may pass the grace by one phase.
   EXPECT_LT(seconds, 30.0) << server.log();
@@ -174,7 +178,7 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
     std::unique_lock<std::mutex> lock(mutex);
     ASSERT_TRUE(done.wait_for(lock, std::chrono::seconds(30), [&] { return finished; }));
   }
-  EXPECT_FALSE(garbage_status.ok());
+  EXPECT_FALSE(garbage_status.ok());  // a grpc::Status
   {
     grpc::ClientContext big_context;
     v1::BuildResponse big_response;
@@ -191,7 +195,7 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
 
   // Still serving, and back to the baseline once everything is released.
   EXPECT_EQ(testing::HealthOf(client->channel(), "galpha.v1.AlphaShapes"), "SERVING");
-  for (const auto& input : inputs) ASSERT_TRUE(client->Release(PointSetHandle(input)).ok());
+  for (const auto& input : inputs) ASSERT_THAT(client->Release(PointSetHandle(input)), IsOk());
   ExpectBackToBaseline(server, baseline);
 }
 
@@ -202,7 +206,7 @@ TEST(FaultTest, ASlowReaderDoesNotHoldUpOthers) {
   auto client = ClientOf(server);
   const auto points = gen::Uniform(300000, 9);
   auto built = client->Build(points, Upload());
-  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_THAT(built, IsOk());
 
   // About 15 messages of ~1 MB, read one per 300 ms: the stream lasts seconds, and the server
   // holds one message for it at a time.
@@ -212,11 +216,11 @@ TEST(FaultTest, ASlowReaderDoesNotHoldUpOthers) {
   ASSERT_TRUE(WaitFor([&] { return std::filesystem::exists(log) && std::filesystem::file_size(log) > 0; }, 30));
   for (int i = 0; i < 20; ++i) {
     const auto start = std::chrono::steady_clock::now();
-    ASSERT_TRUE(client->Describe(built->handle).ok());
+    ASSERT_THAT(client->Describe(built->handle), IsOk());
     v1::ComponentsRequest components;
     components.set_handle(built->handle);
     components.mutable_threshold()->set_rank(i);
-    ASSERT_TRUE(client->Components(components).ok());
+    ASSERT_THAT(client->Components(components), IsOk());
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 2.0);
   }
   EXPECT_TRUE(std::filesystem::exists(log));
@@ -224,7 +228,7 @@ TEST(FaultTest, ASlowReaderDoesNotHoldUpOthers) {
   kill(reader, SIGKILL);
   WaitChild(reader, 10);
   std::filesystem::remove(log);
-  ASSERT_TRUE(client->Release(built->handle).ok());
+  ASSERT_THAT(client->Release(built->handle), IsOk());
   EXPECT_EQ(testing::HealthOf(client->channel(), "galpha.v1.AlphaShapes"), "SERVING");
   ExpectBackToBaseline(server, baseline);
 }

@@ -15,11 +15,14 @@
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Drain;
 using testing::Families;
 using testing::LargeFamily;
@@ -96,7 +99,7 @@ void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::
   SCOPED_TRACE(request.ShortDebugString());
   const AlphaFamily& family = cached->family();
   auto source = MakeClassifySource(cached, request);
-  ASSERT_TRUE(source.ok()) << source.status();
+  ASSERT_THAT(source, IsOk());
   const std::vector<v1::ClassifyResponse> messages = Drain(**source);
   ASSERT_FALSE(messages.empty());
 
@@ -114,7 +117,7 @@ void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::
   EXPECT_EQ(summary.components(), family.Components(level));
   EXPECT_EQ(summary.solid_components(), family.SolidComponents(level));
   const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, mode));
-  ASSERT_TRUE(shape.ok()) << shape.status();
+  ASSERT_THAT(shape, IsOk());
   EXPECT_EQ(summary.interior_area(), shape->area) << "the interior area is the shape's area";
 
   if (request.summary_only()) {
@@ -192,7 +195,8 @@ TEST(QueryAnswersTest, ClassifyNonExteriorOnlyDropsExactlyTheExterior) {
   auto all = MakeClassifySource(cached, request);
   request.set_non_exterior_only(true);
   auto some = MakeClassifySource(cached, request);
-  ASSERT_TRUE(all.ok() && some.ok());
+  ASSERT_THAT(all, IsOk());
+  ASSERT_THAT(some, IsOk());
   const auto all_messages = Drain(**all);
   const auto some_messages = Drain(**some);
   size_t all_sent = 0, exterior = 0, some_sent = 0;
@@ -231,9 +235,9 @@ TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
   const std::shared_ptr<const CachedFamily>& cached = Families()[0].cached;
   ASSERT_NE(cached, nullptr);
   v1::ClassifyRequest request;
-  EXPECT_TRUE(absl::IsInvalidArgument(MakeClassifySource(cached, request).status()));
+  EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   *request.mutable_threshold() = Rank(cached->family().max_level() + 1);
-  EXPECT_TRUE(absl::IsInvalidArgument(MakeClassifySource(cached, request).status()));
+  EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 TEST(QueryAnswersTest, ClassifyChunksNeverExceedTheLimit) {

@@ -11,11 +11,14 @@
 #include "absl/strings/str_cat.h"
 #include "gtest/gtest.h"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Families;
 using testing::NamedFamily;
 using testing::Rank;
@@ -34,7 +37,7 @@ TEST(QueryAnswersTest, ComponentsAtAThresholdAndOverARange) {
       v1::ComponentsRequest request;
       *request.mutable_threshold() = threshold;
       const absl::StatusOr<v1::ComponentsResponse> response = AnswerComponents(family, request);
-      ASSERT_TRUE(response.ok()) << response.status();
+      ASSERT_THAT(response, IsOk());
       const int64_t level = ResolveLevel(family, threshold)->level;
       EXPECT_EQ(response->first_level(), level);
       ASSERT_EQ(response->components_size(), 1);
@@ -49,7 +52,7 @@ TEST(QueryAnswersTest, ComponentsAtAThresholdAndOverARange) {
       request.mutable_ranks()->set_first(first);
       request.mutable_ranks()->set_last(last);
       const absl::StatusOr<v1::ComponentsResponse> response = AnswerComponents(family, request);
-      ASSERT_TRUE(response.ok()) << response.status();
+      ASSERT_THAT(response, IsOk());
       EXPECT_EQ(response->first_level(), first);
       ASSERT_EQ(response->components_size(), last - first + 1);
       ASSERT_EQ(response->solid_components_size(), last - first + 1);
@@ -68,7 +71,8 @@ TEST(QueryAnswersTest, ComponentsRefusesBadRequests) {
     ASSERT_NE(f.cached, nullptr);
     const AlphaFamily& family = f.cached->family();
     const int64_t k = family.max_level();
-    EXPECT_TRUE(absl::IsInvalidArgument(AnswerComponents(family, v1::ComponentsRequest()).status()));
+    EXPECT_THAT(AnswerComponents(family, v1::ComponentsRequest()).status(),
+                StatusIs(absl::StatusCode::kInvalidArgument));
     const std::vector<std::pair<int64_t, int64_t>> bad = {{-1, 0}, {0, k + 1}, {1, 0}, {k + 1, k + 1}, {-5, -1}};
     for (const auto& [first, last] : bad) {
       SCOPED_TRACE(absl::StrCat(first, "..", last));
@@ -76,14 +80,14 @@ TEST(QueryAnswersTest, ComponentsRefusesBadRequests) {
       request.mutable_ranks()->set_first(first);
       request.mutable_ranks()->set_last(last);
       const auto response = AnswerComponents(family, request);
-      EXPECT_TRUE(absl::IsInvalidArgument(response.status())) << response.status();
+      EXPECT_THAT(response.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     }
     v1::ComponentsRequest beyond;
     *beyond.mutable_threshold() = Rank(k + 1);
-    EXPECT_TRUE(absl::IsInvalidArgument(AnswerComponents(family, beyond).status()));
+    EXPECT_THAT(AnswerComponents(family, beyond).status(), StatusIs(absl::StatusCode::kInvalidArgument));
     v1::ComponentsRequest no_value;
     no_value.mutable_threshold();  // a threshold with none of its three values
-    EXPECT_TRUE(absl::IsInvalidArgument(AnswerComponents(family, no_value).status()));
+    EXPECT_THAT(AnswerComponents(family, no_value).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 
@@ -97,7 +101,7 @@ TEST(QueryAnswersTest, OptimalAlphaMatchesTheFamily) {
       v1::OptimalAlphaRequest request;
       request.set_max_components(n);
       const absl::StatusOr<v1::OptimalAlphaResponse> response = AnswerOptimalAlpha(family, request);
-      ASSERT_TRUE(response.ok()) << response.status();
+      ASSERT_THAT(response, IsOk());
       const auto published = [&](int64_t level) {
         return level == 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
       };
@@ -119,7 +123,7 @@ TEST(QueryAnswersTest, OptimalAlphaMatchesTheFamily) {
       }
     }
     const auto refused = AnswerOptimalAlpha(family, v1::OptimalAlphaRequest());
-    EXPECT_TRUE(absl::IsInvalidArgument(refused.status())) << refused.status();
+    EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 

@@ -9,11 +9,14 @@
 #include "absl/strings/str_cat.h"
 #include "gtest/gtest.h"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Alpha;
 using testing::AlphaSq;
 using testing::Families;
@@ -31,14 +34,14 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
     const int64_t k = family.max_level();
     for (int64_t rank = 0; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
       const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(family, Rank(rank));
-      ASSERT_TRUE(resolved.ok()) << resolved.status();
+      ASSERT_THAT(resolved, IsOk());
       EXPECT_EQ(resolved->level, *family.LevelForRank(rank));
       EXPECT_EQ(resolved->alpha_sq, rank == 0 ? 0.0 : family.spectrum()[static_cast<size_t>(rank - 1)]);
     }
     for (const v1::Threshold& threshold : Thresholds(family)) {
       SCOPED_TRACE(threshold.ShortDebugString());
       const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(family, threshold);
-      ASSERT_TRUE(resolved.ok()) << resolved.status();
+      ASSERT_THAT(resolved, IsOk());
       switch (threshold.value_case()) {
         case v1::Threshold::kRank:
           EXPECT_EQ(resolved->level, *family.LevelForRank(threshold.rank()));
@@ -59,7 +62,7 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
     for (int64_t rank = 1; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
       const absl::StatusOr<ResolvedLevel> resolved =
           ResolveLevel(family, AlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
-      ASSERT_TRUE(resolved.ok());
+      ASSERT_THAT(resolved, IsOk());
       EXPECT_EQ(resolved->level, *family.LevelForAlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
     }
   }
@@ -72,14 +75,14 @@ TEST(QueryAnswersTest, ResolveLevelRefusesBadThresholds) {
     const AlphaFamily& family = f.cached->family();
     const int64_t k = family.max_level();
     const absl::StatusOr<ResolvedLevel> none = ResolveLevel(family, v1::Threshold());
-    EXPECT_TRUE(absl::IsInvalidArgument(none.status())) << none.status();
+    EXPECT_THAT(none.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     const absl::StatusOr<ResolvedLevel> beyond = ResolveLevel(family, Rank(k + 1));
-    EXPECT_TRUE(absl::IsInvalidArgument(beyond.status())) << beyond.status();
+    EXPECT_THAT(beyond.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(beyond.status().message().find(absl::StrCat(k + 1)), absl::string_view::npos) << beyond.status();
-    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, Rank(-1)).status()));
-    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, AlphaSq(std::nan(""))).status()));
-    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, Alpha(std::nan(""))).status()));
-    EXPECT_TRUE(absl::IsInvalidArgument(ResolveLevel(family, Alpha(-1.0)).status()));
+    EXPECT_THAT(ResolveLevel(family, Rank(-1)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(family, AlphaSq(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(family, Alpha(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(family, Alpha(-1.0)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 

@@ -13,11 +13,14 @@
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Drain;
 using testing::Families;
 using testing::LargeFamily;
@@ -59,7 +62,7 @@ void CheckMasterList(const std::shared_ptr<const CachedFamily>& cached, int64_t 
   request.set_first_rank(first);
   request.set_last_rank(last_field);
   auto source = MakeMasterListSource(cached, request);
-  ASSERT_TRUE(source.ok()) << source.status();
+  ASSERT_THAT(source, IsOk());
   std::vector<StreamedEntry> streamed;
   const std::vector<v1::MasterListResponse> messages = Drain(**source);
   for (const v1::MasterListResponse& message : messages) {
@@ -130,7 +133,7 @@ TEST(QueryAnswersTest, MasterListRefusesBadRanges) {
       request.set_first_rank(first);
       request.set_last_rank(last);
       const auto source = MakeMasterListSource(f.cached, request);
-      EXPECT_TRUE(absl::IsInvalidArgument(source.status())) << source.status();
+      EXPECT_THAT(source.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     }
   }
 }
@@ -146,7 +149,7 @@ TEST(QueryAnswersTest, MasterListOfAnEmptySpectrumIsRefused) {
       v1::MasterListRequest request;
       request.set_first_rank(first);
       const auto source = MakeMasterListSource(f.cached, request);
-      EXPECT_TRUE(absl::IsInvalidArgument(source.status())) << source.status();
+      EXPECT_THAT(source.status(), StatusIs(absl::StatusCode::kInvalidArgument));
       EXPECT_NE(source.status().message().find("empty"), absl::string_view::npos) << source.status();
     }
   }

@@ -14,11 +14,14 @@
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Drain;
 using testing::Families;
 using testing::LargeFamily;
@@ -38,7 +41,7 @@ TEST(QueryAnswersTest, ShapeTextFormatsMatchTheWriters) {
         SCOPED_TRACE(absl::StrCat(threshold.ShortDebugString(), " mode ", mode));
         const int64_t level = ResolveLevel(family, threshold)->level;
         const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, ToClassifyMode(mode)));
-        ASSERT_TRUE(shape.ok()) << shape.status();
+        ASSERT_THAT(shape, IsOk());
         const std::pair<v1::ShapeFormat, std::string> formats[] = {
             {v1::SHAPE_FORMAT_GEOJSON, ShapeToGeoJson(*shape, family.points())},
             {v1::SHAPE_FORMAT_WKT, ShapeToWkt(*shape, family.points())},
@@ -51,7 +54,7 @@ TEST(QueryAnswersTest, ShapeTextFormatsMatchTheWriters) {
           request.set_mode(mode);
           request.set_format(format);
           auto source = MakeShapeSource(f.cached, request);
-          ASSERT_TRUE(source.ok()) << source.status();
+          ASSERT_THAT(source, IsOk());
           std::string text;
           for (const v1::ShapeResponse& piece : Drain(**source)) {
             ASSERT_EQ(piece.part_case(), v1::ShapeResponse::kText);
@@ -75,11 +78,11 @@ TEST(QueryAnswersTest, ShapeTextOfALargeFamilySpansSeveralPieces) {
   request.set_format(v1::SHAPE_FORMAT_GEOJSON);
   const absl::StatusOr<ShapeGeometry> shape =
       AssembleShape(family.ComplexAt(ResolveLevel(family, request.threshold())->level, ClassifyMode::kGeneral));
-  ASSERT_TRUE(shape.ok()) << shape.status();
+  ASSERT_THAT(shape, IsOk());
   const std::string expected = ShapeToGeoJson(*shape, family.points());
   ASSERT_GT(expected.size(), kShapeTextBytesPerChunk) << "the test needs a text of several pieces";
   auto source = MakeShapeSource(cached, request);
-  ASSERT_TRUE(source.ok()) << source.status();
+  ASSERT_THAT(source, IsOk());
   const std::vector<v1::ShapeResponse> pieces = Drain(**source);
   EXPECT_EQ(pieces.size(), (expected.size() + kShapeTextBytesPerChunk - 1) / kShapeTextBytesPerChunk);
   std::string text;
@@ -146,13 +149,13 @@ TEST(QueryAnswersTest, ShapeRingsReproduceTheGeometry) {
         SCOPED_TRACE(absl::StrCat(threshold.ShortDebugString(), " mode ", mode));
         const int64_t level = ResolveLevel(family, threshold)->level;
         const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, ToClassifyMode(mode)));
-        ASSERT_TRUE(shape.ok()) << shape.status();
+        ASSERT_THAT(shape, IsOk());
         v1::ShapeRequest request;
         *request.mutable_threshold() = threshold;
         request.set_mode(mode);
         request.set_format(v1::SHAPE_FORMAT_RINGS);
         auto source = MakeShapeSource(f.cached, request);
-        ASSERT_TRUE(source.ok()) << source.status();
+        ASSERT_THAT(source, IsOk());
         const std::vector<v1::ShapeResponse> pieces = Drain(**source);
         ASSERT_GE(pieces.size(), 1u) << "even an empty shape sends its area";
         ExpectSameGeometry(JoinRings(pieces), *shape);
@@ -178,9 +181,9 @@ TEST(QueryAnswersTest, ShapeRingsOfALargeFamily) {
     *request.mutable_threshold() = Rank(rank);
     request.set_format(v1::SHAPE_FORMAT_RINGS);
     const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(rank, ClassifyMode::kGeneral));
-    ASSERT_TRUE(shape.ok()) << shape.status();
+    ASSERT_THAT(shape, IsOk());
     auto source = MakeShapeSource(cached, request);
-    ASSERT_TRUE(source.ok()) << source.status();
+    ASSERT_THAT(source, IsOk());
     ExpectSameGeometry(JoinRings(Drain(**source)), *shape);
   }
 }
@@ -191,16 +194,16 @@ TEST(QueryAnswersTest, ShapeRefusesBadRequests) {
   v1::ShapeRequest request;
   *request.mutable_threshold() = Rank(1);
   const auto unspecified = MakeShapeSource(cached, request);
-  EXPECT_TRUE(absl::IsInvalidArgument(unspecified.status())) << unspecified.status();
+  EXPECT_THAT(unspecified.status(), StatusIs(absl::StatusCode::kInvalidArgument));
 
   request.set_format(v1::SHAPE_FORMAT_WKT);
   request.clear_threshold();
-  EXPECT_TRUE(absl::IsInvalidArgument(MakeShapeSource(cached, request).status()));
+  EXPECT_THAT(MakeShapeSource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   *request.mutable_threshold() = Rank(cached->family().max_level() + 1);
-  EXPECT_TRUE(absl::IsInvalidArgument(MakeShapeSource(cached, request).status()));
+  EXPECT_THAT(MakeShapeSource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   request.set_format(static_cast<v1::ShapeFormat>(99));
   *request.mutable_threshold() = Rank(1);
-  EXPECT_TRUE(absl::IsInvalidArgument(MakeShapeSource(cached, request).status()));
+  EXPECT_THAT(MakeShapeSource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 }  // namespace

@@ -10,11 +10,14 @@
 
 #include "gtest/gtest.h"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Families;
 using testing::NamedFamily;
 
@@ -35,7 +38,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
       for (int pages = 0;; ++pages) {
         ASSERT_LT(pages, 100000) << "next_rank never reaches 0";
         const absl::StatusOr<v1::SpectrumResponse> page = AnswerSpectrum(family, request);
-        ASSERT_TRUE(page.ok()) << page.status();
+        ASSERT_THAT(page, IsOk());
         EXPECT_EQ(page->first_rank(), request.first_rank());
         EXPECT_EQ(page->spectrum_size(), k);
         const int64_t size = page->alpha_sq_size();
@@ -53,7 +56,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
     }
     // Without a start: from rank 1, 65536 values per page.
     const absl::StatusOr<v1::SpectrumResponse> whole = AnswerSpectrum(family, v1::SpectrumRequest());
-    ASSERT_TRUE(whole.ok()) << whole.status();
+    ASSERT_THAT(whole, IsOk());
     EXPECT_EQ(whole->first_rank(), 1);
     EXPECT_EQ(std::vector<double>(whole->alpha_sq().begin(), whole->alpha_sq().end()), family.spectrum());
     EXPECT_EQ(whole->next_rank(), 0);
@@ -61,7 +64,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
     v1::SpectrumRequest past;
     past.set_first_rank(k + 1);
     const absl::StatusOr<v1::SpectrumResponse> empty = AnswerSpectrum(family, past);
-    ASSERT_TRUE(empty.ok()) << empty.status();
+    ASSERT_THAT(empty, IsOk());
     EXPECT_EQ(empty->alpha_sq_size(), 0);
     EXPECT_EQ(empty->next_rank(), 0);
     EXPECT_EQ(empty->first_rank(), k + 1);
@@ -88,7 +91,7 @@ TEST(QueryAnswersTest, SpectrumFromAtLeastAlphaSq) {
       request.set_at_least_alpha_sq(x);
       request.set_page_size(5);
       const absl::StatusOr<v1::SpectrumResponse> page = AnswerSpectrum(family, request);
-      ASSERT_TRUE(page.ok()) << page.status();
+      ASSERT_THAT(page, IsOk());
       const int64_t first = family.RankLowerBound(x);
       EXPECT_EQ(page->first_rank(), first);
       const int64_t end = std::min<int64_t>(k, first + 4);
@@ -110,15 +113,15 @@ TEST(QueryAnswersTest, SpectrumRefusesBadRequests) {
     for (const int64_t first : {int64_t{0}, int64_t{-1}, k + 2}) {
       v1::SpectrumRequest request;
       request.set_first_rank(first);
-      EXPECT_TRUE(absl::IsInvalidArgument(AnswerSpectrum(family, request).status())) << first;
+      EXPECT_THAT(AnswerSpectrum(family, request).status(), StatusIs(absl::StatusCode::kInvalidArgument)) << first;
     }
     v1::SpectrumRequest too_large;
     too_large.set_page_size(kMaxSpectrumPage + 1);
     const auto refused = AnswerSpectrum(family, too_large);
-    EXPECT_TRUE(absl::IsInvalidArgument(refused.status())) << refused.status();
+    EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     v1::SpectrumRequest nan;
     nan.set_at_least_alpha_sq(std::nan(""));
-    EXPECT_TRUE(absl::IsInvalidArgument(AnswerSpectrum(family, nan).status()));
+    EXPECT_THAT(AnswerSpectrum(family, nan).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 

@@ -13,11 +13,14 @@
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::Chunk;
 using testing::ClientOf;
 using testing::Header;
@@ -53,7 +56,7 @@ TEST(ServiceTest, ConcurrentBuildsFromSeveralClientsMatchTheLocalEngine) {
   }
   for (auto& thread : threads) thread.join();
   for (int i = 0; i < kClients; ++i) {
-    ASSERT_TRUE(results[static_cast<size_t>(i)].ok()) << results[static_cast<size_t>(i)].status();
+    ASSERT_THAT(results[static_cast<size_t>(i)], IsOk());
     EXPECT_EQ(spectra[static_cast<size_t>(i)], LocalFamily(inputs[static_cast<size_t>(i)]).spectrum()) << i;
   }
   // Three distinct inputs: three families, whatever the interleaving.
@@ -71,10 +74,10 @@ TEST(ServiceTest, FullQueueAnswersResourceExhausted) {
   std::thread runner([&] { first = ClientOf(*server)->Build(large); });
   ASSERT_TRUE(WaitFor([&] { return ScrapeMetric(*server, "galpha_builds_in_flight") == 1.0; }, 60));
   auto second = ClientOf(*server)->Build(gen::Uniform(100, 12));
-  EXPECT_TRUE(absl::IsResourceExhausted(second.status())) << second.status();
+  EXPECT_THAT(second.status(), StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_NE(second.status().message().find("queue is full"), std::string::npos);
   runner.join();
-  EXPECT_TRUE(first.ok()) << first.status();
+  EXPECT_THAT(first, IsOk());
   EXPECT_EQ(ScrapeMetric(*server, "galpha_builds_rejected_total{reason=\"queue_or_memory\"}"), 1.0);
 }
 
@@ -109,19 +112,19 @@ TEST(ServiceTest, DeadlineStopsARunningBuild) {
     const auto start = std::chrono::steady_clock::now();
     auto first = unhurried->Build(points);
     const double total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    ASSERT_TRUE(first.ok()) << first.status();
+    ASSERT_THAT(first, IsOk());
     build_ms = 0;
     for (const auto& stage : first->summary.stage_times()) build_ms += 1e3 * stage.seconds();
     upload_ms = std::max(0.0, total_ms - build_ms);
-    ASSERT_TRUE(unhurried->Release(first->handle).ok());
+    ASSERT_THAT(unhurried->Release(first->handle), IsOk());
   }
   client::ClientOptions options;
   options.target = "127.0.0.1:" + std::to_string(server->port());
   options.deadline = std::chrono::milliseconds(static_cast<int64_t>(upload_ms + build_ms / 3) + 1);
   auto client = client::AlphaClient::Connect(options);
-  ASSERT_TRUE(client.ok());
+  ASSERT_THAT(client, IsOk());
   auto built = (*client)->Build(points);
-  EXPECT_EQ(built.status().code(), absl::StatusCode::kDeadlineExceeded) << built.status();
+  EXPECT_THAT(built.status(), StatusIs(absl::StatusCode::kDeadlineExceeded));
   // The build stops at its next phase boundary and frees what it held.
   EXPECT_TRUE(WaitFor([&] { return ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 60));
   EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 10));

@@ -13,12 +13,16 @@
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::ClientOf;
+using ::testing::Not;
 using testing::ScrapeMetric;
 using testing::StartServer;
 using testing::TestServerOptions;
@@ -31,7 +35,7 @@ TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
     auto probe = StartServer(TestServerOptions());
     ASSERT_NE(probe, nullptr);
     auto built = ClientOf(*probe)->Build(a);
-    ASSERT_TRUE(built.ok());
+    ASSERT_THAT(built, IsOk());
     one_family = built->summary.family_bytes();
   }
   ServerOptions options = TestServerOptions();
@@ -40,16 +44,16 @@ TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
   ASSERT_NE(server, nullptr);
   auto client = ClientOf(*server);
   auto first = client->Build(a);
-  ASSERT_TRUE(first.ok());
+  ASSERT_THAT(first, IsOk());
   auto second = client->Build(b);
-  ASSERT_TRUE(second.ok());
-  EXPECT_TRUE(absl::IsNotFound(client->Describe(first->handle).status()));
-  EXPECT_TRUE(client->Describe(second->handle).ok());
+  ASSERT_THAT(second, IsOk());
+  EXPECT_THAT(client->Describe(first->handle).status(), StatusIs(absl::StatusCode::kNotFound));
+  EXPECT_THAT(client->Describe(second->handle), IsOk());
   EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_evictions_total"), 1.0);
   EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries"), 1.0);
   // A family larger than the whole budget is refused, not cached half-way.
   auto huge = client->Build(gen::Uniform(20000, 23));
-  EXPECT_TRUE(absl::IsResourceExhausted(huge.status())) << huge.status();
+  EXPECT_THAT(huge.status(), StatusIs(absl::StatusCode::kResourceExhausted));
 }
 
 TEST(ServiceTest, MetricsAreScrapedOverHttp) {
@@ -57,9 +61,9 @@ TEST(ServiceTest, MetricsAreScrapedOverHttp) {
   ASSERT_NE(server, nullptr);
   auto client = ClientOf(*server);
   auto built = client->Build(gen::Clustered(5000, 31));
-  ASSERT_TRUE(built.ok());
-  ASSERT_TRUE(client->Describe(built->handle).ok());
-  ASSERT_FALSE(client->Describe(PointSetHandle(gen::Uniform(3, 1))).ok());
+  ASSERT_THAT(built, IsOk());
+  ASSERT_THAT(client->Describe(built->handle), IsOk());
+  ASSERT_THAT(client->Describe(PointSetHandle(gen::Uniform(3, 1))), Not(IsOk()));
   const std::string page = testing::HttpGet(server->metrics_port(), "/metrics");
   using testing::MetricValue;
   EXPECT_EQ(MetricValue(page, "galpha_rpcs_total{code=\"OK\",method=\"Build\"}"), 1.0) << page;
@@ -98,7 +102,7 @@ TEST(ServiceTest, HealthReflectionAndDrain) {
   EXPECT_NE(std::find(services.begin(), services.end(), "galpha.v1.AlphaShapes"), services.end());
   EXPECT_NE(std::find(services.begin(), services.end(), "grpc.health.v1.Health"), services.end());
   auto built = client->Build(gen::Uniform(500, 41));
-  ASSERT_TRUE(built.ok());
+  ASSERT_THAT(built, IsOk());
 
   EXPECT_EQ(testing::HealthOf(channel, "galpha.liveness"), "SERVING");
   std::thread drain([&] { server->Drain(); });
@@ -109,10 +113,10 @@ TEST(ServiceTest, HealthReflectionAndDrain) {
   client::BuildCallOptions upload;
   upload.skip_upload_if_cached = false;
   auto refused = client->Build(gen::Uniform(100, 42), upload);
-  EXPECT_TRUE(absl::IsUnavailable(refused.status())) << refused.status();
-  EXPECT_TRUE(client->Describe(built->handle).ok());
+  EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kUnavailable));
+  EXPECT_THAT(client->Describe(built->handle), IsOk());
   drain.join();
-  EXPECT_FALSE(client->Describe(built->handle).ok());
+  EXPECT_THAT(client->Describe(built->handle), Not(IsOk()));
 }
 
 }  // namespace

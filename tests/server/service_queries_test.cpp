@@ -18,11 +18,14 @@
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
 using testing::ClientOf;
 using testing::LocalFamily;
 using testing::SpectrumRemote;
@@ -87,7 +90,7 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
   client::BuildCallOptions call;
   call.name = label;
   auto built = client.Build(points, call);
-  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_THAT(built, IsOk());
   EXPECT_EQ(built->handle, PointSetHandle(points));
   const v1::BuildSummary& summary = built->summary;
   EXPECT_EQ(summary.points(), points.size());
@@ -110,7 +113,7 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
       request.set_mode(mode);
       request.set_vertex_rule(v1::VERTEX_RULE_CGAL);
       auto answer = ClassifyRemote(client, request);
-      ASSERT_TRUE(answer.ok()) << answer.status();
+      ASSERT_THAT(answer, IsOk());
       const ClassifyMode local_mode = mode == v1::CLASSIFY_MODE_GENERAL ? ClassifyMode::kGeneral : ClassifyMode::kRegularized;
       EXPECT_EQ(answer->rows, ClassifyLocal(local, rank, local_mode, VertexRule::kCgal)) << "rank " << rank;
       EXPECT_EQ(answer->summary.level(), rank);
@@ -131,7 +134,7 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
       kinds += message.kinds();
       return absl::OkStatus();
     });
-    ASSERT_TRUE(status.ok()) << status;
+    ASSERT_THAT(status, IsOk());
     std::vector<uint64_t> local_ranks;
     std::string local_kinds;
     for (int64_t r = 1; r <= k; ++r) {
@@ -149,7 +152,7 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
   components.mutable_ranks()->set_first(0);
   components.mutable_ranks()->set_last(k);
   auto curve = client.Components(components);
-  ASSERT_TRUE(curve.ok()) << curve.status();
+  ASSERT_THAT(curve, IsOk());
   ASSERT_EQ(curve->components_size(), k + 1);
   for (int64_t level = 0; level <= k; ++level) {
     EXPECT_EQ(curve->components(static_cast<int>(level)), local.Components(level));
@@ -160,7 +163,7 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
   optimal.set_handle(built->handle);
   optimal.set_max_components(1);
   auto best = client.OptimalAlpha(optimal);
-  ASSERT_TRUE(best.ok()) << best.status();
+  ASSERT_THAT(best, IsOk());
   EXPECT_EQ(best->has_regularized(), local.OptimalLevelRegularized(1).has_value());
   if (best->has_regularized()) {
     EXPECT_EQ(best->regularized().rank(), *local.OptimalLevelRegularized(1));
@@ -179,9 +182,9 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
     text += message.text();
     return absl::OkStatus();
   });
-  ASSERT_TRUE(status.ok()) << status;
+  ASSERT_THAT(status, IsOk());
   auto local_shape = AssembleShape(local.ComplexAt(k / 2, ClassifyMode::kGeneral));
-  ASSERT_TRUE(local_shape.ok());
+  ASSERT_THAT(local_shape, IsOk());
   EXPECT_EQ(text, ShapeToGeoJson(*local_shape, local.points()));
 }
 
@@ -215,12 +218,12 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
   no_skip.name = "first";
   no_skip.skip_upload_if_cached = false;
   auto first = client->Build(points, no_skip);
-  ASSERT_TRUE(first.ok()) << first.status();
+  ASSERT_THAT(first, IsOk());
   EXPECT_FALSE(first->cached);
   EXPECT_TRUE(first->uploaded);
   // The same points again: a cache hit, nothing recomputed (the summary is the first build's).
   auto again = client->Build(points, no_skip);
-  ASSERT_TRUE(again.ok()) << again.status();
+  ASSERT_THAT(again, IsOk());
   EXPECT_TRUE(again->cached);
   EXPECT_EQ(again->handle, first->handle);
   EXPECT_EQ(again->summary.SerializeAsString(), first->summary.SerializeAsString());
@@ -228,20 +231,20 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
   client::BuildCallOptions skip;
   skip.name = "third";
   auto skipped = client->Build(points, skip);
-  ASSERT_TRUE(skipped.ok()) << skipped.status();
+  ASSERT_THAT(skipped, IsOk());
   EXPECT_TRUE(skipped->cached);
   EXPECT_FALSE(skipped->uploaded);
   auto described = client->Describe(first->handle);
-  ASSERT_TRUE(described.ok()) << described.status();
+  ASSERT_THAT(described, IsOk());
   EXPECT_EQ(described->summary().name(), "first");
   EXPECT_EQ(server->service().cache().GetStats().entries, 1u);
 
   auto released = client->Release(first->handle);
-  ASSERT_TRUE(released.ok());
+  ASSERT_THAT(released, IsOk());
   EXPECT_TRUE(released->released());
-  EXPECT_TRUE(absl::IsNotFound(client->Describe(first->handle).status()));
+  EXPECT_THAT(client->Describe(first->handle).status(), StatusIs(absl::StatusCode::kNotFound));
   auto released_again = client->Release(first->handle);
-  ASSERT_TRUE(released_again.ok());
+  ASSERT_THAT(released_again, IsOk());
   EXPECT_FALSE(released_again->released());
 }
 

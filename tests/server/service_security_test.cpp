@@ -17,11 +17,15 @@
 #include "core/io/point_set_handle.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
 
 namespace v1 = galpha::v1;
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
+using ::testing::Not;
 using testing::StartServer;
 using testing::TestServerOptions;
 
@@ -48,7 +52,7 @@ TEST(ServiceTest, TlsAndTenantScopedTokens) {
   options.tls_cert_file = dir + "/cert.pem";
   options.tls_key_file = dir + "/key.pem";
   auto tokens = TenantTokens::Parse("token-a tenant-a\ntoken-b tenant-b\n", "test");
-  ASSERT_TRUE(tokens.ok());
+  ASSERT_THAT(tokens, IsOk());
   options.service.tokens = *tokens;
   auto server = StartServer(options);
   ASSERT_NE(server, nullptr);
@@ -64,27 +68,27 @@ TEST(ServiceTest, TlsAndTenantScopedTokens) {
   const std::vector<Point2> points = gen::Uniform(800, 51);
   auto a = connect("token-a", true);
   auto built = a->Build(points);
-  ASSERT_TRUE(built.ok()) << built.status();
-  EXPECT_TRUE(a->Describe(built->handle).ok());
+  ASSERT_THAT(built, IsOk());
+  EXPECT_THAT(a->Describe(built->handle), IsOk());
 
   // Plaintext against a TLS port fails; no token or an unknown one is UNAUTHENTICATED.
-  EXPECT_FALSE(connect("token-a", false)->Describe(built->handle).ok());
-  EXPECT_TRUE(absl::IsUnauthenticated(connect("", true)->Describe(built->handle).status()));
-  EXPECT_TRUE(absl::IsUnauthenticated(connect("token-x", true)->Describe(built->handle).status()));
+  EXPECT_THAT(connect("token-a", false)->Describe(built->handle), Not(IsOk()));
+  EXPECT_THAT(connect("", true)->Describe(built->handle).status(), StatusIs(absl::StatusCode::kUnauthenticated));
+  EXPECT_THAT(connect("token-x", true)->Describe(built->handle).status(), StatusIs(absl::StatusCode::kUnauthenticated));
   client::BuildCallOptions upload;
   upload.skip_upload_if_cached = false;
-  EXPECT_TRUE(absl::IsUnauthenticated(connect("", true)->Build(points, upload).status()));
+  EXPECT_THAT(connect("", true)->Build(points, upload).status(), StatusIs(absl::StatusCode::kUnauthenticated));
 
   // Another tenant cannot see tenant A's family, even with its handle; its own build is its own.
   auto b = connect("token-b", true);
-  EXPECT_TRUE(absl::IsNotFound(b->Describe(built->handle).status()));
+  EXPECT_THAT(b->Describe(built->handle).status(), StatusIs(absl::StatusCode::kNotFound));
   auto b_built = b->Build(points, upload);
-  ASSERT_TRUE(b_built.ok()) << b_built.status();
+  ASSERT_THAT(b_built, IsOk());
   EXPECT_FALSE(b_built->cached);
   EXPECT_EQ(b_built->handle, built->handle);
   auto released = b->Release(built->handle);
-  ASSERT_TRUE(released.ok());
-  EXPECT_TRUE(a->Describe(built->handle).ok());  // B's release dropped only B's entry
+  ASSERT_THAT(released, IsOk());
+  EXPECT_THAT(a->Describe(built->handle), IsOk());  // B's release dropped only B's entry
   std::filesystem::remove_all(dir);
 }
 
@@ -137,7 +141,7 @@ TEST(ServiceTest, TheClientSendsTheHandleForRouting) {
   auto client = *client::AlphaClient::Connect(options);
   const std::vector<Point2> points = gen::Uniform(1000, 61);
   // Describe (is it cached?) then the upload: both carry the handle computed before uploading.
-  EXPECT_TRUE(absl::IsUnavailable(client->Build(points).status()));
+  EXPECT_THAT(client->Build(points).status(), StatusIs(absl::StatusCode::kUnavailable));
   EXPECT_EQ(recorder.headers(), std::vector<std::string>(2, PointSetHandle(points)));
   server->Shutdown();
 }

@@ -8,8 +8,11 @@
 
 #include "gpu/alpha/alpha_engine.hpp"
 #include "tests/server/service_test_support.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server::testing {
+
+using galpha::testing::IsOk;
 
 size_t SlowBuildPoints() { return TestBackend() == "cuda" ? 4000000 : 400000; }
 
@@ -17,7 +20,7 @@ AlphaFamily LocalFamily(const std::vector<Point2>& points) {
   BuildOptions options;
   options.backend = Backend::kCpu;
   auto family = BuildAlphaFamily(points, options);
-  EXPECT_TRUE(family.ok()) << family.status();
+  EXPECT_THAT(family, IsOk());
   return *std::move(family);
 }
 
@@ -30,7 +33,7 @@ std::vector<double> SpectrumRemote(client::AlphaClient& client, const std::strin
   while (next != 0) {
     request.set_first_rank(next);
     auto answer = client.Spectrum(request);
-    EXPECT_TRUE(answer.ok()) << answer.status();
+    EXPECT_THAT(answer, IsOk());
     if (!answer.ok()) break;
     values.insert(values.end(), answer->alpha_sq().begin(), answer->alpha_sq().end());
     next = answer->next_rank();

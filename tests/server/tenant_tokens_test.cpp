@@ -7,9 +7,14 @@
 #include <string>
 
 #include "gtest/gtest.h"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
 namespace {
+
+using galpha::testing::IsOk;
+using galpha::testing::StatusIs;
+using ::testing::Not;
 
 // The tenant of `authorization`, or the status's code name when refused.
 std::string TenantOrCode(const TenantTokens& tokens, const std::string& authorization) {
@@ -28,7 +33,7 @@ TEST(TenantTokensTest, ParsesPairsCommentsBlankLinesAndTabs) {
       "tok-carol  \t  carol\r\n"  // CRLF and mixed separators
       "tok-alice-2 alice";        // no final newline; a tenant may hold several tokens
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::Parse(text, "tokens.txt");
-  ASSERT_TRUE(tokens.ok()) << tokens.status();
+  ASSERT_THAT(tokens, IsOk());
   EXPECT_TRUE(tokens->enabled());
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok-alice"), "alice");
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok-bob"), "bob");
@@ -52,8 +57,8 @@ TEST(TenantTokensTest, MalformedLineNamesOriginAndLine) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
     const absl::StatusOr<TenantTokens> tokens = TenantTokens::Parse(c.text, "tokens.txt");
-    ASSERT_FALSE(tokens.ok());
-    EXPECT_TRUE(absl::IsInvalidArgument(tokens.status())) << tokens.status();
+    ASSERT_THAT(tokens, Not(IsOk()));
+    EXPECT_THAT(tokens.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(tokens.status().message().find(c.where), absl::string_view::npos) << tokens.status();
   }
 }
@@ -61,8 +66,8 @@ TEST(TenantTokensTest, MalformedLineNamesOriginAndLine) {
 TEST(TenantTokensTest, RepeatedTokenNamesOriginAndLine) {
   const absl::StatusOr<TenantTokens> tokens =
       TenantTokens::Parse("tok-a alice\ntok-b bob\n# comment\ntok-a mallory\n", "/etc/galpha/tokens");
-  ASSERT_FALSE(tokens.ok());
-  EXPECT_TRUE(absl::IsInvalidArgument(tokens.status())) << tokens.status();
+  ASSERT_THAT(tokens, Not(IsOk()));
+  EXPECT_THAT(tokens.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(tokens.status().message().find("/etc/galpha/tokens:4:"), absl::string_view::npos) << tokens.status();
   EXPECT_NE(tokens.status().message().find("twice"), absl::string_view::npos) << tokens.status();
 }
@@ -71,7 +76,7 @@ TEST(TenantTokensTest, ReadFileOfAMissingFileIsNotFound) {
   const std::string path = ::testing::TempDir() + "galpha_tenant_tokens_test_no_such_file";
   std::remove(path.c_str());
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::ReadFile(path);
-  EXPECT_TRUE(absl::IsNotFound(tokens.status())) << tokens.status();
+  EXPECT_THAT(tokens.status(), StatusIs(absl::StatusCode::kNotFound));
   EXPECT_NE(tokens.status().message().find(path), absl::string_view::npos) << tokens.status();
 }
 
@@ -80,15 +85,15 @@ TEST(TenantTokensTest, ReadFileOfAMissingFileIsNotFound) {
 // with --token_file pointing at a mis-mounted secret volume.
 TEST(TenantTokensTest, ReadFileOfADirectoryIsAnError) {
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::ReadFile(::testing::TempDir());
-  EXPECT_FALSE(tokens.ok()) << "a directory was read as a token table with authentication "
-                            << (tokens.ok() && tokens->enabled() ? "on" : "off");
+  EXPECT_THAT(tokens, Not(IsOk())) << "a directory was read as a token table with authentication "
+                                   << (tokens.ok() && tokens->enabled() ? "on" : "off");
 }
 
 TEST(TenantTokensTest, ReadFileOfAFileWithoutTokensIsAnError) {
   const std::string path = ::testing::TempDir() + "galpha_tenant_tokens_test_empty.txt";
   std::ofstream(path) << "# every token revoked\n\n";
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::ReadFile(path);
-  EXPECT_TRUE(absl::IsInvalidArgument(tokens.status())) << tokens.status();
+  EXPECT_THAT(tokens.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(tokens.status().message().find("lists no tokens"), absl::string_view::npos) << tokens.status();
   std::remove(path.c_str());
 }
@@ -100,7 +105,7 @@ TEST(TenantTokensTest, ReadFileParsesTheFileAndNamesItInErrors) {
     out << "# test tokens\ntok-alice alice\n\ntok-bob\tbob\n";
   }
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::ReadFile(path);
-  ASSERT_TRUE(tokens.ok()) << tokens.status();
+  ASSERT_THAT(tokens, IsOk());
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok-alice"), "alice");
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok-bob"), "bob");
 
@@ -109,7 +114,7 @@ TEST(TenantTokensTest, ReadFileParsesTheFileAndNamesItInErrors) {
     out << "tok-alice alice\ntok-alice bob\n";
   }
   const absl::StatusOr<TenantTokens> repeated = TenantTokens::ReadFile(path);
-  EXPECT_TRUE(absl::IsInvalidArgument(repeated.status())) << repeated.status();
+  EXPECT_THAT(repeated.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(repeated.status().message().find(path + ":2:"), absl::string_view::npos) << repeated.status();
   std::remove(path.c_str());
 }
@@ -118,7 +123,7 @@ TEST(TenantTokensTest, DisabledAnswersTheEmptyTenantForAnything) {
   const TenantTokens tokens;
   EXPECT_FALSE(tokens.enabled());
   const absl::StatusOr<std::string> none = tokens.TenantOf(nullptr);
-  ASSERT_TRUE(none.ok()) << none.status();
+  ASSERT_THAT(none, IsOk());
   EXPECT_EQ(*none, "");
   for (const std::string value : {"", "Bearer tok", "Basic dXNlcjpwYXNz", "garbage"}) {
     SCOPED_TRACE(value);
@@ -128,11 +133,11 @@ TEST(TenantTokensTest, DisabledAnswersTheEmptyTenantForAnything) {
 
 TEST(TenantTokensTest, EnabledRequiresAKnownBearerToken) {
   const absl::StatusOr<TenantTokens> tokens = TenantTokens::Parse("tok alice\nother bob\n", "inline");
-  ASSERT_TRUE(tokens.ok()) << tokens.status();
+  ASSERT_THAT(tokens, IsOk());
   ASSERT_TRUE(tokens->enabled());
 
   const absl::StatusOr<std::string> missing = tokens->TenantOf(nullptr);
-  EXPECT_TRUE(absl::IsUnauthenticated(missing.status())) << missing.status();
+  EXPECT_THAT(missing.status(), StatusIs(absl::StatusCode::kUnauthenticated));
 
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer tok"), "alice");
   EXPECT_EQ(TenantOrCode(*tokens, "Bearer other"), "bob");
@@ -144,7 +149,8 @@ TEST(TenantTokensTest, EnabledRequiresAKnownBearerToken) {
                                   "Bearer tokx", "Bearer alice", "", "Bearer tok other"}) {
     SCOPED_TRACE(value);
     const absl::StatusOr<std::string> tenant = tokens->TenantOf(&value);
-    EXPECT_TRUE(absl::IsUnauthenticated(tenant.status())) << (tenant.ok() ? *tenant : tenant.status().ToString());
+    EXPECT_THAT(tenant.status(), StatusIs(absl::StatusCode::kUnauthenticated))
+        << (tenant.ok() ? *tenant : tenant.status().ToString());
   }
 }
 

@@ -23,9 +23,13 @@
 #include "gpu/triangulation/delaunay.hpp"
 #include "tests/support/geos.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
+
+using testing::IsOk;
+using testing::StatusIs;
 
 using Tri = std::array<uint32_t, 3>;
 using Edge = std::array<uint32_t, 2>;
@@ -162,7 +166,7 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
                          const std::vector<uint32_t>& isolated = {}, Expected expected = {}) {
   const ShapeComplex complex{points, tris, singular, isolated};
   const absl::StatusOr<ShapeGeometry> assembled = AssembleShape(complex);
-  EXPECT_TRUE(assembled.ok()) << assembled.status();
+  EXPECT_THAT(assembled, IsOk());
   if (!assembled.ok()) return {};
   const ShapeGeometry& shape = *assembled;
   CheckRingStructure(shape, tris);
@@ -185,7 +189,7 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
   for (Tri& t : shuffled.triangles) std::rotate(t.begin(), t.begin() + rng() % 3, t.end());
   std::reverse(shuffled.isolated_points.begin(), shuffled.isolated_points.end());
   const auto again = AssembleShape(shuffled);
-  EXPECT_TRUE(again.ok()) << again.status();
+  EXPECT_THAT(again, IsOk());
   if (again.ok()) {
     EXPECT_EQ(ShapeToWkt(*again, points), ShapeToWkt(shape, points))
         << "order must not depend on input order";
@@ -396,7 +400,7 @@ TEST(AssembleShapeTest, BadInputIsInvalidArgumentNamingTheIndex) {
   const Grid g(2, 2);
   auto expect_error = [&](const ShapeComplex& complex, const std::string& needle) {
     const auto got = AssembleShape(complex);
-    ASSERT_EQ(got.status().code(), absl::StatusCode::kInvalidArgument) << got.status();
+    ASSERT_THAT(got.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_NE(got.status().message().find(needle), absl::string_view::npos) << got.status();
   };
   expect_error({g.points, {{0, 1, 7}}, {}, {}}, "index 7");
@@ -422,7 +426,7 @@ TEST(AssembleShapeTest, RandomSubsetsOfTriangulations) {
     for (uint64_t seed : {1, 2, 3}) {
       const std::vector<Point2> points = generator->generate(400, seed);
       const auto triangulation = Triangulate(points, CpuOptions());
-      ASSERT_TRUE(triangulation.ok()) << triangulation.status();
+      ASSERT_THAT(triangulation, IsOk());
       for (double density : {0.3, 0.5, 0.7, 0.9}) {
         SCOPED_TRACE(absl::StrCat(name, " seed ", seed, " density ", density));
         std::mt19937_64 rng(seed * 1000 + static_cast<uint64_t>(density * 10));
@@ -463,7 +467,7 @@ TEST(AssembleShapeTest, RandomSubsetsOfTriangulations) {
 TEST(AssembleShapeTest, WholeTriangulationIsOnePolygonWithoutHoles) {
   const std::vector<Point2> points = gen::Grid(900, 5);
   const auto triangulation = Triangulate(points, CpuOptions());
-  ASSERT_TRUE(triangulation.ok()) << triangulation.status();
+  ASSERT_THAT(triangulation, IsOk());
   CheckShape(points, triangulation->triangles, {}, {}, {1, 0});
 }
 

@@ -15,14 +15,18 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/io/point_io.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
 
+using testing::IsOk;
+using testing::StatusIs;
+
 std::vector<Point2> Points(std::initializer_list<Point2> list) { return list; }
 
 void ExpectPoints(const absl::StatusOr<std::vector<Point2>>& got, const std::vector<Point2>& want) {
-  ASSERT_TRUE(got.ok()) << got.status();
+  ASSERT_THAT(got, IsOk());
   ASSERT_EQ(got->size(), want.size());
   for (size_t i = 0; i < want.size(); ++i) {
     EXPECT_EQ((*got)[i].x, want[i].x) << "point " << i;
@@ -54,18 +58,18 @@ TEST(ParsePointsTextTest, EmptyAndHeaderOnlyGiveNoPoints) {
 
 TEST(ParsePointsTextTest, BadLineIsNamedByNumber) {
   const auto got = ParsePointsText("x,y\n1,2\n3\n", "bad.csv");
-  ASSERT_EQ(got.status().code(), absl::StatusCode::kInvalidArgument) << got.status();
+  ASSERT_THAT(got.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(got.status().message().find("bad.csv:3"), absl::string_view::npos) << got.status();
   // An empty field is a missing coordinate, not a reason to take the next column.
   const auto empty = ParsePointsText("1,2\n3,,4\n", "e.csv");
-  ASSERT_EQ(empty.status().code(), absl::StatusCode::kInvalidArgument) << empty.status();
+  ASSERT_THAT(empty.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(empty.status().message().find("e.csv:2"), absl::string_view::npos) << empty.status();
   // A first line of one number is a bad data line, not a header.
   const auto lone = ParsePointsText("1\n2,3\n", "l.csv");
-  ASSERT_EQ(lone.status().code(), absl::StatusCode::kInvalidArgument) << lone.status();
+  ASSERT_THAT(lone.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(lone.status().message().find("l.csv:1"), absl::string_view::npos) << lone.status();
   const auto word = ParsePointsText("1,2\n3,four\n", "w.csv");
-  ASSERT_EQ(word.status().code(), absl::StatusCode::kInvalidArgument) << word.status();
+  ASSERT_THAT(word.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(word.status().message().find("w.csv:2"), absl::string_view::npos) << word.status();
 }
 
@@ -108,19 +112,19 @@ TEST(ParsePointsNpyTest, COrderFortranOrderBigEndianVersion2) {
 
 TEST(ParsePointsNpyTest, WrongDtypeShapeMagicAndSizeAreErrors) {
   const auto f4 = ParsePointsNpy(Npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 2), }", {1, 2}), "f4.npy");
-  ASSERT_EQ(f4.status().code(), absl::StatusCode::kInvalidArgument) << f4.status();
+  ASSERT_THAT(f4.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(f4.status().message().find("'<f4'"), absl::string_view::npos) << f4.status();
   const auto three = ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 3), }", {1, 2, 3}),
                                     "3.npy");
-  EXPECT_EQ(three.status().code(), absl::StatusCode::kInvalidArgument) << three.status();
+  EXPECT_THAT(three.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   const auto flat = ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (4,), }", {1, 2, 3, 4}),
                                    "1d.npy");
-  EXPECT_EQ(flat.status().code(), absl::StatusCode::kInvalidArgument) << flat.status();
-  EXPECT_EQ(ParsePointsNpy("PK\x03\x04 not numpy", "z.npy").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(flat.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_THAT(ParsePointsNpy("PK\x03\x04 not numpy", "z.npy").status(), StatusIs(absl::StatusCode::kInvalidArgument));
   std::string truncated = Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }", {1, 2, 3, 4});
   truncated.resize(truncated.size() - 8);
   const auto short_data = ParsePointsNpy(truncated, "t.npy");
-  ASSERT_EQ(short_data.status().code(), absl::StatusCode::kDataLoss) << short_data.status();
+  ASSERT_THAT(short_data.status(), StatusIs(absl::StatusCode::kDataLoss));
   EXPECT_NE(short_data.status().message().find("t.npy"), absl::string_view::npos);
 }
 
@@ -150,7 +154,7 @@ TEST(ParsePointsGeoJsonTest, BareGeometriesAndGeometryCollection) {
 TEST(ParsePointsGeoJsonTest, NumbersBeyondADoubleAreAnErrorNotACrash) {
   // Found by tests/fuzz: nlohmann::json throws out_of_range (not parse_error) for 1e400.
   const auto overflow = ParsePointsGeoJson(R"({"type": "Point", "coordinates": [1e400, 0]})", "big.json");
-  ASSERT_EQ(overflow.status().code(), absl::StatusCode::kInvalidArgument) << overflow.status();
+  ASSERT_THAT(overflow.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(overflow.status().message().find("big.json"), std::string::npos) << overflow.status();
 }
 
@@ -159,18 +163,18 @@ TEST(ParsePointsGeoJsonTest, ErrorsNameThePlace) {
       {"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 2]}},
       {"type": "Feature", "geometry": {"type": "LineString", "coordinates": [[1, 2], [3, 4]]}}]})",
                                        "l.geojson");
-  ASSERT_EQ(line.status().code(), absl::StatusCode::kInvalidArgument) << line.status();
+  ASSERT_THAT(line.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(line.status().message().find("features[1].geometry"), absl::string_view::npos) << line.status();
   EXPECT_NE(line.status().message().find("LineString"), absl::string_view::npos) << line.status();
   const auto text = ParsePointsGeoJson(R"({"type": "MultiPoint", "coordinates": [[1, 2], ["3", 4]]})", "s.json");
-  ASSERT_EQ(text.status().code(), absl::StatusCode::kInvalidArgument) << text.status();
+  ASSERT_THAT(text.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(text.status().message().find("coordinates[1]"), absl::string_view::npos) << text.status();
   const auto broken = ParsePointsGeoJson(R"({"type": "Point", "coordinates": [1, 2)", "b.json");
-  ASSERT_EQ(broken.status().code(), absl::StatusCode::kInvalidArgument) << broken.status();
+  ASSERT_THAT(broken.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(broken.status().message().find("not valid JSON"), absl::string_view::npos) << broken.status();
-  EXPECT_EQ(ParsePointsGeoJson(R"({"type": "Feature"})", "n.json").status().code(),
-            absl::StatusCode::kInvalidArgument);
-  EXPECT_EQ(ParsePointsGeoJson(R"([1, 2])", "a.json").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_THAT(ParsePointsGeoJson(R"({"type": "Feature"})", "n.json").status(),
+              StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_THAT(ParsePointsGeoJson(R"([1, 2])", "a.json").status(), StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 class ReadPointsFileTest : public ::testing::Test {
@@ -197,14 +201,14 @@ TEST_F(ReadPointsFileTest, ChoosesTheFormatByExtension) {
                                                  {3, 4}))),
                Points({{3, 4}}));
   const std::string bin = (dir_ / "p.bin").string();
-  ASSERT_TRUE(WritePointsBin(bin, Points({{5, 6}, {7, 8}})).ok());
+  ASSERT_THAT(WritePointsBin(bin, Points({{5, 6}, {7, 8}})), IsOk());
   ExpectPoints(ReadPointsFile(bin), Points({{5, 6}, {7, 8}}));
 }
 
 TEST_F(ReadPointsFileTest, MissingFileIsNotFoundForEveryFormat) {
   for (const char* name : {"none.csv", "none.npy", "none.bin"}) {
     const auto got = ReadPointsFile((dir_ / name).string());
-    EXPECT_EQ(got.status().code(), absl::StatusCode::kNotFound) << name << ": " << got.status();
+    EXPECT_THAT(got.status(), StatusIs(absl::StatusCode::kNotFound)) << name;
   }
 }
 
@@ -212,16 +216,16 @@ TEST_F(ReadPointsFileTest, DirectoryIsInvalidArgumentForEveryFormat) {
   for (const char* name : {"d.csv", "d.npy", "d.bin", "d.geojson"}) {
     std::filesystem::create_directories(dir_ / name);
     const auto got = ReadPointsFile((dir_ / name).string());
-    EXPECT_EQ(got.status().code(), absl::StatusCode::kInvalidArgument) << name << ": " << got.status();
+    EXPECT_THAT(got.status(), StatusIs(absl::StatusCode::kInvalidArgument)) << name;
     EXPECT_NE(got.status().message().find("directory"), absl::string_view::npos) << got.status();
   }
 }
 
 TEST_F(ReadPointsFileTest, TruncatedBinIsDataLoss) {
   const std::string bin = (dir_ / "t.bin").string();
-  ASSERT_TRUE(WritePointsBin(bin, Points({{5, 6}, {7, 8}})).ok());
+  ASSERT_THAT(WritePointsBin(bin, Points({{5, 6}, {7, 8}})), IsOk());
   std::filesystem::resize_file(bin, 8 + 16 + 8);
-  EXPECT_EQ(ReadPointsFile(bin).status().code(), absl::StatusCode::kDataLoss);
+  EXPECT_THAT(ReadPointsFile(bin).status(), StatusIs(absl::StatusCode::kDataLoss));
 }
 
 }  // namespace

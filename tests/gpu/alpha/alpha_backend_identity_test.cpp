@@ -16,9 +16,12 @@
 #include "gtest/gtest.h"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
+
+using testing::IsOk;
 
 using Simplex = std::array<uint32_t, 3>;  // sorted vertex indices; unused slots are ~0u
 
@@ -59,8 +62,8 @@ void ExpectIdentical(const std::vector<Point2>& points, const std::string& where
   cuda_options.backend = Backend::kCuda;
   absl::StatusOr<AlphaFamily> cpu = BuildAlphaFamily(points, cpu_options);
   absl::StatusOr<AlphaFamily> cuda = BuildAlphaFamily(points, cuda_options);
-  ASSERT_TRUE(cpu.ok()) << where << ": " << cpu.status();
-  ASSERT_TRUE(cuda.ok()) << where << ": " << cuda.status();
+  ASSERT_THAT(cpu, IsOk()) << where;
+  ASSERT_THAT(cuda, IsOk()) << where;
   ASSERT_EQ(cuda->report().backend, "cuda");
   ASSERT_EQ(cpu->spectrum(), cuda->spectrum()) << where;
   ASSERT_EQ(cpu->representative(), cuda->representative()) << where;
@@ -96,7 +99,7 @@ TEST(AlphaBackendIdentityTest, RealDataSets) {
   if (!CudaBackendAvailable()) GTEST_SKIP() << "no GPU";
   for (const std::string& file : testdata::PointFiles()) {
     absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
-    ASSERT_TRUE(points.ok()) << points.status();
+    ASSERT_THAT(points, IsOk());
     ExpectIdentical(*points, file);
     if (HasFatalFailure()) return;
   }

@@ -18,9 +18,12 @@
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/bruteforce_alpha_oracle.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha::testing {
 namespace {
+
+using ::testing::Not;
 
 using Tri = BruteTri;
 using Edge = BruteEdge;
@@ -58,7 +61,7 @@ void CheckLevelResolution(const AlphaFamily& f, const BruteFamily& b) {
   for (double x : probes) {
     if (!std::isfinite(x)) continue;
     const absl::StatusOr<int64_t> level = f.LevelForAlphaSq(x);
-    ASSERT_TRUE(level.ok()) << level.status();
+    ASSERT_THAT(level, IsOk());
     ASSERT_EQ(*level, b.LevelOf(mpq_class(x))) << "LevelForAlphaSq(" << x << ")";
     // CGAL's alpha_lower_bound: the first rank whose exact threshold is >= x.
     const int64_t below = std::lower_bound(b.spectrum.begin(), b.spectrum.end(), mpq_class(x)) - b.spectrum.begin();
@@ -69,7 +72,7 @@ void CheckLevelResolution(const AlphaFamily& f, const BruteFamily& b) {
     const double root = std::sqrt(x);
     for (double a : {root, std::nextafter(root, 0.0), std::nextafter(root, INFINITY)}) {
       const absl::StatusOr<int64_t> by_radius = f.LevelForAlpha(a);
-      ASSERT_TRUE(by_radius.ok()) << by_radius.status();
+      ASSERT_THAT(by_radius, IsOk());
       const mpq_class a_sq = mpq_class(a) * mpq_class(a);
       ASSERT_EQ(*by_radius, b.LevelOf(a_sq)) << "LevelForAlpha(" << a << ")";
       if (a_sq == mpq_class(x)) {
@@ -81,20 +84,20 @@ void CheckLevelResolution(const AlphaFamily& f, const BruteFamily& b) {
   for (double a :
        {1e200, std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min(), 1e-160, 1e-300}) {
     const absl::StatusOr<int64_t> by_radius = f.LevelForAlpha(a);
-    ASSERT_TRUE(by_radius.ok()) << by_radius.status();
+    ASSERT_THAT(by_radius, IsOk());
     ASSERT_EQ(*by_radius, b.LevelOf(mpq_class(a) * mpq_class(a))) << "LevelForAlpha(" << a << ")";
   }
   EXPECT_EQ(*f.LevelForAlphaSq(std::numeric_limits<double>::max()), k);
   EXPECT_EQ(*f.LevelForAlphaSq(INFINITY), k);
   EXPECT_EQ(*f.LevelForAlphaSq(-INFINITY), -1);
   EXPECT_EQ(*f.LevelForAlpha(INFINITY), k);
-  EXPECT_FALSE(f.LevelForAlphaSq(std::nan("")).ok());
-  EXPECT_FALSE(f.LevelForAlpha(std::nan("")).ok());
-  EXPECT_FALSE(f.LevelForAlpha(-1.0).ok());
+  EXPECT_THAT(f.LevelForAlphaSq(std::nan("")), Not(IsOk()));
+  EXPECT_THAT(f.LevelForAlpha(std::nan("")), Not(IsOk()));
+  EXPECT_THAT(f.LevelForAlpha(-1.0), Not(IsOk()));
   EXPECT_EQ(f.RankLowerBound(INFINITY), k + 1);
   for (int64_t r = 0; r <= k; ++r) EXPECT_EQ(*f.LevelForRank(r), r);
-  EXPECT_FALSE(f.LevelForRank(-1).ok());
-  EXPECT_FALSE(f.LevelForRank(k + 1).ok());
+  EXPECT_THAT(f.LevelForRank(-1), Not(IsOk()));
+  EXPECT_THAT(f.LevelForRank(k + 1), Not(IsOk()));
 }
 
 }  // namespace
@@ -106,7 +109,7 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
   BuildOptions options;
   options.backend = backend;
   absl::StatusOr<AlphaFamily> built = BuildAlphaFamily(points, options);
-  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_THAT(built, IsOk());
   const AlphaFamily& f = *built;
   const AlphaRanks& r = f.ranks();
   const uint32_t n = static_cast<uint32_t>(points.size());

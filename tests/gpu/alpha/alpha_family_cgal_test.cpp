@@ -12,20 +12,22 @@
 #include <utility>
 #include <vector>
 
+#include "core/exact/radius_rational.hpp"
 #include "core/family/alpha_family.hpp"
 #include "core/io/point_formats.hpp"
-#include "core/exact/radius_rational.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/backend_fixture.hpp"
 #include "tests/support/cgal_alpha_oracle.hpp"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
 
 using testing::CgalAlphaOracle;
+using testing::IsOk;
 using testing::OracleClass;
 
 OracleClass ToOracle(SimplexClass c) {
@@ -87,7 +89,7 @@ void CompareWithCgal(const std::vector<Point2>& points, const std::string& where
   BuildOptions options;
   options.backend = backend;
   absl::StatusOr<AlphaFamily> built = BuildAlphaFamily(points, options);
-  ASSERT_TRUE(built.ok()) << where << ": " << built.status();
+  ASSERT_THAT(built, IsOk()) << where;
   const AlphaFamily& f = *built;
   const CgalAlphaOracle oracle(points);
 
@@ -115,7 +117,7 @@ void CompareWithCgal(const std::vector<Point2>& points, const std::string& where
       const double between = NearestDouble((at + next) / 2);
       if (mpq_class(between) > at && mpq_class(between) < next) {
         absl::StatusOr<int64_t> resolved = f.LevelForAlphaSq(between);
-        ASSERT_TRUE(resolved.ok());
+        ASSERT_THAT(resolved, IsOk());
         ASSERT_EQ(*resolved, level) << where << " alpha_sq " << between;
         CompareAtLevel(f, oracle, level, mpq_class(between), where + " (between)");
         if (::testing::Test::HasFatalFailure()) return;
@@ -126,7 +128,7 @@ void CompareWithCgal(const std::vector<Point2>& points, const std::string& where
       // itself when the double is exact; tiny inputs round many thresholds to one double).
       const double published = f.spectrum()[static_cast<size_t>(level - 1)];
       absl::StatusOr<int64_t> resolved = f.LevelForAlphaSq(published);
-      ASSERT_TRUE(resolved.ok());
+      ASSERT_THAT(resolved, IsOk());
       if (*resolved > 0) {
         ASSERT_LE(ExactThreshold(f, *resolved), mpq_class(published)) << where;
       }
@@ -187,7 +189,7 @@ TEST_P(AlphaCgalTest, RealDataSets) {
   ASSERT_FALSE(files.empty());
   for (const std::string& file : files) {
     absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
-    ASSERT_TRUE(points.ok()) << points.status();
+    ASSERT_THAT(points, IsOk());
     SCOPED_TRACE(file);
     CompareWithCgal(*points, file, GetParam(), points->size() > 50000 ? 4 : 12);
     if (HasFatalFailure()) return;

@@ -16,6 +16,7 @@
 #include "gtest/gtest.h"
 #include "tests/gpu/alpha/alpha_family_fixture.hpp"
 #include "tests/support/backend_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
@@ -23,6 +24,7 @@ namespace {
 using testing::Edge;
 using testing::EdgeRhoSq;
 using testing::ExactThreshold;
+using testing::IsOk;
 using testing::SortedTri;
 using testing::Tri;
 
@@ -85,7 +87,7 @@ TEST_P(GudhiTest, SevenPointsExactBirths) {
   ASSERT_EQ(g.edges.size(), 12u);
   ASSERT_EQ(g.triangles.size(), 6u);
   absl::StatusOr<AlphaFamily> built = Build(g.points);
-  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_THAT(built, IsOk());
   const AlphaFamily& f = *built;
   const AlphaRanks& r = f.ranks();
 

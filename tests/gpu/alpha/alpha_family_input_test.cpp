@@ -18,12 +18,16 @@
 #include "gtest/gtest.h"
 #include "tests/gpu/alpha/alpha_family_fixture.hpp"
 #include "tests/support/backend_fixture.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
 
 using testing::Edge;
 using testing::ExactThreshold;
+using testing::IsOk;
+using ::testing::Not;
+using testing::StatusIs;
 
 using InputTest = testing::AlphaFamilyTest;
 
@@ -38,8 +42,8 @@ TEST_P(InputTest, NonFiniteCoordinatesNameTheirIndex) {
   };
   for (const auto& [points, bad] : cases) {
     const absl::StatusOr<AlphaFamily> built = Build(points);
-    ASSERT_FALSE(built.ok()) << "bad index " << bad;
-    EXPECT_EQ(built.status().code(), absl::StatusCode::kInvalidArgument) << built.status();
+    ASSERT_THAT(built, Not(IsOk())) << "bad index " << bad;
+    EXPECT_THAT(built.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     const std::string message(built.status().message());
     EXPECT_NE(message.find("point " + std::to_string(bad) + " "), std::string::npos) << message;
   }
@@ -96,7 +100,7 @@ void CheckChainFamily(const AlphaFamily& f, const std::vector<Point2>& points) {
   for (SimplexClass c : regularized.edges) EXPECT_EQ(c, SimplexClass::kExterior);
   for (SimplexClass c : regularized.vertices) EXPECT_EQ(c, SimplexClass::kExterior);
   const absl::StatusOr<ShapeGeometry> shape = AssembleShape(f.ComplexAt(f.max_level(), ClassifyMode::kGeneral));
-  ASSERT_TRUE(shape.ok()) << shape.status();
+  ASSERT_THAT(shape, IsOk());
   EXPECT_TRUE(shape->polygons.empty());
   EXPECT_EQ(shape->singular_edges.size(), want_edges.size());
 }
@@ -119,7 +123,7 @@ TEST_P(InputTest, FewPointsAndCollinearSetsAreValid) {
   for (size_t i = 0; i < cases.size(); ++i) {
     SCOPED_TRACE(::testing::Message() << "case " << i);
     const absl::StatusOr<AlphaFamily> built = Build(cases[i]);
-    ASSERT_TRUE(built.ok()) << built.status();
+    ASSERT_THAT(built, IsOk());
     CheckChainFamily(*built, cases[i]);
   }
   // A long chain of integers on one line (many exact ties).
@@ -127,7 +131,7 @@ TEST_P(InputTest, FewPointsAndCollinearSetsAreValid) {
   for (int i = 0; i < 500; ++i)
     line.push_back({static_cast<double>((i * 37) % 500), static_cast<double>(2 * ((i * 37) % 500) + 1)});
   const absl::StatusOr<AlphaFamily> built = Build(line);
-  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_THAT(built, IsOk());
   CheckChainFamily(*built, line);
   EXPECT_EQ(built->max_level(), 1);
 }

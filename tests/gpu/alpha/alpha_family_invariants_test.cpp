@@ -15,6 +15,7 @@
 #include "tests/gpu/alpha/alpha_family_fixture.hpp"
 #include "tests/support/backend_fixture.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
@@ -23,8 +24,9 @@ using testing::Case;
 using testing::Edge;
 using testing::EdgeRhoSq;
 using testing::ExactThreshold;
-using testing::TriangleRhoSq;
+using testing::IsOk;
 using testing::Tri;
+using testing::TriangleRhoSq;
 
 std::vector<Case> InvariantCases() {
   using namespace gen;
@@ -207,7 +209,7 @@ TEST_P(InvariantsTest, MasterListAndIntervals) {
   for (const Case& c : InvariantCases()) {
     SCOPED_TRACE(c.name);
     absl::StatusOr<AlphaFamily> built = Build(c.points);
-    ASSERT_TRUE(built.ok()) << built.status();
+    ASSERT_THAT(built, IsOk());
     CheckInvariants(*built);
     if (HasFatalFailure()) return;
   }

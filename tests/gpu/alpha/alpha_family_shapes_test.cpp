@@ -22,6 +22,7 @@
 #include "tests/support/data_files.hpp"
 #include "tests/support/geos.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
@@ -29,6 +30,7 @@ namespace {
 using testing::Case;
 using testing::Edge;
 using testing::Geos;
+using testing::IsOk;
 using testing::Tri;
 
 // Edge-connected pieces of a set of triangles (union-find over shared edges).
@@ -91,7 +93,7 @@ void CheckShapeAt(const Geos& geos, const AlphaFamily& f, int64_t level) {
     std::sort(want_tris.begin(), want_tris.end());
     ASSERT_EQ(got_tris, want_tris);
     const absl::StatusOr<ShapeGeometry> shape = AssembleShape(complex);
-    ASSERT_TRUE(shape.ok()) << shape.status();
+    ASSERT_THAT(shape, IsOk());
     ASSERT_EQ(shape->polygons.size(), pieces);
     EXPECT_NEAR(shape->area, area, 1e-9 * std::abs(area));
     std::vector<Edge> want_singular = general ? singular : std::vector<Edge>{};
@@ -155,7 +157,7 @@ TEST_P(ShapesTest, GeneratedInputs) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     absl::StatusOr<AlphaFamily> built = Build(c.points);
-    ASSERT_TRUE(built.ok()) << built.status();
+    ASSERT_THAT(built, IsOk());
     CheckShapes(*built);
     if (HasFatalFailure()) return;
   }
@@ -171,9 +173,9 @@ TEST_P(ShapesTest, RealDataSet) {
   }
   SCOPED_TRACE(file);
   absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
-  ASSERT_TRUE(points.ok()) << points.status();
+  ASSERT_THAT(points, IsOk());
   absl::StatusOr<AlphaFamily> built = Build(*points);
-  ASSERT_TRUE(built.ok()) << built.status();
+  ASSERT_THAT(built, IsOk());
   CheckShapes(*built);
 }
 

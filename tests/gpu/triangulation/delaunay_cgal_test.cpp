@@ -20,16 +20,19 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/io/point_io.hpp"
 #include "core/exact/predicates.hpp"
+#include "core/io/point_io.hpp"
 #include "gpu/triangulation/delaunay.hpp"
 #include "gpu/triangulation/triangulation_checks.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
+
+using testing::IsOk;
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<uint32_t, Kernel>;
@@ -192,9 +195,9 @@ void CheckAgainstCgal(const std::vector<Point2>& points, Backend backend, bool g
   TriangulateOptions options;
   options.backend = backend;
   const absl::StatusOr<Triangulation> t = Triangulate(points, options);
-  ASSERT_TRUE(t.ok()) << t.status();
+  ASSERT_THAT(t, IsOk());
   const absl::Status valid = CheckTriangulation(*t);
-  EXPECT_TRUE(valid.ok()) << valid;
+  EXPECT_THAT(valid, IsOk());
   // Compare even an invalid result (CGAL's view helps to diagnose it), unless its arrays are
   // malformed and cannot be indexed safely.
   if (valid.code() == absl::StatusCode::kFailedPrecondition) return;
@@ -219,7 +222,7 @@ TEST(DelaunayCgalTest, RealDataSets) {
   for (const std::string& file : files) {
     SCOPED_TRACE(file);
     const absl::StatusOr<std::vector<Point2>> points = ReadPointsBin(file);
-    ASSERT_TRUE(points.ok()) << points.status();
+    ASSERT_THAT(points, IsOk());
     for (Backend backend : BackendsToTest()) {
       // Real data may hold co-circular quadruples: differences must be explained by them.
       ASSERT_NO_FATAL_FAILURE(CheckAgainstCgal(*points, backend, /*general_position=*/false));

@@ -20,6 +20,7 @@
 #include "tests/support/backend_fixture.hpp"
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 
@@ -27,6 +28,9 @@ namespace galpha {
 static void PrintTo(Backend backend, std::ostream* os) { *os << BackendName(backend); }
 
 namespace {
+
+using testing::IsOk;
+using testing::StatusIs;
 
 using Edge = std::array<uint32_t, 2>;
 using Tri = std::array<uint32_t, 3>;
@@ -92,11 +96,11 @@ class DelaunayTest : public testing::BackendTest {
   // ASSERT_NO_FATAL_FAILURE.
   void RunAndCheck(absl::Span<const Point2> points, Triangulation* out) {
     absl::StatusOr<Triangulation> result = Run(points);
-    ASSERT_TRUE(result.ok()) << result.status();
+    ASSERT_THAT(result, IsOk());
     EXPECT_EQ(result->backend, GetParam());
     EXPECT_TRUE(BitwiseEqual(result->points, points)) << "points are not the input as given";
     const absl::Status valid = CheckTriangulation(*result);
-    ASSERT_TRUE(valid.ok()) << valid;
+    ASSERT_THAT(valid, IsOk());
     *out = *std::move(result);
   }
 };
@@ -136,7 +140,7 @@ TEST_P(DelaunayTest, RealDataSets) {
   for (const std::string& file : files) [&] {
     SCOPED_TRACE(file);
     absl::StatusOr<std::vector<Point2>> points = ReadPointsBin(file);
-    ASSERT_TRUE(points.ok()) << points.status();
+    ASSERT_THAT(points, IsOk());
     Triangulation t;
     ASSERT_NO_FATAL_FAILURE(RunAndCheck(*points, &t));
     // data/README.md: the Autzen cloud holds 7 exact duplicates.
@@ -288,7 +292,7 @@ TEST_P(DelaunayTest, NaNIsRejectedWithItsIndex) {
   std::vector<Point2> points = gen::Uniform(10, 7);
   points[5].x = kNaN;
   const absl::StatusOr<Triangulation> result = Run(points);
-  ASSERT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
+  ASSERT_THAT(result.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(result.status().message().find("5"), absl::string_view::npos) << result.status();
 }
 
@@ -296,14 +300,14 @@ TEST_P(DelaunayTest, InfinityIsRejectedWithItsIndex) {
   std::vector<Point2> points = gen::Uniform(10, 7);
   points[5].y = kInf;
   absl::StatusOr<Triangulation> result = Run(points);
-  ASSERT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
+  ASSERT_THAT(result.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(result.status().message().find("5"), absl::string_view::npos) << result.status();
 
   points = gen::Uniform(20, 7);
   points[13].x = -kInf;
   points[17].y = kNaN;  // only the first bad index is named
   result = Run(points);
-  ASSERT_EQ(result.status().code(), absl::StatusCode::kInvalidArgument) << result.status();
+  ASSERT_THAT(result.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(result.status().message().find("13"), absl::string_view::npos) << result.status();
 }
 
@@ -314,12 +318,12 @@ TEST(DelaunayBackendTest, CudaWithoutGpuIsUnavailable) {
   TriangulateOptions options;
   options.backend = Backend::kCuda;
   const absl::StatusOr<Triangulation> result = Triangulate(gen::Uniform(10, 1), options);
-  EXPECT_EQ(result.status().code(), absl::StatusCode::kUnavailable) << result.status();
+  EXPECT_THAT(result.status(), StatusIs(absl::StatusCode::kUnavailable));
 }
 
 TEST(DelaunayBackendTest, AutoPicksCudaExactlyWhenAvailable) {
   const absl::StatusOr<Triangulation> result = Triangulate(gen::Uniform(100, 1));
-  ASSERT_TRUE(result.ok()) << result.status();
+  ASSERT_THAT(result, IsOk());
   EXPECT_EQ(result->backend, CudaBackendAvailable() ? Backend::kCuda : Backend::kCpu);
 }
 
@@ -337,8 +341,8 @@ TEST(DelaunayBackendTest, CpuAndCudaAgree) {
       cuda_options.backend = Backend::kCuda;
       const absl::StatusOr<Triangulation> cpu = Triangulate(points, cpu_options);
       const absl::StatusOr<Triangulation> cuda = Triangulate(points, cuda_options);
-      ASSERT_TRUE(cpu.ok()) << cpu.status();
-      ASSERT_TRUE(cuda.ok()) << cuda.status();
+      ASSERT_THAT(cpu, IsOk());
+      ASSERT_THAT(cuda, IsOk());
       EXPECT_EQ(cpu->representative, cuda->representative);
       EXPECT_EQ(SortedDifference(CanonicalTriangles(*cpu), CanonicalTriangles(*cuda)), "")
           << "triangles, first = CPU, second = CUDA";

@@ -7,9 +7,13 @@
 #include "gpu/triangulation/delaunay.hpp"
 #include "gpu/triangulation/triangulation_checks.hpp"
 #include "gtest/gtest.h"
+#include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
+
+using testing::IsOk;
+using testing::StatusIs;
 
 // Distinct points, representatives = identity.
 Triangulation WithPoints(std::vector<Point2> points) {
@@ -45,23 +49,22 @@ Triangulation CollinearHullPoint() {
 // Expects a failure of `code` whose message contains `fragment`.
 void ExpectViolation(const Triangulation& t, absl::StatusCode code, const std::string& fragment) {
   const absl::Status status = CheckTriangulation(t);
-  EXPECT_EQ(status.code(), code) << status;
+  EXPECT_THAT(status, StatusIs(code));
   EXPECT_NE(status.message().find(fragment), absl::string_view::npos)
       << "message lacks \"" << fragment << "\": " << status;
 }
 
 TEST(TriangulationChecksTest, ValidTriangulationsPass) {
-  EXPECT_TRUE(CheckTriangulation(SquareWithCentre()).ok()) << CheckTriangulation(SquareWithCentre());
-  EXPECT_TRUE(CheckTriangulation(CollinearHullPoint()).ok())
-      << CheckTriangulation(CollinearHullPoint());
+  EXPECT_THAT(CheckTriangulation(SquareWithCentre()), IsOk());
+  EXPECT_THAT(CheckTriangulation(CollinearHullPoint()), IsOk());
 }
 
 TEST(TriangulationChecksTest, ValidEdgeOnlyOutputsPass) {
-  EXPECT_TRUE(CheckTriangulation(WithPoints({})).ok());
-  EXPECT_TRUE(CheckTriangulation(WithPoints({{1, 1}})).ok());
+  EXPECT_THAT(CheckTriangulation(WithPoints({})), IsOk());
+  EXPECT_THAT(CheckTriangulation(WithPoints({{1, 1}})), IsOk());
   Triangulation line = WithPoints({{0, 0}, {2, 2}, {1, 1}});
   line.edges = {{1, 2}, {0, 2}};
-  EXPECT_TRUE(CheckTriangulation(line).ok()) << CheckTriangulation(line);
+  EXPECT_THAT(CheckTriangulation(line), IsOk());
 }
 
 TEST(TriangulationChecksTest, DuplicateMustMapToFirstOccurrence) {
@@ -70,7 +73,7 @@ TEST(TriangulationChecksTest, DuplicateMustMapToFirstOccurrence) {
   t.representative.push_back(5);
   ExpectViolation(t, absl::StatusCode::kInternal, "representative[5]");
   t.representative.back() = 0;
-  EXPECT_TRUE(CheckTriangulation(t).ok()) << CheckTriangulation(t);
+  EXPECT_THAT(CheckTriangulation(t), IsOk());
   t.num_unique = 6;
   ExpectViolation(t, absl::StatusCode::kInternal, "num_unique");
 }
