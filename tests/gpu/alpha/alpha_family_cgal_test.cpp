@@ -169,6 +169,8 @@ std::vector<Case> GeneratedCases() {
       {"offset_1e9", HugeOffset(1000, 10, 1e9)},
       {"offset_1e15", HugeOffset(1000, 11, 1e15)},
       {"tiny", Tiny(1000, 12)},
+      {"ulp_lattice", UlpLattice(2500, 13)},  // runs longer than one thread sorts: refined keys
+      {"lidar_cm", LidarCentimetres(2000, 14)},
       {"three_points", {{0, 0}, {4, 0}, {2, 3}}},
       {"square", {{0, 0}, {1, 0}, {1, 1}, {0, 1}}},
   };
