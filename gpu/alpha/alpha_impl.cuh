@@ -5,6 +5,7 @@
 // docs/design.md, "Semantics" and "Exactness").
 #pragma once
 
+#include <thrust/binary_search.h>
 #include <thrust/copy.h>
 #include <thrust/count.h>
 #include <thrust/fill.h>
@@ -20,6 +21,7 @@
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <utility>
@@ -496,6 +498,10 @@ PendingDownloadOf<System> StartTablesDownload(System& sys, const PipelineMesh& m
 
 /// Sorts every rank segment of the master list: short ones by one thread each, long ones (exact
 /// ties: a grid's congruent simplices) afterwards.
+/// Up to this many long master-list segments are sorted one by one on the device; more are sorted
+/// together (SortMasterSegments).
+constexpr size_t kMaxSeparateSegmentSorts = 32;
+
 template <class System>
 void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t num_items, uint32_t num_ranks,
                         const Buffer<uint32_t, System>& master_begin, Buffer<uint64_t, System>* master_entries) {
@@ -517,10 +523,24 @@ void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t 
       };
       for (uint32_t item = 0; item < num_items; ++item) endpoints.Visit(item, place);
     } else {
-      for (uint32_t r = 0; r <= num_ranks; ++r) {
-        if (host_long[r]) {
-          thrust::sort(policy, master_entries->data() + host_begin[r], master_entries->data() + host_begin[r + 1]);
+      const auto num_long = static_cast<size_t>(std::count(host_long.begin(), host_long.end(), uint8_t{1}));
+      if (num_long <= kMaxSeparateSegmentSorts) {
+        for (uint32_t r = 0; r <= num_ranks; ++r) {
+          if (host_long[r]) {
+            thrust::sort(policy, master_entries->data() + host_begin[r], master_entries->data() + host_begin[r + 1]);
+          }
         }
+      } else {
+        // Many long segments (lattices: thousands of ranks of exact ties): one sort per segment
+        // would cost a launch and a wait each. Two stable radix sorts of the whole list instead,
+        // by entry and then by rank, give every segment sorted in place, the same order.
+        const uint32_t num_master = host_begin[num_ranks + 1];
+        Buffer<uint32_t, System> rank_of(sys, num_master);
+        thrust::upper_bound(policy, master_begin.data() + 1, master_begin.data() + (num_ranks + 2), zero,
+                            zero + num_master, rank_of.data());
+        thrust::stable_sort_by_key(policy, master_entries->data(), master_entries->data() + num_master,
+                                   rank_of.data());
+        thrust::stable_sort_by_key(policy, rank_of.data(), rank_of.data() + num_master, master_entries->data());
       }
     }
   }

@@ -17,9 +17,12 @@
 //    the device, or the host), which may reorder it freely since its boundaries are certified.
 //  - A run with an entry whose key cannot be refined (exact terms beyond the bounded buffers) is
 //    left whole to the existing repair.
+//  - A long run whose values are all exactly one double (ExactDoubleRadiusSq: a grid) is settled
+//    before any key is computed, by one double comparison per entry.
 #pragma once
 
 #include <thrust/copy.h>
+#include <thrust/count.h>
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
@@ -27,6 +30,9 @@
 #include <thrust/reduce.h>
 #include <thrust/scan.h>
 #include <thrust/sort.h>
+#include <thrust/transform.h>
+#include <thrust/transform_reduce.h>
+#include <thrust/functional.h>
 
 #include <cstdint>
 
@@ -83,13 +89,33 @@ struct RefinedEntryLess {
   }
 };
 
-/// 1 for the entries of runs longer than kMaxDeviceRun (the runs the device cannot sort itself).
+/// 1 for runs longer than kMaxDeviceRun (the runs the device cannot sort itself).
+struct IsLongRun {
+  const uint32_t* run_begin;
+  GALPHA_HD uint8_t operator()(uint32_t r) const { return run_begin[r + 1] - run_begin[r] > kMaxDeviceRun ? 1 : 0; }
+};
+
+/// The entries of long runs that are not all one double (those are settled without keys).
 struct InLongRun {
   const uint32_t* run_of;  // inclusive scan of run starts: 1-based run index of each entry
   const uint32_t* run_begin;
+  const uint8_t* one_double;  // per run: every value is exactly the same double
   GALPHA_HD bool operator()(uint32_t i) const {
     const uint32_t r = run_of[i] - 1;
-    return run_begin[r + 1] - run_begin[r] > kMaxDeviceRun;
+    return run_begin[r + 1] - run_begin[r] > kMaxDeviceRun && !one_double[r];
+  }
+};
+
+/// Cuts the links inside a run whose values are all one double: its entries become settled runs
+/// of one (SettleRunOfOneDouble has marked the values).
+struct CutLinksOfOneDouble {
+  const uint32_t* run_of;
+  const uint32_t* run_begin;
+  const uint8_t* one_double;
+  uint8_t* link;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t r = run_of[i] - 1;
+    if (one_double[r] && i != run_begin[r]) link[i - 1] = 0;
   }
 };
 
@@ -201,8 +227,8 @@ struct ApplyRefinedVerdicts {
 };
 
 /// Orders the entries of runs longer than kMaxDeviceRun by refined keys (see the file comment),
-/// cutting `link` where the order is settled; returns the number of entries refined. The caller
-/// rebuilds its run list from `link`. `ids` and `new_value` hold num_entries entries, `link`
+/// cutting `link` where the order is settled; returns nonzero when it cut links (the caller then
+/// rebuilds its run list from `link`). `ids` and `new_value` hold num_entries entries, `link`
 /// num_entries - 1, `run_begin` num_runs + 1.
 template <class System>
 uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link, const uint32_t* run_begin,
@@ -210,14 +236,30 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
                         ComparisonCounts* counts) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
+  // Long runs whose values are all exactly one double (a grid's congruent simplices) are settled
+  // first, by one double comparison per entry: no keys needed.
+  Buffer<uint8_t, System> one_double(sys, num_runs);
+  thrust::transform(policy, zero, zero + num_runs, one_double.data(), IsLongRun{run_begin});
+  if (thrust::count(policy, one_double.data(), one_double.data() + num_runs, uint8_t{1}) == 0) return 0;
   Buffer<uint32_t, System> run_of(sys, num_entries);
   const auto starts = thrust::make_transform_iterator(zero, RunStartAsU32{link});
   thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
+  thrust::for_each_n(policy, zero, num_entries,
+                     CheckRunOfOneDouble{simplex, ids, run_of.data(), run_begin, one_double.data()});
+  thrust::for_each_n(policy, zero, num_entries,
+                     SettleRunOfOneDouble{run_of.data(), run_begin, one_double.data(), new_value});
+  counts->bounded_exact += thrust::transform_reduce(policy, zero, zero + num_runs,
+                                                    SettledComparisons{run_begin, one_double.data()}, uint64_t{0},
+                                                    thrust::plus<uint64_t>());
   Buffer<uint32_t, System> positions(sys, num_entries);
   const auto num_refined = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_entries, positions.data(), InLongRun{run_of.data(), run_begin}) -
+      thrust::copy_if(policy, zero, zero + num_entries, positions.data(),
+                      InLongRun{run_of.data(), run_begin, one_double.data()}) -
       positions.data());
-  if (num_refined == 0) return 0;
+  thrust::for_each_n(policy, zero, num_entries,
+                     CutLinksOfOneDouble{run_of.data(), run_begin, one_double.data(), link});
+  one_double.Reset();
+  if (num_refined == 0) return 1;  // links may have been cut: the caller lists the runs again
 
   Buffer<RefinedEntry, System> entries(sys, num_refined);
   Buffer<uint8_t, System> run_unrefinable(sys, num_runs);
