@@ -97,9 +97,10 @@ for phase in "${phases[@]}"; do
       ;;
     hard)
       [ -x .carry/bin/alpha_bench ] || { echo "no alpha_bench in .carry"; status=1; continue; }
-      run_step hard 420 .carry/bin/alpha_bench --backend=cuda --sizes=100000,1000000 --repeat=3 --cgal-max=100000
-      run_step hard 300 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --repeat=1 --cgal-max=0
-      run_step hard 400 .carry/bin/alpha_bench --backend=cpu --sizes=1000000 --repeat=1 --cgal-max=0
+      # Sized to fit one 10-minute call; rows print as they finish, so a timeout keeps the rest.
+      run_step hard 300 .carry/bin/alpha_bench --backend=cuda --sizes=100000,1000000 --repeat=3 --cgal-max=100000
+      run_step hard 130 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --repeat=1 --cgal-max=0
+      run_step hard 150 .carry/bin/alpha_bench --backend=cpu --sizes=1000000 --repeat=1 --cgal-max=0
       grep -E '^\|' "$out/hard.log" | grep -vE 'stages of the best run|^\| [a-z_0-9]+ \| [0-9]+ \| (validate|upload)'
       ;;
     identity)

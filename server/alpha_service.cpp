@@ -111,7 +111,7 @@ struct StreamedReply {
 /// take the cached family itself, to keep it while their chunks are written.
 template <typename Answer>
 auto FromAlphaFamily(Answer answer) {
-  return [answer](std::shared_ptr<const CachedFamily> cached, const auto& request) {
+  return [answer](const std::shared_ptr<const CachedFamily>& cached, const auto& request) {
     return answer(cached->family(), request);
   };
 }

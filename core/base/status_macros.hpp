@@ -27,7 +27,7 @@ const absl::Status& AsStatus(const absl::StatusOr<T>& status_or) {
 /// enclosing function when it is not OK.
 #define GALPHA_RETURN_IF_ERROR(expr)                                                     \
   do {                                                                                   \
-    const ::absl::Status galpha_return_if_error_status_ =                                \
+    ::absl::Status galpha_return_if_error_status_ =                                      \
         ::galpha::status_macros_internal::AsStatus(expr);                                \
     if (!galpha_return_if_error_status_.ok()) return galpha_return_if_error_status_;     \
   } while (false)

@@ -4,7 +4,7 @@
 // errors as one line with the local exit codes, and the process's drain on SIGTERM.
 #include <gtest/gtest.h>
 
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill and signal numbers
 #include <sys/wait.h>
 #include <unistd.h>
 

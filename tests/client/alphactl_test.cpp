@@ -56,7 +56,7 @@ CommandResult Alphactl(const std::string& args) {
 }
 
 std::string WriteFile(const std::string& name, const std::string& text) {
-  const std::string path = std::filesystem::temp_directory_path() / name;
+  std::string path = std::filesystem::temp_directory_path() / name;
   std::ofstream(path) << text;
   return path;
 }
@@ -64,7 +64,7 @@ std::string WriteFile(const std::string& name, const std::string& text) {
 /// The raw format: little-endian uint64 N, then N pairs of float64 (this test runs on
 /// little-endian hosts only, as the engine does).
 std::string WriteBin(const std::string& name, const std::vector<std::array<double, 2>>& points) {
-  const std::string path = std::filesystem::temp_directory_path() / name;
+  std::string path = std::filesystem::temp_directory_path() / name;
   std::ofstream out(path, std::ios::binary);
   const uint64_t n = points.size();
   out.write(reinterpret_cast<const char*>(&n), sizeof n);

@@ -294,6 +294,7 @@ TEST_F(FamilyCacheTest, ConcurrentLookupsAndInsertsAreCounted) {
   constexpr int kThreads = 4;
   constexpr int kLookups = 300;
   std::vector<std::thread> threads;
+  threads.reserve(kThreads);
   for (int t = 0; t < kThreads; ++t) {
     threads.emplace_back([&, t] {
       for (int i = 0; i < kLookups; ++i) {

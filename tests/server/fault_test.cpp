@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill and signal numbers
 
 #include <algorithm>
 #include <atomic>
@@ -132,6 +132,7 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
 
   // Clients that die mid-upload: their uploads are dropped and their reservations freed.
   std::vector<pid_t> vanishing;
+  vanishing.reserve(4);
   for (int i = 0; i < 4; ++i) {
     vanishing.push_back(SpawnShell(std::string(GALPHA_FAULT_CLIENT) + " vanish " + server.address() + " 1000000 >/dev/null"));
   }
@@ -141,8 +142,10 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
   constexpr int kBurst = 8;
   std::vector<absl::StatusOr<client::BuildResult>> results(kBurst, absl::UnknownError("not run"));
   std::vector<std::vector<Point2>> inputs;
+  inputs.reserve(kBurst);
   for (int i = 0; i < kBurst; ++i) inputs.push_back(gen::Uniform(150000, 100 + static_cast<uint64_t>(i)));
   std::vector<std::thread> threads;
+  threads.reserve(kBurst);
   for (int i = 0; i < kBurst; ++i) {
     threads.emplace_back([&, i] { results[static_cast<size_t>(i)] = ClientOf(server)->Build(inputs[static_cast<size_t>(i)], Upload()); });
   }
@@ -161,14 +164,14 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
   auto client = ClientOf(server);
   grpc::GenericStub generic(client->channel());
   grpc::ClientContext context;
-  grpc::Slice garbage(std::string("\xff\xff\xff\xff\x0f garbage", 14));
+  grpc::Slice garbage(std::string("\xff\xff\xff\xff\x0f garbage"));
   grpc::ByteBuffer request(&garbage, 1), response;
   std::mutex mutex;
   std::condition_variable done;
   bool finished = false;
   grpc::Status garbage_status;
   generic.UnaryCall(&context, "/galpha.v1.AlphaShapes/Describe", grpc::StubOptions(), &request, &response,
-                    [&](grpc::Status s) {
+                    [&](const grpc::Status& s) {
                       std::lock_guard<std::mutex> lock(mutex);
                       garbage_status = s;
                       finished = true;

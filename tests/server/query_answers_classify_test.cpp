@@ -60,7 +60,7 @@ std::vector<StreamedSimplex> ExpectedSimplices(const AlphaFamily& family, const 
   for (uint32_t t = 0; t < family.triangles().size(); ++t) {
     std::array<uint32_t, 3> triangle = family.triangles()[t];
     std::sort(triangle.begin(), triangle.end());
-    triangles.push_back({triangle, classes.triangles[t]});
+    triangles.emplace_back(triangle, classes.triangles[t]);
   }
   std::sort(triangles.begin(), triangles.end());
   for (const auto& [triangle, c] : triangles) {

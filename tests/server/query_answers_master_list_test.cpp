@@ -73,7 +73,7 @@ void CheckMasterList(const std::shared_ptr<const CachedFamily>& cached, int64_t 
     ASSERT_EQ(message.endpoints().size(), entries);
     int position = 0;
     for (size_t i = 0; i < entries; ++i) {
-      const int kind = message.kinds()[i];
+      const int kind = static_cast<unsigned char>(message.kinds()[i]);
       ASSERT_GE(kind, v1::SIMPLEX_KIND_VERTEX);
       ASSERT_LE(kind, v1::SIMPLEX_KIND_TRIANGLE);
       ASSERT_LE(position + kind, message.vertex_indices_size());
@@ -126,7 +126,7 @@ TEST(QueryAnswersTest, MasterListRefusesBadRanges) {
     const int64_t k = f.cached->family().max_level();
     std::vector<std::pair<int64_t, int64_t>> bad = {{0, 0}, {0, 1}, {-1, 0}, {k + 1, 0}, {k + 1, k + 1},
                                                     {1, k + 1}, {2, 1}};
-    if (k >= 2) bad.push_back({k, k - 1});  // reversed (k - 1 = 0 would mean "first alone")
+    if (k >= 2) bad.emplace_back(k, k - 1);  // reversed (k - 1 = 0 would mean "first alone")
     for (const auto& [first, last] : bad) {
       SCOPED_TRACE(absl::StrCat(first, "..", last));
       v1::MasterListRequest request;

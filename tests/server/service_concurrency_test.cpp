@@ -39,10 +39,12 @@ TEST(ServiceTest, ConcurrentBuildsFromSeveralClientsMatchTheLocalEngine) {
   ASSERT_NE(server, nullptr);
   constexpr int kClients = 6;
   std::vector<std::vector<Point2>> inputs;
+  inputs.reserve(kClients);
   for (int i = 0; i < kClients; ++i) inputs.push_back(gen::Gaussian(4000 + 500 * (i % 3), 100 + static_cast<uint64_t>(i % 3)));
   std::vector<absl::StatusOr<client::BuildResult>> results(kClients, absl::UnknownError("not run"));
   std::vector<std::vector<double>> spectra(kClients);
   std::vector<std::thread> threads;
+  threads.reserve(kClients);
   for (int i = 0; i < kClients; ++i) {
     threads.emplace_back([&, i] {
       auto client = ClientOf(*server);

@@ -47,6 +47,7 @@ absl::StatusOr<ClassifyAnswer> ClassifyRemote(client::AlphaClient& client, const
       const int arity = static_cast<int>(chunk.kind());
       for (size_t i = 0; i < chunk.classes().size(); ++i) {
         std::vector<uint32_t> row;
+        row.reserve(static_cast<size_t>(arity) + 1);
         for (int k = 0; k < arity; ++k) row.push_back(chunk.vertex_indices(static_cast<int>(i) * arity + k));
         row.push_back(static_cast<uint8_t>(chunk.classes()[i]));
         answer.rows.push_back(row);

@@ -111,6 +111,7 @@ bool IsNearestDouble(double d, const mpq_class& value) {
 // triangulation.
 bool InGeneralPosition(const std::vector<Point2>& points) {
   std::vector<QPoint> q;
+  q.reserve(points.size());
   for (const Point2& p : points) q.push_back(ToQ(p));
   const size_t n = q.size();
   for (size_t i = 0; i < n; ++i) {

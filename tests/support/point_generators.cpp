@@ -94,7 +94,8 @@ std::vector<Point2> Grid(size_t n, uint64_t seed) {
   const size_t side = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
   std::vector<Point2> points(n);
   for (size_t i = 0; i < n; ++i) {
-    points[i] = {static_cast<double>(i % side), static_cast<double>(i / side)};
+    const size_t column = i % side, row = i / side;  // integer division: the cell's row
+    points[i] = {static_cast<double>(column), static_cast<double>(row)};
   }
   std::mt19937_64 rng(seed);
   std::shuffle(points.begin(), points.end(), rng);
@@ -219,9 +220,11 @@ std::vector<Point2> UlpLattice(size_t n, uint64_t seed) {
   const auto width = static_cast<size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
   std::vector<Point2> points;
   points.reserve(n);
+  const size_t columns = std::max<size_t>(width, 1);
   for (size_t i = 0; i < n; ++i) {
-    const double x = 1000.0 + 0.1 * static_cast<double>(i % std::max<size_t>(width, 1));
-    const double y = 2000.0 + 0.1 * static_cast<double>(i / std::max<size_t>(width, 1));
+    const size_t column = i % columns, row = i / columns;  // integer division: the point's row
+    const double x = 1000.0 + 0.1 * static_cast<double>(column);
+    const double y = 2000.0 + 0.1 * static_cast<double>(row);
     points.push_back({moved(x), moved(y)});
   }
   std::shuffle(points.begin(), points.end(), rng);

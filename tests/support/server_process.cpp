@@ -1,6 +1,6 @@
 #include "tests/support/server_process.hpp"
 
-#include <signal.h>
+#include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill and signal numbers
 #include <sys/wait.h>
 #include <unistd.h>
 

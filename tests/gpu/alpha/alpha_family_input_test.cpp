@@ -65,7 +65,7 @@ void CheckChainFamily(const AlphaFamily& f, const std::vector<Point2>& points) {
     want_edges.insert({std::min(order[i], order[i + 1]), std::max(order[i], order[i + 1])});
     const mpq_class dx = mpq_class(points[order[i + 1]].x) - points[order[i]].x;
     const mpq_class dy = mpq_class(points[order[i + 1]].y) - points[order[i]].y;
-    spectrum.push_back((dx * dx + dy * dy) / 4);
+    spectrum.emplace_back((dx * dx + dy * dy) / 4);
   }
   std::sort(spectrum.begin(), spectrum.end());
   spectrum.erase(std::unique(spectrum.begin(), spectrum.end()), spectrum.end());
@@ -128,6 +128,7 @@ TEST_P(InputTest, FewPointsAndCollinearSetsAreValid) {
   }
   // A long chain of integers on one line (many exact ties).
   std::vector<Point2> line;
+  line.reserve(500);
   for (int i = 0; i < 500; ++i)
     line.push_back({static_cast<double>((i * 37) % 500), static_cast<double>(2 * ((i * 37) % 500) + 1)});
   const absl::StatusOr<AlphaFamily> built = Build(line);

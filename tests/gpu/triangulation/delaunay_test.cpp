@@ -247,6 +247,7 @@ TEST_P(DelaunayTest, ManyCollinearShuffledWithDuplicates) {
 
 TEST_P(DelaunayTest, CollinearRunPlusOnePointOffTheLine) {
   std::vector<Point2> points;
+  points.reserve(1001);
   for (int i = 0; i < 1000; ++i) points.push_back({static_cast<double>((i * 37) % 1000), 0.0});
   points.push_back({500.0, 1e-9});
   Triangulation t;
