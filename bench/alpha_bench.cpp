@@ -34,10 +34,10 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
 #include "bench/bench_options.hpp"
+#include "bench/sort_floor/sort_floor.hpp"
 #include "core/family/alpha_family.hpp"
 #include "core/io/point_formats.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
-#include "bench/sort_floor/sort_floor.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {
@@ -62,7 +62,8 @@ size_t StatusBytes(const char* field) {
   std::ifstream status("/proc/self/status");
   std::string line;
   while (std::getline(status, line)) {
-    if (line.rfind(field, 0) == 0) return std::strtoull(line.c_str() + std::string(field).size() + 1, nullptr, 10) * 1024;
+    if (line.rfind(field, 0) == 0)
+      return std::strtoull(line.c_str() + std::string(field).size() + 1, nullptr, 10) * 1024;
   }
   return 0;
 }
@@ -108,9 +109,7 @@ struct BenchResult {
   std::string error;
 };
 
-bool IsTransferStage(const std::string& stage) {
-  return stage == "upload" || stage == "download";
-}
+bool IsTransferStage(const std::string& stage) { return stage == "upload" || stage == "download"; }
 
 /// Host work around the engine call (BuildAlphaFamily's own stages).
 bool IsHostStage(const std::string& stage) { return stage == "validate" || stage == "assemble"; }
@@ -150,7 +149,8 @@ BenchResult RunOne(const std::string& name, const std::vector<Point2>& points, c
       }
       result.host_ms = ms - result.transfer_ms - result.pipeline_ms;
       const auto start = std::chrono::steady_clock::now();
-      const Classification c = family->ClassifyAll(family->max_level() / 2, ClassifyMode::kGeneral, VertexRule::kReport);
+      const Classification c =
+          family->ClassifyAll(family->max_level() / 2, ClassifyMode::kGeneral, VertexRule::kReport);
       result.classify_ms = MillisecondsSince(start);
       if (c.edges.size() != family->edges().size()) result.error = "classification size mismatch";
     }
@@ -201,7 +201,8 @@ void PrintRow(const BenchResult& r) {
     cgal_mem = absl::StrCat(static_cast<int64_t>(static_cast<double>(r.cgal_rss) / n));
   }
   std::string spectrum = absl::StrCat(r.spectrum);
-  if (r.cgal_ms >= 0 && r.cgal_spectrum != r.spectrum) absl::StrAppend(&spectrum, " (CGAL ", r.cgal_spectrum, ": MISMATCH)");
+  if (r.cgal_ms >= 0 && r.cgal_spectrum != r.spectrum)
+    absl::StrAppend(&spectrum, " (CGAL ", r.cgal_spectrum, ": MISMATCH)");
   std::string floor = "-", over_floor = "-";
   if (r.floor_ms > 0) {
     char text[48];
@@ -210,13 +211,14 @@ void PrintRow(const BenchResult& r) {
     std::snprintf(text, sizeof text, "%.1f", r.pipeline_ms / r.floor_ms);
     over_floor = text;
   }
-  std::printf("| %s | %zu | %s | %.1f | %.1f | %.1f | %.1f | %s | %s | %s | %.0f | %.0f | %s | %.1f | %s | %llu / %llu / %llu | %s | %s |\n",
-              r.name.c_str(), r.n, r.backend.c_str(), r.galpha_ms, r.transfer_ms, r.pipeline_ms, r.host_ms,
-              cgal.c_str(), ratio.c_str(), pipeline_ratio.c_str(),
-              static_cast<double>(r.galpha_rss) / n, static_cast<double>(r.galpha_engine_peak) / n,
-              cgal_mem.c_str(), r.classify_ms, spectrum.c_str(), static_cast<unsigned long long>(r.counts.filter),
-              static_cast<unsigned long long>(r.counts.bounded_exact),
-              static_cast<unsigned long long>(r.counts.cpu_fallback), floor.c_str(), over_floor.c_str());
+  std::printf(
+      "| %s | %zu | %s | %.1f | %.1f | %.1f | %.1f | %s | %s | %s | %.0f | %.0f | %s | %.1f | %s | %llu / %llu / %llu "
+      "| %s | %s |\n",
+      r.name.c_str(), r.n, r.backend.c_str(), r.galpha_ms, r.transfer_ms, r.pipeline_ms, r.host_ms, cgal.c_str(),
+      ratio.c_str(), pipeline_ratio.c_str(), static_cast<double>(r.galpha_rss) / n,
+      static_cast<double>(r.galpha_engine_peak) / n, cgal_mem.c_str(), r.classify_ms, spectrum.c_str(),
+      static_cast<unsigned long long>(r.counts.filter), static_cast<unsigned long long>(r.counts.bounded_exact),
+      static_cast<unsigned long long>(r.counts.cpu_fallback), floor.c_str(), over_floor.c_str());
   std::fflush(stdout);
 }
 
@@ -237,8 +239,9 @@ void PrintStages(const std::vector<BenchResult>& results) {
 /// Hard inputs against easy ones: each row's pipeline over the uniform row of the same size (when
 /// there is one), over CGAL's time, and its largest stage.
 void PrintHardness(const std::vector<BenchResult>& results) {
-  std::printf("\n| input | n | pipeline ms | pipeline / uniform's | CGAL / pipeline | dominant stage (ms) |\n"
-              "|---|---:|---:|---:|---:|---|\n");
+  std::printf(
+      "\n| input | n | pipeline ms | pipeline / uniform's | CGAL / pipeline | dominant stage (ms) |\n"
+      "|---|---:|---:|---:|---:|---|\n");
   for (const BenchResult& r : results) {
     if (!r.error.empty()) continue;
     std::string vs_uniform = "-", vs_cgal = "-", dominant = "-";

@@ -43,9 +43,9 @@ struct BenchResult {
   std::string name;
   size_t n = 0;
   Backend backend = Backend::kCpu;
-  double galpha_ms = 0;           // the whole call, transfers included
-  double galpha_compute_ms = 0;   // the same run without the upload and download stages
-  size_t galpha_peak_bytes = 0;   // working memory peak on the backend
+  double galpha_ms = 0;          // the whole call, transfers included
+  double galpha_compute_ms = 0;  // the same run without the upload and download stages
+  size_t galpha_peak_bytes = 0;  // working memory peak on the backend
   double cgal_ms = 0;
   size_t galpha_triangles = 0;
   size_t cgal_triangles = 0;
@@ -58,8 +58,7 @@ constexpr char kUsage[] =
     "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]...\n";
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 // Host-device copies: on the CUDA backend these are PCIe transfers, reported apart from compute.
@@ -130,10 +129,9 @@ void PrintRow(const BenchResult& r) {
   if (!r.error.empty()) {
     std::printf("| %s | %zu | - | error: %s | | | | | | |\n", r.name.c_str(), r.n, r.error.c_str());
   } else {
-    const std::string triangles =
-        r.galpha_triangles == r.cgal_triangles
-            ? absl::StrCat(r.galpha_triangles)
-            : absl::StrCat(r.galpha_triangles, " (CGAL ", r.cgal_triangles, ": MISMATCH)");
+    const std::string triangles = r.galpha_triangles == r.cgal_triangles
+                                      ? absl::StrCat(r.galpha_triangles)
+                                      : absl::StrCat(r.galpha_triangles, " (CGAL ", r.cgal_triangles, ": MISMATCH)");
     std::printf("| %s | %zu | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %s |\n", r.name.c_str(), r.n,
                 BackendName(r.backend), r.galpha_compute_ms, r.galpha_ms - r.galpha_compute_ms, r.cgal_ms,
                 r.cgal_ms / r.galpha_compute_ms, r.cgal_ms / r.galpha_ms,
@@ -158,8 +156,7 @@ int Main(int argc, char** argv) {
     return 2;
   }
   std::printf("delaunay_bench: backend %s requested (CUDA %s), best of %d, %u host threads\n\n",
-              BackendName(options->backend),
-              CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
+              BackendName(options->backend), CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
               std::thread::hardware_concurrency());
 
   PrintHeader();

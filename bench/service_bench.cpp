@@ -211,7 +211,8 @@ int Run(const Options& options) {
               simplices, bytes, classify_seconds * 1e3, static_cast<double>(bytes) / classify_seconds / 1e9);
 
   // 3. Concurrent builds of distinct point sets.
-  std::printf("| concurrent clients | builds | wall s | builds/s | throughput vs 1 client |\n|---:|---:|---:|---:|---:|\n");
+  std::printf(
+      "| concurrent clients | builds | wall s | builds/s | throughput vs 1 client |\n|---:|---:|---:|---:|---:|\n");
   double single_rate = 0;
   for (const int c : options.clients) {
     std::vector<std::vector<Point2>> inputs;
@@ -228,7 +229,8 @@ int Run(const Options& options) {
       threads.reserve(static_cast<size_t>(c));
       const auto start = Clock::now();
       for (int i = 0; i < c; ++i) {
-        threads.emplace_back([&, i] { TimedBuild(*clients[static_cast<size_t>(i)], inputs[static_cast<size_t>(i)], nullptr); });
+        threads.emplace_back(
+            [&, i] { TimedBuild(*clients[static_cast<size_t>(i)], inputs[static_cast<size_t>(i)], nullptr); });
       }
       for (auto& t : threads) t.join();
       wall = std::min(wall, SecondsSince(start));

@@ -68,7 +68,8 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
   if (const std::string* server = line->Find("server")) {
     if (server->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
     if (line->Find("backend") != nullptr) {
-      return absl::InvalidArgumentError("--backend applies to local builds; with --server the server picks its backend");
+      return absl::InvalidArgumentError(
+          "--backend applies to local builds; with --server the server picks its backend");
     }
     common.server = *server;
   }

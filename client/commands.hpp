@@ -13,8 +13,8 @@
 #include "absl/strings/string_view.h"
 #include "absl/types/span.h"
 #include "client/cli_args.hpp"
-#include "core/family/alpha_family.hpp"
 #include "core/base/point.hpp"
+#include "core/family/alpha_family.hpp"
 
 namespace galpha::alphactl {
 

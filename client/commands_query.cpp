@@ -110,7 +110,8 @@ int RunSummary(Args args) {
       "\",\"vertex_rule\":\"", VertexRuleName(options->rule), "\",\"vertices\":", ClassCountsJson(counts.vertices),
       ",\"edges\":", ClassCountsJson(counts.edges), ",\"triangles\":", ClassCountsJson(counts.triangles),
       ",\"components\":", family->Components(level), ",\"solid_components\":", family->SolidComponents(level),
-      ",\"interior_area\":", JsonNumber(counts.interior_area), ",\"backend\":", JsonString(family->report().backend), "}\n");
+      ",\"interior_area\":", JsonNumber(counts.interior_area), ",\"backend\":", JsonString(family->report().backend),
+      "}\n");
   std::fputs(json.c_str(), stdout);
   return kExitOk;
 }

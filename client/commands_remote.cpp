@@ -5,10 +5,10 @@
 // from the command line, where other users of the machine could read it.
 #include <algorithm>
 #include <chrono>
-#include <limits>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -84,8 +84,8 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
   remote.build = *std::move(built);
   if (verbose) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "alphactl: %s on the server (%.2f s)\n",
-                 remote.build.cached ? "family found" : "family built", seconds);
+    std::fprintf(stderr, "alphactl: %s on the server (%.2f s)\n", remote.build.cached ? "family found" : "family built",
+                 seconds);
   }
   return remote;
 }
@@ -217,8 +217,8 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
       "{\"file\":", JsonString(common.file), ",\"points\":", remote->input_points,
       ",\"distinct_points\":", build.distinct_points(), ",\"duplicates\":", build.duplicates(),
       ",\"spectrum_size\":", build.spectrum_size(), ",\"level\":", summary.level(),
-      ",\"alpha_sq\":", JsonNumber(summary.alpha_sq()), ",\"mode\":\"", ModeName(options.mode),
-      "\",\"vertex_rule\":\"", VertexRuleName(options.rule), "\",\"vertices\":", ClassCountsJson(FromProto(summary.vertices())),
+      ",\"alpha_sq\":", JsonNumber(summary.alpha_sq()), ",\"mode\":\"", ModeName(options.mode), "\",\"vertex_rule\":\"",
+      VertexRuleName(options.rule), "\",\"vertices\":", ClassCountsJson(FromProto(summary.vertices())),
       ",\"edges\":", ClassCountsJson(FromProto(summary.edges())),
       ",\"triangles\":", ClassCountsJson(FromProto(summary.triangles())), ",\"components\":", summary.components(),
       ",\"solid_components\":", summary.solid_components(), ",\"interior_area\":", JsonNumber(summary.interior_area()),
@@ -307,7 +307,8 @@ int RemoteOptimal(const CommonArgs& common, int64_t components) {
   }
   json += ",\"general\":";
   if (answer->has_general()) {
-    absl::StrAppend(&json, "{\"rank\":", answer->general().rank(), ",\"alpha_sq\":", JsonNumber(answer->general().alpha_sq()),
+    absl::StrAppend(&json, "{\"rank\":", answer->general().rank(),
+                    ",\"alpha_sq\":", JsonNumber(answer->general().alpha_sq()),
                     ",\"components\":", answer->general().components(), "}");
   } else {
     json += "null";

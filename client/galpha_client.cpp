@@ -138,7 +138,8 @@ absl::StatusOr<v1::ReleaseResponse> AlphaClient::Release(const std::string& hand
 
 template <typename Response, typename Request>
 absl::Status AlphaClient::ReadStream(
-    const std::string& handle, std::unique_ptr<grpc::ClientReader<Response>> (v1::AlphaShapes::Stub::*call)(grpc::ClientContext*, const Request&),
+    const std::string& handle,
+    std::unique_ptr<grpc::ClientReader<Response>> (v1::AlphaShapes::Stub::*call)(grpc::ClientContext*, const Request&),
     const Request& request, const std::function<absl::Status(const Response&)>& on_message) {
   grpc::ClientContext context;
   PrepareContext(&context, handle);
@@ -149,8 +150,7 @@ absl::Status AlphaClient::ReadStream(
     consumer_error = on_message(message);
     if (!consumer_error.ok()) {
       context.TryCancel();
-      while (reader->Read(&message)) {
-      }
+      while (reader->Read(&message)) {}
       break;
     }
   }

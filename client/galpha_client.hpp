@@ -85,9 +85,9 @@ class AlphaClient {
  private:
   template <typename Response, typename Request>
   absl::Status ReadStream(const std::string& handle,
-      std::unique_ptr<grpc::ClientReader<Response>> (galpha::v1::AlphaShapes::Stub::*call)(grpc::ClientContext*,
-                                                                                         const Request&),
-      const Request& request, const std::function<absl::Status(const Response&)>& on_message);
+                          std::unique_ptr<grpc::ClientReader<Response>> (galpha::v1::AlphaShapes::Stub::*call)(
+                              grpc::ClientContext*, const Request&),
+                          const Request& request, const std::function<absl::Status(const Response&)>& on_message);
 
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;

@@ -73,8 +73,8 @@ grpc::ServerUnaryReactor* FinishUnary(grpc::CallbackServerContext* context, cons
 // Runs a unary RPC whose `answer` fills the response itself and returns an absl::Status; the
 // reactor finishes with it.
 template <typename Answer>
-grpc::ServerUnaryReactor* AnswerUnary(grpc::CallbackServerContext* context, ServerMetrics* metrics,
-                                      const char* method, Answer answer) {
+grpc::ServerUnaryReactor* AnswerUnary(grpc::CallbackServerContext* context, ServerMetrics* metrics, const char* method,
+                                      Answer answer) {
   RpcRecord record(metrics, method);
   return FinishUnary(context, record, answer());
 }
@@ -155,8 +155,8 @@ absl::StatusOr<std::unique_ptr<AlphaService>> AlphaService::Create(const Service
   }
   const size_t memory = options.build_memory_bytes > 0 ? options.build_memory_bytes : DefaultMemoryBudget(backend);
   service->cache_ = std::make_unique<FamilyCache>(options.cache_bytes, metrics);
-  service->scheduler_ = std::make_unique<BuildScheduler>(std::move(slot_streams), options.max_queued_builds, memory,
-                                                         metrics);
+  service->scheduler_ =
+      std::make_unique<BuildScheduler>(std::move(slot_streams), options.max_queued_builds, memory, metrics);
   metrics->SetBackend(service->backend_name_);
   service->SampleDeviceMemory();
   return service;
@@ -193,8 +193,8 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> AlphaService::Lookup(grpc::C
   }
   auto family = cache_->Find(*tenant, handle);
   if (family == nullptr) {
-    return absl::NotFoundError(absl::StrCat("no family under handle ", handle,
-                                            " (never built here, released or evicted): build it again"));
+    return absl::NotFoundError(
+        absl::StrCat("no family under handle ", handle, " (never built here, released or evicted): build it again"));
   }
   return family;
 }
@@ -234,8 +234,7 @@ grpc::ServerUnaryReactor* AlphaService::Spectrum(grpc::CallbackServerContext* co
 grpc::ServerUnaryReactor* AlphaService::Components(grpc::CallbackServerContext* context,
                                                    const v1::ComponentsRequest* request,
                                                    v1::ComponentsResponse* response) {
-  return AnswerQuery(context, "Components", *request, FromAlphaFamily(AnswerComponents),
-                     UnaryReply(context, response));
+  return AnswerQuery(context, "Components", *request, FromAlphaFamily(AnswerComponents), UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::OptimalAlpha(grpc::CallbackServerContext* context,
@@ -245,8 +244,8 @@ grpc::ServerUnaryReactor* AlphaService::OptimalAlpha(grpc::CallbackServerContext
                      UnaryReply(context, response));
 }
 
-grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* context,
-                                                const v1::ReleaseRequest* request, v1::ReleaseResponse* response) {
+grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* context, const v1::ReleaseRequest* request,
+                                                v1::ReleaseResponse* response) {
   return AnswerUnary(context, metrics_, "Release", [&]() -> absl::Status {
     auto tenant = Authenticate(context);
     if (!tenant.ok()) return tenant.status();

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "galpha/v1/alpha_shapes.grpc.pb.h"
-#include "gpu/triangulation/delaunay.hpp"
 #include "gpu/system/device_streams.hpp"
+#include "gpu/triangulation/delaunay.hpp"
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
 #include "server/family_cache.hpp"
@@ -62,11 +62,11 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   void SampleDeviceMemory();
 
   grpc::ServerReadReactor<galpha::v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
-                                                            galpha::v1::BuildResponse* response) override;
+                                                           galpha::v1::BuildResponse* response) override;
   grpc::ServerUnaryReactor* Describe(grpc::CallbackServerContext* context, const galpha::v1::DescribeRequest* request,
                                      galpha::v1::DescribeResponse* response) override;
-  grpc::ServerWriteReactor<galpha::v1::ClassifyResponse>* Classify(
-      grpc::CallbackServerContext* context, const galpha::v1::ClassifyRequest* request) override;
+  grpc::ServerWriteReactor<galpha::v1::ClassifyResponse>* Classify(grpc::CallbackServerContext* context,
+                                                                   const galpha::v1::ClassifyRequest* request) override;
   grpc::ServerWriteReactor<galpha::v1::MasterListResponse>* MasterList(
       grpc::CallbackServerContext* context, const galpha::v1::MasterListRequest* request) override;
   grpc::ServerUnaryReactor* Spectrum(grpc::CallbackServerContext* context, const galpha::v1::SpectrumRequest* request,

@@ -32,8 +32,8 @@ absl::Status BuildScheduler::Submit(size_t memory_bytes, Job job) {
   queue_.push_back(Pending{memory_bytes, std::move(job)});
   if (WaitingLocked() > max_queue_) {
     queue_.pop_back();
-    return absl::ResourceExhaustedError(absl::StrCat("the build queue is full (", max_queue_,
-                                                     " builds waiting for ", workers_.size(), " slots); retry later"));
+    return absl::ResourceExhaustedError(absl::StrCat("the build queue is full (", max_queue_, " builds waiting for ",
+                                                     workers_.size(), " slots); retry later"));
   }
   ReportLoad();
   changed_.notify_all();

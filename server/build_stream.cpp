@@ -48,9 +48,8 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       decoded_.header = message.header();
       const uint64_t expected = decoded_.header.expected_points();
       if (expected > limits_.max_points) {
-        return absl::ResourceExhaustedError(absl::StrCat("the header announces ", expected,
-                                                         " points; this server builds at most ", limits_.max_points,
-                                                         " points"));
+        return absl::ResourceExhaustedError(absl::StrCat(
+            "the header announces ", expected, " points; this server builds at most ", limits_.max_points, " points"));
       }
       if (expected > 0) {
         // Reserve the announced size up front: the upload is refused now rather than half way.
@@ -108,8 +107,8 @@ absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
   if (!has_header_) return absl::InvalidArgumentError("the build stream is empty: it needs a header, then points");
   const uint64_t expected = decoded_.header.expected_points();
   if (expected > 0 && decoded_.points.size() != expected) {
-    return absl::InvalidArgumentError(absl::StrCat("the stream ended after ", decoded_.points.size(),
-                                                   " points; its header announced ", expected));
+    return absl::InvalidArgumentError(
+        absl::StrCat("the stream ended after ", decoded_.points.size(), " points; its header announced ", expected));
   }
   // Hashed once the points are all here: in parallel (point_set_handle.hpp), ~1 ms at 1M points
   // on 16 cores.

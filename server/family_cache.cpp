@@ -6,8 +6,7 @@
 
 namespace galpha::server {
 
-FamilyCache::FamilyCache(size_t byte_budget, CacheObserver* observer)
-    : byte_budget_(byte_budget), observer_(observer) {
+FamilyCache::FamilyCache(size_t byte_budget, CacheObserver* observer) : byte_budget_(byte_budget), observer_(observer) {
   if (observer_ != nullptr) observer_->OnSize(0, 0);
 }
 
@@ -32,8 +31,9 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> FamilyCache::Insert(const st
                                                                         std::shared_ptr<const CachedFamily> family) {
   const size_t bytes = family->bytes();
   if (bytes > byte_budget_) {
-    return absl::ResourceExhaustedError(absl::StrCat("the family needs ", bytes, " bytes of cache; the cache budget is ",
-                                                     byte_budget_, " bytes (raise --cache_bytes)"));
+    return absl::ResourceExhaustedError(absl::StrCat("the family needs ", bytes,
+                                                     " bytes of cache; the cache budget is ", byte_budget_,
+                                                     " bytes (raise --cache_bytes)"));
   }
   std::lock_guard<std::mutex> lock(mutex_);
   std::string key = Key(tenant, handle);

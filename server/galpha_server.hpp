@@ -57,8 +57,8 @@ class GalphaServer {
   ServerMetrics& metrics() { return *metrics_; }
 
   /// Health goes NOT_SERVING and new builds are refused; after the notice period the server stops
-  /// accepting calls, and calls still running after the grace period are cancelled. Returns when the server has stopped. Safe to
-  /// call more than once and from any thread.
+  /// accepting calls, and calls still running after the grace period are cancelled. Returns when the server has
+  /// stopped. Safe to call more than once and from any thread.
   void Drain();
   /// Ends a running drain's notice period now (a second SIGTERM).
   void CutNoticeShort();

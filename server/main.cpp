@@ -13,8 +13,8 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "absl/strings/str_cat.h"
-#include "grpcpp/grpcpp.h"
 #include "grpc/health/v1/health.grpc.pb.h"
+#include "grpcpp/grpcpp.h"
 #include "server/galpha_server.hpp"
 
 ABSL_FLAG(std::string, listen, "0.0.0.0:50051", "gRPC address (host:port; port 0 picks one)");
@@ -22,7 +22,8 @@ ABSL_FLAG(std::string, metrics_listen, "0.0.0.0:9464", "Prometheus exporter addr
 ABSL_FLAG(std::string, backend, "auto", "auto (GPU when present), cpu or cuda");
 ABSL_FLAG(int, build_slots, 0, "builds running at once (CUDA streams); 0: 4 on a GPU, 1 on the CPU");
 ABSL_FLAG(uint64_t, max_queued_builds, 16, "builds waiting for a slot before RESOURCE_EXHAUSTED");
-ABSL_FLAG(uint64_t, build_memory_bytes, 0, "working memory admitted to running builds; 0: 90% of the GPU's, or half the host's");
+ABSL_FLAG(uint64_t, build_memory_bytes, 0,
+          "working memory admitted to running builds; 0: 90% of the GPU's, or half the host's");
 ABSL_FLAG(uint64_t, max_points_per_build, 100000000, "largest point set one build accepts");
 ABSL_FLAG(uint64_t, max_in_flight_bytes, uint64_t{8} << 30, "bytes of points held by all uploads and builds at once");
 ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30, "byte budget of the family cache (LRU eviction)");

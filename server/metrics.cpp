@@ -33,7 +33,10 @@ struct ServerMetrics::Families {
                         .Name("galpha_rpc_duration_seconds")
                         .Help("Latency of RPCs, by method")
                         .Register(r)),
-        rpcs(prometheus::BuildCounter().Name("galpha_rpcs_total").Help("Finished RPCs by method and status code").Register(r)),
+        rpcs(prometheus::BuildCounter()
+                 .Name("galpha_rpcs_total")
+                 .Help("Finished RPCs by method and status code")
+                 .Register(r)),
         comparisons(prometheus::BuildCounter()
                         .Name("galpha_radius_comparisons_total")
                         .Help("Exact radius comparisons by the path that decided them (filter, device_exact, "
@@ -43,17 +46,25 @@ struct ServerMetrics::Families {
                      .Name("galpha_builds_rejected_total")
                      .Help("Builds refused before running, by reason")
                      .Register(r)),
-        cache_bytes(prometheus::BuildGauge().Name("galpha_cache_bytes").Help("Bytes of families in the cache").Register(r)),
-        cache_entries(
-            prometheus::BuildGauge().Name("galpha_cache_entries").Help("Families in the cache").Register(r)),
-        cache_hits(prometheus::BuildCounter().Name("galpha_cache_hits_total").Help("Cache lookups that found a family").Register(r)),
-        cache_misses(prometheus::BuildCounter().Name("galpha_cache_misses_total").Help("Cache lookups that found nothing").Register(r)),
+        cache_bytes(
+            prometheus::BuildGauge().Name("galpha_cache_bytes").Help("Bytes of families in the cache").Register(r)),
+        cache_entries(prometheus::BuildGauge().Name("galpha_cache_entries").Help("Families in the cache").Register(r)),
+        cache_hits(prometheus::BuildCounter()
+                       .Name("galpha_cache_hits_total")
+                       .Help("Cache lookups that found a family")
+                       .Register(r)),
+        cache_misses(prometheus::BuildCounter()
+                         .Name("galpha_cache_misses_total")
+                         .Help("Cache lookups that found nothing")
+                         .Register(r)),
         cache_evictions(prometheus::BuildCounter()
                             .Name("galpha_cache_evictions_total")
                             .Help("Families evicted to stay within the cache budget")
                             .Register(r)),
-        builds_in_flight(prometheus::BuildGauge().Name("galpha_builds_in_flight").Help("Builds running on a slot").Register(r)),
-        queue_length(prometheus::BuildGauge().Name("galpha_build_queue_length").Help("Builds waiting for a slot").Register(r)),
+        builds_in_flight(
+            prometheus::BuildGauge().Name("galpha_builds_in_flight").Help("Builds running on a slot").Register(r)),
+        queue_length(
+            prometheus::BuildGauge().Name("galpha_build_queue_length").Help("Builds waiting for a slot").Register(r)),
         admitted_bytes(prometheus::BuildGauge()
                            .Name("galpha_build_admitted_bytes")
                            .Help("Estimated working memory of the running builds")
@@ -62,7 +73,10 @@ struct ServerMetrics::Families {
                           .Name("galpha_device_memory_used_bytes")
                           .Help("GPU memory in use (total - free), sampled")
                           .Register(r)),
-        backend(prometheus::BuildGauge().Name("galpha_backend_info").Help("1 for the backend this server runs").Register(r)),
+        backend(prometheus::BuildGauge()
+                    .Name("galpha_backend_info")
+                    .Help("1 for the backend this server runs")
+                    .Register(r)),
         filter(comparisons.Add({{"path", "filter"}})),
         device_exact(comparisons.Add({{"path", "device_exact"}})),
         cpu_fallback(comparisons.Add({{"path", "cpu_fallback"}})),

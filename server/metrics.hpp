@@ -44,7 +44,6 @@ class ServerMetrics final : public CacheObserver, public SchedulerObserver {
   // SchedulerObserver
   void OnLoad(size_t queued, size_t running, size_t admitted_bytes) override;
 
-
  private:
   struct Families;
   std::shared_ptr<prometheus::Registry> registry_;

@@ -63,7 +63,8 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
           return true;
         case Phase::kVertices:
           if (FillChunk(message, v1::SIMPLEX_KIND_VERTEX, 1, family.points().size(), [&](size_t v, uint32_t* out) {
-                if (family.representative()[v] != v) return std::pair<SimplexClass, bool>{SimplexClass::kExterior, false};
+                if (family.representative()[v] != v)
+                  return std::pair<SimplexClass, bool>{SimplexClass::kExterior, false};
                 out[0] = static_cast<uint32_t>(v);
                 return Emit(classes_.vertices[v]);
               })) {
@@ -293,9 +294,8 @@ absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::
     case v1::Threshold::kRank:
       level = family.LevelForRank(threshold.rank());
       if (!level.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("rank ", threshold.rank(), " is outside 0..",
-                                                       family.max_level(), " (the spectrum has ", family.max_level(),
-                                                       " values)"));
+        return absl::InvalidArgumentError(absl::StrCat("rank ", threshold.rank(), " is outside 0..", family.max_level(),
+                                                       " (the spectrum has ", family.max_level(), " values)"));
       }
       resolved.alpha_sq = PublishedAlphaSq(family, *level);
       break;

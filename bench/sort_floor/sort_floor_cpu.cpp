@@ -3,10 +3,10 @@
 #include <new>
 
 #include "absl/strings/str_cat.h"
-#include "gpu/system/backend.hpp"
-#include "gpu/system/engine_system.cuh"
 #include "bench/sort_floor/sort_floor.hpp"
 #include "bench/sort_floor/sort_floor_impl.cuh"
+#include "gpu/system/backend.hpp"
+#include "gpu/system/engine_system.cuh"
 
 namespace galpha {
 

@@ -1,6 +1,6 @@
 // MeasureSortFloorSeconds on the CUDA backend: a device radix sort on a stream of its own.
-#include "gpu/system/cuda_system.cuh"
 #include "bench/sort_floor/sort_floor_impl.cuh"
+#include "gpu/system/cuda_system.cuh"
 
 namespace galpha::detail {
 

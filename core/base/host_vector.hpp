@@ -10,9 +10,9 @@
 
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <algorithm>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
@@ -37,7 +37,7 @@ class DefaultInitAllocator {
     if (count > static_cast<size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
     const size_t bytes = count * sizeof(T);
     if (bytes < kHugeFrom) {
-      void* p = ::operator new(bytes, std::align_val_t{alignof(T)});
+      void* p = ::operator new (bytes, std::align_val_t{alignof(T)});
       return static_cast<T*>(p);
     }
     const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
@@ -49,7 +49,7 @@ class DefaultInitAllocator {
   }
   void deallocate(T* p, size_t count) noexcept {
     if (count * sizeof(T) < kHugeFrom) {
-      ::operator delete(p, std::align_val_t{alignof(T)});
+      ::operator delete (p, std::align_val_t{alignof(T)});
     } else {
       std::free(p);
     }

@@ -11,13 +11,9 @@ struct Point2 {
   double y;
 };
 
-GALPHA_HD inline bool operator==(const Point2& a, const Point2& b) {
-  return a.x == b.x && a.y == b.y;
-}
+GALPHA_HD inline bool operator==(const Point2& a, const Point2& b) { return a.x == b.x && a.y == b.y; }
 
 /// Lexicographic order (x, then y): the order duplicates are found in.
-GALPHA_HD inline bool LexLess(const Point2& a, const Point2& b) {
-  return a.x < b.x || (a.x == b.x && a.y < b.y);
-}
+GALPHA_HD inline bool LexLess(const Point2& a, const Point2& b) { return a.x < b.x || (a.x == b.x && a.y < b.y); }
 
 }  // namespace galpha

@@ -7,9 +7,9 @@
 // and device.
 #pragma once
 
-#include "core/exact/expansion.hpp"
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/expansion.hpp"
 #include "core/exact/predicates.hpp"
 
 namespace galpha {

@@ -101,9 +101,7 @@ GALPHA_HD GALPHA_FORCEINLINE int ExponentOf(double v) {
 }
 
 /// 2^k, exactly, for -1022 <= k <= 1023.
-GALPHA_HD GALPHA_FORCEINLINE double Pow2(int k) {
-  return BitsToDouble(static_cast<uint64_t>(k + 1023) << 52);
-}
+GALPHA_HD GALPHA_FORCEINLINE double Pow2(int k) { return BitsToDouble(static_cast<uint64_t>(k + 1023) << 52); }
 
 /// v * 2^s. Exact when the result is normal (or zero); s >= -1022 is assumed (one rounding at most:
 /// large upward scalings go in steps of 2^1000, each exact because the value only grows).
@@ -154,8 +152,7 @@ GALPHA_HD GALPHA_FORCEINLINE void Split(double a, double& hi, double& lo) {
 
 /// Two-Product with b already split into (bhi, blo). x + y = a * b exactly, x = fl(a * b).
 /// Deliberately built from Split instead of fma: see the header comment.
-GALPHA_HD GALPHA_FORCEINLINE void TwoProductPresplit(double a, double b, double bhi, double blo,
-                                                     double& x, double& y) {
+GALPHA_HD GALPHA_FORCEINLINE void TwoProductPresplit(double a, double b, double bhi, double blo, double& x, double& y) {
   x = Mul(a, b);
   double ahi, alo;
   Split(a, ahi, alo);
@@ -205,8 +202,7 @@ namespace detail {
 /// Fast-Two-Sum; Two-Sum returns the same two numbers whenever Fast-Two-Sum's precondition holds
 /// and stays error-free when it does not, so we use it throughout. Unlike the reference code this
 /// never reads past the end of e or f.
-GALPHA_HD inline int ExpansionSumImpl(int elen, const double* e, int flen, const double* f,
-                                      bool negate_f, double* h) {
+GALPHA_HD inline int ExpansionSumImpl(int elen, const double* e, int flen, const double* f, bool negate_f, double* h) {
   int ei = 0, fi = 0, hindex = 0;
   double q = 0.0;
   bool have_q = false;
@@ -243,14 +239,12 @@ GALPHA_HD inline int ExpansionSumImpl(int elen, const double* e, int flen, const
 /// h = e + f (Fast-Expansion-Sum, zero elimination). Inputs strongly nonoverlapping (everything
 /// these functions produce is); output too. h holds up to elen + flen components and must not
 /// alias e or f.
-GALPHA_HD inline int ExpansionSumZeroElim(int elen, const double* e, int flen, const double* f,
-                                          double* h) {
+GALPHA_HD inline int ExpansionSumZeroElim(int elen, const double* e, int flen, const double* f, double* h) {
   return detail::ExpansionSumImpl(elen, e, flen, f, false, h);
 }
 
 /// h = e - f; same contract as ExpansionSumZeroElim.
-GALPHA_HD inline int ExpansionDiffZeroElim(int elen, const double* e, int flen, const double* f,
-                                           double* h) {
+GALPHA_HD inline int ExpansionDiffZeroElim(int elen, const double* e, int flen, const double* f, double* h) {
   return detail::ExpansionSumImpl(elen, e, flen, f, true, h);
 }
 
@@ -282,8 +276,7 @@ GALPHA_HD inline int ScaleExpansionZeroElim(int elen, const double* e, double b,
 /// (every partial product has at most 2 * max(elen, flen) components, and the sums at most add
 /// the lengths) and must not alias e or f.
 template <int kMaxE, int kMaxF>
-GALPHA_HD inline int ExpansionProduct(int elen, const double* e, int flen, const double* f,
-                                      double* h) {
+GALPHA_HD inline int ExpansionProduct(int elen, const double* e, int flen, const double* f, double* h) {
   constexpr int kMaxLong = kMaxE > kMaxF ? kMaxE : kMaxF;  // NOLINT(bugprone-branch-clone): a max
   constexpr int kMaxOut = 2 * kMaxE * kMaxF;
   static_assert(kMaxE > 0 && kMaxF > 0, "expansion capacities must be positive");

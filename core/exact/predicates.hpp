@@ -43,9 +43,9 @@
 
 #include <cstdint>
 
-#include "core/exact/expansion.hpp"
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/expansion.hpp"
 
 #if defined(__CUDACC__)
 #define GALPHA_PRED_COLD __noinline__
@@ -73,8 +73,7 @@ GALPHA_HD GALPHA_FORCEINLINE double InCircleApprox(Point2 a, Point2 b, Point2 c,
   const double alift = Add(Mul(adx, adx), Mul(ady, ady));
   const double blift = Add(Mul(bdx, bdx), Mul(bdy, bdy));
   const double clift = Add(Mul(cdx, cdx), Mul(cdy, cdy));
-  return Add(Add(Mul(alift, Sub(Mul(bdx, cdy), Mul(cdx, bdy))),
-                 Mul(blift, Sub(Mul(cdx, ady), Mul(adx, cdy)))),
+  return Add(Add(Mul(alift, Sub(Mul(bdx, cdy), Mul(cdx, bdy))), Mul(blift, Sub(Mul(cdx, ady), Mul(adx, cdy)))),
              Mul(clift, Sub(Mul(adx, bdy), Mul(bdx, ady))));
 }
 
@@ -142,8 +141,8 @@ GALPHA_HD inline int Cross(double xi, double yi, double xj, double yj, double* o
 
 /// p + q - r for 4-component inputs, e.g. [1,x,y](i,j,k) = C(i,j) + C(j,k) + C(k,i): at most 12
 /// components.
-GALPHA_HD inline int SumSumDiff(int lp, const double* p, int lq, const double* q, int lr,
-                                const double* r, double* out) {
+GALPHA_HD inline int SumSumDiff(int lp, const double* p, int lq, const double* q, int lr, const double* r,
+                                double* out) {
   double t[8];
   const int lt = ExpansionSumZeroElim(lp, p, lq, q, t);
   return ExpansionDiffZeroElim(lt, t, lr, r, out);
@@ -152,8 +151,8 @@ GALPHA_HD inline int SumSumDiff(int lp, const double* p, int lq, const double* q
 /// [1,u,z](i,j,k) = u_i (z_j - z_k) + u_j (z_k - z_i) + u_k (z_i - z_j), exactly, from scaled
 /// coordinates u and exact lifts z (4 components each); returns its sign. Sizes: z differences
 /// 8, scaled 16, sum 48.
-GALPHA_HD GALPHA_PRED_COLD inline int MinorUZSign(const double* u, const double (*z)[4],
-                                                  const int* zl, int i, int j, int k) {
+GALPHA_HD GALPHA_PRED_COLD inline int MinorUZSign(const double* u, const double (*z)[4], const int* zl, int i, int j,
+                                                  int k) {
   const int idx[3] = {i, j, k};
   double acc[48], next[48];
   int accl = 0;
@@ -212,8 +211,7 @@ GALPHA_HD GALPHA_PRED_COLD inline int Orient2dExpansion(Point2 a, Point2 b, Poin
 /// which is -det4 [[1,x,y,z]] expanded along the z column (z = x^2 + y^2, exact). The
 /// raw-coordinate form keeps every factor a single double (lifts 4 and minors 12 components) where
 /// exact differences would double each factor (1536 components, 4x the local memory).
-GALPHA_HD GALPHA_PRED_COLD inline int InCircleExpansion(Point2 a, Point2 b, Point2 c, Point2 d,
-                                                        double* out) {
+GALPHA_HD GALPHA_PRED_COLD inline int InCircleExpansion(Point2 a, Point2 b, Point2 c, Point2 d, double* out) {
   using namespace pred_detail;
   const Point2 p[4] = {a, b, c, d};
   double x[4], y[4];
@@ -305,8 +303,7 @@ struct ExactnessWitness {
 /// expansion stage is skipped. Returns false when some operation rounded, or when a nonzero
 /// coordinate difference lies outside [2^-240, 2^241), where Two-Product's tail could underflow or
 /// its split overflow and a zero tail would prove nothing.
-GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Point2 b, Point2 c, Point2 d,
-                                                                   int* sign) {
+GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Point2 b, Point2 c, Point2 d, int* sign) {
   ExactnessWitness w;
   const double adx = w.Diff(a.x, d.x), ady = w.Diff(a.y, d.y);
   const double bdx = w.Diff(b.x, d.x), bdy = w.Diff(b.y, d.y);
@@ -343,8 +340,8 @@ GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Poin
   const double alift = Add(Mul(adx, adx), Mul(ady, ady));
   const double blift = Add(Mul(bdx, bdx), Mul(bdy, bdy));
   const double clift = Add(Mul(cdx, cdx), Mul(cdy, cdy));
-  const double det = Add(Add(Mul(alift, Sub(bdxcdy, cdxbdy)), Mul(blift, Sub(cdxady, adxcdy))),
-                         Mul(clift, Sub(adxbdy, bdxady)));
+  const double det =
+      Add(Add(Mul(alift, Sub(bdxcdy, cdxbdy)), Mul(blift, Sub(cdxady, adxcdy))), Mul(clift, Sub(adxbdy, bdxady)));
   const double pa = Add(Abs(bdxcdy), Abs(cdxbdy));
   const double pb = Add(Abs(cdxady), Abs(adxcdy));
   const double pc = Add(Abs(adxbdy), Abs(bdxady));
@@ -352,8 +349,8 @@ GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Poin
   const double errbound = Mul(pred_detail::kIccErrBound, permanent);
   // An underflow error (<= 2^-1075) in a 2x2 product is multiplied by a lift, one in a lift by a
   // cross term, one in a final product by 1: bound their total by 2^-1000 * (sum of those).
-  const double gate = Mul(pred_detail::kUnderflowGate,
-                          Add(Add(Add(Add(alift, blift), Add(clift, pa)), Add(pb, pc)), 1.0));
+  const double gate =
+      Mul(pred_detail::kUnderflowGate, Add(Add(Add(Add(alift, blift), Add(clift, pa)), Add(pb, pc)), 1.0));
   if (errbound >= gate && (det > errbound || -det > errbound)) return det > 0.0 ? 1 : -1;
   int sign;
   if (pred_detail::InCircleSignIfExactInDoubles(a, b, c, d, &sign)) return sign;
@@ -390,8 +387,8 @@ GALPHA_HD inline int SortByIndex(Point2* p, uint32_t* id) {
 /// is D + [1,x](r1,r2) eps^2 - [1,y](r1,r2) eps^4 - [1,x](r0,r2) eps^16 + eps^20 + ...; its sign is
 /// the sign of the first nonzero coefficient. For distinct points the second or third term is
 /// nonzero; the last two only matter for duplicates and make the function total.
-GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSoSDegenerate(Point2 a, uint32_t ia, Point2 b,
-                                                            uint32_t ib, Point2 c, uint32_t ic) {
+GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSoSDegenerate(Point2 a, uint32_t ia, Point2 b, uint32_t ib, Point2 c,
+                                                            uint32_t ic) {
   Point2 p[3] = {a, b, c};
   uint32_t id[3] = {ia, ib, ic};
   const int parity = SortByIndex<3>(p, id);
@@ -435,9 +432,8 @@ GALPHA_HD inline int Det4SoSSign(const Point2* p) {
 }
 
 /// The SoS in-circle sign once the exact in-circle determinant is known to be 0.
-GALPHA_HD GALPHA_PRED_COLD inline int InCircleSoSDegenerate(Point2 a, uint32_t ia, Point2 b,
-                                                            uint32_t ib, Point2 c, uint32_t ic,
-                                                            Point2 d, uint32_t id) {
+GALPHA_HD GALPHA_PRED_COLD inline int InCircleSoSDegenerate(Point2 a, uint32_t ia, Point2 b, uint32_t ib, Point2 c,
+                                                            uint32_t ic, Point2 d, uint32_t id) {
   Point2 p[4] = {a, b, c, d};
   uint32_t ids[4] = {ia, ib, ic, id};
   const int parity = SortByIndex<4>(p, ids);
@@ -449,16 +445,15 @@ GALPHA_HD GALPHA_PRED_COLD inline int InCircleSoSDegenerate(Point2 a, uint32_t i
 /// Orientation under Simulation of Simplicity on the input indices (distinct): never 0, equal to
 /// Orient2dSign whenever that is nonzero, and antisymmetric under swapping two arguments (with
 /// their indices).
-GALPHA_HD GALPHA_FORCEINLINE int Orient2dSoS(Point2 a, uint32_t ia, Point2 b, uint32_t ib, Point2 c,
-                                             uint32_t ic) {
+GALPHA_HD GALPHA_FORCEINLINE int Orient2dSoS(Point2 a, uint32_t ia, Point2 b, uint32_t ib, Point2 c, uint32_t ic) {
   const int s = Orient2dSign(a, b, c);
   return s != 0 ? s : pred_detail::Orient2dSoSDegenerate(a, ia, b, ib, c, ic);
 }
 
 /// In-circle test under Simulation of Simplicity (same perturbation as Orient2dSoS): never 0,
 /// equal to InCircleSign whenever that is nonzero (+1: d inside the ccw circle a, b, c).
-GALPHA_HD GALPHA_FORCEINLINE int InCircleSoS(Point2 a, uint32_t ia, Point2 b, uint32_t ib, Point2 c,
-                                             uint32_t ic, Point2 d, uint32_t id) {
+GALPHA_HD GALPHA_FORCEINLINE int InCircleSoS(Point2 a, uint32_t ia, Point2 b, uint32_t ib, Point2 c, uint32_t ic,
+                                             Point2 d, uint32_t id) {
   const int s = InCircleSign(a, b, c, d);
   return s != 0 ? s : pred_detail::InCircleSoSDegenerate(a, ia, b, ib, c, ic, d, id);
 }

@@ -150,8 +150,6 @@ GALPHA_HD inline RadiusSqApprox ApproxRadiusSq(const Point2* p, int n) {
 }
 
 /// Whether two certified keys (lo <= hi) may stand for tied or misordered exact values.
-GALPHA_HD GALPHA_FORCEINLINE bool RadiusKeysMayTie(uint64_t lo, uint64_t hi) {
-  return hi - lo <= kRadiusKeyGap + 1;
-}
+GALPHA_HD GALPHA_FORCEINLINE bool RadiusKeysMayTie(uint64_t lo, uint64_t hi) { return hi - lo <= kRadiusKeyGap + 1; }
 
 }  // namespace galpha

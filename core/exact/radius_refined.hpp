@@ -144,7 +144,7 @@ GALPHA_HD inline bool RefinedKeysSeparated(const RefinedRadiusSq& a, const Refin
   const double scale = gap == 1 ? 2.0 : 1.0;  // exact
   // b - a - 2^-146 by Grow-Expansion only, which keeps an expansion nonoverlapping (Shewchuk 1997,
   // Theorem 10) so that its most significant component carries the sign; every step is exact.
-  const double terms[7] = {Mul(b.lo, scale), Mul(b.mid, scale), Mul(b.hi, scale), -a.lo, -a.mid, -a.hi,
+  const double terms[7] = {Mul(b.lo, scale),   Mul(b.mid, scale), Mul(b.hi, scale), -a.lo, -a.mid, -a.hi,
                            -kRefinedSeparation};
   double e[8];
   int en = 0;

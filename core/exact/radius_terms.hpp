@@ -86,16 +86,15 @@ GALPHA_HD inline int Compress(int n, double* e) {
 }
 
 /// out = e + f (or e - f with negate_f), failing when the result may not fit the buffer.
-GALPHA_HD inline bool BoundedSum(int en, const double* e, int fn, const double* f, bool negate_f,
-                                 double* out, int* outn) {
+GALPHA_HD inline bool BoundedSum(int en, const double* e, int fn, const double* f, bool negate_f, double* out,
+                                 int* outn) {
   if (en + fn > kBoundedCapacity) return false;
   *outn = negate_f ? ExpansionDiffZeroElim(en, e, fn, f, out) : ExpansionSumZeroElim(en, e, fn, f, out);
   return true;
 }
 
 /// out = e * f, compressed; fails when an intermediate may not fit. out must not alias e or f.
-GALPHA_HD inline bool BoundedProduct(int en, const double* e, int fn, const double* f, double* out,
-                                     int* outn) {
+GALPHA_HD inline bool BoundedProduct(int en, const double* e, int fn, const double* f, double* out, int* outn) {
   if (en == 0 || fn == 0) {
     *outn = 0;
     return true;

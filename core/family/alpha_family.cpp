@@ -93,8 +93,8 @@ absl::StatusOr<int64_t> AlphaFamily::LevelForAlpha(double alpha) const {
 
 absl::StatusOr<int64_t> AlphaFamily::LevelForRank(int64_t rank) const {
   if (rank < 0 || rank > max_level()) {
-    return absl::OutOfRangeError(absl::StrCat("rank ", rank, " is outside 0..", max_level(),
-                                              " (the spectrum has ", max_level(), " values)"));
+    return absl::OutOfRangeError(
+        absl::StrCat("rank ", rank, " is outside 0..", max_level(), " (the spectrum has ", max_level(), " values)"));
   }
   return rank;
 }
@@ -200,7 +200,8 @@ std::optional<int64_t> AlphaFamily::OptimalLevelRegularized(uint32_t n) const {
 std::optional<int64_t> AlphaFamily::OptimalLevelGeneral(uint32_t n) const {
   // Components never increase with alpha: binary search for the first level with at most n.
   if (parts_.ranks.components.back() > n) return std::nullopt;
-  const auto it = std::partition_point(parts_.ranks.components.begin(), parts_.ranks.components.end(), [n](uint32_t c) { return c > n; });
+  const auto it = std::partition_point(parts_.ranks.components.begin(), parts_.ranks.components.end(),
+                                       [n](uint32_t c) { return c > n; });
   return static_cast<int64_t>(it - parts_.ranks.components.begin());
 }
 

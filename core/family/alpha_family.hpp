@@ -15,10 +15,10 @@
 
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
-#include "core/family/alpha_ranks.hpp"
 #include "core/base/point.hpp"
-#include "core/geometry/shape.hpp"
 #include "core/base/stage_time.hpp"
+#include "core/family/alpha_ranks.hpp"
+#include "core/geometry/shape.hpp"
 
 namespace galpha {
 

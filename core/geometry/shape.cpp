@@ -7,8 +7,8 @@
 #include "absl/status/status.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
-#include "core/exact/predicates.hpp"
 #include "core/base/status_macros.hpp"
+#include "core/exact/predicates.hpp"
 
 namespace galpha {
 namespace {
@@ -17,8 +17,8 @@ namespace {
 
 absl::Status CheckIndex(uint32_t index, size_t num_points, absl::string_view what, size_t item) {
   if (index >= num_points) {
-    return absl::InvalidArgumentError(absl::StrCat(what, " ", item, " names point index ", index,
-                                                   ", but there are only ", num_points, " points"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, " ", item, " names point index ", index, ", but there are only ", num_points, " points"));
   }
   return absl::OkStatus();
 }
@@ -30,8 +30,7 @@ absl::Status ValidateComplex(const ShapeComplex& complex) {
     for (uint32_t v : tri) GALPHA_RETURN_IF_ERROR(CheckIndex(v, n, "triangle", t));
     // Ring orientation and the turn at pinch vertices rely on strictly ccw triangles.
     if (Orient2dSign(complex.points[tri[0]], complex.points[tri[1]], complex.points[tri[2]]) <= 0) {
-      return absl::InvalidArgumentError(absl::StrCat("triangle ", t, " (", tri[0], ", ", tri[1],
-                                                     ", ", tri[2],
+      return absl::InvalidArgumentError(absl::StrCat("triangle ", t, " (", tri[0], ", ", tri[1], ", ", tri[2],
                                                      ") is not strictly counter-clockwise"));
     }
   }
@@ -39,8 +38,7 @@ absl::Status ValidateComplex(const ShapeComplex& complex) {
     const auto& edge = complex.singular_edges[e];
     for (uint32_t v : edge) GALPHA_RETURN_IF_ERROR(CheckIndex(v, n, "singular edge", e));
     if (edge[0] == edge[1]) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("singular edge ", e, " joins point ", edge[0], " to itself"));
+      return absl::InvalidArgumentError(absl::StrCat("singular edge ", e, " joins point ", edge[0], " to itself"));
     }
   }
   for (size_t i = 0; i < complex.isolated_points.size(); ++i) {
@@ -126,8 +124,7 @@ absl::StatusOr<std::vector<Ring>> TraceRings(absl::Span<const Point2> points,
                                      [](const BoundaryEdge& e, uint32_t x) { return e.from < x; });
     auto hi = lo;
     while (hi != boundary.end() && hi->from == v) ++hi;
-    return std::make_pair(static_cast<size_t>(lo - boundary.begin()),
-                          static_cast<size_t>(hi - boundary.begin()));
+    return std::make_pair(static_cast<size_t>(lo - boundary.begin()), static_cast<size_t>(hi - boundary.begin()));
   };
   for (size_t start = 0; start < boundary.size(); ++start) {
     if (used[start]) continue;
@@ -170,8 +167,7 @@ int RingOrientation(absl::Span<const Point2> points, const std::vector<uint32_t>
   for (size_t i = 1; i < m; ++i) {
     if (LexLess(points[ring[i]], points[ring[low]])) low = i;
   }
-  return Orient2dSign(points[ring[(low + m - 1) % m]], points[ring[low]],
-                      points[ring[(low + 1) % m]]);
+  return Orient2dSign(points[ring[(low + m - 1) % m]], points[ring[low]], points[ring[(low + 1) % m]]);
 }
 
 void RotateToSmallest(std::vector<uint32_t>& ring) {
@@ -203,9 +199,8 @@ void AppendJsonPoint(std::string& out, const Point2& p) {
 
 // Appends a ring, closed by repeating its first vertex (both formats ask for that).
 template <typename AppendPoint>
-void AppendRing(std::string& out, const std::vector<uint32_t>& ring,
-                absl::Span<const Point2> points, const char* open, const char* separator,
-                const char* close, AppendPoint append_point) {
+void AppendRing(std::string& out, const std::vector<uint32_t>& ring, absl::Span<const Point2> points, const char* open,
+                const char* separator, const char* close, AppendPoint append_point) {
   out += open;
   for (size_t i = 0; i <= ring.size(); ++i) {
     if (i > 0) out += separator;
@@ -230,8 +225,7 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
   edges.reserve(3 * triangles.size());
   for (size_t t = 0; t < triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      edges.push_back(
-          {EdgeKey(triangles[t][k], triangles[t][(k + 1) % 3]), static_cast<uint32_t>(t)});
+      edges.push_back({EdgeKey(triangles[t][k], triangles[t][(k + 1) % 3]), static_cast<uint32_t>(t)});
     }
   }
   std::sort(edges.begin(), edges.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
@@ -239,14 +233,14 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
   });
   for (size_t i = 1; i < edges.size(); ++i) {
     if (edges[i].key == edges[i - 1].key) {
-      return OverlapError(absl::StrCat("triangles ", edges[i - 1].triangle, " and ",
-                                       edges[i].triangle, " both hold the directed edge ",
-                                       EdgeFrom(edges[i].key), " -> ", EdgeTo(edges[i].key)));
+      return OverlapError(absl::StrCat("triangles ", edges[i - 1].triangle, " and ", edges[i].triangle,
+                                       " both hold the directed edge ", EdgeFrom(edges[i].key), " -> ",
+                                       EdgeTo(edges[i].key)));
     }
   }
   auto find_edge = [&edges](uint64_t key) -> const DirectedEdge* {
-    const auto it = std::lower_bound(edges.begin(), edges.end(), key,
-                                     [](const DirectedEdge& e, uint64_t k) { return e.key < k; });
+    const auto it =
+        std::lower_bound(edges.begin(), edges.end(), key, [](const DirectedEdge& e, uint64_t k) { return e.key < k; });
     return it != edges.end() && it->key == key ? &*it : nullptr;
   };
 
@@ -255,8 +249,7 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
   UnionFind pieces(triangles.size());
   std::vector<bool> has_twin(edges.size(), false);
   for (size_t i = 0; i < edges.size(); ++i) {
-    if (const DirectedEdge* twin =
-            find_edge(EdgeKey(EdgeTo(edges[i].key), EdgeFrom(edges[i].key)))) {
+    if (const DirectedEdge* twin = find_edge(EdgeKey(EdgeTo(edges[i].key), EdgeFrom(edges[i].key)))) {
       has_twin[i] = true;
       pieces.Union(edges[i].triangle, twin->triangle);
     }
@@ -264,8 +257,7 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
   std::vector<BoundaryEdge> boundary;  // sorted by (from, to), as `edges` is
   for (size_t i = 0; i < edges.size(); ++i) {
     if (has_twin[i]) continue;
-    boundary.push_back(
-        {EdgeFrom(edges[i].key), EdgeTo(edges[i].key), pieces.Find(edges[i].triangle)});
+    boundary.push_back({EdgeFrom(edges[i].key), EdgeTo(edges[i].key), pieces.Find(edges[i].triangle)});
   }
 
   GALPHA_ASSIGN_OR_RETURN(std::vector<Ring> rings, TraceRings(points, boundary));
@@ -279,13 +271,11 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
     Ring& ring = rings[r];
     orientation[r] = RingOrientation(points, ring.vertices);
     if (orientation[r] == 0) {
-      return OverlapError(
-          absl::StrCat("a boundary ring doubles back near point ", ring.vertices[0]));
+      return OverlapError(absl::StrCat("a boundary ring doubles back near point ", ring.vertices[0]));
     }
     if (orientation[r] < 0) continue;
     if (polygon_of_piece[ring.piece] != kNoPolygon) {
-      return OverlapError(
-          absl::StrCat("the piece of triangle ", ring.piece, " has two outer rings"));
+      return OverlapError(absl::StrCat("the piece of triangle ", ring.piece, " has two outer rings"));
     }
     polygon_of_piece[ring.piece] = static_cast<uint32_t>(shape.polygons.size());
     RotateToSmallest(ring.vertices);
@@ -295,8 +285,7 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
     if (orientation[r] > 0) continue;
     const uint32_t polygon = polygon_of_piece[rings[r].piece];
     if (polygon == kNoPolygon) {
-      return OverlapError(
-          absl::StrCat("the piece of triangle ", rings[r].piece, " has no outer ring"));
+      return OverlapError(absl::StrCat("the piece of triangle ", rings[r].piece, " has no outer ring"));
     }
     RotateToSmallest(rings[r].vertices);
     shape.polygons[polygon].holes.push_back(std::move(rings[r].vertices));
@@ -315,9 +304,8 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
                              shape.singular_edges.end());
   shape.isolated_points = complex.isolated_points;
   std::sort(shape.isolated_points.begin(), shape.isolated_points.end());
-  shape.isolated_points.erase(
-      std::unique(shape.isolated_points.begin(), shape.isolated_points.end()),
-      shape.isolated_points.end());
+  shape.isolated_points.erase(std::unique(shape.isolated_points.begin(), shape.isolated_points.end()),
+                              shape.isolated_points.end());
   return shape;
 }
 
@@ -445,16 +433,14 @@ std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> poin
   const std::string stroke = number(0.0015 * extent);
   const std::string width = number(max_x - min_x + 2 * margin);
   const std::string height = number(max_y - min_y + 2 * margin);
-  std::string out =
-      absl::StrCat("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"", number(-margin), " ",
-                   number(-margin), " ", width, " ", height, "\" width=\"800\" height=\"",
-                   number(800.0 * (max_y - min_y + 2 * margin) / (max_x - min_x + 2 * margin)),
-                   "\" preserveAspectRatio=\"xMidYMid meet\">\n",
-                   "<g fill=\"#4a90d9\" fill-opacity=\"0.6\" stroke=\"#1f4e79\" stroke-width=\"",
-                   stroke, "\" stroke-linejoin=\"round\" fill-rule=\"evenodd\">\n");
+  std::string out = absl::StrCat("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"", number(-margin), " ",
+                                 number(-margin), " ", width, " ", height, "\" width=\"800\" height=\"",
+                                 number(800.0 * (max_y - min_y + 2 * margin) / (max_x - min_x + 2 * margin)),
+                                 "\" preserveAspectRatio=\"xMidYMid meet\">\n",
+                                 "<g fill=\"#4a90d9\" fill-opacity=\"0.6\" stroke=\"#1f4e79\" stroke-width=\"", stroke,
+                                 "\" stroke-linejoin=\"round\" fill-rule=\"evenodd\">\n");
   auto append_ring = [&](const std::vector<uint32_t>& ring) {
-    for (size_t i = 0; i < ring.size(); ++i)
-      absl::StrAppend(&out, i == 0 ? "M" : " L", local(points[ring[i]]));
+    for (size_t i = 0; i < ring.size(); ++i) absl::StrAppend(&out, i == 0 ? "M" : " L", local(points[ring[i]]));
     out += " Z";
   };
   for (const ShapePolygon& polygon : shape.polygons) {
@@ -471,13 +457,13 @@ std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> poin
   for (const auto& edge : shape.singular_edges) {
     const Point2& a = points[edge[0]];
     const Point2& b = points[edge[1]];
-    absl::StrAppend(&out, "<line x1=\"", number(a.x - min_x), "\" y1=\"", number(max_y - a.y),
-                    "\" x2=\"", number(b.x - min_x), "\" y2=\"", number(max_y - b.y), "\"/>\n");
+    absl::StrAppend(&out, "<line x1=\"", number(a.x - min_x), "\" y1=\"", number(max_y - a.y), "\" x2=\"",
+                    number(b.x - min_x), "\" y2=\"", number(max_y - b.y), "\"/>\n");
   }
   out += "</g>\n<g fill=\"#2c3e50\">\n";
   for (uint32_t v : shape.isolated_points) {
-    absl::StrAppend(&out, "<circle cx=\"", number(points[v].x - min_x), "\" cy=\"",
-                    number(max_y - points[v].y), "\" r=\"", number(radius), "\"/>\n");
+    absl::StrAppend(&out, "<circle cx=\"", number(points[v].x - min_x), "\" cy=\"", number(max_y - points[v].y),
+                    "\" r=\"", number(radius), "\"/>\n");
   }
   out += "</g>\n</svg>\n";
   return out;

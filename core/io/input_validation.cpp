@@ -8,9 +8,8 @@ namespace galpha {
 
 absl::Status ValidatePoints(absl::Span<const Point2> points) {
   if (points.size() > kMaxPoints) {
-    return absl::ResourceExhaustedError(absl::StrCat("too many points: ", points.size(),
-                                                     " exceeds the limit of ", kMaxPoints,
-                                                     " (32-bit triangle indices)"));
+    return absl::ResourceExhaustedError(absl::StrCat("too many points: ", points.size(), " exceeds the limit of ",
+                                                     kMaxPoints, " (32-bit triangle indices)"));
   }
   // On every core (a serial pass took 24 ms at 10M points); the first bad index is the smallest.
   const int64_t n = static_cast<int64_t>(points.size());

@@ -107,8 +107,7 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
     }
     const nlohmann::json& items = object[member];
     for (size_t i = 0; i < items.size(); ++i) {
-      absl::Status status =
-          AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points);
+      absl::Status status = AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points);
       if (!status.ok()) return status;
     }
     return absl::OkStatus();
@@ -169,9 +168,9 @@ absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, cons
     first_line = false;
     if (header) continue;
     if (!x_numeric || !y_numeric) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          source, ":", line_number, ": expected x and y as the first two numeric fields, got '",
-          line.substr(0, 80), "'"));
+      return absl::InvalidArgumentError(absl::StrCat(source, ":", line_number,
+                                                     ": expected x and y as the first two numeric fields, got '",
+                                                     line.substr(0, 80), "'"));
     }
     points.push_back(p);
   }
@@ -225,15 +224,13 @@ absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, cons
     std::vector<absl::string_view> dims = absl::StrSplit(inside, ',', absl::SkipWhitespace());
     if (dims.size() != 2 || !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[0]), &n) ||
         !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[1]), &columns) || columns != 2) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(source, ": the array's shape is ", shape, "; (N, 2) is needed"));
+      return absl::InvalidArgumentError(absl::StrCat(source, ": the array's shape is ", shape, "; (N, 2) is needed"));
     }
   }
   const uint64_t data_bytes = bytes.size() - data_offset;
   if (n > data_bytes / 16 || data_bytes != n * 16) {
-    return absl::DataLossError(absl::StrCat(source, ": the .npy header announces ", n, " points (",
-                                            n * 16, " bytes) but the file holds ", data_bytes,
-                                            " bytes of data"));
+    return absl::DataLossError(absl::StrCat(source, ": the .npy header announces ", n, " points (", n * 16,
+                                            " bytes) but the file holds ", data_bytes, " bytes of data"));
   }
   std::vector<Point2> points(n);
   for (uint64_t i = 0; i < n; ++i) {

@@ -49,8 +49,7 @@ struct FileCloser {
 using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
 absl::Status OpenError(const std::string& path, const char* purpose, int error_number) {
-  return absl::ErrnoToStatus(error_number, absl::StrCat("cannot open points file '", path,
-                                                        "' for ", purpose));
+  return absl::ErrnoToStatus(error_number, absl::StrCat("cannot open points file '", path, "' for ", purpose));
 }
 
 }  // namespace
@@ -62,22 +61,18 @@ absl::StatusOr<std::vector<Point2>> ReadPointsBin(const std::string& path) {
     return absl::NotFoundError(absl::StrCat("points file '", path, "' does not exist"));
   }
   if (error) {
-    return absl::ErrnoToStatus(error.value(),
-                               absl::StrCat("cannot inspect points file '", path, "'"));
+    return absl::ErrnoToStatus(error.value(), absl::StrCat("cannot inspect points file '", path, "'"));
   }
   if (status.type() != std::filesystem::file_type::regular) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("points file '", path, "' is not a regular file"));
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' is not a regular file"));
   }
   const uint64_t file_bytes = std::filesystem::file_size(path, error);
   if (error) {
-    return absl::ErrnoToStatus(error.value(),
-                               absl::StrCat("cannot size points file '", path, "'"));
+    return absl::ErrnoToStatus(error.value(), absl::StrCat("cannot size points file '", path, "'"));
   }
   if (file_bytes < kHeaderBytes) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("points file '", path, "' has ", file_bytes,
-                     " bytes, fewer than its 8-byte header (uint64 point count)"));
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' has ", file_bytes,
+                                                   " bytes, fewer than its 8-byte header (uint64 point count)"));
   }
 
   FilePtr file(std::fopen(path.c_str(), "rb"));
@@ -93,17 +88,14 @@ absl::StatusOr<std::vector<Point2>> ReadPointsBin(const std::string& path) {
   if (count != body_bytes / kBytesPerPoint || body_bytes % kBytesPerPoint != 0) {
     const bool truncated = count > body_bytes / kBytesPerPoint;
     return absl::DataLossError(absl::StrCat(
-        "points file '", path, "': header says ", count, " points but the file has ", file_bytes,
-        " bytes, room for ", body_bytes / kBytesPerPoint, " points",
-        truncated ? " (truncated)"
-                  : absl::StrCat(" and ", body_bytes - count * kBytesPerPoint,
-                                 " trailing bytes")));
+        "points file '", path, "': header says ", count, " points but the file has ", file_bytes, " bytes, room for ",
+        body_bytes / kBytesPerPoint, " points",
+        truncated ? " (truncated)" : absl::StrCat(" and ", body_bytes - count * kBytesPerPoint, " trailing bytes")));
   }
 
   std::vector<Point2> points(count);
   if (count > 0 && std::fread(points.data(), kBytesPerPoint, count, file.get()) != count) {
-    return absl::DataLossError(absl::StrCat("short read in points file '", path, "': expected ",
-                                            count, " points"));
+    return absl::DataLossError(absl::StrCat("short read in points file '", path, "': expected ", count, " points"));
   }
   if (!HostIsLittleEndian()) SwapPointBytes(&points);
   return points;
@@ -117,20 +109,17 @@ absl::Status WritePointsBin(const std::string& path, absl::Span<const Point2> po
   bool written = std::fwrite(&header, sizeof header, 1, file.get()) == 1;
   if (written && !points.empty()) {
     if (HostIsLittleEndian()) {
-      written = std::fwrite(points.data(), kBytesPerPoint, points.size(), file.get()) ==
-                points.size();
+      written = std::fwrite(points.data(), kBytesPerPoint, points.size(), file.get()) == points.size();
     } else {
       std::vector<Point2> swapped(points.begin(), points.end());
       SwapPointBytes(&swapped);
-      written = std::fwrite(swapped.data(), kBytesPerPoint, swapped.size(), file.get()) ==
-                swapped.size();
+      written = std::fwrite(swapped.data(), kBytesPerPoint, swapped.size(), file.get()) == swapped.size();
     }
   }
   // fclose flushes: its failure is a lost write too.
   const bool closed = std::fclose(file.release()) == 0;
   if (!written || !closed) {
-    return absl::DataLossError(absl::StrCat("cannot write ", points.size(),
-                                            " points to points file '", path, "'"));
+    return absl::DataLossError(absl::StrCat("cannot write ", points.size(), " points to points file '", path, "'"));
   }
   return absl::OkStatus();
 }

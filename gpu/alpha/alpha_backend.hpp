@@ -8,10 +8,10 @@
 #include <functional>
 #include <vector>
 
-#include "core/family/alpha_ranks.hpp"
 #include "core/base/host_vector.hpp"
 #include "core/base/point.hpp"
 #include "core/base/stage_time.hpp"
+#include "core/family/alpha_ranks.hpp"
 
 namespace galpha::detail {
 

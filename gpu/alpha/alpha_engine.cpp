@@ -5,12 +5,12 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "core/io/input_validation.hpp"
 #include "core/base/status_macros.hpp"
+#include "core/io/input_validation.hpp"
 #include "gpu/alpha/alpha_backend.hpp"
-#include "gpu/triangulation/delaunay_backend.hpp"
 #include "gpu/system/engine_status.hpp"
 #include "gpu/system/host_copy.hpp"
+#include "gpu/triangulation/delaunay_backend.hpp"
 
 namespace galpha {
 namespace {

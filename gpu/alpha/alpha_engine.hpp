@@ -7,8 +7,8 @@
 
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
-#include "core/family/alpha_family.hpp"
 #include "core/base/point.hpp"
+#include "core/family/alpha_family.hpp"
 #include "gpu/triangulation/delaunay.hpp"
 
 namespace galpha {

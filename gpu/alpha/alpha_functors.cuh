@@ -5,14 +5,14 @@
 
 #include <cstdint>
 
-#include "core/family/alpha_ranks.hpp"
-#include "core/exact/attachment.hpp"
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/attachment.hpp"
 #include "core/exact/order.hpp"
 #include "core/exact/radius_compare.hpp"
 #include "core/exact/radius_key.hpp"
 #include "core/exact/radius_nearest.hpp"
+#include "core/family/alpha_ranks.hpp"
 #include "gpu/system/atomic_increment.cuh"
 
 namespace galpha::detail {
@@ -36,8 +36,7 @@ GALPHA_HD inline void AtomicMinU32(uint32_t* p, uint32_t v) {
   atomicMin(p, v);
 #else
   uint32_t old = __atomic_load_n(p, __ATOMIC_RELAXED);
-  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-  }
+  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
 #endif
 }
 GALPHA_HD inline void AtomicMaxU32(uint32_t* p, uint32_t v) {
@@ -45,8 +44,7 @@ GALPHA_HD inline void AtomicMaxU32(uint32_t* p, uint32_t v) {
   atomicMax(p, v);
 #else
   uint32_t old = __atomic_load_n(p, __ATOMIC_RELAXED);
-  while (v > old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-  }
+  while (v > old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
 #endif
 }
 
@@ -310,7 +308,7 @@ struct EdgeIntervals {
   uint32_t* edge_rho_rank;  // 0 written for attached edges
   uint32_t* edge_mu_low;
   uint32_t* edge_mu_high;
-  const uint64_t* keys;     // kAttachedKey marks attached edges
+  const uint64_t* keys;  // kAttachedKey marks attached edges
   uint32_t num_tri;
   uint32_t* vertex_mu_low;
   uint32_t* vertex_mu_high;
@@ -383,7 +381,8 @@ struct MasterEndpoints {
       const uint32_t v = item;
       if (representative[v] != v) return;
       if (real(vertex_mu_low[v])) visit(vertex_mu_low[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuLow));
-      if (real(vertex_mu_high[v])) visit(vertex_mu_high[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuHigh));
+      if (real(vertex_mu_high[v]))
+        visit(vertex_mu_high[v], PackMasterEntry(SimplexKind::kVertex, v, Endpoint::kMuHigh));
       return;
     }
     item -= num_points;

@@ -104,7 +104,8 @@ bool RepairRunOfExactDoubles(ExactComparator& cmp, uint32_t* ids, uint32_t n, ui
     values[i].second = ids[i];
   }
   // Congruent simplices (a grid's triangles) are all equal: one pass proves it.
-  const bool all_equal = std::all_of(values.begin(), values.end(), [&](const auto& v) { return v.first == values[0].first; });
+  const bool all_equal =
+      std::all_of(values.begin(), values.end(), [&](const auto& v) { return v.first == values[0].first; });
   if (!all_equal) std::sort(values.begin(), values.end());
   for (uint32_t i = 0; i < n; ++i) {
     ids[i] = values[i].second;
@@ -168,8 +169,9 @@ void MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, std
     }
     if (lo < starts.size()) at = cmp((*ids)[starts[lo]], odd[i]);
     // Copy main entries of the groups below, and of an equal group (the odd entry joins it).
-    const size_t copy_end = lo < starts.size() ? (at == 0 ? (lo + 1 < starts.size() ? starts[lo + 1] : ids->size()) : starts[lo])
-                                               : ids->size();
+    const size_t copy_end = lo < starts.size()
+                                ? (at == 0 ? (lo + 1 < starts.size() ? starts[lo + 1] : ids->size()) : starts[lo])
+                                : ids->size();
     for (; next_main < copy_end; ++next_main) {
       merged_ids.push_back((*ids)[next_main]);
       merged_new.push_back((*new_value)[next_main]);

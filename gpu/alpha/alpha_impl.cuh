@@ -9,8 +9,8 @@
 #include <thrust/copy.h>
 #include <thrust/count.h>
 #include <thrust/fill.h>
-#include <thrust/functional.h>
 #include <thrust/for_each.h>
+#include <thrust/functional.h>
 #include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
@@ -33,8 +33,8 @@
 #include "gpu/alpha/alpha_host_repair.hpp"
 #include "gpu/alpha/component_curve.cuh"
 #include "gpu/alpha/spectrum_refine.cuh"
-#include "gpu/triangulation/delaunay_impl.cuh"
 #include "gpu/system/engine_system.cuh"
+#include "gpu/triangulation/delaunay_impl.cuh"
 
 namespace galpha::detail {
 
@@ -189,10 +189,9 @@ HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, 
   family->representative.resize(mesh.n);
   family->num_unique = t.num_unique;
   HostMesh<System> host{
-      sys.DownloadAsync(
-          {{family->triangles.data(), t.tri.data(), size_t{mesh.num_tri} * sizeof(TriIdx)},
-           {family->edges.data(), t.edges.data(), size_t{mesh.num_edges} * sizeof(EdgeIdx)},
-           {family->representative.data(), t.representative.data(), size_t{mesh.n} * sizeof(uint32_t)}}),
+      sys.DownloadAsync({{family->triangles.data(), t.tri.data(), size_t{mesh.num_tri} * sizeof(TriIdx)},
+                         {family->edges.data(), t.edges.data(), size_t{mesh.num_edges} * sizeof(EdgeIdx)},
+                         {family->representative.data(), t.representative.data(), size_t{mesh.n} * sizeof(uint32_t)}}),
       AlphaInput{}};
   host.input.points = host_points;
   host.input.triangles = family->triangles.data();
@@ -236,15 +235,15 @@ SortedSpectrum<System> SortSpectrum(System& sys, const PipelineMesh& mesh, Simpl
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t num_simplices = mesh.num_simplices();
   Buffer<uint32_t, System> ids(sys, num_simplices);
-  const uint32_t num_entries = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_simplices, ids.data(),
-                      IsSpectrumEntry{keys->key.data(), keys->uncertified.data(), false}) -
-      ids.data());
+  const uint32_t num_entries =
+      static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_simplices, ids.data(),
+                                            IsSpectrumEntry{keys->key.data(), keys->uncertified.data(), false}) -
+                            ids.data());
   Buffer<uint32_t, System> odd_ids(sys, num_simplices - num_entries);
-  const uint32_t num_odd = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_simplices, odd_ids.data(),
-                      IsSpectrumEntry{keys->key.data(), keys->uncertified.data(), true}) -
-      odd_ids.data());
+  const uint32_t num_odd =
+      static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_simplices, odd_ids.data(),
+                                            IsSpectrumEntry{keys->key.data(), keys->uncertified.data(), true}) -
+                            odd_ids.data());
   keys->uncertified.Reset();
   Buffer<uint64_t, System> sorted_keys(sys, num_entries);
   thrust::gather(policy, ids.data(), ids.data() + num_entries, keys->key.data(), sorted_keys.data());
@@ -294,15 +293,15 @@ uint32_t SettleRunsOfOneDouble(System& sys, const PipelineMesh& mesh, const Tied
   thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
   Buffer<uint8_t, System> settled(sys, num_runs);
   thrust::copy_n(policy, needs_host->data(), num_runs, settled.data());
-  thrust::for_each_n(policy, zero, num_entries,
-                     CheckRunOfOneDouble{mesh.simplex(), spectrum->ids.data(), run_of.data(), runs.run_begin.data(),
-                                         settled.data()});
-  thrust::for_each_n(policy, zero, num_entries,
-                     SettleRunOfOneDouble{run_of.data(), runs.run_begin.data(), settled.data(),
-                                          spectrum->new_value.data()});
-  counts->bounded_exact += thrust::transform_reduce(policy, zero, zero + num_runs,
-                                                    SettledComparisons{runs.run_begin.data(), settled.data()},
-                                                    uint64_t{0}, thrust::plus<uint64_t>());
+  thrust::for_each_n(
+      policy, zero, num_entries,
+      CheckRunOfOneDouble{mesh.simplex(), spectrum->ids.data(), run_of.data(), runs.run_begin.data(), settled.data()});
+  thrust::for_each_n(
+      policy, zero, num_entries,
+      SettleRunOfOneDouble{run_of.data(), runs.run_begin.data(), settled.data(), spectrum->new_value.data()});
+  counts->bounded_exact +=
+      thrust::transform_reduce(policy, zero, zero + num_runs, SettledComparisons{runs.run_begin.data(), settled.data()},
+                               uint64_t{0}, thrust::plus<uint64_t>());
   thrust::transform(policy, zero, zero + num_runs, needs_host->data(),
                     StillNeedsHost{needs_host->data(), settled.data()});
   return static_cast<uint32_t>(thrust::count(policy, needs_host->data(), needs_host->data() + num_runs, uint8_t{1}));
@@ -341,8 +340,8 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
   TiedRuns<System> runs = FindTiedRuns(sys, sorted_keys, spectrum->num_entries);
   // Runs too long for one thread are ordered by refined keys first (spectrum_refine.cuh); what
   // they settle is cut out of the runs, and what is left is repaired below like any run.
-  if (RefineLongRuns(sys, mesh.simplex(), runs.link.data(), runs.run_begin.data(), runs.num_runs,
-                     spectrum->ids.data(), spectrum->new_value.data(), spectrum->num_entries, counts) > 0) {
+  if (RefineLongRuns(sys, mesh.simplex(), runs.link.data(), runs.run_begin.data(), runs.num_runs, spectrum->ids.data(),
+                     spectrum->new_value.data(), spectrum->num_entries, counts) > 0) {
     runs.num_runs = ListRunStarts(sys, runs.link, spectrum->num_entries, &runs.run_begin);
   }
   const uint32_t num_runs = runs.num_runs;
@@ -443,13 +442,13 @@ SpectrumValues<System> RoundSpectrumValues(System& sys, const PipelineMesh& mesh
 /// keys are not needed after them.
 template <class System>
 IntervalRanks<System> ComputeIntervals(System& sys, const PipelineMesh& mesh, const Buffer<EdgeTris, System>& edge_tris,
-                                   SpectrumRanks<System>* ranks, SimplexKeys<System>* keys) {
+                                       SpectrumRanks<System>* ranks, SimplexKeys<System>* keys) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t n = mesh.n;
   IntervalRanks<System> iv{Buffer<uint32_t, System>(sys, mesh.num_edges), Buffer<uint32_t, System>(sys, mesh.num_edges),
-                       Buffer<uint32_t, System>(sys, n), Buffer<uint32_t, System>(sys, n),
-                       Buffer<uint32_t, System>(sys, n)};
+                           Buffer<uint32_t, System>(sys, n), Buffer<uint32_t, System>(sys, n),
+                           Buffer<uint32_t, System>(sys, n)};
   thrust::fill_n(policy, iv.vertex_mu_low.data(), n, kNeverRank);
   thrust::fill_n(policy, iv.vertex_mu_high.data(), n, uint32_t{0});
   thrust::fill_n(policy, iv.vertex_tri_low.data(), n, kNeverRank);
@@ -538,8 +537,7 @@ void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t 
         Buffer<uint32_t, System> rank_of(sys, num_master);
         thrust::upper_bound(policy, master_begin.data() + 1, master_begin.data() + (num_ranks + 2), zero,
                             zero + num_master, rank_of.data());
-        thrust::stable_sort_by_key(policy, master_entries->data(), master_entries->data() + num_master,
-                                   rank_of.data());
+        thrust::stable_sort_by_key(policy, master_entries->data(), master_entries->data() + num_master, rank_of.data());
         thrust::stable_sort_by_key(policy, rank_of.data(), rank_of.data() + num_master, master_entries->data());
       }
     }
@@ -550,13 +548,14 @@ void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t 
 /// segment, then sort every segment (O(entries): no global sort).
 template <class System>
 MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, const SpectrumRanks<System>& ranks,
-                                   const IntervalRanks<System>& iv) {
+                                      const IntervalRanks<System>& iv) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t num_ranks = ranks.num_ranks;
-  const MasterEndpoints endpoints{mesh.representative,        iv.vertex_mu_low.data(), iv.vertex_mu_high.data(),
-                                  ranks.edge_rho_rank.data(), iv.edge_mu_low.data(),   iv.edge_mu_high.data(),
-                                  ranks.tri_rank.data(),      mesh.n,                  mesh.num_edges};
+  const MasterEndpoints endpoints{
+      mesh.representative,   iv.vertex_mu_low.data(), iv.vertex_mu_high.data(), ranks.edge_rho_rank.data(),
+      iv.edge_mu_low.data(), iv.edge_mu_high.data(),  ranks.tri_rank.data(),    mesh.n,
+      mesh.num_edges};
   const uint32_t num_items = mesh.n + mesh.num_edges + mesh.num_tri;
   Buffer<uint32_t, System> master_begin(sys, static_cast<size_t>(num_ranks) + 2);
   thrust::fill_n(policy, master_begin.data(), num_ranks + 2, uint32_t{0});
@@ -600,11 +599,11 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
   out->master.resize(master.num_master);
-  sys.Download({{out->components.data(), counts.components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
-                {out->solid_components.data(), counts.solid_components.data(),
-                 (size_t{num_ranks} + 1) * sizeof(uint32_t)},
-                {out->master_begin.data(), master.begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
-                {out->master.data(), master.entries.data(), size_t{master.num_master} * sizeof(uint64_t)}});
+  sys.Download(
+      {{out->components.data(), counts.components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+       {out->solid_components.data(), counts.solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+       {out->master_begin.data(), master.begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
+       {out->master.data(), master.entries.data(), size_t{master.num_master} * sizeof(uint64_t)}});
   tables_download->Wait();
   const AlphaInput& host_input = host_mesh->Get();
   if (values.any_needs_host) NearestValuesOnHost(host_input, values.needs_host.ToHostVector(num_ranks), out);

@@ -23,8 +23,8 @@
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
 #include "gpu/system/atomic_increment.cuh"
-#include "gpu/triangulation/delaunay_backend.hpp"
 #include "gpu/system/engine_system.cuh"
+#include "gpu/triangulation/delaunay_backend.hpp"
 
 namespace galpha::detail {
 
@@ -39,8 +39,7 @@ GALPHA_HD inline void AtomicMinU64(unsigned long long* p, unsigned long long v) 
   atomicMin(p, v);
 #else
   unsigned long long old = __atomic_load_n(p, __ATOMIC_RELAXED);
-  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
-  }
+  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
 #endif
 }
 
@@ -209,8 +208,8 @@ void CountForestEdgesByRank(System& sys, WeightedEdge* edges, uint32_t num_edges
     sys.Replay(hook_round, [&] {
       sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active.data(), best.data()});
       sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active.data(), best.data(), target.data()});
-      sys.ForEachBelow(count + kLiveLabels, HookComponent{labels.data(), best.data(), target.data(), parent.data(),
-                                                          merges_at_rank});
+      sys.ForEachBelow(count + kLiveLabels,
+                       HookComponent{labels.data(), best.data(), target.data(), parent.data(), merges_at_rank});
       jump_group();
     });
     // The round's wait: whether edges were left for it (none: it changed nothing, and the forest
@@ -226,8 +225,7 @@ void CountForestEdgesByRank(System& sys, WeightedEdge* edges, uint32_t num_edges
     sys.Replay(shrink_round, [&] {
       sys.ForEachBelow(count + kLiveLabels, ResetBest{labels.data(), best.data()});
       sys.ForEachBelow(count + kLiveEdges, RelabelEdge{active.data(), parent.data()});
-      sys.AppendIf(count + kLiveEdges, 1, active.data(), active.data(), JoinsTwoComponents{}, kept,
-                   count + kKeptEdges);
+      sys.AppendIf(count + kLiveEdges, 1, active.data(), active.data(), JoinsTwoComponents{}, kept, count + kKeptEdges);
       sys.AppendIf(count + kLiveLabels, 1, labels.data(), labels.data(), IsRoot{parent.data()}, kept_labels.data(),
                    count + kKeptLabels);
       sys.ForEachBelow(count + kKeptEdges, CopyItem<WeightedEdge>{kept, active.data()});

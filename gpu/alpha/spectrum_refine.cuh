@@ -25,6 +25,7 @@
 #include <thrust/count.h>
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
+#include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/reduce.h>
@@ -32,7 +33,6 @@
 #include <thrust/sort.h>
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
-#include <thrust/functional.h>
 
 #include <cstdint>
 
@@ -70,7 +70,7 @@ GALPHA_HD inline int CompareRefinedValues(const RefinedRadiusSq& a, const Refine
     if (a.hi - b.hi > 0x1p-51) return -1;
   }
   const double bs = gap == 1 ? 2.0 : 1.0, as = gap == -1 ? 2.0 : 1.0;  // to a common exponent
-  const double terms[6] = {Mul(b.lo, bs), Mul(b.mid, bs), Mul(b.hi, bs),
+  const double terms[6] = {Mul(b.lo, bs),  Mul(b.mid, bs),  Mul(b.hi, bs),
                            -Mul(a.lo, as), -Mul(a.mid, as), -Mul(a.hi, as)};
   double e[7];
   int en = 0;
@@ -248,34 +248,33 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
                      CheckRunOfOneDouble{simplex, ids, run_of.data(), run_begin, one_double.data()});
   thrust::for_each_n(policy, zero, num_entries,
                      SettleRunOfOneDouble{run_of.data(), run_begin, one_double.data(), new_value});
-  counts->bounded_exact += thrust::transform_reduce(policy, zero, zero + num_runs,
-                                                    SettledComparisons{run_begin, one_double.data()}, uint64_t{0},
-                                                    thrust::plus<uint64_t>());
+  counts->bounded_exact +=
+      thrust::transform_reduce(policy, zero, zero + num_runs, SettledComparisons{run_begin, one_double.data()},
+                               uint64_t{0}, thrust::plus<uint64_t>());
   Buffer<uint32_t, System> positions(sys, num_entries);
-  const auto num_refined = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_entries, positions.data(),
-                      InLongRun{run_of.data(), run_begin, one_double.data()}) -
-      positions.data());
-  thrust::for_each_n(policy, zero, num_entries,
-                     CutLinksOfOneDouble{run_of.data(), run_begin, one_double.data(), link});
+  const auto num_refined =
+      static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_entries, positions.data(),
+                                            InLongRun{run_of.data(), run_begin, one_double.data()}) -
+                            positions.data());
+  thrust::for_each_n(policy, zero, num_entries, CutLinksOfOneDouble{run_of.data(), run_begin, one_double.data(), link});
   one_double.Reset();
   if (num_refined == 0) return 1;  // links may have been cut: the caller lists the runs again
 
   Buffer<RefinedEntry, System> entries(sys, num_refined);
   Buffer<uint8_t, System> run_unrefinable(sys, num_runs);
   thrust::fill_n(policy, run_unrefinable.data(), num_runs, uint8_t{0});
-  thrust::for_each_n(policy, zero, num_refined,
-                     ComputeRefinedEntry{simplex, positions.data(), run_of.data(), ids, entries.data(),
-                                         run_unrefinable.data()});
+  thrust::for_each_n(
+      policy, zero, num_refined,
+      ComputeRefinedEntry{simplex, positions.data(), run_of.data(), ids, entries.data(), run_unrefinable.data()});
   run_of.Reset();
   thrust::sort(policy, entries.data(), entries.data() + num_refined, RefinedEntryLess{});
   thrust::for_each_n(policy, zero, num_refined, ScatterRefinedIds{positions.data(), entries.data(), ids});
 
   Buffer<uint8_t, System> verdict(sys, num_refined);
   Buffer<uint32_t, System> comparisons(sys, num_refined);
-  thrust::for_each_n(policy, zero, num_refined,
-                     JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(),
-                                      comparisons.data()});
+  thrust::for_each_n(
+      policy, zero, num_refined,
+      JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(), comparisons.data()});
   counts->bounded_exact += thrust::reduce(policy, comparisons.data(), comparisons.data() + num_refined, uint64_t{0});
   comparisons.Reset();
 

@@ -14,12 +14,12 @@
 #include <utility>
 #include <vector>
 
-#include <cub/device/device_select.cuh>
 #include <thrust/fill.h>
 #include <thrust/system/cuda/execution_policy.h>
+#include <cub/device/device_select.cuh>
 
-#include "gpu/system/backend.hpp"
 #include "gpu/system/atomic_increment.cuh"
+#include "gpu/system/backend.hpp"
 #include "gpu/system/engine_system.cuh"
 #include "gpu/system/host_copy.hpp"
 #include "gpu/system/pinned_staging.cuh"
@@ -30,8 +30,8 @@ namespace galpha::detail {
 inline void CheckCuda(cudaError_t result, const char* what) {
   if (result == cudaSuccess) return;
   cudaGetLastError();  // clear a non-sticky error so the next build starts clean
-  const auto kind = result == cudaErrorMemoryAllocation ? EngineError::Kind::kResourceExhausted
-                                                        : EngineError::Kind::kInternal;
+  const auto kind =
+      result == cudaErrorMemoryAllocation ? EngineError::Kind::kResourceExhausted : EngineError::Kind::kInternal;
   throw EngineError(kind, std::string(what) + ": " + cudaGetErrorString(result));
 }
 
@@ -312,7 +312,7 @@ class CudaSystem {
 
   cudaStream_t stream_;
   cudaStream_t copy_stream_ = nullptr;  // DownloadAsync's, made on first use
-  MemoryLedger ledger_;  // declared before temp_, which points at it
+  MemoryLedger ledger_;                 // declared before temp_, which points at it
   StreamOrderedAllocator temp_;
   std::unique_ptr<PinnedCounters> counters_;  // ReadCountLater's, leased on first use
   int next_counter_word_ = 0;

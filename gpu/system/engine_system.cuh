@@ -187,8 +187,7 @@ class CpuSystem {
 template <class T, class System>
 class Buffer {
  public:
-  Buffer(System& system, size_t count)
-      : system_(&system), data_(system.template Allocate<T>(count)), size_(count) {}
+  Buffer(System& system, size_t count) : system_(&system), data_(system.template Allocate<T>(count)), size_(count) {}
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
   Buffer(Buffer&& other) noexcept

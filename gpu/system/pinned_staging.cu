@@ -50,9 +50,9 @@ PinnedStaging::Slots* NewSlots() {
   auto* slots = new PinnedStaging::Slots();
   try {
     for (int i = 0; i < 2; ++i) {
-      CheckCuda(cudaHostAlloc(reinterpret_cast<void**>(&slots->memory[i]), PinnedStaging::kSlotBytes,
-                              cudaHostAllocDefault),
-                "cudaHostAlloc (pinned staging)");
+      CheckCuda(
+          cudaHostAlloc(reinterpret_cast<void**>(&slots->memory[i]), PinnedStaging::kSlotBytes, cudaHostAllocDefault),
+          "cudaHostAlloc (pinned staging)");
       CheckCuda(cudaEventCreateWithFlags(&slots->done[i], cudaEventDisableTiming), "cudaEventCreate");
     }
   } catch (...) {
@@ -77,8 +77,7 @@ std::vector<Piece> CutIntoPieces(const std::vector<HostCopy>& copies) {
   std::vector<Piece> pieces;
   for (const HostCopy& c : copies) {
     for (size_t at = 0; at < c.bytes; at += PinnedStaging::kSlotBytes) {
-      pieces.push_back({static_cast<char*>(c.host) + at,
-                        const_cast<char*>(static_cast<const char*>(c.system)) + at,
+      pieces.push_back({static_cast<char*>(c.host) + at, const_cast<char*>(static_cast<const char*>(c.system)) + at,
                         std::min(PinnedStaging::kSlotBytes, c.bytes - at)});
     }
   }
@@ -149,7 +148,8 @@ PinnedCounters::Block* NewCounterBlock() {
     CheckCuda(cudaHostAlloc(reinterpret_cast<void**>(&block->words), PinnedCounters::kWords * sizeof(uint32_t),
                             cudaHostAllocDefault),
               "cudaHostAlloc (pinned counters)");
-    for (cudaEvent_t& e : block->done) CheckCuda(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
+    for (cudaEvent_t& e : block->done)
+      CheckCuda(cudaEventCreateWithFlags(&e, cudaEventDisableTiming), "cudaEventCreate");
   } catch (...) {
     if (block->words != nullptr) cudaFreeHost(block->words);
     for (cudaEvent_t e : block->done) {

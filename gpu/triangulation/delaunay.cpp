@@ -6,14 +6,13 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "core/io/input_validation.hpp"
 #include "core/base/status_macros.hpp"
-#include "gpu/triangulation/delaunay_backend.hpp"
+#include "core/io/input_validation.hpp"
 #include "gpu/system/backend.hpp"
 #include "gpu/system/engine_status.hpp"
+#include "gpu/triangulation/delaunay_backend.hpp"
 
 namespace galpha {
-
 
 absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points, const TriangulateOptions& options) {
   GALPHA_RETURN_IF_ERROR(ValidatePoints(points));

@@ -70,7 +70,6 @@ struct Triangulation {
 /// there are more points than a 32-bit index allows; Unavailable when the CUDA backend is asked for
 /// and there is none; Internal when a device call fails. 0, 1 or 2 distinct points and collinear
 /// input are valid: no triangles, and the edges join the points in sorted order along their line.
-absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points,
-                                          const TriangulateOptions& options = {});
+absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points, const TriangulateOptions& options = {});
 
 }  // namespace galpha

@@ -49,7 +49,8 @@ struct IsFlatFiniteTriangle {
 template <class System>
 class DelaunayBuilder {
  public:
-  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m, int32_t a, int32_t b, int32_t c)
+  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m, int32_t a, int32_t b,
+                  int32_t c)
       : sys_(sys),
         m_(m),
         capacity_(2 * m),
@@ -127,8 +128,8 @@ class DelaunayBuilder {
       thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
       sys_.ForEachBelow(pending_count, VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
       // Inclusive, so that its last entry is the number of splits.
-      thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
-                                       split_count_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
+      thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
+                                       HasWinner(), thrust::plus<int32_t>());
       // The round's one wait: splits, pending points, and whether a relocation walk failed.
       int32_t num_split = 0;
       int32_t walk_failed = 0;
@@ -176,9 +177,9 @@ class DelaunayBuilder {
     int32_t* next = flat_next.data();
     uint32_t num_touched = 0;
     while (num_flat > 0) {
-      thrust::for_each(pol, first, first + num_flat,
-                       ProposeFlatRepairs{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(),
-                                          flip_vote_.data()});
+      thrust::for_each(
+          pol, first, first + num_flat,
+          ProposeFlatRepairs{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data()});
       thrust::for_each(pol, first, first + num_flat,
                        ExecuteFlips{mesh_, flat, proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
                                     partner_.data()});
@@ -190,8 +191,8 @@ class DelaunayBuilder {
       num_touched = static_cast<uint32_t>(thrust::copy_if(pol, candidates(), candidates() + 2 * num_flat,
                                                           touched.data() + num_touched, IsNonNegative()) -
                                           touched.data());
-      const uint32_t remaining = static_cast<uint32_t>(
-          thrust::copy_if(pol, flat, flat + num_flat, still_flat.data(), next, IsSet()) - next);
+      const uint32_t remaining =
+          static_cast<uint32_t>(thrust::copy_if(pol, flat, flat + num_flat, still_flat.data(), next, IsSet()) - next);
       std::swap(flat, next);
       // The smallest proposer always wins both of its votes, so every round repairs at least
       // one. Flat triangles wait on each other in chains and a round repairs one per chain: when a
@@ -242,8 +243,8 @@ class DelaunayBuilder {
         host_mesh.tri = tri.data();
         host_mesh.nbr = nbr.data();
         int32_t failed = 0;
-        RepairFlatChainsSerially{host_mesh,        host_flat.data(), num_flat, host_stack.data(), on_stack.data(),
-                                 &failed,          &flips,           host_touched.data()}(0);
+        RepairFlatChainsSerially{host_mesh,       host_flat.data(), num_flat, host_stack.data(),
+                                 on_stack.data(), &failed,          &flips,   host_touched.data()}(0);
         if (failed != 0) throw EngineError(EngineError::Kind::kInternal, "flat hull triangles could not be repaired");
         sys_.FromHost(tri_.data(), tri.data(), tri.size());
         sys_.FromHost(nbr_.data(), nbr.data(), nbr.size());
@@ -286,11 +287,11 @@ class DelaunayBuilder {
                                           split_count_or_nb_.data(), flip_vote_.data(), hull_may_change});
     sys_.ForEachBelow(count, ExecuteFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
                                           flip_vote_.data(), partner_.data()});
-    sys_.ForEachBelow(count,
-                      LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
-    sys_.ForEachBelow(count, CollectNextActive{active_.data(), proposal_edge_.data(), split_count_or_nb_.data(),
-                                               flip_vote_.data(), partner_.data(), stamp_.data(), generation,
-                                               candidates(), candidate_mask_.data()});
+    sys_.ForEachBelow(
+        count, LinkFlips{mesh_, active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), partner_.data()});
+    sys_.ForEachBelow(
+        count, CollectNextActive{active_.data(), proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
+                                 partner_.data(), stamp_.data(), generation, candidates(), candidate_mask_.data()});
     auto from = thrust::make_zip_iterator(thrust::make_tuple(candidates(), candidate_mask_.data()));
     auto to = thrust::make_zip_iterator(thrust::make_tuple(active_.data(), active_mask_.data()));
     sys_.AppendIf(count, 2, from, candidates(), IsNonNegative(), to, next_count);

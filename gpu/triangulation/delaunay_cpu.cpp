@@ -1,7 +1,7 @@
 // The OpenMP instantiation of the triangulation pipeline.
+#include "gpu/system/engine_system.cuh"
 #include "gpu/triangulation/delaunay_backend.hpp"
 #include "gpu/triangulation/delaunay_impl.cuh"
-#include "gpu/system/engine_system.cuh"
 
 namespace galpha::detail {
 

@@ -51,9 +51,9 @@ struct ProposeFlips {
   MeshView mesh;
   const int32_t* active;
   const uint8_t* active_mask;
-  int8_t* proposal_edge;     // per active entry: k, or -1
-  int32_t* proposal_nb;      // per active entry: the neighbour across that edge
-  uint32_t* flip_vote;       // per triangle, kNoFlipVote when untouched
+  int8_t* proposal_edge;  // per active entry: k, or -1
+  int32_t* proposal_nb;   // per active entry: the neighbour across that edge
+  uint32_t* flip_vote;    // per triangle, kNoFlipVote when untouched
   bool hull_may_change;
 
   GALPHA_HD void operator()(uint32_t i) const {
@@ -77,7 +77,7 @@ struct ProposeFlips {
 struct ExecuteFlips {
   MeshView mesh;
   const int32_t* active;
-  int8_t* proposal_edge;     // set to 3 for a winner (re-linked next), kept for losers
+  int8_t* proposal_edge;  // set to 3 for a winner (re-linked next), kept for losers
   const int32_t* proposal_nb;
   const uint32_t* flip_vote;
   int32_t* partner;
@@ -233,8 +233,8 @@ struct CollectFlatRepairs {
   const int32_t* proposal_nb;
   uint32_t* flip_vote;
   int32_t* partner;
-  int32_t* flipped_pairs;       // two per entry, -1 when unused
-  uint8_t* still_flat;          // per entry
+  int32_t* flipped_pairs;  // two per entry, -1 when unused
+  uint8_t* still_flat;     // per entry
 
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t t = flat[i];
@@ -260,13 +260,13 @@ struct CollectFlatRepairs {
 /// stack, so that each flat triangle is visited O(1) times.
 struct RepairFlatChainsSerially {
   MeshView mesh;
-  const int32_t* flat;   // the flat triangles left
+  const int32_t* flat;  // the flat triangles left
   uint32_t num_flat;
-  int32_t* stack;        // num_flat entries
-  uint32_t* on_stack;    // per triangle, kNoFlipVote (the idle flip votes) when not on the stack
-  int32_t* failed;       // set when flat triangles remain (reported as an internal error)
+  int32_t* stack;      // num_flat entries
+  uint32_t* on_stack;  // per triangle, kNoFlipVote (the idle flip votes) when not on the stack
+  int32_t* failed;     // set when flat triangles remain (reported as an internal error)
   int32_t* flips_done;
-  int32_t* touched;      // the two triangles of every repair flip, for the Lawson pass after
+  int32_t* touched;  // the two triangles of every repair flip, for the Lawson pass after
 
   GALPHA_HD void SerialFlip(int32_t t, int k) const {
     const Tri x = mesh.tri[t];

@@ -42,9 +42,7 @@ namespace galpha::detail {
 struct NotCollinearWith {
   const Point2* pts;
   Point2 a, b;
-  GALPHA_HD bool operator()(uint32_t input_index) const {
-    return Orient2dSign(a, b, pts[input_index]) != 0;
-  }
+  GALPHA_HD bool operator()(uint32_t input_index) const { return Orient2dSign(a, b, pts[input_index]) != 0; }
 };
 
 struct NotCollinearWithVertices {
@@ -240,8 +238,7 @@ void OutputTriangles(System& sys, const DelaunayBuilder<System>& builder, System
   Buffer<int32_t, System> finite_id(sys, num_tri);
   thrust::transform_exclusive_scan(pol, tfirst, tfirst + num_tri, finite_id.begin(), IsFiniteTriangle{mesh}, 0,
                                    thrust::plus<int32_t>());
-  const int32_t num_finite =
-      static_cast<int32_t>(thrust::count_if(pol, tfirst, tfirst + num_tri, IsFiniteTri{mesh}));
+  const int32_t num_finite = static_cast<int32_t>(thrust::count_if(pol, tfirst, tfirst + num_tri, IsFiniteTri{mesh}));
   result->tri = Buffer<Tri, System>(sys, num_finite);
   result->nbr = Buffer<TriNbr, System>(sys, num_finite);
   thrust::for_each(pol, tfirst, tfirst + num_tri,

@@ -81,10 +81,9 @@ struct VoteForInsertion {
       const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
       const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
       score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
-                                                                     : (power < 0 ? -3.0e38f : 3.0e38f);
+                                                                    : (power < 0 ? -3.0e38f : 3.0e38f);
     }
-    const unsigned long long key =
-        (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
+    const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
     cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(tri_vote[t]);
     slot.fetch_min(key);
   }
@@ -110,7 +109,7 @@ struct SplitTriangles {
   const unsigned long long* tri_vote;
   const int32_t* split_count;  // inclusive scan of HasWinner
   const int32_t* pending;
-  uint8_t* inserted;            // per uninserted point
+  uint8_t* inserted;  // per uninserted point
   int32_t num_tri;
 
   GALPHA_HD void operator()(int32_t t) const {

@@ -27,11 +27,11 @@ GALPHA_HD inline int Prev(int k) { return k == 0 ? 2 : k - 1; }
 
 /// Mutable view of the mesh; copied by value into functors.
 struct MeshView {
-  const Point2* pts;     // vertex coordinates, Hilbert order
-  const uint32_t* sos;   // input index of each vertex: the Simulation-of-Simplicity rank
+  const Point2* pts;    // vertex coordinates, Hilbert order
+  const uint32_t* sos;  // input index of each vertex: the Simulation-of-Simplicity rank
   Tri* tri;
   TriNbr* nbr;
-  int32_t inf;           // id of the vertex at infinity (= number of finite vertices)
+  int32_t inf;  // id of the vertex at infinity (= number of finite vertices)
   // The vertices of the first triangle. Their symbolic interior point c = a + e1 (b - a) +
   // e2 (c - a) (0 < e2 << e1 << 1) lies inside every later hull; rays from it through the hull
   // vertices split the outside into disjoint sectors, one per infinite triangle, so points

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/exact/predicates.hpp"
 #include "core/base/status_macros.hpp"
+#include "core/exact/predicates.hpp"
 
 namespace galpha {
 namespace {
@@ -51,8 +51,8 @@ absl::Status CheckShapes(const Triangulation& t) {
     return absl::FailedPreconditionError(absl::StrCat(n, " points do not fit 32-bit indices"));
   }
   if (t.representative.size() != n) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        "representative has ", t.representative.size(), " entries for ", n, " points"));
+    return absl::FailedPreconditionError(
+        absl::StrCat("representative has ", t.representative.size(), " entries for ", n, " points"));
   }
   for (size_t i = 0; i < n; ++i) {
     if (t.representative[i] >= n) {
@@ -62,15 +62,14 @@ absl::Status CheckShapes(const Triangulation& t) {
   }
   const size_t f = t.triangles.size();
   if (t.neighbors.size() != f || t.tri_edge_begin.size() != f) {
-    return absl::FailedPreconditionError(absl::StrCat(
-        f, " triangles but ", t.neighbors.size(), " neighbour triples and ",
-        t.tri_edge_begin.size(), " tri_edge_begin entries"));
+    return absl::FailedPreconditionError(absl::StrCat(f, " triangles but ", t.neighbors.size(),
+                                                      " neighbour triples and ", t.tri_edge_begin.size(),
+                                                      " tri_edge_begin entries"));
   }
   for (size_t tri = 0; tri < f; ++tri) {
     for (int k = 0; k < 3; ++k) {
       if (t.triangles[tri][k] >= n) {
-        return absl::FailedPreconditionError(
-            absl::StrCat(TriangleName(t, tri), " has a vertex out of range"));
+        return absl::FailedPreconditionError(absl::StrCat(TriangleName(t, tri), " has a vertex out of range"));
       }
       const int32_t nb = t.neighbors[tri][k];
       if (nb != Triangulation::kNoNeighbor && (nb < 0 || static_cast<size_t>(nb) >= f)) {
@@ -105,13 +104,12 @@ absl::Status CheckRepresentatives(Context& c) {
     }
     if (t.representative[i] != first) {
       return absl::InternalError(absl::StrCat("representative[", i, "] is ", t.representative[i],
-                                              " but the first occurrence of ", PointName(t, i),
-                                              " is ", first));
+                                              " but the first occurrence of ", PointName(t, i), " is ", first));
     }
   }
   if (t.num_unique != c.distinct.size()) {
-    return absl::InternalError(absl::StrCat("num_unique is ", t.num_unique, " but there are ",
-                                            c.distinct.size(), " distinct points"));
+    return absl::InternalError(
+        absl::StrCat("num_unique is ", t.num_unique, " but there are ", c.distinct.size(), " distinct points"));
   }
   return absl::OkStatus();
 }
@@ -122,9 +120,8 @@ absl::Status CheckEdgeOnlyOutput(const Context& c) {
   const std::vector<uint32_t>& d = c.distinct;
   for (size_t k = 2; k < d.size(); ++k) {
     if (Orient2dSign(t.points[d[0]], t.points[d[1]], t.points[d[k]]) != 0) {
-      return absl::InternalError(absl::StrCat("no triangles, but ", PointName(t, d[0]), ", ",
-                                              PointName(t, d[1]), " and ", PointName(t, d[k]),
-                                              " are not collinear"));
+      return absl::InternalError(absl::StrCat("no triangles, but ", PointName(t, d[0]), ", ", PointName(t, d[1]),
+                                              " and ", PointName(t, d[k]), " are not collinear"));
     }
   }
   // On a line the lexicographic order is the order along it.
@@ -137,15 +134,13 @@ absl::Status CheckEdgeOnlyOutput(const Context& c) {
   std::sort(actual.begin(), actual.end());
   if (actual.size() != expected.size()) {
     return absl::InternalError(absl::StrCat("collinear output has ", actual.size(),
-                                            " edges; consecutive distinct points need ",
-                                            expected.size()));
+                                            " edges; consecutive distinct points need ", expected.size()));
   }
   for (size_t e = 0; e < expected.size(); ++e) {
     if (actual[e] != expected[e]) {
-      return absl::InternalError(absl::StrCat(
-          "collinear output: expected edge (", expected[e][0], ", ", expected[e][1],
-          ") between consecutive points along the line, found (", actual[e][0], ", ",
-          actual[e][1], ")"));
+      return absl::InternalError(absl::StrCat("collinear output: expected edge (", expected[e][0], ", ", expected[e][1],
+                                              ") between consecutive points along the line, found (", actual[e][0],
+                                              ", ", actual[e][1], ")"));
     }
   }
   return absl::OkStatus();
@@ -161,15 +156,13 @@ absl::Status CheckTriangleVertices(const Context& c) {
     for (uint32_t vertex : v) {
       if (t.representative[vertex] != vertex) {
         return absl::InternalError(absl::StrCat(TriangleName(t, tri), " uses duplicate ", vertex,
-                                                " instead of its representative ",
-                                                t.representative[vertex]));
+                                                " instead of its representative ", t.representative[vertex]));
       }
     }
     const int orientation = Orient2dSign(t.points[v[0]], t.points[v[1]], t.points[v[2]]);
     if (orientation <= 0) {
-      return absl::InternalError(absl::StrCat(TriangleName(t, tri),
-                                              " is not strictly counter-clockwise (orientation ",
-                                              orientation, ")"));
+      return absl::InternalError(
+          absl::StrCat(TriangleName(t, tri), " is not strictly counter-clockwise (orientation ", orientation, ")"));
     }
   }
   return absl::OkStatus();
@@ -191,8 +184,8 @@ absl::Status CheckNeighbors(const Context& c) {
       if (nb == Triangulation::kNoNeighbor) continue;
       const uint32_t a = t.triangles[tri][(k + 1) % 3];
       const uint32_t b = t.triangles[tri][(k + 2) % 3];
-      const std::string where = absl::StrCat(TriangleName(t, tri), " has neighbour ",
-                                             TriangleName(t, nb), " across edge (", a, ", ", b, ")");
+      const std::string where =
+          absl::StrCat(TriangleName(t, tri), " has neighbour ", TriangleName(t, nb), " across edge (", a, ", ", b, ")");
       if (static_cast<size_t>(nb) == tri) return absl::InternalError(where + ": itself");
       const int j = FindDirectedEdge(t.triangles[nb], b, a);
       if (j < 0) {
@@ -200,9 +193,8 @@ absl::Status CheckNeighbors(const Context& c) {
             absl::StrCat("neighbour symmetry: ", where, ", which lacks the edge (", b, ", ", a, ")"));
       }
       if (t.neighbors[nb][j] != static_cast<int32_t>(tri)) {
-        return absl::InternalError(absl::StrCat("neighbour symmetry: ", where,
-                                                ", whose neighbour across it is ",
-                                                t.neighbors[nb][j]));
+        return absl::InternalError(
+            absl::StrCat("neighbour symmetry: ", where, ", whose neighbour across it is ", t.neighbors[nb][j]));
       }
     }
   }
@@ -218,12 +210,11 @@ absl::Status CheckDirectedEdges(Context& c) {
     for (int k = 0; k < 3; ++k) {
       const uint32_t a = t.triangles[tri][(k + 1) % 3];
       const uint32_t b = t.triangles[tri][(k + 2) % 3];
-      const auto [it, inserted] =
-          c.directed_edges.emplace(DirectedKey(a, b), static_cast<uint32_t>(3 * tri + k));
+      const auto [it, inserted] = c.directed_edges.emplace(DirectedKey(a, b), static_cast<uint32_t>(3 * tri + k));
       if (!inserted) {
         return absl::InternalError(absl::StrCat("directed edge (", a, ", ", b, ") occurs in ",
-                                                TriangleName(t, it->second / 3), " and ",
-                                                TriangleName(t, tri), ": triangles overlap"));
+                                                TriangleName(t, it->second / 3), " and ", TriangleName(t, tri),
+                                                ": triangles overlap"));
       }
     }
   }
@@ -234,9 +225,8 @@ absl::Status CheckDirectedEdges(Context& c) {
       const uint32_t b = t.triangles[tri][(k + 2) % 3];
       const auto twin = c.directed_edges.find(DirectedKey(b, a));
       if (twin != c.directed_edges.end()) {
-        return absl::InternalError(absl::StrCat(
-            TriangleName(t, tri), " has no neighbour across edge (", a, ", ", b, ") but ",
-            TriangleName(t, twin->second / 3), " holds its reverse"));
+        return absl::InternalError(absl::StrCat(TriangleName(t, tri), " has no neighbour across edge (", a, ", ", b,
+                                                ") but ", TriangleName(t, twin->second / 3), " holds its reverse"));
       }
     }
   }
@@ -261,8 +251,8 @@ absl::Status CheckConnected(const Context& c) {
   }
   if (count != t.triangles.size()) {
     const size_t missed = std::find(reached.begin(), reached.end(), false) - reached.begin();
-    return absl::InternalError(absl::StrCat("triangles are not edge-connected: ",
-                                            TriangleName(t, missed), " is unreachable from 0"));
+    return absl::InternalError(
+        absl::StrCat("triangles are not edge-connected: ", TriangleName(t, missed), " is unreachable from 0"));
   }
   return absl::OkStatus();
 }
@@ -275,8 +265,7 @@ absl::Status CheckEdgeList(const Context& c) {
   size_t next = 0;
   for (size_t tri = 0; tri < t.triangles.size(); ++tri) {
     if (t.tri_edge_begin[tri] != next) {
-      return absl::InternalError(absl::StrCat("tri_edge_begin of ", TriangleName(t, tri), " is ",
-                                              t.tri_edge_begin[tri],
+      return absl::InternalError(absl::StrCat("tri_edge_begin of ", TriangleName(t, tri), " is ", t.tri_edge_begin[tri],
                                               "; the scan of owned edge counts gives ", next));
     }
     const Tri& v = t.triangles[tri];
@@ -287,26 +276,24 @@ absl::Status CheckEdgeList(const Context& c) {
       if (from > to && !hull) continue;
       const Edge expected = {std::min(from, to), std::max(from, to)};
       if (next >= t.edges.size() || t.edges[next] != expected) {
-        return absl::InternalError(absl::StrCat(
-            "edge list: ", TriangleName(t, tri), " owns edge (", expected[0], ", ", expected[1],
-            ") at position ", next, ", which holds ",
-            next < t.edges.size()
-                ? absl::StrCat("(", t.edges[next][0], ", ", t.edges[next][1], ")")
-                : std::string("nothing")));
+        return absl::InternalError(absl::StrCat("edge list: ", TriangleName(t, tri), " owns edge (", expected[0], ", ",
+                                                expected[1], ") at position ", next, ", which holds ",
+                                                next < t.edges.size()
+                                                    ? absl::StrCat("(", t.edges[next][0], ", ", t.edges[next][1], ")")
+                                                    : std::string("nothing")));
       }
       ++next;
     }
   }
   if (next != t.edges.size()) {
-    return absl::InternalError(absl::StrCat("edge list has ", t.edges.size(),
-                                            " edges; the triangles own ", next));
+    return absl::InternalError(absl::StrCat("edge list has ", t.edges.size(), " edges; the triangles own ", next));
   }
   std::vector<Edge> sorted = t.edges;
   std::sort(sorted.begin(), sorted.end());
   const auto repeat = std::adjacent_find(sorted.begin(), sorted.end());
   if (repeat != sorted.end()) {
-    return absl::InternalError(absl::StrCat("edge (", (*repeat)[0], ", ", (*repeat)[1],
-                                            ") appears twice in the edge list"));
+    return absl::InternalError(
+        absl::StrCat("edge (", (*repeat)[0], ", ", (*repeat)[1], ") appears twice in the edge list"));
   }
   return absl::OkStatus();
 }
@@ -330,12 +317,11 @@ absl::Status CheckVerticesAndEuler(const Context& c) {
   const int64_t e = static_cast<int64_t>(t.edges.size());
   const int64_t f = static_cast<int64_t>(t.triangles.size());
   if (2 * e != 3 * f + static_cast<int64_t>(hull_edges)) {
-    return absl::InternalError(absl::StrCat("edge count: 2E = ", 2 * e, " but 3F + h = ",
-                                            3 * f + static_cast<int64_t>(hull_edges)));
+    return absl::InternalError(
+        absl::StrCat("edge count: 2E = ", 2 * e, " but 3F + h = ", 3 * f + static_cast<int64_t>(hull_edges)));
   }
   if (v - e + f != 1) {
-    return absl::InternalError(absl::StrCat("Euler: V - E + F = ", v, " - ", e, " + ", f, " = ",
-                                            v - e + f, ", not 1"));
+    return absl::InternalError(absl::StrCat("Euler: V - E + F = ", v, " - ", e, " + ", f, " = ", v - e + f, ", not 1"));
   }
   return absl::OkStatus();
 }
@@ -371,8 +357,8 @@ absl::Status CheckHull(const Context& c) {
       const uint32_t a = t.triangles[tri][(k + 1) % 3];
       const uint32_t b = t.triangles[tri][(k + 2) % 3];
       if (!next.emplace(a, b).second) {
-        return absl::InternalError(absl::StrCat("boundary is not a simple cycle: vertex ", a,
-                                                " starts two hull edges"));
+        return absl::InternalError(
+            absl::StrCat("boundary is not a simple cycle: vertex ", a, " starts two hull edges"));
       }
     }
   }
@@ -383,27 +369,26 @@ absl::Status CheckHull(const Context& c) {
   while (boundary.size() <= next.size()) {
     const auto step = next.find(boundary.back());
     if (step == next.end()) {
-      return absl::InternalError(absl::StrCat("boundary: no hull edge leaves ",
-                                              PointName(t, boundary.back())));
+      return absl::InternalError(absl::StrCat("boundary: no hull edge leaves ", PointName(t, boundary.back())));
     }
     if (step->second == hull[0]) break;
     boundary.push_back(step->second);
   }
   if (boundary.size() != next.size()) {
-    return absl::InternalError(absl::StrCat("boundary edges do not form one closed cycle: the cycle"
-                                            " through ", PointName(t, hull[0]), " has ",
-                                            boundary.size(), " of the ", next.size(), " hull edges"));
+    return absl::InternalError(
+        absl::StrCat("boundary edges do not form one closed cycle: the cycle"
+                     " through ",
+                     PointName(t, hull[0]), " has ", boundary.size(), " of the ", next.size(), " hull edges"));
   }
   for (size_t k = 0; k < std::min(hull.size(), boundary.size()); ++k) {
     if (hull[k] != boundary[k]) {
-      return absl::InternalError(absl::StrCat("boundary differs from the convex hull at position ",
-                                              k, ": expected ", PointName(t, hull[k]), ", found ",
-                                              PointName(t, boundary[k])));
+      return absl::InternalError(absl::StrCat("boundary differs from the convex hull at position ", k, ": expected ",
+                                              PointName(t, hull[k]), ", found ", PointName(t, boundary[k])));
     }
   }
   if (hull.size() != boundary.size()) {
-    return absl::InternalError(absl::StrCat("boundary has ", boundary.size(),
-                                            " vertices, the convex hull ", hull.size()));
+    return absl::InternalError(
+        absl::StrCat("boundary has ", boundary.size(), " vertices, the convex hull ", hull.size()));
   }
   return absl::OkStatus();
 }
@@ -420,10 +405,9 @@ absl::Status CheckLocallyDelaunay(const Context& c) {
       const uint32_t b = v[(k + 2) % 3];
       const uint32_t d = t.triangles[nb][FindDirectedEdge(t.triangles[nb], b, a)];
       if (InCircleSoS(p[v[0]], v[0], p[v[1]], v[1], p[v[2]], v[2], p[d], d) > 0) {
-        return absl::InternalError(absl::StrCat(
-            "edge (", a, ", ", b, ") is not locally Delaunay: vertex ", d, " of ",
-            TriangleName(t, nb), " lies inside the circumcircle of ", TriangleName(t, tri),
-            " (in-circle with Simulation of Simplicity)"));
+        return absl::InternalError(absl::StrCat("edge (", a, ", ", b, ") is not locally Delaunay: vertex ", d, " of ",
+                                                TriangleName(t, nb), " lies inside the circumcircle of ",
+                                                TriangleName(t, tri), " (in-circle with Simulation of Simplicity)"));
       }
     }
   }

@@ -110,7 +110,8 @@ TEST(AlphactlRemoteTest, TokensComeFromTheEnvironment) {
   const CommandResult without = Alphactl("summary --rank 1 " + file + " --server " + server.address());
   EXPECT_EQ(without.exit_code, 1);
   EXPECT_NE(without.err.find("Bearer TOKEN"), std::string::npos) << without.err;
-  const CommandResult with = Alphactl("summary --rank 1 " + file + " --server " + server.address(), "GALPHA_TOKEN=secret-1");
+  const CommandResult with =
+      Alphactl("summary --rank 1 " + file + " --server " + server.address(), "GALPHA_TOKEN=secret-1");
   EXPECT_EQ(with.exit_code, 0) << with.err;
   std::filesystem::remove(tokens);
 }

@@ -44,8 +44,7 @@ std::string Slurp(const std::string& path) {
 CommandResult Alphactl(const std::string& args) {
   const std::string dir = std::filesystem::temp_directory_path() / ("alphactl_test_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
-  const std::string command =
-      std::string(GALPHA_ALPHACTL) + " " + args + " >" + dir + "/out 2>" + dir + "/err";
+  const std::string command = std::string(GALPHA_ALPHACTL) + " " + args + " >" + dir + "/out 2>" + dir + "/err";
   const int status = std::system(command.c_str());
   CommandResult run;
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -150,9 +149,25 @@ TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
   const CommandResult help = Alphactl("--help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_TRUE(help.err.empty());
-  for (const char* word : {"triangulate", "spectrum", "classify", "summary", "shape", "masterlist", "optimal",
-                           "bench", "--alpha-sq", "--alpha ", "--rank", "--mode", "--vertex-rule", "--format",
-                           "--components", "--repeat", "--backend", "geojson|wkt|svg", "general|regularized",
+  for (const char* word : {"triangulate",
+                           "spectrum",
+                           "classify",
+                           "summary",
+                           "shape",
+                           "masterlist",
+                           "optimal",
+                           "bench",
+                           "--alpha-sq",
+                           "--alpha ",
+                           "--rank",
+                           "--mode",
+                           "--vertex-rule",
+                           "--format",
+                           "--components",
+                           "--repeat",
+                           "--backend",
+                           "geojson|wkt|svg",
+                           "general|regularized",
                            "report|cgal"}) {
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   }
@@ -175,12 +190,12 @@ TEST(AlphactlTest, SpectrumsArePrintedExactly) {
   const std::string obtuse = WriteFile("alphactl_obtuse.txt", "0 0\n4 0\n2 1\n");
   EXPECT_EQ(Succeeds("spectrum", obtuse, ""), "1.25\n6.25\n");
   EXPECT_EQ(Succeeds("classify", obtuse, "--rank 1"),
-            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 1 EXTERIOR", "e 0 2 SINGULAR",
-                   "e 1 2 SINGULAR", "t 0 1 2 EXTERIOR"}));
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 1 EXTERIOR", "e 0 2 SINGULAR", "e 1 2 SINGULAR",
+                   "t 0 1 2 EXTERIOR"}));
   // The attached edge is born with its triangle; hull edges stay REGULAR.
   EXPECT_EQ(Succeeds("classify", obtuse, "--rank 2"),
-            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 1 REGULAR", "e 0 2 REGULAR",
-                   "e 1 2 REGULAR", "t 0 1 2 INTERIOR"}));
+            Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "e 0 1 REGULAR", "e 0 2 REGULAR", "e 1 2 REGULAR",
+                   "t 0 1 2 INTERIOR"}));
   std::filesystem::remove(triangle);
   std::filesystem::remove(obtuse);
 }
@@ -188,24 +203,21 @@ TEST(AlphactlTest, SpectrumsArePrintedExactly) {
 TEST(AlphactlTest, ClassifiesTheSquareAtEveryRank) {
   const std::string& square = SquareCsv();
   EXPECT_EQ(Succeeds("classify", square, "--rank 0"),
-            Lines({"v 0 SINGULAR", "v 1 SINGULAR", "v 2 SINGULAR", "v 3 SINGULAR", "e 0 1 EXTERIOR",
-                   "e 0 3 EXTERIOR", "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR",
-                   "t 1 2 3 EXTERIOR"}));
+            Lines({"v 0 SINGULAR", "v 1 SINGULAR", "v 2 SINGULAR", "v 3 SINGULAR", "e 0 1 EXTERIOR", "e 0 3 EXTERIOR",
+                   "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR", "t 1 2 3 EXTERIOR"}));
   // alpha_sq = 1/4: the sides are in with no triangle; vertices are REGULAR by the rule of the
   // report "Computing 2D Alpha Shapes Using GPU" (an incident edge is in), SINGULAR by CGAL's (no
   // incident triangle).
-  const std::string rank1_edges =
-      Lines({"e 0 1 SINGULAR", "e 0 3 SINGULAR", "e 1 2 SINGULAR", "e 1 3 EXTERIOR", "e 2 3 SINGULAR",
-             "t 0 1 3 EXTERIOR", "t 1 2 3 EXTERIOR"});
+  const std::string rank1_edges = Lines({"e 0 1 SINGULAR", "e 0 3 SINGULAR", "e 1 2 SINGULAR", "e 1 3 EXTERIOR",
+                                         "e 2 3 SINGULAR", "t 0 1 3 EXTERIOR", "t 1 2 3 EXTERIOR"});
   EXPECT_EQ(Succeeds("classify", square, "--rank 1 --backend=cpu"),
             Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "v 3 REGULAR"}) + rank1_edges);
   EXPECT_EQ(Succeeds("classify", square, "--rank 1 --vertex-rule cgal"),
             Lines({"v 0 SINGULAR", "v 1 SINGULAR", "v 2 SINGULAR", "v 3 SINGULAR"}) + rank1_edges);
   // Regularized: nothing bounds a triangle yet.
   EXPECT_EQ(Succeeds("classify", square, "--rank 1 --mode regularized"),
-            Lines({"v 0 EXTERIOR", "v 1 EXTERIOR", "v 2 EXTERIOR", "v 3 EXTERIOR", "e 0 1 EXTERIOR",
-                   "e 0 3 EXTERIOR", "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR",
-                   "t 1 2 3 EXTERIOR"}));
+            Lines({"v 0 EXTERIOR", "v 1 EXTERIOR", "v 2 EXTERIOR", "v 3 EXTERIOR", "e 0 1 EXTERIOR", "e 0 3 EXTERIOR",
+                   "e 1 2 EXTERIOR", "e 1 3 EXTERIOR", "e 2 3 EXTERIOR", "t 0 1 3 EXTERIOR", "t 1 2 3 EXTERIOR"}));
   const std::string all_in =
       Lines({"v 0 REGULAR", "v 1 REGULAR", "v 2 REGULAR", "v 3 REGULAR", "e 0 1 REGULAR", "e 0 3 REGULAR",
              "e 1 2 REGULAR", "e 1 3 INTERIOR", "e 2 3 REGULAR", "t 0 1 3 INTERIOR", "t 1 2 3 INTERIOR"});
@@ -261,27 +273,25 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(run.out);
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size",
-                                             "level", "alpha_sq", "mode", "vertex_rule", "vertices", "edges",
-                                             "triangles", "components", "solid_components", "interior_area",
-                                             "backend"}));
-  const nlohmann::json expected = {
-      {"file", SquareCsv()},
-      {"points", 4},
-      {"distinct_points", 4},
-      {"duplicates", 0},
-      {"spectrum_size", 2},
-      {"level", 1},
-      {"alpha_sq", 0.25},
-      {"mode", "general"},
-      {"vertex_rule", "report"},
-      {"vertices", {{"EXTERIOR", 0}, {"SINGULAR", 0}, {"REGULAR", 4}, {"INTERIOR", 0}}},
-      {"edges", {{"EXTERIOR", 1}, {"SINGULAR", 4}, {"REGULAR", 0}, {"INTERIOR", 0}}},
-      {"triangles", {{"EXTERIOR", 2}, {"SINGULAR", 0}, {"REGULAR", 0}, {"INTERIOR", 0}}},
-      {"components", 1},
-      {"solid_components", 0},
-      {"interior_area", 0.0},
-      {"backend", "cpu"}};
+  EXPECT_EQ(keys, (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size", "level",
+                                            "alpha_sq", "mode", "vertex_rule", "vertices", "edges", "triangles",
+                                            "components", "solid_components", "interior_area", "backend"}));
+  const nlohmann::json expected = {{"file", SquareCsv()},
+                                   {"points", 4},
+                                   {"distinct_points", 4},
+                                   {"duplicates", 0},
+                                   {"spectrum_size", 2},
+                                   {"level", 1},
+                                   {"alpha_sq", 0.25},
+                                   {"mode", "general"},
+                                   {"vertex_rule", "report"},
+                                   {"vertices", {{"EXTERIOR", 0}, {"SINGULAR", 0}, {"REGULAR", 4}, {"INTERIOR", 0}}},
+                                   {"edges", {{"EXTERIOR", 1}, {"SINGULAR", 4}, {"REGULAR", 0}, {"INTERIOR", 0}}},
+                                   {"triangles", {{"EXTERIOR", 2}, {"SINGULAR", 0}, {"REGULAR", 0}, {"INTERIOR", 0}}},
+                                   {"components", 1},
+                                   {"solid_components", 0},
+                                   {"interior_area", 0.0},
+                                   {"backend", "cpu"}};
   EXPECT_EQ(nlohmann::json::parse(run.out), expected);
 
   const nlohmann::json full =
@@ -334,8 +344,8 @@ TEST(AlphactlTest, MasterListOfTheSquare) {
   check(Succeeds("masterlist", SquareCsv(), "--rank 1"),
         {"v 0 MU_LOW", "v 1 MU_LOW", "v 2 MU_LOW", "v 3 MU_LOW", "e 0 1 RHO", "e 0 3 RHO", "e 1 2 RHO", "e 2 3 RHO"});
   check(Succeeds("masterlist", SquareCsv(), "--rank 2"),
-        {"e 0 1 MU_LOW", "e 0 3 MU_LOW", "e 1 2 MU_LOW", "e 2 3 MU_LOW", "e 1 3 RHO", "e 1 3 MU_LOW",
-         "e 1 3 MU_HIGH", "t 0 1 3 RHO", "t 1 2 3 RHO"});
+        {"e 0 1 MU_LOW", "e 0 3 MU_LOW", "e 1 2 MU_LOW", "e 2 3 MU_LOW", "e 1 3 RHO", "e 1 3 MU_LOW", "e 1 3 MU_HIGH",
+         "t 0 1 3 RHO", "t 1 2 3 RHO"});
   ExpectError(Alphactl("masterlist " + Quote(SquareCsv()) + " --rank 0"), 2, "--rank 0 is outside 1..2");
   ExpectError(Alphactl("masterlist " + Quote(SquareCsv()) + " --rank 3"), 2, "--rank 3 is outside 1..2");
   ExpectError(Alphactl("masterlist " + Quote(SquareCsv())), 2, "missing --rank");
@@ -386,9 +396,9 @@ TEST(AlphactlTest, BenchPrintsEveryStageAndTheCounts) {
   for (const auto& stage : nlohmann::json::parse(triangulate.out)["stage_ms"].items()) {
     EXPECT_TRUE(rows.count(stage.key())) << stage.key() << " in\n" << run.out;
   }
-  for (const char* name : {"spectrum_sort", "master_list", "components", "total", "peak_memory_bytes",
-                           "bytes_per_point", "comparisons_filter", "comparisons_bounded_exact",
-                           "comparisons_cpu_fallback"}) {
+  for (const char* name :
+       {"spectrum_sort", "master_list", "components", "total", "peak_memory_bytes", "bytes_per_point",
+        "comparisons_filter", "comparisons_bounded_exact", "comparisons_cpu_fallback"}) {
     ASSERT_TRUE(rows.count(name)) << name << " in\n" << run.out;
     EXPECT_GE(std::stod(rows[name]), 0.0) << name;
   }
@@ -533,10 +543,9 @@ TEST(AlphactlTest, RealDataAgreesAcrossCommands) {
     counts[group[kind]][word] = counts[group[kind]][word].get<int>() + 1;
   }
   for (const auto& [kind, name] : group) EXPECT_EQ(counts[name], summary[name]) << name;
-  EXPECT_EQ(summary["distinct_points"], summary["vertices"]["EXTERIOR"].get<int>() +
-                                            summary["vertices"]["SINGULAR"].get<int>() +
-                                            summary["vertices"]["REGULAR"].get<int>() +
-                                            summary["vertices"]["INTERIOR"].get<int>());
+  EXPECT_EQ(summary["distinct_points"],
+            summary["vertices"]["EXTERIOR"].get<int>() + summary["vertices"]["SINGULAR"].get<int>() +
+                summary["vertices"]["REGULAR"].get<int>() + summary["vertices"]["INTERIOR"].get<int>());
   EXPECT_EQ(summary["points"], 1351);
   EXPECT_EQ(summary["level"], 100);
   EXPECT_EQ(SplitLines(Succeeds("spectrum", file, "")).size(), summary["spectrum_size"].get<size_t>());

@@ -240,8 +240,7 @@ TEST(BuildSchedulerTest, MemoryAdmissionKeepsBuildsWithinTheBudget) {
   auto track = [&] {
     const int now = ++current;
     int seen = max_concurrent.load();
-    while (now > seen && !max_concurrent.compare_exchange_weak(seen, now)) {
-    }
+    while (now > seen && !max_concurrent.compare_exchange_weak(seen, now)) {}
   };
   auto finish = [&] {
     --current;
@@ -483,8 +482,8 @@ TEST(BuildSchedulerTest, ObserverSeesTheLoadRiseAndFall) {
     ASSERT_TRUE(first_started.Wait());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 1 && l.admitted_bytes == 300; }));
     ASSERT_THAT(scheduler.Submit(200, [&](const BuildSlot&, bool) { second_done.Open(); }), IsOk());
-    ASSERT_TRUE(recorder.WaitFor(
-        [](const Load& l) { return l.queued == 1 && l.running == 1 && l.admitted_bytes == 300; }));
+    ASSERT_TRUE(
+        recorder.WaitFor([](const Load& l) { return l.queued == 1 && l.running == 1 && l.admitted_bytes == 300; }));
     release_first.Open();
     ASSERT_TRUE(second_done.Wait());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.queued == 0 && l.running == 0; }));

@@ -2,9 +2,9 @@
 // operations): SIGTERM during a build, clients that vanish mid-upload, a burst of builds over the
 // queue limit, malformed and oversized messages, a slow reader of a large Classify stream. After
 // each, the server is still up and answering, and its resident memory is back near its baseline.
-#include <gtest/gtest.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 #include <signal.h>  // NOLINT(modernize-deprecated-headers): POSIX kill and signal numbers
 
 #include <algorithm>
@@ -124,8 +124,9 @@ TEST(FaultTest, SigtermWithAShortGraceCancelsTheBuildCleanly) {
 }
 
 TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
-  ServerProcess server(GALPHA_SERVER, "--drain_notice_ms 0 --build_slots 1 --max_queued_builds 2 "
-                                      "--max_message_bytes 2097152");
+  ServerProcess server(GALPHA_SERVER,
+                       "--drain_notice_ms 0 --build_slots 1 --max_queued_builds 2 "
+                       "--max_message_bytes 2097152");
   ASSERT_GT(server.port(), 0) << server.log();
   const size_t baseline = WarmBaseline(server);
   ASSERT_GT(baseline, 0u);
@@ -134,7 +135,8 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
   std::vector<pid_t> vanishing;
   vanishing.reserve(4);
   for (int i = 0; i < 4; ++i) {
-    vanishing.push_back(SpawnShell(std::string(GALPHA_FAULT_CLIENT) + " vanish " + server.address() + " 1000000 >/dev/null"));
+    vanishing.push_back(
+        SpawnShell(std::string(GALPHA_FAULT_CLIENT) + " vanish " + server.address() + " 1000000 >/dev/null"));
   }
   for (pid_t pid : vanishing) EXPECT_EQ(WaitChild(pid, 60), 0);
 
@@ -147,7 +149,9 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
   std::vector<std::thread> threads;
   threads.reserve(kBurst);
   for (int i = 0; i < kBurst; ++i) {
-    threads.emplace_back([&, i] { results[static_cast<size_t>(i)] = ClientOf(server)->Build(inputs[static_cast<size_t>(i)], Upload()); });
+    threads.emplace_back([&, i] {
+      results[static_cast<size_t>(i)] = ClientOf(server)->Build(inputs[static_cast<size_t>(i)], Upload());
+    });
   }
   for (auto& t : threads) t.join();
   int ok = 0, exhausted = 0;

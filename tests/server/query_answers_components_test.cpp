@@ -58,8 +58,7 @@ TEST(QueryAnswersTest, ComponentsAtAThresholdAndOverARange) {
       ASSERT_EQ(response->solid_components_size(), last - first + 1);
       for (int64_t level = first; level <= last; ++level) {
         EXPECT_EQ(response->components(static_cast<int>(level - first)), family.Components(level)) << level;
-        EXPECT_EQ(response->solid_components(static_cast<int>(level - first)), family.SolidComponents(level))
-            << level;
+        EXPECT_EQ(response->solid_components(static_cast<int>(level - first)), family.SolidComponents(level)) << level;
       }
     }
   }

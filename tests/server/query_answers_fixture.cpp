@@ -64,8 +64,12 @@ v1::Threshold Alpha(double alpha) {
 std::vector<v1::Threshold> Thresholds(const AlphaFamily& family) {
   const int64_t k = family.max_level();
   const auto& s = family.spectrum();
-  std::vector<v1::Threshold> out = {Rank(0), Rank(k), AlphaSq(-1.0), AlphaSq(0.0),
-                                    AlphaSq(std::numeric_limits<double>::infinity()), Alpha(0.0),
+  std::vector<v1::Threshold> out = {Rank(0),
+                                    Rank(k),
+                                    AlphaSq(-1.0),
+                                    AlphaSq(0.0),
+                                    AlphaSq(std::numeric_limits<double>::infinity()),
+                                    Alpha(0.0),
                                     Alpha(std::numeric_limits<double>::infinity())};
   if (k >= 1) {
     out.push_back(Rank(1));

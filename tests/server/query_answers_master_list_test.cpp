@@ -124,8 +124,8 @@ TEST(QueryAnswersTest, MasterListRefusesBadRanges) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
     const int64_t k = f.cached->family().max_level();
-    std::vector<std::pair<int64_t, int64_t>> bad = {{0, 0}, {0, 1}, {-1, 0}, {k + 1, 0}, {k + 1, k + 1},
-                                                    {1, k + 1}, {2, 1}};
+    std::vector<std::pair<int64_t, int64_t>> bad = {{0, 0},         {0, 1},     {-1, 0}, {k + 1, 0},
+                                                    {k + 1, k + 1}, {1, k + 1}, {2, 1}};
     if (k >= 2) bad.emplace_back(k, k - 1);  // reversed (k - 1 = 0 would mean "first alone")
     for (const auto& [first, last] : bad) {
       SCOPED_TRACE(absl::StrCat(first, "..", last));

@@ -1,7 +1,7 @@
 // The real server under concurrent use: builds from several clients at once, a full build queue,
 // a client cancelling mid-upload, a deadline expiring during a build.
-#include <gtest/gtest.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
@@ -40,7 +40,8 @@ TEST(ServiceTest, ConcurrentBuildsFromSeveralClientsMatchTheLocalEngine) {
   constexpr int kClients = 6;
   std::vector<std::vector<Point2>> inputs;
   inputs.reserve(kClients);
-  for (int i = 0; i < kClients; ++i) inputs.push_back(gen::Gaussian(4000 + 500 * (i % 3), 100 + static_cast<uint64_t>(i % 3)));
+  for (int i = 0; i < kClients; ++i)
+    inputs.push_back(gen::Gaussian(4000 + 500 * (i % 3), 100 + static_cast<uint64_t>(i % 3)));
   std::vector<absl::StatusOr<client::BuildResult>> results(kClients, absl::UnknownError("not run"));
   std::vector<std::vector<double>> spectra(kClients);
   std::vector<std::thread> threads;

@@ -1,7 +1,7 @@
 // The real server's error statuses: malformed Build streams, message and in-flight limits, and
 // queries with bad handles, thresholds or requests.
-#include <gtest/gtest.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <cstdint>
 #include <limits>

@@ -1,7 +1,7 @@
 // The real server as operators see it: eviction under a small cache budget, the metrics page over
 // HTTP, health, reflection and the drain.
-#include <gtest/gtest.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
@@ -73,7 +73,8 @@ TEST(ServiceTest, MetricsAreScrapedOverHttp) {
   EXPECT_EQ(MetricValue(page, "galpha_build_stage_seconds_count{stage=\"insert_and_flip\"}"), 1.0);
   EXPECT_EQ(MetricValue(page, "galpha_build_seconds_count"), 1.0);
   const v1::ComparisonCounts& counts = built->summary.comparisons();
-  EXPECT_EQ(MetricValue(page, "galpha_radius_comparisons_total{path=\"filter\"}"), static_cast<double>(counts.filter()));
+  EXPECT_EQ(MetricValue(page, "galpha_radius_comparisons_total{path=\"filter\"}"),
+            static_cast<double>(counts.filter()));
   EXPECT_GT(counts.filter(), 0u);
   EXPECT_EQ(MetricValue(page, "galpha_radius_comparisons_total{path=\"device_exact\"}"),
             static_cast<double>(counts.device_exact()));

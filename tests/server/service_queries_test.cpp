@@ -2,8 +2,8 @@
 // every RPC against the local engine as the oracle (Build, Spectrum, Classify, MasterList,
 // Components, OptimalAlpha, Shape), on generated inputs and a real data set; Describe, Release and
 // the cache.
-#include <gtest/gtest.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
@@ -70,7 +70,8 @@ std::vector<std::vector<uint32_t>> ClassifyLocal(const AlphaFamily& family, int6
   std::vector<std::vector<uint32_t>> edges, triangles;
   for (uint32_t e = 0; e < family.edges().size(); ++e) {
     const auto& edge = family.edges()[e];
-    edges.push_back({std::min(edge[0], edge[1]), std::max(edge[0], edge[1]), static_cast<uint32_t>(classes.edges[e]) + 1});
+    edges.push_back(
+        {std::min(edge[0], edge[1]), std::max(edge[0], edge[1]), static_cast<uint32_t>(classes.edges[e]) + 1});
   }
   for (uint32_t t = 0; t < family.triangles().size(); ++t) {
     std::array<uint32_t, 3> tri = family.triangles()[t];
@@ -85,7 +86,8 @@ std::vector<std::vector<uint32_t>> ClassifyLocal(const AlphaFamily& family, int6
 }
 
 /// Compares everything the service answers about `points` with the local engine.
-void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Point2>& points, const std::string& label) {
+void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Point2>& points,
+                               const std::string& label) {
   SCOPED_TRACE(label);
   const AlphaFamily local = LocalFamily(points);
   client::BuildCallOptions call;
@@ -115,7 +117,8 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
       request.set_vertex_rule(v1::VERTEX_RULE_CGAL);
       auto answer = ClassifyRemote(client, request);
       ASSERT_THAT(answer, IsOk());
-      const ClassifyMode local_mode = mode == v1::CLASSIFY_MODE_GENERAL ? ClassifyMode::kGeneral : ClassifyMode::kRegularized;
+      const ClassifyMode local_mode =
+          mode == v1::CLASSIFY_MODE_GENERAL ? ClassifyMode::kGeneral : ClassifyMode::kRegularized;
       EXPECT_EQ(answer->rows, ClassifyLocal(local, rank, local_mode, VertexRule::kCgal)) << "rank " << rank;
       EXPECT_EQ(answer->summary.level(), rank);
       EXPECT_EQ(answer->summary.components(), local.Components(rank));

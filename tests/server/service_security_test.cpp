@@ -1,7 +1,7 @@
 // The real server's TLS and tenant-scoped bearer tokens, and the routing header the client sends
 // (against a recording stand-in server).
-#include <gtest/gtest.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <unistd.h>
 
@@ -31,9 +31,10 @@ using testing::TestServerOptions;
 
 /// A self-signed certificate for "localhost" made with the openssl command.
 bool MakeCertificate(const std::string& dir) {
-  const std::string command = "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
-                              "-addext subjectAltName=DNS:localhost -keyout " +
-                              dir + "/key.pem -out " + dir + "/cert.pem >/dev/null 2>&1";
+  const std::string command =
+      "openssl req -x509 -newkey rsa:2048 -nodes -days 1 -subj /CN=localhost "
+      "-addext subjectAltName=DNS:localhost -keyout " +
+      dir + "/key.pem -out " + dir + "/cert.pem >/dev/null 2>&1";
   return std::system(command.c_str()) == 0;
 }
 
@@ -106,8 +107,7 @@ class HeaderRecorder final : public v1::AlphaShapes::CallbackService {
     reactor->Finish(grpc::Status(grpc::StatusCode::NOT_FOUND, "recorder"));
     return reactor;
   }
-  grpc::ServerReadReactor<v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
-                                                   v1::BuildResponse*) override {
+  grpc::ServerReadReactor<v1::BuildRequest>* Build(grpc::CallbackServerContext* context, v1::BuildResponse*) override {
     Record(context);
     class Refuse final : public grpc::ServerReadReactor<v1::BuildRequest> {
      public:

@@ -1,8 +1,8 @@
 // The calls of service_test_calls.hpp.
 #include "tests/server/service_test_calls.hpp"
 
-#include <gtest/gtest.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <utility>
 

@@ -14,8 +14,8 @@
 #include <sstream>
 #include <thread>
 
-#include "grpc/health/v1/health.grpc.pb.h"
 #include "galpha_testing/reflection.pb.h"
+#include "grpc/health/v1/health.grpc.pb.h"
 
 namespace galpha::server::testing {
 
@@ -112,7 +112,7 @@ std::vector<std::string> ReflectedServices(const std::shared_ptr<grpc::Channel>&
   std::unique_ptr<grpc::ClientReaderWriter<reflection::ServerReflectionRequest, reflection::ServerReflectionResponse>>
       stream(grpc::internal::ClientReaderWriterFactory<reflection::ServerReflectionRequest,
                                                        reflection::ServerReflectionResponse>::Create(channel.get(),
-                                                                                                      method, &context));
+                                                                                                     method, &context));
   reflection::ServerReflectionRequest request;
   request.set_list_services("*");
   std::vector<std::string> names;

@@ -22,13 +22,11 @@ class BackendTest : public ::testing::TestWithParam<Backend> {
 };
 
 /// The backend's name as a test parameter name: "cpu", "cuda".
-inline std::string BackendParamName(const ::testing::TestParamInfo<Backend>& info) {
-  return BackendName(info.param);
-}
+inline std::string BackendParamName(const ::testing::TestParamInfo<Backend>& info) { return BackendName(info.param); }
 
 }  // namespace galpha::testing
 
 /// Instantiates the BackendTest suite `suite` on the CPU and the CUDA backend.
-#define GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(suite)                                                        \
+#define GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(suite)                                                              \
   INSTANTIATE_TEST_SUITE_P(Backends, suite, ::testing::Values(::galpha::Backend::kCpu, ::galpha::Backend::kCuda), \
                            ::galpha::testing::BackendParamName)

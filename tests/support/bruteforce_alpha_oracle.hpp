@@ -61,9 +61,9 @@ struct BruteClasses {
 struct BruteFamily {
   std::vector<Point2> points;
   std::vector<QPoint> q;
-  std::vector<uint32_t> rep;   // first occurrence of each input point
-  std::vector<uint32_t> uniq;  // the distinct points, by input index
-  std::vector<BruteTri> tris;  // ascending input indices
+  std::vector<uint32_t> rep;     // first occurrence of each input point
+  std::vector<uint32_t> uniq;    // the distinct points, by input index
+  std::vector<BruteTri> tris;    // ascending input indices
   std::vector<BruteEdge> edges;  // (smaller, larger)
   std::vector<std::vector<uint32_t>> edge_tris, vertex_edges, vertex_tris;
   std::vector<bool> on_hull;  // by input index (representatives)

@@ -59,16 +59,16 @@
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include <algorithm>
-#include <numeric>
 #include <iterator>
+#include <numeric>
 #include <type_traits>
 
 namespace galpha::testing {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
-using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<uint32_t, Kernel,
-                                                               CGAL::Alpha_shape_vertex_base_2<Kernel>>;
+using VertexBase =
+    CGAL::Triangulation_vertex_base_with_info_2<uint32_t, Kernel, CGAL::Alpha_shape_vertex_base_2<Kernel>>;
 using FaceBase = CGAL::Alpha_shape_face_base_2<Kernel>;
 using DataStructure = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, DataStructure>;
@@ -94,16 +94,18 @@ using ExactType = std::decay_t<decltype(CGAL::exact(std::declval<FT>()))>;
 
 mpq_class ToMpq(const FT& value) { return ExactToMpq(CGAL::exact(value)); }
 
-FT FromMpq(const mpq_class& value) {
-  return FT(MpqToExact(value, static_cast<const ExactType*>(nullptr)));
-}
+FT FromMpq(const mpq_class& value) { return FT(MpqToExact(value, static_cast<const ExactType*>(nullptr))); }
 
 OracleClass FromCgal(AlphaShape::Classification_type type) {
   switch (type) {
-    case AlphaShape::EXTERIOR: return OracleClass::kExterior;
-    case AlphaShape::SINGULAR: return OracleClass::kSingular;
-    case AlphaShape::REGULAR: return OracleClass::kRegular;
-    case AlphaShape::INTERIOR: return OracleClass::kInterior;
+    case AlphaShape::EXTERIOR:
+      return OracleClass::kExterior;
+    case AlphaShape::SINGULAR:
+      return OracleClass::kSingular;
+    case AlphaShape::REGULAR:
+      return OracleClass::kRegular;
+    case AlphaShape::INTERIOR:
+      return OracleClass::kInterior;
   }
   return OracleClass::kExterior;
 }
@@ -132,8 +134,7 @@ CgalAlphaOracle::CgalAlphaOracle(absl::Span<const galpha::Point2> points) {
   // The distinct points, each with the input index of its first occurrence.
   std::vector<uint32_t> order(points.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t a, uint32_t b) { return LexLess(points[a], points[b]); });
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return LexLess(points[a], points[b]); });
   std::vector<std::pair<Kernel::Point_2, uint32_t>> firsts;
   for (size_t r = 0; r < order.size(); ++r) {
     const uint32_t i = order[r];
@@ -189,12 +190,12 @@ CgalAlphaOracle::Classes CgalAlphaOracle::Classify(const mpq_class& alpha_sq) co
   // CGAL's own edge lists (a second code path: the sorted interval map, not classify()).
   const FT previous_alpha = shape.set_alpha(alpha);
   shape.set_mode(AlphaShape::REGULARIZED);
-  const auto regular = static_cast<size_t>(
-      std::distance(shape.alpha_shape_edges_begin(), shape.alpha_shape_edges_end()));
+  const auto regular =
+      static_cast<size_t>(std::distance(shape.alpha_shape_edges_begin(), shape.alpha_shape_edges_end()));
   shape.set_mode(AlphaShape::GENERAL);
   shape.set_alpha(alpha);  // drops the cached lists
-  const auto general = static_cast<size_t>(
-      std::distance(shape.alpha_shape_edges_begin(), shape.alpha_shape_edges_end()));
+  const auto general =
+      static_cast<size_t>(std::distance(shape.alpha_shape_edges_begin(), shape.alpha_shape_edges_end()));
   shape.set_alpha(previous_alpha);
   out.regularized_edges_regular = regular;
   out.regularized_edges_singular = general - regular;

@@ -61,8 +61,7 @@ TEST(CgalAlphaOracleTest, AcuteTriangle) {
 
   for (const char* alpha : {"169/36", "1000000"}) {
     c = oracle.Classify(Q(alpha));
-    EXPECT_EQ(c.edges, (std::map<Edge, OracleClass>{{{0, 1}, kReg}, {{0, 2}, kReg}, {{1, 2}, kReg}}))
-        << alpha;
+    EXPECT_EQ(c.edges, (std::map<Edge, OracleClass>{{{0, 1}, kReg}, {{0, 2}, kReg}, {{1, 2}, kReg}})) << alpha;
     EXPECT_EQ(c.vertices, (std::map<uint32_t, OracleClass>{{0, kReg}, {1, kReg}, {2, kReg}}));
     EXPECT_EQ(c.interior_triangles, 1u);
     EXPECT_EQ(c.solid_components, 1u);
@@ -161,8 +160,7 @@ TEST(CgalAlphaOracleTest, DuplicatesMapToFirstOccurrence) {
 
 TEST(CgalAlphaOracleTest, OptimalAlphaAnswersOneValuePastTheFirstQualifying) {
   // Two far-apart right triangles: r^2 = 2 and 8; legs 1 and 4; every bridge is >= 2401.
-  const CgalAlphaOracle oracle(
-      std::vector<Point2>{{0, 0}, {2, 0}, {0, 2}, {100, 0}, {104, 0}, {100, 4}});
+  const CgalAlphaOracle oracle(std::vector<Point2>{{0, 0}, {2, 0}, {0, 2}, {100, 0}, {104, 0}, {100, 4}});
   const auto& spectrum = oracle.spectrum();
   ASSERT_GT(spectrum.size(), 5u);
   EXPECT_EQ(std::vector<mpq_class>(spectrum.begin(), spectrum.begin() + 4), Qs({"1", "2", "4", "8"}));
@@ -206,8 +204,7 @@ TEST(CgalAlphaOracleTest, AgreesWithGudhiSevenPoints) {
   ASSERT_EQ(edge_birth.size(), 12u);
   ASSERT_EQ(triangle_birth.size(), 6u);
 
-  const CgalAlphaOracle oracle(
-      std::vector<Point2>{{1, 1}, {7, 0}, {4, 6}, {9, 6}, {0, 14}, {2, 19}, {9, 17}});
+  const CgalAlphaOracle oracle(std::vector<Point2>{{1, 1}, {7, 0}, {4, 6}, {9, 6}, {0, 14}, {2, 19}, {9, 17}});
   EXPECT_EQ(oracle.spectrum(), std::vector<mpq_class>(births.begin(), births.end()));
   for (const mpq_class& alpha : oracle.spectrum()) {
     const auto c = oracle.Classify(alpha);

@@ -26,7 +26,7 @@ std::vector<int64_t> DistinctIntegers(size_t count, int64_t lo, int64_t hi, std:
 
 // `count` distinct pairs of integers in [lo, hi]^2 (hi - lo < 2^32), in random order.
 std::vector<std::pair<int64_t, int64_t>> DistinctIntegerPairs(size_t count, int64_t lo, int64_t hi,
-                                                             std::mt19937_64& rng) {
+                                                              std::mt19937_64& rng) {
   std::uniform_int_distribution<int64_t> pick(lo, hi);
   std::unordered_set<uint64_t> seen;
   std::vector<std::pair<int64_t, int64_t>> pairs;
@@ -42,9 +42,7 @@ std::vector<std::pair<int64_t, int64_t>> DistinctIntegerPairs(size_t count, int6
 
 // Integer line parameters are drawn from [-range, range]: wide enough that drawing n distinct ones
 // stays fast, small enough that every coordinate stays an exact double.
-int64_t ParameterRange(size_t n) {
-  return std::max<int64_t>(int64_t{1} << 20, 2 * static_cast<int64_t>(n));
-}
+int64_t ParameterRange(size_t n) { return std::max<int64_t>(int64_t{1} << 20, 2 * static_cast<int64_t>(n)); }
 
 }  // namespace
 
@@ -198,12 +196,10 @@ std::vector<Point2> Tiny(size_t n, uint64_t seed) {
   std::vector<Point2> points;
   points.reserve(n);
   for (const auto& [a, b] : DistinctIntegerPairs(normal, 1, kMaxInteger, rng)) {
-    points.push_back({std::ldexp(static_cast<double>(a), -1000),
-                      std::ldexp(static_cast<double>(b), -1000)});
+    points.push_back({std::ldexp(static_cast<double>(a), -1000), std::ldexp(static_cast<double>(b), -1000)});
   }
   for (const auto& [a, b] : DistinctIntegerPairs(n - normal, 1, kMaxInteger, rng)) {
-    points.push_back({std::ldexp(static_cast<double>(a), -1074),
-                      std::ldexp(static_cast<double>(b), -1074)});
+    points.push_back({std::ldexp(static_cast<double>(a), -1074), std::ldexp(static_cast<double>(b), -1074)});
   }
   std::shuffle(points.begin(), points.end(), rng);
   return points;
@@ -254,8 +250,7 @@ std::vector<NamedGenerator> AllDistributions() {
       {"parallel_lines", ParallelLines, false},
       {"with_duplicates", WithDuplicates, true},
       {"huge_offset_1e9", [](size_t n, uint64_t seed) { return HugeOffset(n, seed, 1e9); }, true},
-      {"huge_offset_1e15", [](size_t n, uint64_t seed) { return HugeOffset(n, seed, 1e15); },
-       false},
+      {"huge_offset_1e15", [](size_t n, uint64_t seed) { return HugeOffset(n, seed, 1e15); }, false},
       {"tiny", Tiny, false},
       {"ulp_lattice", UlpLattice, false},
       {"lidar_cm", LidarCentimetres, false},
@@ -263,8 +258,7 @@ std::vector<NamedGenerator> AllDistributions() {
 }
 
 const NamedGenerator* FindDistribution(const std::string& name) {
-  static const std::vector<NamedGenerator>* const kAll =
-      new std::vector<NamedGenerator>(AllDistributions());
+  static const std::vector<NamedGenerator>* const kAll = new std::vector<NamedGenerator>(AllDistributions());
   for (const NamedGenerator& generator : *kAll) {
     if (generator.name == name) return &generator;
   }

@@ -52,8 +52,7 @@ TEST(StatusMatchersTest, StatusIsMatchesTheCode) {
 TEST(StatusMatchersTest, StatusIsFailsOnAnotherCodeAndPrintsTheStatus) {
   EXPECT_NONFATAL_FAILURE(EXPECT_THAT(Error(), StatusIs(absl::StatusCode::kNotFound)),
                           "INVALID_ARGUMENT: point 3 has a NaN y coordinate");
-  EXPECT_NONFATAL_FAILURE(EXPECT_THAT(Error(), StatusIs(absl::StatusCode::kNotFound)),
-                          "has status code NOT_FOUND");
+  EXPECT_NONFATAL_FAILURE(EXPECT_THAT(Error(), StatusIs(absl::StatusCode::kNotFound)), "has status code NOT_FOUND");
   EXPECT_NONFATAL_FAILURE(EXPECT_THAT(Value(), StatusIs(absl::StatusCode::kInvalidArgument)), "whose status is OK");
   EXPECT_NONFATAL_FAILURE(EXPECT_THAT(absl::OkStatus(), StatusIs(absl::StatusCode::kUnavailable)),
                           "has status code UNAVAILABLE");

@@ -20,15 +20,15 @@ struct Case {
 };
 
 int ExactSign(const Case& c) {
-  const mpq_class dot = (mpq_class(c.p.x) - c.r.x) * (mpq_class(c.q.x) - c.r.x) +
-                        (mpq_class(c.p.y) - c.r.y) * (mpq_class(c.q.y) - c.r.y);
+  const mpq_class dot =
+      (mpq_class(c.p.x) - c.r.x) * (mpq_class(c.q.x) - c.r.x) + (mpq_class(c.p.y) - c.r.y) * (mpq_class(c.q.y) - c.r.y);
   return -sgn(dot);  // inside the diametral circle: negative dot product
 }
 
 std::string Show(const Case& c) {
   char text[256];
-  std::snprintf(text, sizeof text, "p=(%.17g, %.17g) q=(%.17g, %.17g) r=(%.17g, %.17g)", c.p.x, c.p.y, c.q.x,
-                c.q.y, c.r.x, c.r.y);
+  std::snprintf(text, sizeof text, "p=(%.17g, %.17g) q=(%.17g, %.17g) r=(%.17g, %.17g)", c.p.x, c.p.y, c.q.x, c.q.y,
+                c.r.x, c.r.y);
   return text;
 }
 

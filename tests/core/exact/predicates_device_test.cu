@@ -56,17 +56,14 @@ struct Evaluate {
 
 std::vector<Case> MakeCases() {
   std::mt19937_64 rng(7);
-  auto U = [&](double lo, double hi) {
-    return std::uniform_real_distribution<double>(lo, hi)(rng);
-  };
+  auto U = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
   auto I = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
   auto mixed = [&](int emin, int emax) {
     const double v = std::ldexp(U(1.0, 2.0), I(emin, emax));
     return I(0, 1) ? v : -v;
   };
   auto nudge = [&](double v, int ulps) {
-    for (int k = I(-ulps, ulps); k != 0; k += k > 0 ? -1 : 1)
-      v = std::nextafter(v, k > 0 ? 1e308 : -1e308);
+    for (int k = I(-ulps, ulps); k != 0; k += k > 0 ? -1 : 1) v = std::nextafter(v, k > 0 ? 1e308 : -1e308);
     return v;
   };
   // Integer points on x^2 + y^2 = 25^2 (cocircular, and collinear triples among them).
@@ -114,8 +111,7 @@ std::vector<Case> MakeCases() {
     }
     if (family == 0 && i % 16 == 0) {  // near-collinear first three points
       const double t = U(-2, 3);
-      c.p[2] = {nudge(c.p[0].x + t * (c.p[1].x - c.p[0].x), 2),
-                nudge(c.p[0].y + t * (c.p[1].y - c.p[0].y), 2)};
+      c.p[2] = {nudge(c.p[0].x + t * (c.p[1].x - c.p[0].x), 2), nudge(c.p[0].y + t * (c.p[1].y - c.p[0].y), 2)};
     }
     for (int k = 0; k < 4; ++k) {
       c.id[k] = static_cast<uint32_t>(rng()) & ~3u;

@@ -51,8 +51,7 @@ int HighBit(double v) { return std::ilogb(v); }
 // Sorted by increasing magnitude, nonzero, nonoverlapping (Shewchuk's definition).
 ::testing::AssertionResult WellFormed(int n, const double* e) {
   for (int i = 0; i < n; ++i) {
-    if (e[i] == 0.0 || !std::isfinite(e[i]))
-      return ::testing::AssertionFailure() << "component " << i;
+    if (e[i] == 0.0 || !std::isfinite(e[i])) return ::testing::AssertionFailure() << "component " << i;
     if (i > 0 && HighBit(e[i - 1]) >= LowBit(e[i])) {
       return ::testing::AssertionFailure() << "components " << i - 1 << " and " << i << " overlap";
     }
@@ -62,8 +61,7 @@ int HighBit(double v) { return std::ilogb(v); }
 
 Q Det(const Tri& t) {
   const Point2 a = t[0], b = t[1], c = t[2];
-  return (Exact(b.x) - Exact(a.x)) * (Exact(c.y) - Exact(a.y)) -
-         (Exact(b.y) - Exact(a.y)) * (Exact(c.x) - Exact(a.x));
+  return (Exact(b.x) - Exact(a.x)) * (Exact(c.y) - Exact(a.y)) - (Exact(b.y) - Exact(a.y)) * (Exact(c.x) - Exact(a.x));
 }
 
 Q Det(const Quad& q) {
@@ -71,8 +69,7 @@ Q Det(const Quad& q) {
   const Q adx = Exact(a.x) - Exact(d.x), ady = Exact(a.y) - Exact(d.y);
   const Q bdx = Exact(b.x) - Exact(d.x), bdy = Exact(b.y) - Exact(d.y);
   const Q cdx = Exact(c.x) - Exact(d.x), cdy = Exact(c.y) - Exact(d.y);
-  return (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy) +
-         (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy) +
+  return (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy) + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy) +
          (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady);
 }
 
@@ -82,9 +79,7 @@ int Sign(const Quad& q) { return InCircleSign(q[0], q[1], q[2], q[3]); }
 double Approx(const Tri& t) { return Orient2dApprox(t[0], t[1], t[2]); }
 double Approx(const Quad& q) { return InCircleApprox(q[0], q[1], q[2], q[3]); }
 int Expansion(const Tri& t, double* e) { return exact::Orient2dExpansion(t[0], t[1], t[2], e); }
-int Expansion(const Quad& q, double* e) {
-  return exact::InCircleExpansion(q[0], q[1], q[2], q[3], e);
-}
+int Expansion(const Quad& q, double* e) { return exact::InCircleExpansion(q[0], q[1], q[2], q[3], e); }
 
 template <size_t n>
 std::string Show(const std::array<Point2, n>& p) {
@@ -147,10 +142,8 @@ TEST(Expansion, SumScaleProductAreExact) {
   for (int iter = 0; iter < 3000; ++iter) {
     double e[16], f[8], h[24];
     int el = 0, fl = 0;  // grow random values into expansions (in place, which is allowed)
-    for (int i = 0; i < 8; ++i)
-      el = exact::GrowExpansionZeroElim(el, e, RandomDouble(rng, -200, 200), e);
-    for (int i = 0; i < 4; ++i)
-      fl = exact::GrowExpansionZeroElim(fl, f, RandomDouble(rng, -200, 200), f);
+    for (int i = 0; i < 8; ++i) el = exact::GrowExpansionZeroElim(el, e, RandomDouble(rng, -200, 200), e);
+    for (int i = 0; i < 4; ++i) fl = exact::GrowExpansionZeroElim(fl, f, RandomDouble(rng, -200, 200), f);
     ASSERT_TRUE(WellFormed(el, e));
     ASSERT_TRUE(WellFormed(fl, f));
     const Q ev = Value(el, e), fv = Value(fl, f);
@@ -313,14 +306,12 @@ std::vector<Tri> OrientCases(const std::string& kind, int n, uint64_t seed) {
       for (auto& p : t) p = alt ? Scale2(p, -1000) : Point2{p.x * 1e-300, p.y * 1e-300};
     } else if (kind == "subnormal") {  // multiples of 2^-1074 (4.9e-324)
       t = ExactCollinear(g);
-      for (auto& p : t)
-        p = Scale2(alt ? p : Point2{double(g.I(-50, 50)), double(g.I(-9, 9))}, -1074);
+      for (auto& p : t) p = Scale2(alt ? p : Point2{double(g.I(-50, 50)), double(g.I(-9, 9))}, -1074);
     } else if (kind == "mixed") {  // magnitudes 2^-420 .. 2^501: H / m < 2^930
       if (alt) {
         for (auto& p : t) p = {g.Mixed(-420, 499), g.Mixed(-420, 499)};
       } else {
-        const Point2 a{g.Mixed(-420, 499), g.Mixed(-420, 499)},
-            b{g.Mixed(-420, 499), g.Mixed(-420, 499)};
+        const Point2 a{g.Mixed(-420, 499), g.Mixed(-420, 499)}, b{g.Mixed(-420, 499), g.Mixed(-420, 499)};
         const double s = g.U(-2, 3);
         t = {a, b, g.NudgeP({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y)}, 1)};
       }
@@ -406,9 +397,8 @@ std::vector<Quad> InCircleCases(const std::string& kind, int n, uint64_t seed) {
   return out;
 }
 
-const char* const kOrientFamilies[] = {"random",    "near_collinear", "collinear", "grid",
-                                       "offset1e9", "offset1e15",     "tiny",      "subnormal",
-                                       "mixed",     "range_edge",     "huge"};
+const char* const kOrientFamilies[] = {"random", "near_collinear", "collinear", "grid",       "offset1e9", "offset1e15",
+                                       "tiny",   "subnormal",      "mixed",     "range_edge", "huge"};
 const char* const kInCircleFamilies[] = {"random",    "cocircular", "collinear",  "near_circle",
                                          "grid",      "offset1e9",  "offset1e15", "tiny",
                                          "subnormal", "mixed",      "range_edge", "huge"};
@@ -525,16 +515,12 @@ int BruteForceSoS(const std::array<Point2, n>& p, const std::array<uint32_t, n>&
   return LeadingSign(det);
 }
 
-int SoS(const Tri& t, const std::array<uint32_t, 3>& id) {
-  return Orient2dSoS(t[0], id[0], t[1], id[1], t[2], id[2]);
-}
+int SoS(const Tri& t, const std::array<uint32_t, 3>& id) { return Orient2dSoS(t[0], id[0], t[1], id[1], t[2], id[2]); }
 int SoS(const Quad& q, const std::array<uint32_t, 4>& id) {
   return InCircleSoS(q[0], id[0], q[1], id[1], q[2], id[2], q[3], id[3]);
 }
 int BruteForce(const Tri& t, const std::array<uint32_t, 3>& id) { return BruteForceSoS<3>(t, id); }
-int BruteForce(const Quad& q, const std::array<uint32_t, 4>& id) {
-  return -BruteForceSoS<4>(q, id);
-}
+int BruteForce(const Quad& q, const std::array<uint32_t, 4>& id) { return -BruteForceSoS<4>(q, id); }
 
 template <size_t n>
 std::array<uint32_t, n> DistinctIds(Rng& rng) {
@@ -577,8 +563,7 @@ void CheckSoS(const std::array<Point2, n>& p, const std::array<uint32_t, n>& id,
 TEST(SoS, OrientDegenerateMatchesBruteForce) {
   Gen g(21);
   int degenerate = 0;
-  for (const char* kind :
-       {"collinear", "grid", "subnormal", "offset1e15", "near_collinear", "random"}) {
+  for (const char* kind : {"collinear", "grid", "subnormal", "offset1e15", "near_collinear", "random"}) {
     for (const Tri& t : OrientCases(kind, 600, 22)) {
       CheckSoS<3>(t, DistinctIds<3>(g.rng), &degenerate);
       if (HasFatalFailure()) return;
@@ -590,8 +575,7 @@ TEST(SoS, OrientDegenerateMatchesBruteForce) {
 TEST(SoS, InCircleDegenerateMatchesBruteForce) {
   Gen g(23);
   int degenerate = 0;
-  for (const char* kind :
-       {"cocircular", "collinear", "grid", "subnormal", "offset1e15", "tiny", "near_circle"}) {
+  for (const char* kind : {"cocircular", "collinear", "grid", "subnormal", "offset1e15", "tiny", "near_circle"}) {
     for (const Quad& q : InCircleCases(kind, 400, 24)) {
       CheckSoS<4>(q, DistinctIds<4>(g.rng), &degenerate);
       if (HasFatalFailure()) return;

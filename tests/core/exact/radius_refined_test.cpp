@@ -54,18 +54,24 @@ mpq_class RefinedValue(const RefinedRadiusSq& r) {
 std::vector<Simplex> PerturbedLattice(double offset, double h, int ulps, int count, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<int> cell(0, 999), nudge(-ulps, ulps), kind(0, 3);
-  auto at = [&](int i, int j) {
-    return Point2{Ulps(offset + h * i, nudge(rng)), Ulps(offset + h * j, nudge(rng))};
-  };
+  auto at = [&](int i, int j) { return Point2{Ulps(offset + h * i, nudge(rng)), Ulps(offset + h * j, nudge(rng))}; };
   std::vector<Simplex> out;
   for (int c = 0; c < count; ++c) {
     const int i = cell(rng), j = cell(rng);
     Simplex s;
     switch (kind(rng)) {
-      case 0: s = {{at(i, j), at(i + 1, j), at(i, j + 1)}, 3}; break;
-      case 1: s = {{at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)}, 3}; break;
-      case 2: s = {{at(i, j), at(i + 1, j), {}}, 2}; break;
-      default: s = {{at(i, j), at(i + 1, j + 1), {}}, 2}; break;
+      case 0:
+        s = {{at(i, j), at(i + 1, j), at(i, j + 1)}, 3};
+        break;
+      case 1:
+        s = {{at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)}, 3};
+        break;
+      case 2:
+        s = {{at(i, j), at(i + 1, j), {}}, 2};
+        break;
+      default:
+        s = {{at(i, j), at(i + 1, j + 1), {}}, 2};
+        break;
     }
     out.push_back(s);
   }
@@ -117,15 +123,13 @@ TEST(RefinedRadiusSqTest, ErrorWithinTheCertifiedBoundOnLattices) {
   ExpectWithinBound(PerturbedLattice(1e9, 1.0, 3, 2000, 4));
 }
 
-TEST(RefinedRadiusSqTest, ErrorWithinTheCertifiedBoundOnAssortedScales) {
-  ExpectWithinBound(Assorted(4000, 5));
-}
+TEST(RefinedRadiusSqTest, ErrorWithinTheCertifiedBoundOnAssortedScales) { ExpectWithinBound(Assorted(4000, 5)); }
 
 // Sorted by refined key, every pair the keys call separated must be in exact order. Near ties
 // a few ulps apart are the point: they are what the 64-bit keys cannot order.
 TEST(RefinedRadiusSqTest, SeparatedKeysAreInExactOrder) {
-  for (const auto& [offset, h, ulps] : {std::tuple{1000.0, 0.1, 2}, std::tuple{500000.0, 0.01, 1},
-                                        std::tuple{0.0, 1.0, 1}, std::tuple{1e9, 1.0, 3}}) {
+  for (const auto& [offset, h, ulps] :
+       {std::tuple{1000.0, 0.1, 2}, std::tuple{500000.0, 0.01, 1}, std::tuple{0.0, 1.0, 1}, std::tuple{1e9, 1.0, 3}}) {
     SCOPED_TRACE(offset);
     std::vector<Simplex> simplices = PerturbedLattice(offset, h, ulps, 3000, 7);
     std::vector<std::pair<RefinedRadiusSq, Simplex>> keyed;
@@ -227,8 +231,8 @@ TEST(RefinedRadiusSqTest, TranslatesAreProvenEqual) {
   EXPECT_TRUE(RadiusCongruent(t1, 3, t1, 3));
   // A half-turn: a lattice's upper cell triangle against its lower one.
   const Point2 lower[3] = {{1000.0, 2000.0}, {Ulps(1000.125, 1), 2000.0}, {1000.0, Ulps(2000.125, -1)}};
-  const Point2 upper[3] = {{Ulps(1000.125, 1), Ulps(2000.125, -1)}, {1000.0, Ulps(2000.125, -1)},
-                           {Ulps(1000.125, 1), 2000.0}};
+  const Point2 upper[3] = {
+      {Ulps(1000.125, 1), Ulps(2000.125, -1)}, {1000.0, Ulps(2000.125, -1)}, {Ulps(1000.125, 1), 2000.0}};
   // lower's edge vectors negated: (a + b + c) - lower, exact here, is upper's vertex list.
   EXPECT_EQ(RadiusCongruent(lower, 3, upper, 3), CompareRadiusSqRational(lower, 3, upper, 3) == 0);
   const Point2 sheared[3] = {{1000.0, 2000.0}, {Ulps(1000.125, 1), 2000.0}, {Ulps(1000.0, 1), Ulps(2000.125, -1)}};

@@ -4,8 +4,8 @@
 // huge offsets with small spacing, tiny and subnormal coordinates, mixed magnitudes.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -182,8 +182,8 @@ TEST_P(RadiusTest, FastNearestDoubleIsExactWhenItAnswers) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Families, RadiusTest,
-                         ::testing::Values("uniform", "grid", "nudged", "offset1e9", "offset1e15", "tiny",
-                                           "subnormal", "mixed", "flat"));
+                         ::testing::Values("uniform", "grid", "nudged", "offset1e9", "offset1e15", "tiny", "subnormal",
+                                           "mixed", "flat"));
 
 TEST(RadiusTest, HandComputedValues) {
   // Unit square's triangle (0,0) (1,0) (1,1): circumradius^2 = 1/2; its side as an edge: 1/4.

@@ -77,31 +77,25 @@ void CheckRingStructure(const ShapeGeometry& shape, const std::vector<Tri>& tris
   std::multiset<std::pair<uint32_t, uint32_t>> ring_edges;
   auto add_ring = [&](const std::vector<uint32_t>& ring) {
     ASSERT_GE(ring.size(), 3u);
-    EXPECT_EQ(ring[0], *std::min_element(ring.begin(), ring.end()))
-        << "ring must start at its smallest index";
-    EXPECT_EQ(std::set<uint32_t>(ring.begin(), ring.end()).size(), ring.size())
-        << "ring touches itself";
-    for (size_t i = 0; i < ring.size(); ++i)
-      ring_edges.insert({ring[i], ring[(i + 1) % ring.size()]});
+    EXPECT_EQ(ring[0], *std::min_element(ring.begin(), ring.end())) << "ring must start at its smallest index";
+    EXPECT_EQ(std::set<uint32_t>(ring.begin(), ring.end()).size(), ring.size()) << "ring touches itself";
+    for (size_t i = 0; i < ring.size(); ++i) ring_edges.insert({ring[i], ring[(i + 1) % ring.size()]});
   };
   for (const ShapePolygon& polygon : shape.polygons) {
     add_ring(polygon.outer);
     for (const auto& hole : polygon.holes) add_ring(hole);
     EXPECT_TRUE(std::is_sorted(polygon.holes.begin(), polygon.holes.end()));
   }
-  EXPECT_TRUE(std::is_sorted(
-      shape.polygons.begin(), shape.polygons.end(),
-      [](const ShapePolygon& a, const ShapePolygon& b) { return a.outer < b.outer; }));
+  EXPECT_TRUE(std::is_sorted(shape.polygons.begin(), shape.polygons.end(),
+                             [](const ShapePolygon& a, const ShapePolygon& b) { return a.outer < b.outer; }));
   EXPECT_EQ(ring_edges, BoundaryEdges(tris)) << "every boundary edge in exactly one ring";
 }
 
 void CheckGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points) {
-  const auto json =
-      nlohmann::json::parse(ShapeToGeoJson(shape, points), nullptr, /*allow_exceptions=*/false);
+  const auto json = nlohmann::json::parse(ShapeToGeoJson(shape, points), nullptr, /*allow_exceptions=*/false);
   ASSERT_FALSE(json.is_discarded()) << ShapeToGeoJson(shape, points);
   ASSERT_EQ(json["type"], "FeatureCollection");
-  const size_t parts =
-      !shape.polygons.empty() + !shape.singular_edges.empty() + !shape.isolated_points.empty();
+  const size_t parts = !shape.polygons.empty() + !shape.singular_edges.empty() + !shape.isolated_points.empty();
   ASSERT_EQ(json["features"].size(), parts);
   auto expect_position = [&](const nlohmann::json& position, uint32_t index) {
     ASSERT_EQ(position.size(), 2u);
@@ -162,8 +156,8 @@ void CheckSvg(const ShapeGeometry& shape, absl::Span<const Point2> points) {
 
 // Assembles the complex and checks it against GEOS and the structural rules; returns the shape.
 ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>& tris,
-                         const std::vector<Edge>& singular = {},
-                         const std::vector<uint32_t>& isolated = {}, Expected expected = {}) {
+                         const std::vector<Edge>& singular = {}, const std::vector<uint32_t>& isolated = {},
+                         Expected expected = {}) {
   const ShapeComplex complex{points, tris, singular, isolated};
   const absl::StatusOr<ShapeGeometry> assembled = AssembleShape(complex);
   EXPECT_THAT(assembled, IsOk());
@@ -191,8 +185,7 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
   const auto again = AssembleShape(shuffled);
   EXPECT_THAT(again, IsOk());
   if (again.ok()) {
-    EXPECT_EQ(ShapeToWkt(*again, points), ShapeToWkt(shape, points))
-        << "order must not depend on input order";
+    EXPECT_EQ(ShapeToWkt(*again, points), ShapeToWkt(shape, points)) << "order must not depend on input order";
   }
 
   Geos geos;
@@ -221,12 +214,10 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
     EXPECT_NE(merged, nullptr);
     if (merged != nullptr) {
       EXPECT_EQ(GEOSEquals_r(geos.ctx(), multi, merged.get()), 1) << wkt;
-      EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), merged.get()),
-                static_cast<int>(shape.polygons.size()));
+      EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), merged.get()), static_cast<int>(shape.polygons.size()));
       int geos_holes = 0;
       for (int p = 0; p < GEOSGetNumGeometries_r(geos.ctx(), merged.get()); ++p) {
-        geos_holes +=
-            GEOSGetNumInteriorRings_r(geos.ctx(), GEOSGetGeometryN_r(geos.ctx(), merged.get(), p));
+        geos_holes += GEOSGetNumInteriorRings_r(geos.ctx(), GEOSGetGeometryN_r(geos.ctx(), merged.get(), p));
       }
       EXPECT_EQ(static_cast<size_t>(geos_holes), holes);
     }
@@ -234,14 +225,12 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
   if (!shape.singular_edges.empty()) {
     const GEOSGeometry* lines = GEOSGetGeometryN_r(geos.ctx(), collection.get(), part++);
     EXPECT_EQ(GEOSGeomTypeId_r(geos.ctx(), lines), GEOS_MULTILINESTRING);
-    EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), lines),
-              static_cast<int>(shape.singular_edges.size()));
+    EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), lines), static_cast<int>(shape.singular_edges.size()));
   }
   if (!shape.isolated_points.empty()) {
     const GEOSGeometry* multipoint = GEOSGetGeometryN_r(geos.ctx(), collection.get(), part++);
     EXPECT_EQ(GEOSGeomTypeId_r(geos.ctx(), multipoint), GEOS_MULTIPOINT);
-    EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), multipoint),
-              static_cast<int>(shape.isolated_points.size()));
+    EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), multipoint), static_cast<int>(shape.isolated_points.size()));
   }
   EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), collection.get()), part);
 
@@ -286,8 +275,7 @@ struct Grid {
 void RemoveCell(std::vector<Tri>& tris, const Grid& g, uint32_t x, uint32_t y) {
   std::vector<Tri> cell;
   g.AddCell(cell, x, y);
-  tris.erase(std::remove_if(tris.begin(), tris.end(),
-                            [&](const Tri& t) { return t == cell[0] || t == cell[1]; }),
+  tris.erase(std::remove_if(tris.begin(), tris.end(), [&](const Tri& t) { return t == cell[0] || t == cell[1]; }),
              tris.end());
 }
 
@@ -297,8 +285,7 @@ TEST(AssembleShapeTest, OneTriangleAndTwoSharingAnEdge) {
   ASSERT_EQ(one.polygons.size(), 1u);
   EXPECT_EQ(one.polygons[0].outer, (std::vector<uint32_t>{0, 1, 3}));
   EXPECT_EQ(one.area, 0.5);
-  EXPECT_EQ(ShapeToWkt(one, g.points),
-            "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 0))))");
+  EXPECT_EQ(ShapeToWkt(one, g.points), "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 0))))");
   std::vector<Tri> cell;
   g.AddCell(cell, 0, 0);
   const ShapeGeometry square = CheckShape(g.points, cell, {}, {}, {1, 0});
@@ -307,8 +294,7 @@ TEST(AssembleShapeTest, OneTriangleAndTwoSharingAnEdge) {
 
 TEST(AssembleShapeTest, TwoTrianglesTouchingAtAVertexAreTwoPolygons) {
   const Grid g(3, 3);
-  CheckShape(g.points, {{g.At(0, 0), g.At(1, 0), g.At(1, 1)}, {g.At(1, 1), g.At(2, 1), g.At(2, 2)}},
-             {}, {}, {2, 0});
+  CheckShape(g.points, {{g.At(0, 0), g.At(1, 0), g.At(1, 1)}, {g.At(1, 1), g.At(2, 1), g.At(2, 2)}}, {}, {}, {2, 0});
 }
 
 TEST(AssembleShapeTest, RingOfCellsAroundAHole) {
@@ -316,8 +302,7 @@ TEST(AssembleShapeTest, RingOfCellsAroundAHole) {
   std::vector<Tri> tris;
   g.AddCellRing(tris, 0, 3);
   const ShapeGeometry shape = CheckShape(g.points, tris, {}, {}, {1, 1});
-  EXPECT_EQ(shape.polygons[0].holes[0],
-            (std::vector<uint32_t>{g.At(1, 1), g.At(1, 2), g.At(2, 2), g.At(2, 1)}));
+  EXPECT_EQ(shape.polygons[0].holes[0], (std::vector<uint32_t>{g.At(1, 1), g.At(1, 2), g.At(2, 2), g.At(2, 1)}));
 }
 
 TEST(AssembleShapeTest, HoleTouchingTheOuterRingAtAVertex) {
@@ -348,12 +333,9 @@ TEST(AssembleShapeTest, TriangleTouchingAPieceAtTwoVertices) {
 
 TEST(AssembleShapeTest, BowTiesAroundOneVertex) {
   const Grid g(3, 3);
-  CheckShape(g.points, {g.Fan(1, 1, 0), g.Fan(1, 1, 1), g.Fan(1, 1, 4), g.Fan(1, 1, 5)}, {}, {},
-             {2, 0});
-  CheckShape(g.points, {g.Fan(1, 1, 0), g.Fan(1, 1, 2), g.Fan(1, 1, 4), g.Fan(1, 1, 6)}, {}, {},
-             {4, 0});
-  CheckShape(g.points, {g.Fan(1, 1, 0), g.Fan(1, 1, 1), g.Fan(1, 1, 2), g.Fan(1, 1, 5)}, {}, {},
-             {2, 0});
+  CheckShape(g.points, {g.Fan(1, 1, 0), g.Fan(1, 1, 1), g.Fan(1, 1, 4), g.Fan(1, 1, 5)}, {}, {}, {2, 0});
+  CheckShape(g.points, {g.Fan(1, 1, 0), g.Fan(1, 1, 2), g.Fan(1, 1, 4), g.Fan(1, 1, 6)}, {}, {}, {4, 0});
+  CheckShape(g.points, {g.Fan(1, 1, 0), g.Fan(1, 1, 1), g.Fan(1, 1, 2), g.Fan(1, 1, 5)}, {}, {}, {2, 0});
 }
 
 TEST(AssembleShapeTest, PieceTouchingItselfThreeTimesAtOneVertex) {
@@ -390,10 +372,9 @@ TEST(AssembleShapeTest, EmptyAndLowerDimensionalParts) {
   const ShapeGeometry parts = CheckShape(g.points, {{0, 1, 4}}, {{8, 5}, {5, 8}, {6, 7}}, {2, 2});
   EXPECT_EQ(parts.singular_edges, (std::vector<Edge>{{5, 8}, {6, 7}}));
   EXPECT_EQ(parts.isolated_points, (std::vector<uint32_t>{2}));
-  EXPECT_EQ(
-      ShapeToWkt(parts, g.points),
-      "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 0))), MULTILINESTRING ((2 1, 2 2), "
-      "(0 2, 1 2)), MULTIPOINT ((2 0)))");
+  EXPECT_EQ(ShapeToWkt(parts, g.points),
+            "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 0))), MULTILINESTRING ((2 1, 2 2), "
+            "(0 2, 1 2)), MULTIPOINT ((2 0)))");
 }
 
 TEST(AssembleShapeTest, BadInputIsInvalidArgumentNamingTheIndex) {
@@ -419,8 +400,7 @@ TriangulateOptions CpuOptions() {
 }
 
 TEST(AssembleShapeTest, RandomSubsetsOfTriangulations) {
-  for (const char* name :
-       {"uniform", "grid", "clustered", "with_duplicates", "circle", "huge_offset_1e9"}) {
+  for (const char* name : {"uniform", "grid", "clustered", "with_duplicates", "circle", "huge_offset_1e9"}) {
     const gen::NamedGenerator* generator = gen::FindDistribution(name);
     ASSERT_NE(generator, nullptr) << name;
     for (uint64_t seed : {1, 2, 3}) {

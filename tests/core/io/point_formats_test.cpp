@@ -74,8 +74,7 @@ TEST(ParsePointsTextTest, BadLineIsNamedByNumber) {
 }
 
 // The bytes of an .npy file: magic, version, header length, header padded to 64 bytes, data.
-std::string Npy(const std::string& dict, const std::vector<double>& values, int version = 1,
-                bool big_endian = false) {
+std::string Npy(const std::string& dict, const std::vector<double>& values, int version = 1, bool big_endian = false) {
   const size_t length_width = version == 1 ? 2 : 4;
   std::string header = dict;
   while ((6 + 2 + length_width + header.size() + 1) % 64 != 0) header += ' ';
@@ -94,31 +93,28 @@ std::string Npy(const std::string& dict, const std::vector<double>& values, int 
 }
 
 TEST(ParsePointsNpyTest, COrderFortranOrderBigEndianVersion2) {
-  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }", {1, 2, 3, 4}),
-                              "c.npy"),
+  ExpectPoints(
+      ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }", {1, 2, 3, 4}), "c.npy"),
+      Points({{1, 2}, {3, 4}}));
+  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': True, 'shape': (2, 2), }", {1, 3, 2, 4}), "f.npy"),
                Points({{1, 2}, {3, 4}}));
-  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': True, 'shape': (2, 2), }", {1, 3, 2, 4}),
-                              "f.npy"),
-               Points({{1, 2}, {3, 4}}));
-  ExpectPoints(ParsePointsNpy(Npy("{'descr': '>f8', 'fortran_order': False, 'shape': (1, 2), }", {5, -6}, 1, true),
-                              "b.npy"),
-               Points({{5, -6}}));
-  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 2), }", {7, 8}, 2),
-                              "v2.npy"),
+  ExpectPoints(
+      ParsePointsNpy(Npy("{'descr': '>f8', 'fortran_order': False, 'shape': (1, 2), }", {5, -6}, 1, true), "b.npy"),
+      Points({{5, -6}}));
+  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 2), }", {7, 8}, 2), "v2.npy"),
                Points({{7, 8}}));
-  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (0, 2), }", {}), "0.npy"),
-               {});
+  ExpectPoints(ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (0, 2), }", {}), "0.npy"), {});
 }
 
 TEST(ParsePointsNpyTest, WrongDtypeShapeMagicAndSizeAreErrors) {
   const auto f4 = ParsePointsNpy(Npy("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 2), }", {1, 2}), "f4.npy");
   ASSERT_THAT(f4.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_NE(f4.status().message().find("'<f4'"), absl::string_view::npos) << f4.status();
-  const auto three = ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 3), }", {1, 2, 3}),
-                                    "3.npy");
+  const auto three =
+      ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 3), }", {1, 2, 3}), "3.npy");
   EXPECT_THAT(three.status(), StatusIs(absl::StatusCode::kInvalidArgument));
-  const auto flat = ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (4,), }", {1, 2, 3, 4}),
-                                   "1d.npy");
+  const auto flat =
+      ParsePointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (4,), }", {1, 2, 3, 4}), "1d.npy");
   EXPECT_THAT(flat.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   EXPECT_THAT(ParsePointsNpy("PK\x03\x04 not numpy", "z.npy").status(), StatusIs(absl::StatusCode::kInvalidArgument));
   std::string truncated = Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 2), }", {1, 2, 3, 4});
@@ -197,9 +193,9 @@ TEST_F(ReadPointsFileTest, ChoosesTheFormatByExtension) {
   ExpectPoints(ReadPointsFile(Write("p.csv", "x,y\n1,2\n")), Points({{1, 2}}));
   ExpectPoints(ReadPointsFile(Write("p.XYZ", "1 2 3\n")), Points({{1, 2}}));
   ExpectPoints(ReadPointsFile(Write("p.geojson", R"({"type": "Point", "coordinates": [9, 10]})")), Points({{9, 10}}));
-  ExpectPoints(ReadPointsFile(Write("p.npy", Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 2), }",
-                                                 {3, 4}))),
-               Points({{3, 4}}));
+  ExpectPoints(
+      ReadPointsFile(Write("p.npy", Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 2), }", {3, 4}))),
+      Points({{3, 4}}));
   const std::string bin = (dir_ / "p.bin").string();
   ASSERT_THAT(WritePointsBin(bin, Points({{5, 6}, {7, 8}})), IsOk());
   ExpectPoints(ReadPointsFile(bin), Points({{5, 6}, {7, 8}}));

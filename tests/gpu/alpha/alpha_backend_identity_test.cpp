@@ -84,9 +84,9 @@ void ExpectIdentical(const std::vector<Point2>& points, const std::string& where
 
 TEST(AlphaBackendIdentityTest, EveryGenerator) {
   if (!CudaBackendAvailable()) GTEST_SKIP() << "no GPU";
-  for (const char* name : {"uniform", "gaussian", "clustered", "grid", "circle", "thin_circle", "two_lines",
-                           "parallel_lines", "with_duplicates", "huge_offset_1e9", "huge_offset_1e15", "tiny",
-                           "ulp_lattice", "lidar_cm"}) {
+  for (const char* name :
+       {"uniform", "gaussian", "clustered", "grid", "circle", "thin_circle", "two_lines", "parallel_lines",
+        "with_duplicates", "huge_offset_1e9", "huge_offset_1e15", "tiny", "ulp_lattice", "lidar_cm"}) {
     const gen::NamedGenerator* generator = gen::FindDistribution(name);
     ASSERT_NE(generator, nullptr) << name;
     for (size_t n : {size_t{1000}, size_t{100000}}) {

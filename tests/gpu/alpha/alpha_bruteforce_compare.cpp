@@ -224,9 +224,9 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
     const mpq_class A = b.Threshold(level);
     for (ClassifyMode mode : {ClassifyMode::kGeneral, ClassifyMode::kRegularized}) {
       for (VertexRule rule : {VertexRule::kReport, VertexRule::kCgal}) {
-        SCOPED_TRACE(::testing::Message() << "level " << level
-                                        << (mode == ClassifyMode::kGeneral ? " GENERAL" : " REGULARIZED")
-                                        << (rule == VertexRule::kReport ? " report rule" : " CGAL rule"));
+        SCOPED_TRACE(::testing::Message()
+                     << "level " << level << (mode == ClassifyMode::kGeneral ? " GENERAL" : " REGULARIZED")
+                     << (rule == VertexRule::kReport ? " report rule" : " CGAL rule"));
         const BruteClasses want = ClassifyBrute(b, A, mode, rule);
         const Classification got = f.ClassifyAll(level, mode, rule);
         ASSERT_EQ(got.vertices.size(), n);

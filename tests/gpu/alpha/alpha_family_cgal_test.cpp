@@ -77,8 +77,8 @@ void CompareAtLevel(const AlphaFamily& f, const CgalAlphaOracle& oracle, int64_t
   for (const auto& [v, cls] : expected.vertices) {
     ASSERT_EQ(ToOracle(got.vertices[v]), cls) << where << " level " << level << " vertex " << v;
   }
-  const size_t interior = static_cast<size_t>(
-      std::count(got.triangles.begin(), got.triangles.end(), SimplexClass::kInterior));
+  const size_t interior =
+      static_cast<size_t>(std::count(got.triangles.begin(), got.triangles.end(), SimplexClass::kInterior));
   if (oracle.dimension() == 2) {
     EXPECT_EQ(interior, expected.interior_triangles) << where << " level " << level;
     EXPECT_EQ(f.SolidComponents(level), expected.solid_components) << where << " level " << level;

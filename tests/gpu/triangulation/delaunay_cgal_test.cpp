@@ -48,8 +48,7 @@ uint64_t DirectedKey(uint32_t from, uint32_t to) { return (uint64_t{from} << 32)
 CgalDelaunay TriangulateWithCgal(const std::vector<Point2>& points) {
   std::vector<uint32_t> order(points.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t a, uint32_t b) { return LexLess(points[a], points[b]); });
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return LexLess(points[a], points[b]); });
   std::vector<std::pair<Kernel::Point_2, uint32_t>> firsts;
   for (size_t r = 0; r < order.size(); ++r) {
     const uint32_t i = order[r];
@@ -65,8 +64,7 @@ std::vector<Edge> CgalEdges(const CgalDelaunay& dt) {
   for (auto e = dt.finite_edges_begin(); e != dt.finite_edges_end(); ++e) {
     const auto face = e->first;
     const int i = e->second;
-    edges.push_back(Undirected(face->vertex(CgalDelaunay::cw(i))->info(),
-                               face->vertex(CgalDelaunay::ccw(i))->info()));
+    edges.push_back(Undirected(face->vertex(CgalDelaunay::cw(i))->info(), face->vertex(CgalDelaunay::ccw(i))->info()));
   }
   std::sort(edges.begin(), edges.end());
   return edges;
@@ -105,8 +103,7 @@ struct EdgeVerdict {
 
 // `edge` in our triangulation: acceptable iff it is interior and its two triangles' four vertices
 // are exactly co-circular.
-EdgeVerdict JudgeOurEdge(const Triangulation& t,
-                         const std::unordered_map<uint64_t, uint32_t>& directed, Edge edge) {
+EdgeVerdict JudgeOurEdge(const Triangulation& t, const std::unordered_map<uint64_t, uint32_t>& directed, Edge edge) {
   const auto forward = directed.find(DirectedKey(edge[0], edge[1]));
   const auto backward = directed.find(DirectedKey(edge[1], edge[0]));
   if (forward == directed.end() || backward == directed.end()) {
@@ -120,16 +117,15 @@ EdgeVerdict JudgeOurEdge(const Triangulation& t,
 }
 
 // `edge` in CGAL's triangulation: the same question on CGAL's two faces.
-EdgeVerdict JudgeCgalEdge(const CgalDelaunay& dt,
-                          const std::unordered_map<uint64_t, CgalDelaunay::Edge>& cgal_edges,
+EdgeVerdict JudgeCgalEdge(const CgalDelaunay& dt, const std::unordered_map<uint64_t, CgalDelaunay::Edge>& cgal_edges,
                           Edge edge) {
   const CgalDelaunay::Edge& e = cgal_edges.at(DirectedKey(edge[0], edge[1]));
   const auto face = e.first;
   const auto mirror = face->neighbor(e.second);
   if (dt.is_infinite(face) || dt.is_infinite(mirror)) return {false, "a hull edge of CGAL's only"};
   auto point = [](CgalDelaunay::Vertex_handle v) { return Point2{v->point().x(), v->point().y()}; };
-  const int in_circle = InCircleSign(point(face->vertex(0)), point(face->vertex(1)),
-                                     point(face->vertex(2)), point(dt.mirror_vertex(face, e.second)));
+  const int in_circle = InCircleSign(point(face->vertex(0)), point(face->vertex(1)), point(face->vertex(2)),
+                                     point(dt.mirror_vertex(face, e.second)));
   return {in_circle == 0, absl::StrCat("CGAL's only, in-circle sign ", in_circle)};
 }
 
@@ -148,10 +144,8 @@ void ExpectMatchesCgal(const Triangulation& t, bool require_identical) {
 
   std::vector<Edge> ours_only;
   std::vector<Edge> theirs_only;
-  std::set_difference(ours.begin(), ours.end(), theirs.begin(), theirs.end(),
-                      std::back_inserter(ours_only));
-  std::set_difference(theirs.begin(), theirs.end(), ours.begin(), ours.end(),
-                      std::back_inserter(theirs_only));
+  std::set_difference(ours.begin(), ours.end(), theirs.begin(), theirs.end(), std::back_inserter(ours_only));
+  std::set_difference(theirs.begin(), theirs.end(), ours.begin(), ours.end(), std::back_inserter(theirs_only));
   if (require_identical) {
     EXPECT_TRUE(ours_only.empty() && theirs_only.empty())
         << ours_only.size() << " edges only in ours, " << theirs_only.size()

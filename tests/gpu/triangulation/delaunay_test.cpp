@@ -78,8 +78,7 @@ std::string SortedDifference(const std::vector<T>& a, const std::vector<T>& b) {
 }
 
 bool BitwiseEqual(const std::vector<Point2>& a, absl::Span<const Point2> b) {
-  return a.size() == b.size() &&
-         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Point2)) == 0);
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Point2)) == 0);
 }
 
 // The backend fixture (the CUDA instance skips where this build or machine has none) that
@@ -137,17 +136,18 @@ TEST_P(DelaunayTest, EveryDistribution) {
 TEST_P(DelaunayTest, RealDataSets) {
   const std::vector<std::string> files = testdata::PointFiles();
   ASSERT_FALSE(files.empty()) << "no *.bin files in " << testdata::DataDir();
-  for (const std::string& file : files) [&] {
-    SCOPED_TRACE(file);
-    absl::StatusOr<std::vector<Point2>> points = ReadPointsBin(file);
-    ASSERT_THAT(points, IsOk());
-    Triangulation t;
-    ASSERT_NO_FATAL_FAILURE(RunAndCheck(*points, &t));
-    // data/README.md: the Autzen cloud holds 7 exact duplicates.
-    if (std::filesystem::path(file).filename() == "lidar_autzen.bin") {
-      EXPECT_EQ(t.num_unique, 110000u - 7u);
-    }
-  }();
+  for (const std::string& file : files)
+    [&] {
+      SCOPED_TRACE(file);
+      absl::StatusOr<std::vector<Point2>> points = ReadPointsBin(file);
+      ASSERT_THAT(points, IsOk());
+      Triangulation t;
+      ASSERT_NO_FATAL_FAILURE(RunAndCheck(*points, &t));
+      // data/README.md: the Autzen cloud holds 7 exact duplicates.
+      if (std::filesystem::path(file).filename() == "lidar_autzen.bin") {
+        EXPECT_EQ(t.num_unique, 110000u - 7u);
+      }
+    }();
 }
 
 // The ledger counts every buffer: the build holds at least the input and the mesh of 2n triangles
@@ -347,8 +347,7 @@ TEST(DelaunayBackendTest, CpuAndCudaAgree) {
       EXPECT_EQ(cpu->representative, cuda->representative);
       EXPECT_EQ(SortedDifference(CanonicalTriangles(*cpu), CanonicalTriangles(*cuda)), "")
           << "triangles, first = CPU, second = CUDA";
-      EXPECT_EQ(SortedDifference(SortedEdges(*cpu), SortedEdges(*cuda)), "")
-          << "edges, first = CPU, second = CUDA";
+      EXPECT_EQ(SortedDifference(SortedEdges(*cpu), SortedEdges(*cuda)), "") << "edges, first = CPU, second = CUDA";
     }
   }
 }
