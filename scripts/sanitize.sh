@@ -3,7 +3,8 @@
 # CMakePresets.json:
 #   asan  AddressSanitizer + UndefinedBehaviorSanitizer (leaks included) on the exact arithmetic,
 #         the point parsers, the family build and its queries, and the upload decoder: the code
-#         that handles untrusted input and raw indices.
+#         that handles untrusted input and raw indices. UBSan reports halt the test
+#         (halt_on_error); scripts/ubsan.supp suppresses one report inside Thrust's own headers.
 #   tsan  ThreadSanitizer on the service's threaded parts (build scheduler, family cache, upload
 #         streams). OpenMP runs one thread there (OMP_NUM_THREADS=1 in the preset): Debian's
 #         libgomp is not instrumented, and its own threads would only report its internals.
