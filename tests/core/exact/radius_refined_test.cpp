@@ -14,29 +14,14 @@
 
 #include "core/exact/radius_rational.hpp"
 #include "core/exact/radius_refined.hpp"
+#include "tests/core/exact/simplex_samples.hpp"
 
 namespace galpha {
 namespace {
 
-struct Simplex {
-  Point2 p[3];
-  int n;
-};
-
-std::string Show(const Simplex& s) {
-  std::string out;
-  char text[96];
-  for (int i = 0; i < s.n; ++i) {
-    std::snprintf(text, sizeof text, "(%.17g, %.17g) ", s.p[i].x, s.p[i].y);
-    out += text;
-  }
-  return out;
-}
-
-double Ulps(double v, int n) {
-  for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? INFINITY : -INFINITY);
-  return v;
-}
+using testing_support::Show;
+using testing_support::Simplex;
+using testing_support::Ulps;
 
 // The exact value of a refined key: (hi + mid + lo) 2^exponent.
 mpq_class RefinedValue(const RefinedRadiusSq& r) {

@@ -16,29 +16,14 @@
 #include "core/exact/radius_key.hpp"
 #include "core/exact/radius_nearest.hpp"
 #include "core/exact/radius_rational.hpp"
+#include "tests/core/exact/simplex_samples.hpp"
 
 namespace galpha {
 namespace {
 
-struct Simplex {
-  Point2 p[3];
-  int n;
-};
-
-std::string Show(const Simplex& s) {
-  std::string out;
-  char text[96];
-  for (int i = 0; i < s.n; ++i) {
-    std::snprintf(text, sizeof text, "(%.17g, %.17g) ", s.p[i].x, s.p[i].y);
-    out += text;
-  }
-  return out;
-}
-
-double Ulps(double v, int n) {
-  for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? INFINITY : -INFINITY);
-  return v;
-}
+using testing_support::Show;
+using testing_support::Simplex;
+using testing_support::Ulps;
 
 // Simplices of one family: integer-ish shapes placed at `offset`, scaled by 2^scale, optionally
 // nudged by ulps so that exact ties become near ties.
