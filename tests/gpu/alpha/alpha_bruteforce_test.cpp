@@ -22,7 +22,18 @@ using testing::BruteForce;
 using testing::CompareWithBruteForce;
 using testing::InGeneralPosition;
 
-enum class Scale { kUnit, kOffset1e9, kTiny, kMixedSigns, kSmallIntegers };
+enum class Scale {
+  kUnit,
+  kOffset1e9,
+  kTiny,
+  kMixedSigns,
+  kSmallIntegers,
+  // The edges of the input domain (core/io/input_validation.hpp): magnitudes just below 2^500;
+  // every coordinate subnormal; magnitudes spread over almost 2^437 in one set.
+  kDomainTop,
+  kSubnormal,
+  kWidestSpread,
+};
 
 std::vector<Point2> RandomSet(std::mt19937_64& rng, size_t n, Scale scale) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -45,6 +56,20 @@ std::vector<Point2> RandomSet(std::mt19937_64& rng, size_t n, Scale scale) {
           x = 2 * x - 1;
           y = (2 * y - 1) * 1e-3;  // flat: many obtuse triangles and attached edges
           break;
+        case Scale::kDomainTop:
+          x = std::ldexp(2 * x - 1, 500);  // |x| < 2^500
+          y = std::ldexp(2 * y - 1, 500);
+          break;
+        case Scale::kSubnormal:
+          // Multiples of 2^-1074 below 2^-1040: coarse enough to collide, hence the retry below.
+          x = std::ldexp(std::floor(x * 0x1p34), -1074);
+          y = std::ldexp(std::floor(y * 0x1p34), -1074);
+          break;
+        case Scale::kWidestSpread:
+          // Most coordinates near 2^200; the first point's y just above 2^(200-437); one zero.
+          x = std::ldexp(0.5 + x / 2, 200);
+          y = i == 0 ? std::ldexp(1.0 + y, 200 - 437) : (i == 3 ? 0.0 : std::ldexp(0.5 + y / 2, 200));
+          break;
         case Scale::kSmallIntegers:
           // Exact ties of lengths and radii, right angles (third vertices on diametral circles),
           // collinear runs and duplicates; kept only where the triangulation is still unique.
@@ -64,8 +89,9 @@ using AlphaBruteForceTest = testing::BackendTest;
 
 TEST_P(AlphaBruteForceTest, RandomGeneralPosition) {
   std::mt19937_64 rng(20240607);
-  for (Scale scale : {Scale::kUnit, Scale::kOffset1e9, Scale::kTiny, Scale::kMixedSigns}) {
-    const int sets = scale == Scale::kTiny ? 40 : 80;
+  for (Scale scale : {Scale::kUnit, Scale::kOffset1e9, Scale::kTiny, Scale::kMixedSigns, Scale::kDomainTop,
+                      Scale::kSubnormal, Scale::kWidestSpread}) {
+    const int sets = scale == Scale::kUnit || scale == Scale::kOffset1e9 || scale == Scale::kMixedSigns ? 80 : 40;
     for (int s = 0; s < sets; ++s) {
       const size_t n = 4 + static_cast<size_t>(rng() % 11);  // 4..14
       SCOPED_TRACE(::testing::Message() << "scale " << static_cast<int>(scale) << " set " << s);

@@ -9,6 +9,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -46,6 +47,26 @@ TEST_P(InputTest, NonFiniteCoordinatesNameTheirIndex) {
     EXPECT_THAT(built.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     const std::string message(built.status().message());
     EXPECT_NE(message.find("point " + std::to_string(bad) + " "), std::string::npos) << message;
+  }
+}
+
+// Outside the input domain (core/io/input_validation.hpp) the build is refused, naming the point
+// and the bound, on every backend: near the largest double the predicates overflowed and the
+// issue's five points came out collinear (0 triangles) with an OK status.
+TEST_P(InputTest, OutsideTheInputDomainIsRefusedNamingThePointAndTheBound) {
+  const std::vector<std::tuple<std::vector<Point2>, size_t, std::string>> cases = {
+      {{{1e308, 1e308}, {-1e308, 1e308}, {0, -1e308}, {1e308, -1e308}, {0, 0}}, 0, "2^500"},
+      {{{0, 0}, {1, 0}, {0, 1}, {0x1p500, 1}}, 3, "2^500"},
+      {{{1, 1}, {2, 0}, {0, 1e-140}, {3, 3}}, 2, "2^437"},
+      {{{0x1p-585, 0}, {0x1p-1074, 0x1p-1070}, {0, 0x1p-600}}, 1, "2^437"},
+  };
+  for (const auto& [points, bad, bound] : cases) {
+    const absl::StatusOr<AlphaFamily> built = Build(points);
+    ASSERT_THAT(built, Not(IsOk())) << "bad index " << bad;
+    EXPECT_THAT(built.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    const std::string message(built.status().message());
+    EXPECT_EQ(message.rfind("point " + std::to_string(bad) + " ", 0), 0u) << message;
+    EXPECT_NE(message.find(bound), std::string::npos) << message;
   }
 }
 
