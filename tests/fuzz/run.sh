@@ -2,6 +2,7 @@
 # Builds the libFuzzer targets with clang (ASan + UBSan) and runs each for a short while:
 #   tests/fuzz/run.sh [SECONDS_PER_TARGET]   (default 20; CI uses the default)
 # Only the sources a target needs are compiled, so the engine (OpenMP, CUDA) is not involved.
+# predicates_fuzzer compares the exact predicates with GMP rationals on arbitrary finite doubles.
 # Corpora start from seeds/ and grow in build/fuzz/corpus (kept between local runs).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -16,8 +17,10 @@ clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp
   "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}"
 clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp \
   -o "$out/point_formats_fuzzer" "${libs[@]}"
+clang++ "${flags[@]}" tests/fuzz/predicates_fuzzer.cpp core/io/input_validation.cpp \
+  -o "$out/predicates_fuzzer" "${libs[@]}" $(pkg-config --libs absl_str_format) -lgmpxx -lgmp
 
-for target in build_stream_fuzzer point_formats_fuzzer; do
+for target in build_stream_fuzzer point_formats_fuzzer predicates_fuzzer; do
   corpus="$out/corpus/$target"
   mkdir -p "$corpus"
   echo "fuzz: $target for ${seconds} s"
