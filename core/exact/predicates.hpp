@@ -25,7 +25,8 @@
 // overflows, but one binary64 exponent range (2^-1074 .. 2^1024) cannot hold every partial product
 // of a degree-4 polynomial whose inputs span more than ~2^437 (degree 2: ~2^930); outside the range
 // a product's tail may underflow and the sign is then only almost always right.
-// Non-finite inputs (inf, NaN) are not supported.
+// Non-finite inputs (inf, NaN) are not supported. The engine keeps every call within this range by
+// refusing point sets outside its input domain (core/io/input_validation.hpp) before any work.
 //
 // Filters and underflow: Shewchuk's bounds assume no underflow. An underflowing product can be off
 // by up to 2^-1075 absolutely, which such bounds do not cover, so the filters also require the
