@@ -1,6 +1,6 @@
 // alphactl: galpha on the command line, working locally with no server (the embedded engine).
 //
-//   alphactl COMMAND FILE [OPTIONS]      (alphactl --help lists the commands: cli_args.cpp)
+//   alphactl [GLOBAL OPTIONS] COMMAND FILE [OPTIONS]   (alphactl --help lists them: cli_args.cpp)
 //
 // Output is for scripts (docs/design.md, "Formats"): JSON on one line, or one simplex or value per line.
 // Errors are one line on standard error starting with "alphactl: ", and a non-zero exit status:
@@ -51,18 +51,25 @@ int main(int argc, char** argv) {
     std::fputs(cli::kUsage, stdout);
     return cli::kExitUsage;
   }
-  if (args[0] == "help" || AsksForHelp(args)) {
+  if (AsksForHelp(args)) {
+    std::fputs(cli::kUsage, stdout);
+    return cli::kExitOk;
+  }
+  // Global options may come before the command: they are handed to it with its own words.
+  auto invocation = cli::SplitAtCommand(args);
+  if (!invocation.ok()) return cli::UsageError(invocation.status());
+  if (invocation->command == "help") {
     std::fputs(cli::kUsage, stdout);
     return cli::kExitOk;
   }
   for (const Command& command : kCommands) {
-    if (args[0] != command.name) continue;
+    if (invocation->command != command.name) continue;
     // The engine reports its errors as statuses; anything thrown past it is still one line.
     try {
-      return command.run(cli::Args(args).subspan(1));
+      return command.run(invocation->args);
     } catch (const std::exception& e) {
-      return cli::Failure(absl::InternalError(absl::StrCat(args[0], " failed: ", e.what())));
+      return cli::Failure(absl::InternalError(absl::StrCat(invocation->command, " failed: ", e.what())));
     }
   }
-  return cli::UsageError(absl::InvalidArgumentError(absl::StrCat("unknown command '", args[0], "'")));
+  return cli::UsageError(absl::InvalidArgumentError(absl::StrCat("unknown command '", invocation->command, "'")));
 }

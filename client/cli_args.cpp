@@ -1,15 +1,20 @@
 #include "client/cli_args.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstddef>
 #include <cstdlib>
+#include <iterator>
 
 #include "absl/strings/str_cat.h"
+#include "client/point_input.hpp"
+#include "core/io/input_validation.hpp"
 
 namespace galpha::alphactl {
 
 const char kUsage[] =
-    "usage: alphactl COMMAND FILE [OPTIONS]\n"
+    "usage: alphactl [GLOBAL OPTIONS] COMMAND FILE [OPTIONS]\n"
     "Exact 2D alpha shapes of the points in FILE, computed locally, or by a galpha server (--server).\n"
     "\n"
     "commands:\n"
@@ -35,11 +40,13 @@ const char kUsage[] =
     "  --alpha R                   a radius R >= 0 (R*R compared exactly)\n"
     "  --rank K                    the K-th spectrum value (0: the points alone)\n"
     "\n"
-    "every command also takes:\n"
+    "GLOBAL OPTIONS, for every command, before or after it:\n"
     "  --backend auto|cpu|cuda     where the engine runs (default auto: CUDA when a GPU is visible)\n"
     "  --server HOST:PORT          run on a galpha server instead: FILE is hashed locally and uploaded\n"
     "                              only when the server does not hold it; same output (not triangulate)\n"
     "  --tls-ca FILE               with --server: talk TLS, trusting the PEM roots in FILE\n"
+    "  --max-points N              read at most N points (default 100000000, a default server's limit;\n"
+    "                              at most 1073741824, the engine's)\n"
     "  -h, --help                  this text\n"
     "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
     "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
@@ -49,11 +56,55 @@ const char kUsage[] =
     "\n"
     "FILE: .bin (little-endian uint64 N, then N pairs of float64 x, y), .npy (float64, N x 2),\n"
     "      .geojson/.json (Point, MultiPoint), or delimited text (CSV, TSV, whitespace: x and y\n"
-    "      first, optional header line)\n"
+    "      first, optional header line, at most 65536 bytes a line). A regular file, or delimited\n"
+    "      text from a named pipe (mkfifo, /dev/stdin) or from '-', standard input; devices,\n"
+    "      directories and sockets are refused.\n"
     "\n"
-    "exit status: 0 success, 1 failure (unreadable file, bad input), 2 usage error (including a\n"
-    "rank outside the spectrum). Progress goes to standard error for 100000 points or more.\n"
+    "exit status: 0 success, 1 failure (unreadable file, bad input, more than --max-points), 2 usage\n"
+    "error (including a rank outside the spectrum). Progress goes to standard error for 100000\n"
+    "points or more.\n"
     "environment: GALPHA_TOKEN, the bearer token a server with authentication expects.\n";
+
+// kUsage quotes these numbers.
+static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && InputOptions{}.max_line_bytes == 65536,
+              "update kUsage");
+
+const absl::string_view kGlobalOptions[4] = {"backend", "server", "tls-ca", "max-points"};
+
+namespace {
+
+bool IsGlobalOption(absl::string_view name) {
+  return std::find(std::begin(kGlobalOptions), std::end(kGlobalOptions), name) != std::end(kGlobalOptions);
+}
+
+}  // namespace
+
+absl::StatusOr<Invocation> SplitAtCommand(absl::Span<const std::string> argv) {
+  Invocation invocation;
+  size_t i = 0;
+  for (; i < argv.size(); ++i) {
+    const std::string& arg = argv[i];
+    if (arg.size() < 2 || arg[0] != '-') break;  // the command ('-' alone is no option either)
+    if (arg == "--") return absl::InvalidArgumentError("expected a command before '--'");
+    const size_t equals = arg.find('=');
+    const absl::string_view name = absl::string_view(arg).substr(0, equals);
+    if (name.size() < 3 || name[1] != '-' || !IsGlobalOption(name.substr(2))) {
+      std::string global;
+      for (absl::string_view option : kGlobalOptions)
+        absl::StrAppend(&global, global.empty() ? "" : ", ", "--", option);
+      return absl::InvalidArgumentError(
+          absl::StrCat("unknown option '", name, "' before the command (only ", global, " may come before it)"));
+    }
+    invocation.args.push_back(arg);
+    if (equals != std::string::npos) continue;
+    if (i + 1 == argv.size()) return absl::InvalidArgumentError(absl::StrCat("option ", name, " needs a value"));
+    invocation.args.push_back(argv[++i]);
+  }
+  if (i == argv.size()) return absl::InvalidArgumentError("missing COMMAND");
+  invocation.command = argv[i];
+  invocation.args.insert(invocation.args.end(), argv.begin() + static_cast<std::ptrdiff_t>(i) + 1, argv.end());
+  return invocation;
+}
 
 const std::string* CommandLine::Find(absl::string_view name) const {
   for (const auto& [option, value] : options) {
@@ -162,6 +213,18 @@ absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line) {
     threshold.kind = ThresholdArg::Kind::kAlpha;
   }
   return threshold;
+}
+
+absl::StatusOr<uint64_t> ParseMaxPoints(const CommandLine& line) {
+  const std::string* text = line.Find("max-points");
+  if (text == nullptr) return kDefaultMaxPoints;
+  auto value = ParseInteger("max-points", *text, 1);
+  if (!value.ok()) return value.status();
+  if (static_cast<uint64_t>(*value) > kMaxPoints) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--max-points '", *text, "' is more than ", kMaxPoints, ", the most points the engine takes"));
+  }
+  return static_cast<uint64_t>(*value);
 }
 
 absl::StatusOr<Backend> ParseBackend(const CommandLine& line) {

@@ -24,6 +24,26 @@ constexpr int kExitUsage = 2;
 /// The full usage text (every command and its options), ending in a newline.
 extern const char kUsage[];
 
+/// The options that apply to every command, accepted before the command too (as git's and
+/// kubectl's are): --backend, --server, --tls-ca, --max-points.
+extern const absl::string_view kGlobalOptions[4];
+
+/// The command line split at its command.
+struct Invocation {
+  std::string command;
+  /// The global options given before the command, then the words after it, for ParseCommandLine:
+  /// an option given on both sides is an option given twice.
+  std::vector<std::string> args;
+};
+
+/// Finds the command in `argv` (the words after the program's name): the first word that is not
+/// a global option or its value. Options take their values as in ParseCommandLine.
+///
+/// Errors (InvalidArgument): an option before the command that is not a global one (named, with
+/// the global ones listed), a global option without its value, '--' or nothing where the command
+/// should be.
+absl::StatusOr<Invocation> SplitAtCommand(absl::Span<const std::string> argv);
+
 /// One command's arguments, split. Option names are kept without their leading "--".
 struct CommandLine {
   std::vector<std::string> positional;
@@ -59,6 +79,10 @@ struct ThresholdArg {
 
 /// Exactly one of --alpha-sq, --alpha (a radius, >= 0) or --rank (>= 0).
 absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line);
+
+/// --max-points (default kDefaultMaxPoints of point_input.hpp): an integer in 1..kMaxPoints, the
+/// engine's own limit (core/io/input_validation.hpp).
+absl::StatusOr<uint64_t> ParseMaxPoints(const CommandLine& line);
 
 /// --backend (default auto).
 absl::StatusOr<Backend> ParseBackend(const CommandLine& line);

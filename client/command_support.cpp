@@ -2,17 +2,15 @@
 #include <chrono>
 #include <cstdio>
 #include <exception>
-#include <filesystem>
+#include <iterator>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
-#include "core/io/point_formats.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 
 namespace galpha::alphactl {
@@ -51,9 +49,7 @@ int Failure(const absl::Status& status) {
 absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
                                        absl::Span<const absl::string_view> allowed) {
   std::vector<absl::string_view> names(allowed.begin(), allowed.end());
-  names.emplace_back("backend");
-  names.emplace_back("server");
-  names.emplace_back("tls-ca");
+  names.insert(names.end(), std::begin(kGlobalOptions), std::end(kGlobalOptions));
   auto line = ParseCommandLine(command, args, names);
   if (!line.ok()) return line.status();
   CommonArgs common;
@@ -65,6 +61,9 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
   auto backend = ParseBackend(*line);
   if (!backend.ok()) return backend.status();
   common.backend = *backend;
+  auto max_points = ParseMaxPoints(*line);
+  if (!max_points.ok()) return max_points.status();
+  common.input.max_points = *max_points;
   if (const std::string* server = line->Find("server")) {
     if (server->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
     if (line->Find("backend") != nullptr) {
@@ -95,26 +94,18 @@ absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line) {
   return parsed;
 }
 
-absl::StatusOr<std::vector<Point2>> ReadPoints(const std::string& file) {
-  // ReadPointsFile lets std::ifstream throw on a directory (reading one fails with EISDIR).
-  std::error_code error;
-  if (std::filesystem::is_directory(file, error)) {
-    return absl::InvalidArgumentError(absl::StrCat("points file '", file, "' is a directory"));
-  }
+absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common) {
   try {
-    return ReadPointsFile(file);
+    return ReadInputPoints(common.file, common.input);
   } catch (const std::exception& e) {
-    return absl::DataLossError(absl::StrCat("points file '", file, "' cannot be read: ", e.what()));
+    return absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
   }
 }
 
-absl::StatusOr<AlphaFamily> LoadFamily(const std::string& file, Backend backend, size_t* input_points) {
-  auto points = ReadPoints(file);
-  if (!points.ok()) return points.status();
-  *input_points = points->size();
+absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points) {
   BuildOptions options;
-  options.backend = backend;
-  if (points->size() >= kProgressMinPoints) {
+  options.backend = common.backend;
+  if (points.size() >= kProgressMinPoints) {
     const auto start = std::chrono::steady_clock::now();
     options.progress = [start](std::string_view phase, double fraction) {
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -122,7 +113,14 @@ absl::StatusOr<AlphaFamily> LoadFamily(const std::string& file, Backend backend,
                    fraction * 100.0, seconds);
     };
   }
-  return BuildAlphaFamily(*points, options);
+  return BuildAlphaFamily(points, options);
+}
+
+absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points) {
+  auto points = ReadPoints(common);
+  if (!points.ok()) return points.status();
+  *input_points = points->size();
+  return BuildFamily(common, *points);
 }
 
 double LevelAlphaSq(const AlphaFamily& family, int64_t level) {

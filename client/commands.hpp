@@ -13,6 +13,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/types/span.h"
 #include "client/cli_args.hpp"
+#include "client/point_input.hpp"
 #include "core/base/point.hpp"
 #include "core/family/alpha_family.hpp"
 
@@ -39,7 +40,7 @@ int ArgumentError(const absl::Status& status);
 /// Prints "alphactl: MESSAGE" on one line to stderr; returns kExitFailure.
 int Failure(const absl::Status& status);
 
-/// What every command parses first: its options, its one FILE and --backend.
+/// What every command parses first: its options, its one FILE and the global options.
 struct CommonArgs {
   CommandLine line;
   std::string file;
@@ -48,9 +49,11 @@ struct CommonArgs {
   std::string server;
   /// --tls-ca FILE: PEM roots; talk TLS to the server.
   std::string tls_ca_file;
+  /// How FILE is read: --max-points.
+  InputOptions input;
 };
-/// ParseCommandLine, then exactly one positional FILE, a valid --backend, and --server / --tls-ca
-/// (added to `allowed`). --backend with --server, or --tls-ca without it, is a usage error.
+/// ParseCommandLine with `allowed` and kGlobalOptions, then exactly one positional FILE and valid
+/// global options. --backend with --server, or --tls-ca without it, is a usage error.
 absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
                                        absl::Span<const absl::string_view> allowed);
 
@@ -62,12 +65,16 @@ struct ClassifyArgs {
 };
 absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line);
 
-/// ReadPointsFile, with a directory or an I/O exception reported as an error.
-absl::StatusOr<std::vector<Point2>> ReadPoints(const std::string& file);
+/// ReadInputPoints of the command's FILE (read once: it may be a pipe), with an exception thrown
+/// while reading (out of memory) reported as an error.
+absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common);
 
-/// Reads FILE and builds its family; for 100000 points or more, reports each build phase on
-/// stderr. `input_points` receives the number of points read.
-absl::StatusOr<AlphaFamily> LoadFamily(const std::string& file, Backend backend, size_t* input_points);
+/// Builds the family of `points` on the command's backend; for 100000 points or more, reports
+/// each build phase on stderr.
+absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points);
+
+/// ReadPoints, then BuildFamily. `input_points` receives the number of points read.
+absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points);
 
 /// A threshold resolved against a family: its level, and the alpha_sq it stands for (for a rank
 /// K > 0 the published spectrum double spectrum[K-1]; 0 for rank 0; the given value for --alpha-sq;

@@ -24,7 +24,7 @@ int RunTriangulate(Args args) {
   TriangulateOptions options;
   options.backend = common->backend;
 
-  auto points = ReadPoints(common->file);
+  auto points = ReadPoints(*common);
   if (!points.ok()) return Failure(points.status());
   auto tri = Triangulate(*points, options);
   if (!tri.ok()) return Failure(tri.status());
@@ -55,7 +55,7 @@ int RunSpectrum(Args args) {
   if (!common.ok()) return UsageError(common.status());
   if (!common->server.empty()) return RemoteSpectrum(*common);
   size_t input_points = 0;
-  auto family = LoadFamily(common->file, common->backend, &input_points);
+  auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
   ChunkedWriter out(stdout);
   for (const double alpha_sq : family->spectrum()) {
@@ -77,14 +77,16 @@ int RunBench(Args args) {
   }
   if (!common->server.empty()) return RemoteBench(*common, repeat);
 
-  // Best of `repeat` per stage, matched by name in the first build's order; the total is the
-  // best build's sum (not the sum of the per-stage bests).
+  // Read once: FILE may be a pipe. Best of `repeat` per stage, matched by name in the first
+  // build's order; the total is the best build's sum (not the sum of the per-stage bests).
+  auto points = ReadPoints(*common);
+  if (!points.ok()) return Failure(points.status());
+  const size_t input_points = points->size();
   std::vector<std::pair<std::string, double>> best;
   double best_total = 0.0;
-  size_t input_points = 0;
   std::optional<AlphaFamily> family;
   for (int64_t run = 0; run < repeat; ++run) {
-    auto built = LoadFamily(common->file, common->backend, &input_points);
+    auto built = BuildFamily(*common, *points);
     if (!built.ok()) return Failure(built.status());
     double total = 0.0;
     for (const StageTime& s : built->report().stage_times) {

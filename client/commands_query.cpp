@@ -56,7 +56,7 @@ int RunClassify(Args args) {
   if (!options.ok()) return UsageError(options.status());
   if (!common->server.empty()) return RemoteClassify(*common, *options);
   size_t input_points = 0;
-  auto family = LoadFamily(common->file, common->backend, &input_points);
+  auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, options->threshold);
   if (!threshold.ok()) return ArgumentError(threshold.status());
@@ -93,7 +93,7 @@ int RunSummary(Args args) {
   if (!options.ok()) return UsageError(options.status());
   if (!common->server.empty()) return RemoteSummary(*common, *options);
   size_t input_points = 0;
-  auto family = LoadFamily(common->file, common->backend, &input_points);
+  auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, options->threshold);
   if (!threshold.ok()) return ArgumentError(threshold.status());
@@ -131,7 +131,7 @@ int RunShape(Args args) {
   }
   if (!common->server.empty()) return RemoteShape(*common, *threshold_arg, *mode, *format);
   size_t input_points = 0;
-  auto family = LoadFamily(common->file, common->backend, &input_points);
+  auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, *threshold_arg);
   if (!threshold.ok()) return ArgumentError(threshold.status());
@@ -157,7 +157,7 @@ int RunMasterList(Args args) {
   if (!rank.ok()) return UsageError(rank.status());
   if (!common->server.empty()) return RemoteMasterList(*common, *rank);
   size_t input_points = 0;
-  auto family = LoadFamily(common->file, common->backend, &input_points);
+  auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
   if (absl::Status s = CheckMasterListRank(*rank, family->max_level()); !s.ok()) return ArgumentError(s);
 
@@ -195,7 +195,7 @@ int RunOptimal(Args args) {
   if (!components.ok()) return UsageError(components.status());
   if (!common->server.empty()) return RemoteOptimal(*common, *components);
   size_t input_points = 0;
-  auto family = LoadFamily(common->file, common->backend, &input_points);
+  auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
 
   // Counts are 32-bit: "at most N" for any larger N means the same as for the largest count.

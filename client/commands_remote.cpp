@@ -57,7 +57,7 @@ absl::Status ServerError(const CommonArgs& common, const absl::Status& status) {
 
 /// Reads FILE, then finds or builds its family on the server (progress on stderr for large files).
 absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_upload_if_cached = true) {
-  auto points = ReadPoints(common.file);
+  auto points = ReadPoints(common);
   if (!points.ok()) return points.status();
   RemoteFamily remote;
   remote.input_points = points->size();
@@ -323,11 +323,11 @@ int RemoteBench(const CommonArgs& common, int64_t repeat) {
   std::vector<std::pair<std::string, double>> best;
   double best_engine = 0.0, best_rpc = 0.0;
   v1::BuildSummary summary;
-  size_t input_points = 0;
+  // Read once: FILE may be a pipe.
+  auto points = ReadPoints(common);
+  if (!points.ok()) return Failure(points.status());
+  const size_t input_points = points->size();
   for (int64_t run = 0; run < repeat; ++run) {
-    auto points = ReadPoints(common.file);
-    if (!points.ok()) return Failure(points.status());
-    input_points = points->size();
     auto connected = ConnectTo(common);
     if (!connected.ok()) return Failure(connected.status());
     auto released = (*connected)->Release(PointSetHandle(*points));

@@ -41,10 +41,12 @@ std::string Slurp(const std::string& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-CommandResult Alphactl(const std::string& args) {
+/// Runs alphactl with `args`; `before` is shell text put in front of it (a pipe into it).
+CommandResult Alphactl(const std::string& args, const std::string& before = "") {
   const std::string dir = std::filesystem::temp_directory_path() / ("alphactl_test_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
-  const std::string command = std::string(GALPHA_ALPHACTL) + " " + args + " >" + dir + "/out 2>" + dir + "/err";
+  const std::string command =
+      before + std::string(GALPHA_ALPHACTL) + " " + args + " >" + dir + "/out 2>" + dir + "/err";
   const int status = std::system(command.c_str());
   CommandResult run;
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -149,25 +151,13 @@ TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
   const CommandResult help = Alphactl("--help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_TRUE(help.err.empty());
-  for (const char* word : {"triangulate",
-                           "spectrum",
-                           "classify",
-                           "summary",
-                           "shape",
-                           "masterlist",
-                           "optimal",
-                           "bench",
-                           "--alpha-sq",
-                           "--alpha ",
-                           "--rank",
-                           "--mode",
-                           "--vertex-rule",
-                           "--format",
-                           "--components",
-                           "--repeat",
-                           "--backend",
-                           "geojson|wkt|svg",
-                           "general|regularized",
+  for (const char* word : {"triangulate",    "spectrum",        "classify",
+                           "summary",        "shape",           "masterlist",
+                           "optimal",        "bench",           "--alpha-sq",
+                           "--alpha ",       "--rank",          "--mode",
+                           "--vertex-rule",  "--format",        "--components",
+                           "--repeat",       "--backend",       "--max-points",
+                           "GLOBAL OPTIONS", "geojson|wkt|svg", "general|regularized",
                            "report|cgal"}) {
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   }
@@ -580,6 +570,104 @@ TEST(AlphactlTest, ProgressGoesToStandardErrorForLargeInputs) {
   EXPECT_EQ(lines[2].rfind("alphactl: components done (100%, ", 0), 0u) << lines[2];
   // Small inputs are quiet (Run checks that stderr is empty).
   Succeeds("summary", SquareCsv(), "--rank 0");
+}
+
+// Input that never ends, or is larger than a server builds, is refused with its reason. Each run
+// is capped at 4 GiB of address space, so that an alphactl that did read without bound fails
+// rather than take the machine's memory.
+constexpr char kMemoryCap[] = "ulimit -v 4194304; ";
+
+TEST(AlphactlTest, DevicesAndEndlessInputAreRefused) {
+  ExpectError(Alphactl("triangulate /dev/zero", kMemoryCap), 1,
+              "points file '/dev/zero' is a character device: alphactl reads regular files, named pipes and '-'");
+  ExpectError(Alphactl("summary /dev/zero --rank 0", kMemoryCap), 1, "'/dev/zero' is a character device");
+  // A pipe of zero bytes, and one line that does not end, stop at the line limit.
+  const std::string zeros = std::string(kMemoryCap) + "head -c 200000000 /dev/zero | ";
+  ExpectError(Alphactl("triangulate -", zeros), 1,
+              "standard input: line 1 (from byte offset 0) is longer than 65536 bytes");
+  ExpectError(Alphactl("spectrum /dev/stdin", zeros + "tr '\\0' 7 | "), 1,
+              "/dev/stdin: line 1 (from byte offset 0) is longer than 65536 bytes");
+  ExpectError(Alphactl("triangulate -", std::string(kMemoryCap) + "printf '1 2\\n3 4\\n' | cat - /dev/zero | "), 1,
+              "line 3 (from byte offset 8) is longer than 65536 bytes");
+  // A .bin with room for more points than a default server builds is refused from its size (a
+  // sparse file: nothing is written or read).
+  const std::string big = std::filesystem::temp_directory_path() / "alphactl_big.bin";
+  {
+    std::ofstream out(big, std::ios::binary);
+    const uint64_t n = 100000001;
+    out.write(reinterpret_cast<const char*>(&n), sizeof n);
+  }
+  std::filesystem::resize_file(big, 8 + 16 * uint64_t{100000001});
+  ExpectError(Alphactl("triangulate " + Quote(big), kMemoryCap), 1,
+              "room for 100000001 points: more than 100000000, the limit (--max-points raises it)");
+  std::filesystem::remove(big);
+}
+
+TEST(AlphactlTest, PipesAndStandardInputCarryText) {
+  const std::string square = "printf 'x,y\\n0,0\\n1,0\\n1,1\\n0,1\\n' | ";
+  const CommandResult piped = Alphactl("summary - --rank 2", square);
+  ASSERT_EQ(piped.exit_code, 0) << piped.err;
+  nlohmann::json from_pipe = nlohmann::json::parse(piped.out);
+  EXPECT_EQ(from_pipe["file"], "-");
+  from_pipe.erase("file");
+  nlohmann::json from_file = nlohmann::json::parse(Succeeds("summary", SquareCsv(), "--rank 2"));
+  from_file.erase("file");
+  EXPECT_EQ(from_pipe, from_file);
+  const CommandResult dev_stdin = Alphactl("spectrum /dev/stdin", square);
+  EXPECT_EQ(dev_stdin.exit_code, 0) << dev_stdin.err;
+  EXPECT_EQ(dev_stdin.out, Succeeds("spectrum", SquareCsv(), ""));
+  // bench builds R times from one read of the pipe.
+  const CommandResult bench = Alphactl("bench - --repeat 2 --backend cpu", square);
+  EXPECT_EQ(bench.exit_code, 0) << bench.err;
+  EXPECT_NE(bench.out.find("# -: 4 points, 4 distinct, best of 2 builds"), std::string::npos) << bench.out;
+  ExpectError(Alphactl("spectrum - < /dev/null"), 1, "standard input is a character device");
+  ExpectError(Alphactl("spectrum -", "printf '1 2\\n1 oops\\n' | "), 1, "standard input:2: expected x and y");
+}
+
+TEST(AlphactlTest, MaxPointsBoundsEveryInput) {
+  const std::string four = Quote(SquareCsv());
+  ExpectError(Alphactl("--max-points 3 triangulate " + four), 1, "more than 3 points, the limit");
+  ExpectError(Alphactl("summary " + four + " --rank 0 --max-points=3"), 1, "more than 3 points, the limit");
+  EXPECT_EQ(Alphactl("--max-points 4 summary " + four + " --rank 0").exit_code, 0);
+  ExpectError(Alphactl("spectrum - --max-points 3", "printf '0 0\\n1 0\\n0 1\\n1 1\\n' | "), 1,
+              "standard input: more than 3 points");
+  const std::string bin = WriteBin("alphactl_five.bin", {{0, 0}, {1, 0}, {0, 1}, {1, 1}, {2, 2}});
+  ExpectError(Alphactl("--max-points 4 spectrum " + Quote(bin)), 1, "room for 5 points: more than 4");
+  std::filesystem::remove(bin);
+  ExpectError(Alphactl("spectrum " + four + " --max-points 0"), 2, "--max-points '0' is out of range");
+  ExpectError(Alphactl("spectrum " + four + " --max-points 1073741825"), 2,
+              "--max-points '1073741825' is more than 1073741824");
+}
+
+// Options for every command may come before it, as git's and kubectl's do.
+TEST(AlphactlTest, GlobalOptionsComeBeforeOrAfterTheCommand) {
+  const std::string square = Quote(SquareCsv());
+  const CommandResult after = Alphactl("summary " + square + " --rank 1 --backend cpu");
+  const CommandResult before = Alphactl("--backend cpu summary " + square + " --rank 1");
+  const CommandResult before_equals = Alphactl("--backend=cpu --max-points=10 summary " + square + " --rank 1");
+  ASSERT_EQ(after.exit_code, 0) << after.err;
+  EXPECT_EQ(before.exit_code, 0) << before.err;
+  EXPECT_EQ(before.out, after.out);
+  EXPECT_EQ(before_equals.out, after.out);
+  const CommandResult triangulate = Alphactl("--backend cpu triangulate " + square);
+  ASSERT_EQ(triangulate.exit_code, 0) << triangulate.err;
+  EXPECT_EQ(nlohmann::json::parse(triangulate.out)["backend"], "cpu");
+
+  ExpectError(Alphactl("--rank 1 summary " + square), 2,
+              "unknown option '--rank' before the command (only --backend, --server, --tls-ca, --max-points");
+  ExpectError(Alphactl("--frobnicate summary " + square), 2, "unknown option '--frobnicate' before the command");
+  ExpectError(Alphactl("-x summary " + square), 2, "unknown option '-x' before the command");
+  ExpectError(Alphactl("--backend cpu summary " + square + " --rank 1 --backend cpu"), 2, "--backend given twice");
+  ExpectError(Alphactl("--tls-ca ca.pem summary " + square + " --rank 1"), 2, "--tls-ca needs --server");
+  ExpectError(Alphactl("--backend cpu --server localhost:1 spectrum " + square), 2,
+              "--backend applies to local builds");
+  ExpectError(Alphactl("--backend=cpu"), 2, "missing COMMAND");
+  ExpectError(Alphactl("--server"), 2, "option --server needs a value");
+  ExpectError(Alphactl("--backend cpu -- summary " + square), 2, "expected a command before '--'");
+  ExpectError(Alphactl("--backend cpu frobnicate " + square), 2, "unknown command 'frobnicate'");
+  const CommandResult help = Alphactl("--backend cpu help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("GLOBAL OPTIONS"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,221 @@
+#include "client/point_input.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/string_view.h"
+#include "core/base/status_macros.hpp"
+#include "core/io/point_formats.hpp"
+
+namespace galpha::alphactl {
+
+namespace {
+
+/// Bytes asked of read(2) at a time.
+constexpr size_t kReadChunkBytes = size_t{64} << 10;
+
+/// The first line of every batch after the one that held the input's first record (below).
+constexpr absl::string_view kSentinelLine = "0 0\n";
+
+// The lines ParsePointsText skips (empty after trimming, or a '#' comment). Only used to know when
+// the input's first other line, the one that may be a header, has been parsed.
+bool IsSkippedLine(absl::string_view line) {
+  line = absl::StripAsciiWhitespace(line);
+  return line.empty() || line[0] == '#';
+}
+
+absl::Status TooManyPoints(const std::string& source, uint64_t max_points) {
+  return absl::ResourceExhaustedError(
+      absl::StrCat(source, ": more than ", max_points, " points, the limit (--max-points raises it)"));
+}
+
+/// Delimited text fed in pieces of any size and parsed by ParsePointsText in batches of whole
+/// lines. ParsePointsText takes the first line it does not skip as a header when it is not numeric;
+/// only the input's first such line may be one, so every batch after the one that held it starts
+/// with a numeric sentinel line (whose point is dropped), and a non-numeric line there is an error
+/// as it would be in one whole parse.
+class TextBatches {
+ public:
+  TextBatches(const std::string& source, const InputOptions& options) : source_(source), options_(options) {}
+
+  /// Appends `bytes`, parsing each batch as it fills.
+  absl::Status Append(absl::string_view bytes) {
+    while (!bytes.empty()) {
+      const size_t newline = bytes.find('\n');
+      const bool line_ends = newline != absl::string_view::npos;
+      const absl::string_view piece = bytes.substr(0, line_ends ? newline + 1 : bytes.size());
+      batch_.append(piece.data(), piece.size());
+      bytes_read_ += piece.size();
+      bytes.remove_prefix(piece.size());
+      const size_t line_bytes = batch_.size() - line_start_ - (line_ends ? 1 : 0);
+      if (line_bytes > options_.max_line_bytes) {
+        return absl::ResourceExhaustedError(absl::StrCat(source_, ": line ", lines_ + 1, " (from byte offset ",
+                                                         line_offset_, ") is longer than ", options_.max_line_bytes,
+                                                         " bytes, the limit for one line of delimited text"));
+      }
+      if (!line_ends) break;
+      if (!header_decided_ && !IsSkippedLine(absl::string_view(batch_).substr(line_start_))) batch_has_record_ = true;
+      ++lines_;
+      line_start_ = batch_.size();
+      line_offset_ = bytes_read_;
+      if (batch_.size() >= options_.batch_bytes) GALPHA_RETURN_IF_ERROR(ParseBatch());
+    }
+    return absl::OkStatus();
+  }
+
+  /// Parses the last batch (its last line may lack a '\n') and hands over the points.
+  absl::StatusOr<std::vector<Point2>> Finish() && {
+    if (batch_.size() > (sentinel_ ? kSentinelLine.size() : 0)) GALPHA_RETURN_IF_ERROR(ParseBatch());
+    return std::move(points_);
+  }
+
+ private:
+  absl::Status ParseBatch() {
+    absl::StatusOr<std::vector<Point2>> parsed = ParsePointsText(batch_, source_);
+    if (!parsed.ok()) return Renumbered(parsed.status());
+    points_.insert(points_.end(), parsed->begin() + (sentinel_ ? 1 : 0), parsed->end());
+    if (points_.size() > options_.max_points) return TooManyPoints(source_, options_.max_points);
+    header_decided_ = header_decided_ || batch_has_record_;
+    batch_has_record_ = false;
+    batch_first_line_ = lines_ + 1;
+    sentinel_ = header_decided_;
+    batch_.clear();  // keeps its capacity for the next batch
+    if (sentinel_) batch_.append(kSentinelLine.data(), kSentinelLine.size());
+    line_start_ = batch_.size();
+    return absl::OkStatus();
+  }
+
+  // The parser numbers the lines of the batch; parsing it again behind empty lines (skipped, and
+  // the sentinel on the line before the batch) gives the error the input's line numbers. Memory
+  // of one byte per earlier line, on this error path only.
+  absl::Status Renumbered(const absl::Status& batch_error) const {
+    if (batch_first_line_ == 1) return batch_error;
+    std::string padded(batch_first_line_ - 1 - (sentinel_ ? 1 : 0), '\n');
+    padded += batch_;
+    absl::StatusOr<std::vector<Point2>> again = ParsePointsText(padded, source_);
+    return again.ok() ? batch_error : again.status();
+  }
+
+  const std::string& source_;
+  const InputOptions& options_;
+  std::vector<Point2> points_;
+  std::string batch_;              // whole lines, then the start of the next; after the sentinel if sentinel_
+  bool sentinel_ = false;          // batch_ starts with kSentinelLine
+  bool header_decided_ = false;    // an earlier batch held a line the parser does not skip
+  bool batch_has_record_ = false;  // this batch holds one
+  uint64_t batch_first_line_ = 1;  // the input's number of batch_'s first line (after the sentinel)
+  uint64_t lines_ = 0;             // complete lines so far
+  size_t line_start_ = 0;          // where the current line starts in batch_
+  uint64_t line_offset_ = 0;       // its byte offset in the input
+  uint64_t bytes_read_ = 0;
+};
+
+/// Closes a descriptor this file opened.
+class OwnedFd {
+ public:
+  explicit OwnedFd(int fd) : fd_(fd) {}
+  OwnedFd(const OwnedFd&) = delete;
+  OwnedFd& operator=(const OwnedFd&) = delete;
+  ~OwnedFd() {
+    if (fd_ >= 0) close(fd_);
+  }
+  int get() const { return fd_; }
+
+ private:
+  int fd_;
+};
+
+/// "a directory", "a character device", ...: what a refused input is, for its error.
+const char* KindOf(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file or a pipe";
+}
+
+bool IsReadable(mode_t mode) { return S_ISREG(mode) || S_ISFIFO(mode); }
+
+absl::StatusOr<std::vector<Point2>> CheckCount(absl::StatusOr<std::vector<Point2>> points, const std::string& source,
+                                               uint64_t max_points) {
+  if (points.ok() && points->size() > max_points) return TooManyPoints(source, max_points);
+  return points;
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<Point2>> ReadTextPoints(int fd, const std::string& source, const InputOptions& options) {
+  TextBatches batches(source, options);
+  std::string buffer(kReadChunkBytes, '\0');
+  while (true) {
+    const ssize_t got = read(fd, buffer.data(), buffer.size());
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot read ", source));
+    if (got == 0) break;
+    GALPHA_RETURN_IF_ERROR(batches.Append(absl::string_view(buffer.data(), static_cast<size_t>(got))));
+  }
+  return std::move(batches).Finish();
+}
+
+absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, const InputOptions& options) {
+  struct stat info {};
+  if (file == "-") {
+    const std::string source = "standard input";
+    if (fstat(STDIN_FILENO, &info) != 0) return absl::ErrnoToStatus(errno, "cannot inspect standard input");
+    // A terminal (a character device) most likely means the pipe was forgotten.
+    if (!IsReadable(info.st_mode)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("standard input is ", KindOf(info.st_mode), ": pipe the points in, or name a file"));
+    }
+    return ReadTextPoints(STDIN_FILENO, source, options);
+  }
+
+  const std::string named = absl::StrCat("points file '", file, "'");
+  if (stat(file.c_str(), &info) != 0) {
+    if (errno == ENOENT) return absl::NotFoundError(absl::StrCat(named, " does not exist"));
+    return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
+  }
+  // Refused before opening: opening a device can block or act (a terminal, a tape).
+  if (!IsReadable(info.st_mode)) {
+    return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info.st_mode),
+                                                   ": alphactl reads regular files, named pipes and '-' "
+                                                   "(standard input)"));
+  }
+  const std::string extension = absl::AsciiStrToLower(std::filesystem::path(file).extension().string());
+  const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json";
+  if (S_ISFIFO(info.st_mode) && !text) {
+    // Their readers need the whole input at once: only a file's size bounds it in advance.
+    return absl::InvalidArgumentError(absl::StrCat(
+        named,
+        " is a named pipe: only delimited text is read from pipes (.bin, .npy and GeoJSON need a regular file)"));
+  }
+  if (text) {
+    OwnedFd fd(open(file.c_str(), O_RDONLY | O_CLOEXEC));
+    if (fd.get() < 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open ", named));
+    // The path may have changed since stat(): what was opened is what counts.
+    if (fstat(fd.get(), &info) != 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
+    if (!IsReadable(info.st_mode)) return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info.st_mode)));
+    return ReadTextPoints(fd.get(), file, options);
+  }
+  // A .bin holds its points in 16 bytes each after an 8-byte header (and ReadPointsFile checks
+  // that its header agrees): its size alone shows that it is over the limit.
+  if (extension == ".bin" && static_cast<uint64_t>(info.st_size) >= 8 &&
+      (static_cast<uint64_t>(info.st_size) - 8) / sizeof(Point2) > options.max_points) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        named, " has ", info.st_size, " bytes, room for ", (static_cast<uint64_t>(info.st_size) - 8) / sizeof(Point2),
+        " points: more than ", options.max_points, ", the limit (--max-points raises it)"));
+  }
+  return CheckCount(ReadPointsFile(file), named, options.max_points);
+}
+
+}  // namespace galpha::alphactl

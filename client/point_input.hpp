@@ -1,0 +1,56 @@
+// What alphactl reads its points from, and how much of it: every input is bounded, so that a
+// device or a pipe that never ends (/dev/zero, `yes`) ends in an error rather than in all of memory.
+//
+//   regular files   read in their format (point_formats.hpp); a .bin larger than the point limit
+//                   allows is refused from its size, before it is read
+//   named pipes     (mkfifo, /dev/stdin, <(cmd)) and '-' (standard input, a pipe or a redirected
+//                   file): delimited text only, which is parsed as it streams
+//   anything else   (character and block devices, directories, sockets) is refused, naming it
+//
+// Delimited text, from any of these, is parsed in batches of whole lines, so memory holds the
+// points and one batch however the input is laid out; a line longer than max_line_bytes ends the
+// read (the one-line records of the format are short: it is how endless bytes without a newline are
+// caught). Every input holds at most max_points points.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/base/point.hpp"
+
+namespace galpha::alphactl {
+
+/// The server's default --max_points_per_build (server/main.cpp): by default alphactl reads no
+/// more than a default server would build.
+inline constexpr uint64_t kDefaultMaxPoints = 100'000'000;
+
+/// How an input is read and bounded.
+struct InputOptions {
+  /// More points than this is ResourceExhausted (the command line's --max-points).
+  uint64_t max_points = kDefaultMaxPoints;
+  /// The longest line of delimited text in bytes, its '\n' apart: a line holds one point and its
+  /// attributes, so anything longer is not point data.
+  size_t max_line_bytes = size_t{64} << 10;
+  /// Text is parsed in batches of whole lines of about this many bytes (memory, not a limit).
+  size_t batch_bytes = size_t{1} << 20;
+};
+
+/// Reads the points of `file`, or of standard input when `file` is "-", as the header comment
+/// describes. O(input).
+///
+/// Errors name the file (or "standard input"): NotFound when it does not exist; InvalidArgument when
+/// it is a directory, device or socket, or a pipe whose name asks for a format other than delimited
+/// text; ResourceExhausted for more than max_points points or a line longer than max_line_bytes (with
+/// the line's number and byte offset); errno-derived codes when it cannot be opened or read; the
+/// parsers' errors (point_formats.hpp).
+absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, const InputOptions& options);
+
+/// Parses the delimited text (ParsePointsText's format) read from descriptor `fd` until its end, in
+/// batches of whole lines; `source` names it in errors, whose line numbers count from the start of
+/// the stream. Memory: the points and one batch. Errors as ReadInputPoints's.
+absl::StatusOr<std::vector<Point2>> ReadTextPoints(int fd, const std::string& source, const InputOptions& options);
+
+}  // namespace galpha::alphactl
