@@ -81,6 +81,32 @@ TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
   EXPECT_NE(bench.out.find("backend"), std::string::npos);
 }
 
+// --server, like every global option, may come before the command (as in git and kubectl), and
+// a pipe is read once and uploaded like a file.
+TEST(AlphactlRemoteTest, ServerMayComeBeforeTheCommand) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  const std::string file = galpha::testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
+  const CommandResult local = Alphactl("summary " + file + " --rank 40");
+  const CommandResult before = Alphactl("--server " + server.address() + " summary " + file + " --rank 40");
+  const CommandResult equals = Alphactl("--server=" + server.address() + " masterlist " + file + " --rank 7");
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  EXPECT_EQ(before.exit_code, 0) << before.err;
+  EXPECT_EQ(before.out, local.out);
+  EXPECT_EQ(equals.exit_code, 0) << equals.err;
+  EXPECT_EQ(equals.out, Alphactl("masterlist " + file + " --rank 7").out);
+
+  const CommandResult piped =
+      Alphactl("--server " + server.address() + " bench - --repeat 2", "printf '0 0\\n1 0\\n0 1\\n1 1\\n' |");
+  EXPECT_EQ(piped.exit_code, 0) << piped.err;
+  EXPECT_NE(piped.out.find("# -: 4 points, 4 distinct, best of 2 builds"), std::string::npos) << piped.out;
+
+  const CommandResult twice =
+      Alphactl("--server " + server.address() + " spectrum " + file + " --server " + server.address());
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.err.find("--server given twice"), std::string::npos) << twice.err;
+}
+
 TEST(AlphactlRemoteTest, ErrorsKeepTheLocalExitCodes) {
   ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
