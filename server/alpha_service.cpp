@@ -131,7 +131,10 @@ size_t DefaultMemoryBudget(Backend backend) {
 // ---- The service ------------------------------------------------------------------------------------
 
 AlphaService::AlphaService(const ServiceOptions& options, ServerMetrics* metrics)
-    : options_(options), metrics_(metrics), in_flight_(options.max_in_flight_bytes) {}
+    : options_(options),
+      metrics_(metrics),
+      in_flight_(options.max_in_flight_bytes, options.max_tenant_in_flight_bytes),
+      upload_watchdog_(options.upload_idle_timeout) {}
 
 AlphaService::~AlphaService() = default;
 
@@ -155,8 +158,8 @@ absl::StatusOr<std::unique_ptr<AlphaService>> AlphaService::Create(const Service
   }
   const size_t memory = options.build_memory_bytes > 0 ? options.build_memory_bytes : DefaultMemoryBudget(backend);
   service->cache_ = std::make_unique<FamilyCache>(options.cache_bytes, metrics);
-  service->scheduler_ =
-      std::make_unique<BuildScheduler>(std::move(slot_streams), options.max_queued_builds, memory, metrics);
+  service->scheduler_ = std::make_unique<BuildScheduler>(std::move(slot_streams), options.max_queued_builds,
+                                                         options.max_tenant_queued_builds, memory, metrics);
   metrics->SetBackend(service->backend_name_);
   service->SampleDeviceMemory();
   return service;
@@ -183,14 +186,17 @@ absl::StatusOr<std::string> AlphaService::Authenticate(grpc::CallbackServerConte
   return options_.tokens.TenantOf(&value);
 }
 
+absl::Status AlphaService::CheckHandle(const std::string& handle) {
+  if (IsWellFormedHandle(handle)) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("handle '", handle.substr(0, 80), "' is not a handle (expected sha256- and 64 hex digits)"));
+}
+
 absl::StatusOr<std::shared_ptr<const CachedFamily>> AlphaService::Lookup(grpc::CallbackServerContext* context,
                                                                          const std::string& handle) {
   auto tenant = Authenticate(context);
   if (!tenant.ok()) return tenant.status();
-  if (!IsWellFormedHandle(handle)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("'", handle.substr(0, 80), "' is not a handle (expected sha256- and 64 hex digits)"));
-  }
+  if (absl::Status s = CheckHandle(handle); !s.ok()) return s;
   auto family = cache_->Find(*tenant, handle);
   if (family == nullptr) {
     return absl::NotFoundError(
@@ -249,6 +255,9 @@ grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* con
   return AnswerUnary(context, metrics_, "Release", [&]() -> absl::Status {
     auto tenant = Authenticate(context);
     if (!tenant.ok()) return tenant.status();
+    // A malformed handle is the caller's mistake (a typo, an empty field), which an OK answer
+    // with released=false would hide; a well-formed unknown one is not (Release is idempotent).
+    if (absl::Status s = CheckHandle(request->handle()); !s.ok()) return s;
     // The family's deleter returns its memory to the system when the last query using it ends.
     response->set_released(cache_->Erase(*tenant, request->handle()));
     return absl::OkStatus();

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@
 #include "server/family_cache.hpp"
 #include "server/metrics.hpp"
 #include "server/tenant_tokens.hpp"
+#include "server/upload_watchdog.hpp"
 
 namespace galpha::server {
 
@@ -32,11 +34,20 @@ struct ServiceOptions {
   int build_slots = 0;
   /// Builds waiting for a slot before RESOURCE_EXHAUSTED.
   size_t max_queued_builds = 16;
+  /// Builds of one tenant waiting for a slot before RESOURCE_EXHAUSTED (half the queue: one
+  /// tenant cannot fill it). Without tokens every caller is the one anonymous tenant.
+  size_t max_tenant_queued_builds = 8;
   /// Working memory admitted to running builds; 0: 90% of the GPU's memory, or half the host's.
   size_t build_memory_bytes = 0;
   uint64_t max_points_per_build = 100'000'000;
-  /// Bytes of points held by uploads and builds at once.
+  /// Bytes of points held by uploads and builds at once; 0: no limit.
   size_t max_in_flight_bytes = size_t{8} << 30;
+  /// Bytes of points one tenant's uploads and builds hold at once (half the server's: one tenant
+  /// cannot take the whole budget); 0: no limit per tenant.
+  size_t max_tenant_in_flight_bytes = size_t{4} << 30;
+  /// A Build stream with no message for this long is ended (DEADLINE_EXCEEDED) and its points
+  /// dropped; zero: never.
+  std::chrono::milliseconds upload_idle_timeout{30000};
   /// Byte budget of the family cache.
   size_t cache_bytes = size_t{8} << 30;
   TenantTokens tokens;
@@ -52,8 +63,9 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   const std::string& backend_name() const { return backend_name_; }
   size_t build_slots() const { return scheduler_->slots(); }
   FamilyCache& cache() { return *cache_; }
-  /// Bytes of points held by uploads and builds right now.
+  /// Bytes of points held by uploads and builds right now, in all and by one tenant.
   size_t in_flight_bytes() const { return in_flight_.held(); }
+  size_t in_flight_bytes_of(const std::string& tenant) const { return in_flight_.held_by(tenant); }
 
   /// Refuses new builds (UNAVAILABLE); queued builds that have not started fail UNAVAILABLE,
   /// running ones finish. Queries go on until the server shuts down.
@@ -88,6 +100,8 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
 
   /// The caller's tenant, or Unauthenticated.
   absl::StatusOr<std::string> Authenticate(grpc::CallbackServerContext* context) const;
+  /// InvalidArgument naming `handle` when it is not one (sha256- and 64 hex digits).
+  static absl::Status CheckHandle(const std::string& handle);
   /// The cached family of (tenant, handle), or NotFound / InvalidArgument.
   absl::StatusOr<std::shared_ptr<const CachedFamily>> Lookup(grpc::CallbackServerContext* context,
                                                              const std::string& handle);
@@ -106,6 +120,7 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   std::unique_ptr<CudaStreamPool> streams_;
   std::unique_ptr<FamilyCache> cache_;
   InFlightBytes in_flight_;
+  UploadWatchdog upload_watchdog_;
   std::atomic<bool> draining_{false};
   // Last: its workers run builds that use everything above, so it stops first.
   std::unique_ptr<BuildScheduler> scheduler_;

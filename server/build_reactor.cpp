@@ -6,8 +6,10 @@
 #include <memory>
 #include <utility>
 
+#include "absl/strings/str_cat.h"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "server/alpha_service.hpp"
+#include "server/build_refusal.hpp"
 #include "server/grpc_status.hpp"
 #include "server/query_answers.hpp"
 
@@ -35,30 +37,73 @@ BuildReactor::BuildReactor(AlphaService* service, grpc::CallbackServerContext* c
       context_(context),
       response_(response),
       record_(service->metrics_, "Build"),
-      decoder_(BuildStreamLimits{service->options_.max_points_per_build}, &service->in_flight_) {
+      decoder_(BuildStreamLimits{service->options_.max_points_per_build}, &service->in_flight_,
+               tenant.ok() ? *tenant : std::string()) {
   if (!tenant.ok()) {
     Respond(tenant.status());
     return;
   }
   tenant_ = *std::move(tenant);
   if (service_->draining_) {
-    Respond(absl::UnavailableError("the server is draining and accepts no new builds"));
+    Respond(TagRefusal(absl::UnavailableError("the server is draining and accepts no new builds"),
+                       BuildRefusal::kDraining));
     return;
   }
-  StartRead(&request_);
+  last_activity_ = Clock::now().time_since_epoch().count();
+  uploading_ = true;
+  service_->upload_watchdog_.Watch(this);
+  std::lock_guard<std::mutex> lock(upload_mutex_);
+  if (!upload_over_) StartRead(&request_);  // else the watchdog already ended the call
+}
+
+void BuildReactor::OnDone() {
+  // After this the watchdog never calls this reactor again.
+  service_->upload_watchdog_.Unwatch(this);
+  delete this;
+}
+
+std::optional<BuildReactor::Clock::time_point> BuildReactor::LastActivity() const {
+  if (!uploading_) return std::nullopt;
+  return Clock::time_point(Clock::duration(last_activity_.load()));
+}
+
+void BuildReactor::TimeOut() {
+  {
+    std::lock_guard<std::mutex> lock(upload_mutex_);
+    if (upload_over_) return;
+    upload_over_ = true;
+    uploading_ = false;
+    // The points and their reservation go now, not when gRPC is done with the call.
+    decoder_.ReleasePoints();
+  }
+  // The read still pending completes (not ok) after Finish; OnReadDone then sees upload_over_.
+  Respond(TagRefusal(absl::DeadlineExceededError(absl::StrCat(
+                         "the upload sent nothing for ", service_->upload_watchdog_.idle_timeout().count(),
+                         " ms, the server's idle limit (--upload_idle_timeout_ms): the build was dropped")),
+                     BuildRefusal::kIdleTimeout));
 }
 
 void BuildReactor::OnReadDone(bool ok) {
-  if (!ok) {
+  absl::Status refused;
+  {
+    std::lock_guard<std::mutex> lock(upload_mutex_);
+    if (upload_over_) return;  // the watchdog ended the call
+    if (ok) {
+      last_activity_ = Clock::now().time_since_epoch().count();
+      refused = decoder_.Add(request_);
+      if (refused.ok()) {
+        StartRead(&request_);
+        return;
+      }
+    }
+    upload_over_ = true;
+    uploading_ = false;
+  }
+  if (ok) {
+    Respond(refused);
+  } else {
     EndOfStream();
-    return;
   }
-  if (absl::Status status = decoder_.Add(request_); !status.ok()) {
-    if (absl::IsResourceExhausted(status)) service_->metrics_->RecordRejectedBuild("limits");
-    Respond(status);
-    return;
-  }
-  StartRead(&request_);
 }
 
 void BuildReactor::EndOfStream() {
@@ -77,17 +122,15 @@ void BuildReactor::EndOfStream() {
     return;
   }
   const size_t need = build_->points.size() * (kBuildBytesPerPoint + sizeof(Point2));
-  absl::Status submitted =
-      service_->scheduler_->Submit(need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
-  if (!submitted.ok()) {
-    service_->metrics_->RecordRejectedBuild(absl::IsUnavailable(submitted) ? "draining" : "queue_or_memory");
-    Respond(submitted);
-  }
+  absl::Status submitted = service_->scheduler_->Submit(
+      tenant_, need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
+  if (!submitted.ok()) Respond(submitted);
 }
 
 void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   if (draining) {
-    Respond(absl::UnavailableError("the server is shutting down; the build had not started"));
+    Respond(TagRefusal(absl::UnavailableError("the server is shutting down; the build had not started"),
+                       BuildRefusal::kDraining));
     return;
   }
   if (cancelled_) {
@@ -110,15 +153,15 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   service_->metrics_->RecordBuild(family->report(), seconds);
   // The last owner of a family (the cache, or a query still streaming from it after a release
   // or an eviction) frees hundreds of megabytes: give them back to the system right then.
-  std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family), build_->header.name()),
-                                             [](const CachedFamily* f) {
-                                               delete f;
-                                               ReturnFreedMemory();
-                                             });
+  std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family)), [](const CachedFamily* f) {
+    delete f;
+    ReturnFreedMemory();
+  });
   auto inserted = service_->cache_->Insert(tenant_, build_->handle, std::move(cached));
   ReturnFreedMemory();  // the engine's working memory and the points
   if (!inserted.ok()) {
-    Respond(inserted.status());
+    Respond(absl::IsResourceExhausted(inserted.status()) ? TagRefusal(inserted.status(), BuildRefusal::kCacheBytes)
+                                                         : inserted.status());
     return;
   }
   Succeed(**inserted, /*was_cached=*/false);
@@ -128,10 +171,16 @@ void BuildReactor::Succeed(const CachedFamily& family, bool was_cached) {
   response_->set_handle(build_->handle);
   response_->set_cached(was_cached);
   FillBuildSummary(family, response_->mutable_summary());
+  // The name is the caller's label (proto: BuildHeader.name): a cache hit answers with this
+  // caller's name, never the one of the build that computed the family.
+  response_->mutable_summary()->set_name(build_->header.name());
   Respond(absl::OkStatus());
 }
 
 void BuildReactor::Respond(const absl::Status& status) {
+  if (const std::string reason = RefusalLabelOf(status); !reason.empty()) {
+    service_->metrics_->RecordRejectedBuild(reason);
+  }
   const grpc::Status result = ToGrpcStatus(status);
   record_.Done(result);
   Finish(result);

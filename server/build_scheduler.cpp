@@ -3,12 +3,16 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/build_refusal.hpp"
 
 namespace galpha::server {
 
-BuildScheduler::BuildScheduler(std::vector<void*> slot_streams, size_t max_queue, size_t memory_budget_bytes,
-                               SchedulerObserver* observer)
-    : max_queue_(max_queue), memory_budget_(memory_budget_bytes), observer_(observer) {
+BuildScheduler::BuildScheduler(std::vector<void*> slot_streams, size_t max_queue, size_t max_queue_per_tenant,
+                               size_t memory_budget_bytes, SchedulerObserver* observer)
+    : max_queue_(max_queue),
+      max_queue_per_tenant_(max_queue_per_tenant),
+      memory_budget_(memory_budget_bytes),
+      observer_(observer) {
   for (size_t i = 0; i < slot_streams.size(); ++i) {
     workers_.emplace_back([this, slot = BuildSlot{static_cast<int>(i), slot_streams[i]}] { WorkerLoop(slot); });
   }
@@ -19,21 +23,36 @@ BuildScheduler::~BuildScheduler() {
   for (std::thread& worker : workers_) worker.join();
 }
 
-absl::Status BuildScheduler::Submit(size_t memory_bytes, Job job) {
+absl::Status BuildScheduler::Submit(const std::string& tenant, size_t memory_bytes, Job job) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (stopping_) return absl::UnavailableError("the server is shutting down and accepts no new builds");
+  if (stopping_) {
+    return TagRefusal(absl::UnavailableError("the server is shutting down and accepts no new builds"),
+                      BuildRefusal::kDraining);
+  }
   if (memory_budget_ != 0 && memory_bytes > memory_budget_) {
-    return absl::ResourceExhaustedError(absl::StrCat("the build needs about ", memory_bytes,
-                                                     " bytes of working memory; this server admits at most ",
-                                                     memory_budget_, " bytes per build"));
+    return TagRefusal(
+        absl::ResourceExhaustedError(absl::StrCat("the build needs about ", memory_bytes,
+                                                  " bytes of working memory; this server admits at most ",
+                                                  memory_budget_, " bytes per build (--build_memory_bytes)")),
+        BuildRefusal::kBuildMemory);
   }
   // A job that a free slot takes at once (a slot idle and its memory admitted) is not queued; the
-  // others wait, and at most max_queue_ of them may.
-  queue_.push_back(Pending{memory_bytes, std::move(job)});
+  // others wait, at most max_queue_ of them, and at most max_queue_per_tenant_ of one tenant's.
+  queue_.push_back(Pending{tenant, memory_bytes, std::move(job)});
+  if (WaitingOfLocked(tenant) > max_queue_per_tenant_) {
+    queue_.pop_back();
+    return TagRefusal(absl::ResourceExhaustedError(absl::StrCat(
+                          tenant.empty() ? std::string("the anonymous tenant") : absl::StrCat("tenant '", tenant, "'"),
+                          " already has ", max_queue_per_tenant_,
+                          " builds waiting, its limit (--max_tenant_queued_builds); retry when one has started")),
+                      BuildRefusal::kTenantQueuedBuilds);
+  }
   if (WaitingLocked() > max_queue_) {
     queue_.pop_back();
-    return absl::ResourceExhaustedError(absl::StrCat("the build queue is full (", max_queue_, " builds waiting for ",
-                                                     workers_.size(), " slots); retry later"));
+    return TagRefusal(
+        absl::ResourceExhaustedError(absl::StrCat("the build queue is full (", max_queue_, " builds waiting for ",
+                                                  workers_.size(), " slots, --max_queued_builds); retry later")),
+        BuildRefusal::kQueueFull);
   }
   ReportLoad();
   changed_.notify_all();
@@ -46,7 +65,7 @@ void BuildScheduler::Stop() {
   changed_.notify_all();
 }
 
-size_t BuildScheduler::WaitingLocked() const {
+size_t BuildScheduler::StartingLocked() const {
   // The jobs at the head that free slots and the memory budget admit now start at once (FIFO:
   // the first that cannot start holds back the rest).
   size_t free_slots = workers_.size() - running_;
@@ -58,7 +77,14 @@ size_t BuildScheduler::WaitingLocked() const {
     admitted += pending.memory_bytes;
     ++starting;
   }
-  return queue_.size() - starting;
+  return starting;
+}
+
+size_t BuildScheduler::WaitingOfLocked(const std::string& tenant) const {
+  const size_t starting = StartingLocked();
+  size_t waiting = 0;
+  for (size_t i = starting; i < queue_.size(); ++i) waiting += queue_[i].tenant == tenant ? 1 : 0;
+  return waiting;
 }
 
 void BuildScheduler::ReportLoad() {

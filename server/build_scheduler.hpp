@@ -11,6 +11,7 @@
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -37,18 +38,20 @@ class BuildScheduler {
   /// its turn, with `draining` true (it then only reports that it did not run).
   using Job = std::function<void(const BuildSlot& slot, bool draining)>;
 
-  /// One worker thread per stream in `slot_streams` (null entries on the CPU backend).
-  /// `memory_budget_bytes` 0 admits everything.
-  BuildScheduler(std::vector<void*> slot_streams, size_t max_queue, size_t memory_budget_bytes,
-                 SchedulerObserver* observer);
+  /// One worker thread per stream in `slot_streams` (null entries on the CPU backend). At most
+  /// `max_queue` jobs wait, and at most `max_queue_per_tenant` of one tenant's, so that one
+  /// tenant cannot fill the queue. `memory_budget_bytes` 0 admits everything.
+  BuildScheduler(std::vector<void*> slot_streams, size_t max_queue, size_t max_queue_per_tenant,
+                 size_t memory_budget_bytes, SchedulerObserver* observer);
   /// Stop(), then joins the workers.
   ~BuildScheduler();
   BuildScheduler(const BuildScheduler&) = delete;
   BuildScheduler& operator=(const BuildScheduler&) = delete;
 
-  /// Queues `job`. ResourceExhausted when the queue is full or `memory_bytes` exceeds the whole
-  /// budget; Unavailable after Stop().
-  absl::Status Submit(size_t memory_bytes, Job job);
+  /// Queues `tenant`'s `job`. ResourceExhausted when the queue is full, when `tenant` already has
+  /// its most jobs waiting, or when `memory_bytes` exceeds the whole budget; Unavailable after
+  /// Stop(). Every refusal is tagged with its BuildRefusal.
+  absl::Status Submit(const std::string& tenant, size_t memory_bytes, Job job);
 
   /// Refuses new jobs; queued jobs that have not started run with `draining` true. Running jobs
   /// finish. Returns at once.
@@ -56,19 +59,26 @@ class BuildScheduler {
 
   size_t slots() const { return workers_.size(); }
   size_t max_queue() const { return max_queue_; }
+  size_t max_queue_per_tenant() const { return max_queue_per_tenant_; }
   size_t memory_budget_bytes() const { return memory_budget_; }
 
  private:
   struct Pending {
+    std::string tenant;
     size_t memory_bytes;
     Job job;
   };
   void WorkerLoop(BuildSlot slot);
   void ReportLoad();
+  /// Queued jobs at the head that free slots and memory let start now (the lock held).
+  size_t StartingLocked() const;
   /// Queued jobs that cannot start now (the lock held).
-  size_t WaitingLocked() const;
+  size_t WaitingLocked() const { return queue_.size() - StartingLocked(); }
+  /// `tenant`'s queued jobs that cannot start now (the lock held).
+  size_t WaitingOfLocked(const std::string& tenant) const;
 
   const size_t max_queue_;
+  const size_t max_queue_per_tenant_;
   const size_t memory_budget_;
   SchedulerObserver* const observer_;
   std::mutex mutex_;

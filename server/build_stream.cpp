@@ -1,40 +1,99 @@
 #include "server/build_stream.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "server/build_refusal.hpp"
 
 namespace galpha::server {
 
-bool InFlightBytes::TryReserve(size_t bytes) {
-  size_t held = held_.load();
-  do {
-    if (limit_ != 0 && held + bytes > limit_) return false;
-  } while (!held_.compare_exchange_weak(held, held + bytes));
-  return true;
+namespace {
+
+std::string TenantName(const std::string& tenant) {
+  return tenant.empty() ? std::string("the anonymous tenant") : absl::StrCat("tenant '", tenant, "'");
 }
 
-BuildStreamDecoder::BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight)
-    : limits_(limits), in_flight_(in_flight) {}
+}  // namespace
+
+absl::Status InFlightBytes::Reserve(const std::string& tenant, size_t bytes) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (limit_ != 0 && held_ + bytes > limit_) {
+    return TagRefusal(absl::ResourceExhaustedError(absl::StrCat(
+                          "the server holds ", held_, " bytes of points in flight; ", bytes,
+                          " more would exceed its limit of ", limit_, " bytes (--max_in_flight_bytes): retry later")),
+                      BuildRefusal::kInFlightBytes);
+  }
+  const auto it = held_by_tenant_.find(tenant);
+  const size_t tenant_held = it == held_by_tenant_.end() ? 0 : it->second;
+  if (tenant_limit_ != 0 && tenant_held + bytes > tenant_limit_) {
+    return TagRefusal(absl::ResourceExhaustedError(absl::StrCat(
+                          TenantName(tenant), " holds ", tenant_held, " bytes of points in flight; ", bytes,
+                          " more would exceed its limit of ", tenant_limit_,
+                          " bytes (--max_tenant_in_flight_bytes): finish or cancel its other uploads, or retry later")),
+                      BuildRefusal::kTenantInFlightBytes);
+  }
+  held_ += bytes;
+  if (bytes > 0) held_by_tenant_[tenant] = tenant_held + bytes;
+  return absl::OkStatus();
+}
+
+absl::Status InFlightBytes::CheckCanEverFit(const std::string& tenant, size_t bytes) const {
+  if (limit_ != 0 && bytes > limit_) {
+    return TagRefusal(absl::ResourceExhaustedError(absl::StrCat("the header announces ", bytes,
+                                                                " bytes of points; the server holds at most ", limit_,
+                                                                " bytes of points in flight (--max_in_flight_bytes)")),
+                      BuildRefusal::kInFlightBytes);
+  }
+  if (tenant_limit_ != 0 && bytes > tenant_limit_) {
+    return TagRefusal(absl::ResourceExhaustedError(absl::StrCat("the header announces ", bytes, " bytes of points; ",
+                                                                TenantName(tenant), " may hold at most ", tenant_limit_,
+                                                                " bytes in flight (--max_tenant_in_flight_bytes)")),
+                      BuildRefusal::kTenantInFlightBytes);
+  }
+  return absl::OkStatus();
+}
+
+void InFlightBytes::Release(const std::string& tenant, size_t bytes) {
+  if (bytes == 0) return;
+  std::lock_guard<std::mutex> lock(mutex_);
+  held_ -= bytes;
+  const auto it = held_by_tenant_.find(tenant);
+  if (it == held_by_tenant_.end()) return;
+  it->second -= bytes;
+  if (it->second == 0) held_by_tenant_.erase(it);  // the map holds active tenants only
+}
+
+size_t InFlightBytes::held() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return held_;
+}
+
+size_t InFlightBytes::held_by(const std::string& tenant) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = held_by_tenant_.find(tenant);
+  return it == held_by_tenant_.end() ? 0 : it->second;
+}
+
+BuildStreamDecoder::BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant)
+    : limits_(limits), in_flight_(in_flight), tenant_(std::move(tenant)) {}
 
 BuildStreamDecoder::~BuildStreamDecoder() {
-  if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(reserved_);
+  if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(tenant_, reserved_);
 }
 
 void BuildStreamDecoder::ReleasePoints() {
   HostVector<Point2>().swap(decoded_.points);
-  if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(reserved_);
+  if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(tenant_, reserved_);
   reserved_ = 0;
 }
 
 absl::Status BuildStreamDecoder::Reserve(size_t bytes) {
   if (in_flight_ == nullptr || bytes == 0) return absl::OkStatus();
-  if (!in_flight_->TryReserve(bytes)) {
-    return absl::ResourceExhaustedError(absl::StrCat("the server holds ", in_flight_->held(),
-                                                     " bytes of points in flight; its limit is ", in_flight_->limit(),
-                                                     " bytes: retry later"));
-  }
+  if (absl::Status s = in_flight_->Reserve(tenant_, bytes); !s.ok()) return s;
   reserved_ += bytes;
   return absl::OkStatus();
 }
@@ -46,16 +105,23 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       if (has_header_) return absl::InvalidArgumentError("the build stream has a second header");
       has_header_ = true;
       decoded_.header = message.header();
+      if (decoded_.header.name().size() > kMaxBuildNameBytes) {
+        return absl::InvalidArgumentError(absl::StrCat("the header's name is ", decoded_.header.name().size(),
+                                                       " bytes long; a name is at most ", kMaxBuildNameBytes,
+                                                       " bytes"));
+      }
       const uint64_t expected = decoded_.header.expected_points();
       if (expected > limits_.max_points) {
-        return absl::ResourceExhaustedError(absl::StrCat(
-            "the header announces ", expected, " points; this server builds at most ", limits_.max_points, " points"));
+        return TagRefusal(absl::ResourceExhaustedError(
+                              absl::StrCat("the header announces ", expected, " points; this server builds at most ",
+                                           limits_.max_points, " points (--max_points_per_build)")),
+                          BuildRefusal::kPointsPerBuild);
       }
-      if (expected > 0) {
-        // Reserve the announced size up front: the upload is refused now rather than half way.
-        if (absl::Status s = Reserve(expected * sizeof(Point2)); !s.ok()) return s;
-        decoded_.points.reserve(expected);
-      }
+      // Nothing is reserved for an announced size (a stream that only announces would hold the
+      // budget for nothing): only a size that no limit could ever hold is refused now.
+      if (in_flight_ == nullptr) return absl::OkStatus();
+      const uint64_t most = std::numeric_limits<uint64_t>::max();
+      return in_flight_->CheckCanEverFit(tenant_, expected > most / sizeof(Point2) ? most : expected * sizeof(Point2));
       return absl::OkStatus();
     }
     case galpha::v1::BuildRequest::kPoints: {
@@ -69,8 +135,10 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       }
       const uint64_t after = before + count / 2;
       if (after > limits_.max_points) {
-        return absl::ResourceExhaustedError(absl::StrCat("the stream carries more than ", limits_.max_points,
-                                                         " points, this server's limit per build"));
+        return TagRefusal(absl::ResourceExhaustedError(absl::StrCat("the stream carries more than ", limits_.max_points,
+                                                                    " points, this server's limit per build "
+                                                                    "(--max_points_per_build)")),
+                          BuildRefusal::kPointsPerBuild);
       }
       const uint64_t expected = decoded_.header.expected_points();
       if (expected > 0 && after > expected) {
@@ -88,8 +156,14 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
                                                        std::isnan(values[i]) ? "NaN" : "infinite", " ",
                                                        i % 2 == 0 ? "x" : "y", " coordinate"));
       }
-      if (expected == 0) {
-        if (absl::Status s = Reserve(count * sizeof(double)); !s.ok()) return s;
+      if (absl::Status s = Reserve(count * sizeof(double)); !s.ok()) return s;
+      if (after > decoded_.points.capacity()) {
+        // Capacity grows with the bytes that arrived (doubling, as a vector does, but never past an
+        // announced count), not with the announcement: an announced 100M points would otherwise
+        // map 1.6 GB per stream before a single point arrives.
+        size_t capacity = std::max<size_t>(after, 2 * decoded_.points.capacity());
+        if (expected > 0) capacity = std::min<size_t>(capacity, expected);
+        decoded_.points.reserve(capacity);
       }
       decoded_.points.resize(after);
       if (count > 0) std::memcpy(&decoded_.points[before], coordinates.data(), count * sizeof(double));

@@ -4,8 +4,9 @@
 // the unit tests drive it directly.
 #pragma once
 
-#include <atomic>
 #include <cstdint>
+#include <map>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -18,20 +19,40 @@
 
 namespace galpha::server {
 
-/// Bytes of points held by uploads and builds across the whole server, against a limit.
+/// Bytes of points held by uploads and builds: against a server-wide limit, and against a limit per
+/// tenant so that one tenant's uploads cannot take the whole budget from the others. Uploads
+/// reserve as their bytes arrive (never what a header announces), so a stream that only announces
+/// holds nothing. Thread-safe.
 class InFlightBytes {
  public:
-  explicit InFlightBytes(size_t limit) : limit_(limit) {}
-  /// Whether `bytes` more fit; if so they are held until Release.
-  bool TryReserve(size_t bytes);
-  void Release(size_t bytes) { held_.fetch_sub(bytes); }
-  size_t held() const { return held_.load(); }
+  /// `limit`: the server's (--max_in_flight_bytes); `tenant_limit`: each tenant's
+  /// (--max_tenant_in_flight_bytes). 0: no such limit.
+  explicit InFlightBytes(size_t limit, size_t tenant_limit = 0) : limit_(limit), tenant_limit_(tenant_limit) {}
+
+  /// Holds `bytes` more for `tenant` until Release. ResourceExhausted naming the limit (tagged
+  /// kInFlightBytes or kTenantInFlightBytes) when they do not fit now; nothing is held then.
+  absl::Status Reserve(const std::string& tenant, size_t bytes);
+  /// ResourceExhausted (tagged as Reserve's) when `bytes` exceed a limit even with nothing else
+  /// held: such an upload can never fit, so it is refused at its header, before it is sent.
+  absl::Status CheckCanEverFit(const std::string& tenant, size_t bytes) const;
+  void Release(const std::string& tenant, size_t bytes);
+
+  size_t held() const;
+  size_t held_by(const std::string& tenant) const;
   size_t limit() const { return limit_; }
+  size_t tenant_limit() const { return tenant_limit_; }
 
  private:
   const size_t limit_;
-  std::atomic<size_t> held_{0};
+  const size_t tenant_limit_;
+  mutable std::mutex mutex_;
+  size_t held_ = 0;
+  std::map<std::string, size_t> held_by_tenant_;  // only tenants holding bytes
 };
+
+/// Longest BuildHeader.name, in bytes: a label, not a payload (it is kept with the family and sent
+/// back with every Build and Describe answer).
+inline constexpr size_t kMaxBuildNameBytes = 256;
 
 struct BuildStreamLimits {
   uint64_t max_points = 100'000'000;
@@ -46,18 +67,20 @@ struct DecodedBuild {
 
 class BuildStreamDecoder {
  public:
-  /// `in_flight` may be null (no server-wide limit); it must outlive the decoder.
-  BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight);
+  /// `in_flight` may be null (no limit on bytes in flight); it must outlive the decoder. `tenant`
+  /// is whose bytes these are ("" without authentication: one anonymous tenant).
+  BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant = "");
   /// Releases the bytes this stream holds in `in_flight` (also after Finish: the builder keeps
   /// the decoder alive while it uses the points).
   ~BuildStreamDecoder();
   BuildStreamDecoder(const BuildStreamDecoder&) = delete;
   BuildStreamDecoder& operator=(const BuildStreamDecoder&) = delete;
 
-  /// One message. InvalidArgument: a chunk before the header, a second header, an odd number of
-  /// coordinates, NaN or infinity (naming the point's index in the whole stream), more points
-  /// than the header announced. ResourceExhausted: more points than the limit, or more bytes in
-  /// flight on the server than its limit.
+  /// One message. InvalidArgument: a chunk before the header, a second header, a name longer than
+  /// kMaxBuildNameBytes, an odd number of coordinates, NaN or infinity (naming the point's index in
+  /// the whole stream), more points than the header announced. ResourceExhausted (tagged with its
+  /// BuildRefusal): more points than the limit, more bytes in flight than the server's or the
+  /// tenant's limit (a header announcing more than a limit could ever hold is refused at once).
   absl::Status Add(const galpha::v1::BuildRequest& message);
 
   /// The end of the stream. InvalidArgument: no header (an empty stream), or fewer points than
@@ -75,6 +98,7 @@ class BuildStreamDecoder {
 
   const BuildStreamLimits limits_;
   InFlightBytes* const in_flight_;
+  const std::string tenant_;
   size_t reserved_ = 0;
   bool has_header_ = false;
   bool finished_ = false;

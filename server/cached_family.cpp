@@ -6,8 +6,8 @@
 
 namespace galpha::server {
 
-CachedFamily::CachedFamily(AlphaFamily family, std::string name) : family_(std::move(family)), name_(std::move(name)) {
-  bytes_ = sizeof(*this) + family_.HostBytes() + name_.capacity() + family_.edges().size() * 3 * sizeof(uint32_t) +
+CachedFamily::CachedFamily(AlphaFamily family) : family_(std::move(family)) {
+  bytes_ = sizeof(*this) + family_.HostBytes() + family_.edges().size() * 3 * sizeof(uint32_t) +
            family_.triangles().size() * 4 * sizeof(uint32_t);
 }
 

@@ -1,5 +1,7 @@
-// A family as the service holds it: the immutable AlphaFamily, the build summary a Describe returns,
-// and the index orders Classify streams in (computed on first use, once).
+// A family as the service holds it: the immutable AlphaFamily (whose report is the build summary a
+// Describe returns) and the index orders Classify streams in (computed on first use, once). No
+// name: a BuildHeader.name is the label of one Build call, echoed in that call's answer only
+// (proto: BuildHeader), so the family that any caller of the tenant may reach keeps none.
 #pragma once
 
 #include <cstdint>
@@ -14,10 +16,9 @@ namespace galpha::server {
 
 class CachedFamily {
  public:
-  CachedFamily(AlphaFamily family, std::string name);
+  explicit CachedFamily(AlphaFamily family);
 
   const AlphaFamily& family() const { return family_; }
-  const std::string& name() const { return name_; }
   /// Bytes charged to the cache: the family, plus the index orders and ordered vertices once
   /// computed (charged up front so that the charge never changes while cached).
   size_t bytes() const { return bytes_; }
@@ -34,7 +35,6 @@ class CachedFamily {
   void ComputeOrders() const;
 
   AlphaFamily family_;
-  std::string name_;
   size_t bytes_ = 0;
   mutable std::once_flag orders_once_;
   mutable std::vector<uint32_t> edge_order_, triangle_order_;

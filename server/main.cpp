@@ -22,10 +22,19 @@ ABSL_FLAG(std::string, metrics_listen, "0.0.0.0:9464", "Prometheus exporter addr
 ABSL_FLAG(std::string, backend, "auto", "auto (GPU when present), cpu or cuda");
 ABSL_FLAG(int, build_slots, 0, "builds running at once (CUDA streams); 0: 4 on a GPU, 1 on the CPU");
 ABSL_FLAG(uint64_t, max_queued_builds, 16, "builds waiting for a slot before RESOURCE_EXHAUSTED");
+ABSL_FLAG(uint64_t, max_tenant_queued_builds, 8,
+          "builds of one tenant waiting for a slot before RESOURCE_EXHAUSTED (without --token_file every caller "
+          "is one anonymous tenant)");
 ABSL_FLAG(uint64_t, build_memory_bytes, 0,
           "working memory admitted to running builds; 0: 90% of the GPU's, or half the host's");
 ABSL_FLAG(uint64_t, max_points_per_build, 100000000, "largest point set one build accepts");
-ABSL_FLAG(uint64_t, max_in_flight_bytes, uint64_t{8} << 30, "bytes of points held by all uploads and builds at once");
+ABSL_FLAG(uint64_t, max_in_flight_bytes, uint64_t{8} << 30,
+          "bytes of points held by all uploads and builds at once; 0: no limit");
+ABSL_FLAG(uint64_t, max_tenant_in_flight_bytes, uint64_t{4} << 30,
+          "bytes of points held by one tenant's uploads and builds at once; 0: no limit per tenant");
+ABSL_FLAG(int, upload_idle_timeout_ms, 30000,
+          "a Build stream with no message for this long is ended with DEADLINE_EXCEEDED and its points dropped; "
+          "0: never");
 ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30, "byte budget of the family cache (LRU eviction)");
 ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
 ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
@@ -87,9 +96,13 @@ int main(int argc, char** argv) {
   if (absl::GetFlag(FLAGS_build_slots) < 0) return Fail("--build_slots must be >= 0");
   options.service.build_slots = absl::GetFlag(FLAGS_build_slots);
   options.service.max_queued_builds = absl::GetFlag(FLAGS_max_queued_builds);
+  options.service.max_tenant_queued_builds = absl::GetFlag(FLAGS_max_tenant_queued_builds);
   options.service.build_memory_bytes = absl::GetFlag(FLAGS_build_memory_bytes);
   options.service.max_points_per_build = absl::GetFlag(FLAGS_max_points_per_build);
   options.service.max_in_flight_bytes = absl::GetFlag(FLAGS_max_in_flight_bytes);
+  options.service.max_tenant_in_flight_bytes = absl::GetFlag(FLAGS_max_tenant_in_flight_bytes);
+  if (absl::GetFlag(FLAGS_upload_idle_timeout_ms) < 0) return Fail("--upload_idle_timeout_ms must be >= 0");
+  options.service.upload_idle_timeout = std::chrono::milliseconds(absl::GetFlag(FLAGS_upload_idle_timeout_ms));
   options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
   if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
     auto tokens = galpha::server::TenantTokens::ReadFile(path);

@@ -9,6 +9,7 @@
 #include <exception>
 
 #include "absl/strings/str_cat.h"
+#include "server/build_refusal.hpp"
 
 namespace galpha::server {
 
@@ -44,7 +45,8 @@ struct ServerMetrics::Families {
                         .Register(r)),
         rejected(prometheus::BuildCounter()
                      .Name("galpha_builds_rejected_total")
-                     .Help("Builds refused before running, by reason")
+                     .Help("Builds refused or ended by a limit, by reason (the limit's name: in_flight_bytes, "
+                           "idle_timeout, queue_full, ...; server/README.md)")
                      .Register(r)),
         cache_bytes(
             prometheus::BuildGauge().Name("galpha_cache_bytes").Help("Bytes of families in the cache").Register(r)),
@@ -89,7 +91,10 @@ struct ServerMetrics::Families {
         in_flight(builds_in_flight.Add({})),
         queued(queue_length.Add({})),
         admitted(admitted_bytes.Add({})),
-        device(device_memory.Add({})) {}
+        device(device_memory.Add({})) {
+    // Every reason from the start, at 0: an alert on a rate sees the series before its first refusal.
+    for (const BuildRefusal reason : kAllBuildRefusals) rejected.Add({{"reason", std::string(RefusalLabel(reason))}});
+  }
 
   prometheus::Family<prometheus::Histogram>& stage_seconds;
   prometheus::Family<prometheus::Histogram>& build_seconds;

@@ -34,7 +34,7 @@ class ServerMetrics final : public CacheObserver, public SchedulerObserver {
   void SetDeviceMemoryInUse(double bytes);
   /// 1 for the backend this server runs ("cuda" or "cpu").
   void SetBackend(const std::string& backend);
-  /// Build requests refused before a slot (queue full, limits, memory).
+  /// A Build refused or ended by a limit; `reason` is a RefusalLabel (build_refusal.hpp).
   void RecordRejectedBuild(std::string_view reason);
 
   // CacheObserver

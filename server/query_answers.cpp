@@ -315,17 +315,34 @@ absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::
   return resolved;
 }
 
-ClassifyMode ToClassifyMode(v1::ClassifyMode mode) {
-  return mode == v1::CLASSIFY_MODE_REGULARIZED ? ClassifyMode::kRegularized : ClassifyMode::kGeneral;
+absl::StatusOr<ClassifyMode> ToClassifyMode(v1::ClassifyMode mode) {
+  switch (mode) {
+    case v1::CLASSIFY_MODE_UNSPECIFIED:
+    case v1::CLASSIFY_MODE_GENERAL:
+      return ClassifyMode::kGeneral;
+    case v1::CLASSIFY_MODE_REGULARIZED:
+      return ClassifyMode::kRegularized;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat(
+          "mode ", static_cast<int>(mode), " is not a ClassifyMode (GENERAL = 1 or REGULARIZED = 2; 0 means GENERAL)"));
+  }
 }
 
-VertexRule ToVertexRule(v1::VertexRule rule) {
-  return rule == v1::VERTEX_RULE_CGAL ? VertexRule::kCgal : VertexRule::kReport;
+absl::StatusOr<VertexRule> ToVertexRule(v1::VertexRule rule) {
+  switch (rule) {
+    case v1::VERTEX_RULE_UNSPECIFIED:
+    case v1::VERTEX_RULE_REPORT:
+      return VertexRule::kReport;
+    case v1::VERTEX_RULE_CGAL:
+      return VertexRule::kCgal;
+    default:
+      return absl::InvalidArgumentError(absl::StrCat("vertex_rule ", static_cast<int>(rule),
+                                                     " is not a VertexRule (REPORT = 1 or CGAL = 2; 0 means REPORT)"));
+  }
 }
 
 void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
   const AlphaFamily& family = cached.family();
-  summary->set_name(cached.name());
   summary->set_points(family.points().size());
   summary->set_distinct_points(family.num_unique());
   summary->set_duplicates(family.num_duplicates());
@@ -349,10 +366,13 @@ void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifySource(
     std::shared_ptr<const CachedFamily> cached, const v1::ClassifyRequest& request) {
   const AlphaFamily& family = cached->family();
+  const absl::StatusOr<ClassifyMode> mode = ToClassifyMode(request.mode());
+  if (!mode.ok()) return mode.status();
+  const absl::StatusOr<VertexRule> rule = ToVertexRule(request.vertex_rule());
+  if (!rule.ok()) return rule.status();
   auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
-  Classification classes =
-      family.ClassifyAll(level->level, ToClassifyMode(request.mode()), ToVertexRule(request.vertex_rule()));
+  Classification classes = family.ClassifyAll(level->level, *mode, *rule);
   const ClassificationSummary counts = SummarizeClassification(family, classes);
   return std::make_unique<ClassifySource>(std::move(cached), std::move(classes), counts, *level,
                                           request.non_exterior_only(), request.summary_only());
@@ -385,10 +405,12 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
   if (request.format() == v1::SHAPE_FORMAT_UNSPECIFIED) {
     return absl::InvalidArgumentError("the shape request has no format: GEOJSON, WKT, SVG or RINGS");
   }
+  const absl::StatusOr<ClassifyMode> mode = ToClassifyMode(request.mode());
+  if (!mode.ok()) return mode.status();
   const AlphaFamily& family = cached->family();
   auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
-  auto shape = AssembleShape(family.ComplexAt(level->level, ToClassifyMode(request.mode())));
+  auto shape = AssembleShape(family.ComplexAt(level->level, *mode));
   if (!shape.ok()) return shape.status();
   const absl::Span<const Point2> points = family.points();
   switch (request.format()) {
@@ -424,7 +446,9 @@ absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family, c
   }
   uint32_t page = request.page_size() == 0 ? kDefaultSpectrumPage : request.page_size();
   if (page > kMaxSpectrumPage) {
-    return absl::InvalidArgumentError(absl::StrCat("page_size ", page, " exceeds ", kMaxSpectrumPage));
+    return absl::InvalidArgumentError(absl::StrCat("page_size ", page, " exceeds the largest page, ", kMaxSpectrumPage,
+                                                   " values (0 asks for the default, ", kDefaultSpectrumPage,
+                                                   "): page through the spectrum with first_rank and next_rank"));
   }
   v1::SpectrumResponse response;
   response.set_first_rank(first);

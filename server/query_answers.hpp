@@ -22,7 +22,9 @@ inline constexpr uint32_t kMasterEntriesPerChunk = 1u << 17;
 /// Bytes of text per Shape message; indices per ShapeRings message (about).
 inline constexpr size_t kShapeTextBytesPerChunk = 1u << 20;
 inline constexpr size_t kShapeIndicesPerChunk = 1u << 18;
-/// Spectrum page sizes and the longest Components range.
+/// Spectrum page sizes (page_size 0 asks for the default; more than the largest is refused) and the
+/// longest Components range. The largest page, 2 MiB of doubles, stays under the 4 MiB that gRPC
+/// clients receive by default: a whole spectrum in one message would pass it from ~500K values.
 inline constexpr uint32_t kDefaultSpectrumPage = 65536;
 inline constexpr uint32_t kMaxSpectrumPage = 262144;
 inline constexpr int64_t kMaxComponentLevels = 262144;
@@ -35,10 +37,14 @@ struct ResolvedLevel {
 /// InvalidArgument: no threshold set, NaN, a negative alpha, a rank outside 0..K.
 absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const galpha::v1::Threshold& threshold);
 
-ClassifyMode ToClassifyMode(galpha::v1::ClassifyMode mode);
-VertexRule ToVertexRule(galpha::v1::VertexRule rule);
+/// The engine's mode and vertex rule of a request's `mode` and `vertex_rule` (UNSPECIFIED: GENERAL,
+/// REPORT). InvalidArgument naming the field and the value for a number the enum does not define
+/// (proto3 enums are open: a newer client's value, or garbage): the default would answer another
+/// question than the one asked.
+absl::StatusOr<ClassifyMode> ToClassifyMode(galpha::v1::ClassifyMode mode);
+absl::StatusOr<VertexRule> ToVertexRule(galpha::v1::VertexRule rule);
 
-/// Describe's and Build's summary of a cached family.
+/// Describe's and Build's summary of a cached family, without a name (Build adds its caller's).
 void FillBuildSummary(const CachedFamily& cached, galpha::v1::BuildSummary* summary);
 
 /// A generator of a server-streamed answer: Next fills the next message, false when done.
@@ -49,7 +55,8 @@ class ChunkSource {
   virtual bool Next(Message* message) = 0;
 };
 
-/// Classify: the summary, then vertex, edge and triangle chunks in index order.
+/// Classify: the summary, then vertex, edge and triangle chunks in index order. InvalidArgument
+/// for a bad threshold, mode or vertex rule.
 absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>>> MakeClassifySource(
     std::shared_ptr<const CachedFamily> cached, const galpha::v1::ClassifyRequest& request);
 
@@ -57,7 +64,8 @@ absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>>> MakeC
 absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::MasterListResponse>>> MakeMasterListSource(
     std::shared_ptr<const CachedFamily> cached, const galpha::v1::MasterListRequest& request);
 
-/// Shape as text chunks or ring chunks. InvalidArgument for an unspecified format.
+/// Shape as text chunks or ring chunks. InvalidArgument for an unspecified or unknown format, an
+/// unknown mode or a bad threshold.
 absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ShapeResponse>>> MakeShapeSource(
     std::shared_ptr<const CachedFamily> cached, const galpha::v1::ShapeRequest& request);
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "gtest/gtest.h"
+#include "server/build_refusal.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
@@ -31,6 +32,9 @@ using galpha::testing::StatusIs;
 constexpr std::chrono::seconds kDeadlock{20};
 // How long a test watches for something that must not happen while a job is held.
 constexpr std::chrono::milliseconds kWatch{150};
+
+// A per-tenant queue limit that the tests of the shared queue never reach.
+constexpr size_t kNoTenantCap = 1000;
 
 void* FakeStream(uintptr_t value) { return reinterpret_cast<void*>(value); }
 
@@ -121,7 +125,7 @@ TEST(BuildSchedulerTest, JobsRunOnTheSlotsWithTheirStreams) {
   LoadRecorder recorder;
   std::vector<JobRun> runs(3);
   {
-    BuildScheduler scheduler(streams, /*max_queue=*/0, /*memory_budget_bytes=*/0, &recorder);
+    BuildScheduler scheduler(streams, /*max_queue=*/0, kNoTenantCap, /*memory_budget_bytes=*/0, &recorder);
     EXPECT_EQ(scheduler.slots(), 3u);
     EXPECT_EQ(scheduler.max_queue(), 0u);
     EXPECT_EQ(scheduler.memory_budget_bytes(), 0u);
@@ -130,7 +134,7 @@ TEST(BuildSchedulerTest, JobsRunOnTheSlotsWithTheirStreams) {
     std::atomic<int> started{0};
     Gate all_started, release;
     for (size_t i = 0; i < runs.size(); ++i) {
-      ASSERT_THAT(scheduler.Submit(1,
+      ASSERT_THAT(scheduler.Submit("", 1,
                                    [&, i](const BuildSlot& slot, bool draining) {
                                      runs[i].slot = slot;
                                      runs[i].draining = draining;
@@ -141,7 +145,7 @@ TEST(BuildSchedulerTest, JobsRunOnTheSlotsWithTheirStreams) {
                   IsOk());
     }
     ASSERT_TRUE(all_started.Wait());
-    EXPECT_THAT(scheduler.Submit(1, [](const BuildSlot&, bool) {}), StatusIs(absl::StatusCode::kResourceExhausted))
+    EXPECT_THAT(scheduler.Submit("", 1, [](const BuildSlot&, bool) {}), StatusIs(absl::StatusCode::kResourceExhausted))
         << "every slot busy and no queue";
     release.Open();
   }
@@ -165,22 +169,22 @@ TEST(BuildSchedulerTest, FullQueueRefusesWithResourceExhausted) {
   std::atomic<int> third_calls{0};
   JobRun second;
   {
-    BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/1, /*memory_budget_bytes=*/0, &recorder);
-    ASSERT_THAT(scheduler.Submit(0,
+    BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/1, kNoTenantCap, /*memory_budget_bytes=*/0, &recorder);
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot&, bool) {
                                    first_started.Open();
                                    release_first.Wait();
                                  }),
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
-    ASSERT_THAT(scheduler.Submit(0,
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot& slot, bool draining) {
                                    second = JobRun{slot, draining, second.calls + 1};
                                    second_done.Open();
                                  }),
                 IsOk());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.queued == 1 && l.running == 1; }));
-    const absl::Status refused = scheduler.Submit(0, [&](const BuildSlot&, bool) { ++third_calls; });
+    const absl::Status refused = scheduler.Submit("", 0, [&](const BuildSlot&, bool) { ++third_calls; });
     EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted));
     EXPECT_NE(refused.message().find("queue"), absl::string_view::npos) << refused;
 
@@ -193,7 +197,7 @@ TEST(BuildSchedulerTest, FullQueueRefusesWithResourceExhausted) {
     // The queue has room again once the second job left it.
     Gate fourth_done;
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 0; }));
-    ASSERT_THAT(scheduler.Submit(0, [&](const BuildSlot&, bool) { fourth_done.Open(); }), IsOk());
+    ASSERT_THAT(scheduler.Submit("", 0, [&](const BuildSlot&, bool) { fourth_done.Open(); }), IsOk());
     ASSERT_TRUE(fourth_done.Wait());
   }
   EXPECT_EQ(third_calls.load(), 0) << "a refused job never runs";
@@ -206,8 +210,8 @@ TEST(BuildSchedulerTest, JobsRunInSubmissionOrder) {
   std::mutex mutex;
   std::vector<int> order;
   {
-    BuildScheduler scheduler({nullptr}, /*max_queue=*/8, /*memory_budget_bytes=*/0, nullptr);
-    ASSERT_THAT(scheduler.Submit(0,
+    BuildScheduler scheduler({nullptr}, /*max_queue=*/8, kNoTenantCap, /*memory_budget_bytes=*/0, nullptr);
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot&, bool) {
                                    first_started.Open();
                                    release_first.Wait();
@@ -215,7 +219,7 @@ TEST(BuildSchedulerTest, JobsRunInSubmissionOrder) {
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
     for (int i = 1; i <= 5; ++i) {
-      ASSERT_THAT(scheduler.Submit(0,
+      ASSERT_THAT(scheduler.Submit("", 0,
                                    [&, i](const BuildSlot& slot, bool draining) {
                                      EXPECT_FALSE(draining);
                                      EXPECT_EQ(slot.cuda_stream, nullptr);
@@ -247,13 +251,13 @@ TEST(BuildSchedulerTest, MemoryAdmissionKeepsBuildsWithinTheBudget) {
     if (++done == 3) all_done.Open();
   };
   {
-    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/4, /*memory_budget_bytes=*/100,
-                             &recorder);
-    const absl::Status too_big = scheduler.Submit(101, [](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
+    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/4, kNoTenantCap,
+                             /*memory_budget_bytes=*/100, &recorder);
+    const absl::Status too_big = scheduler.Submit("", 101, [](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
     EXPECT_THAT(too_big, StatusIs(absl::StatusCode::kResourceExhausted));
     EXPECT_NE(too_big.message().find("101"), absl::string_view::npos) << too_big;
 
-    ASSERT_THAT(scheduler.Submit(60,
+    ASSERT_THAT(scheduler.Submit("", 60,
                                  [&](const BuildSlot&, bool draining) {
                                    EXPECT_FALSE(draining);
                                    track();
@@ -265,7 +269,7 @@ TEST(BuildSchedulerTest, MemoryAdmissionKeepsBuildsWithinTheBudget) {
     ASSERT_TRUE(first_started.Wait());
     // The second needs 60 (60 + 60 > 100); the third needs only 10 but queues behind the second.
     for (const size_t need : {size_t{60}, size_t{10}}) {
-      ASSERT_THAT(scheduler.Submit(need,
+      ASSERT_THAT(scheduler.Submit("", need,
                                    [&](const BuildSlot&, bool draining) {
                                      EXPECT_FALSE(draining);
                                      track();
@@ -294,11 +298,11 @@ TEST(BuildSchedulerTest, TwoBuildsOfSixtyNeverOverlap) {
   std::atomic<int> current{0}, max_concurrent{0}, done{0};
   Gate all_done;
   {
-    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/8, /*memory_budget_bytes=*/100,
-                             &recorder);
+    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/8, kNoTenantCap,
+                             /*memory_budget_bytes=*/100, &recorder);
     constexpr int kJobs = 6;
     for (int i = 0; i < kJobs; ++i) {
-      ASSERT_THAT(scheduler.Submit(60,
+      ASSERT_THAT(scheduler.Submit("", 60,
                                    [&](const BuildSlot&, bool) {
                                      const int now = ++current;
                                      int seen = max_concurrent.load();
@@ -326,9 +330,9 @@ TEST(BuildSchedulerTest, JobsWaitingForMemoryCountAsQueued) {
   Gate first_started, release_first;
   std::atomic<int> later_calls{0};
   {
-    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/1, /*memory_budget_bytes=*/100,
-                             &recorder);
-    ASSERT_THAT(scheduler.Submit(60,
+    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/1, kNoTenantCap,
+                             /*memory_budget_bytes=*/100, &recorder);
+    ASSERT_THAT(scheduler.Submit("", 60,
                                  [&](const BuildSlot&, bool) {
                                    first_started.Open();
                                    release_first.Wait();
@@ -336,9 +340,9 @@ TEST(BuildSchedulerTest, JobsWaitingForMemoryCountAsQueued) {
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 1; }));
-    ASSERT_THAT(scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; }), IsOk());
+    ASSERT_THAT(scheduler.Submit("", 60, [&](const BuildSlot&, bool) { ++later_calls; }), IsOk());
     EXPECT_EQ(recorder.last().queued, 1u) << "the second job waits for memory, so it is queued";
-    const absl::Status third = scheduler.Submit(60, [&](const BuildSlot&, bool) { ++later_calls; });
+    const absl::Status third = scheduler.Submit("", 60, [&](const BuildSlot&, bool) { ++later_calls; });
     EXPECT_THAT(third, StatusIs(absl::StatusCode::kResourceExhausted)) << "max_queue 1, one job already waiting";
     release_first.Open();
   }
@@ -348,9 +352,9 @@ TEST(BuildSchedulerTest, JobsWaitingForMemoryCountAsQueued) {
 TEST(BuildSchedulerTest, ZeroBudgetAdmitsEverything) {
   Gate both_started;
   std::atomic<int> started{0};
-  BuildScheduler scheduler({nullptr, nullptr}, /*max_queue=*/0, /*memory_budget_bytes=*/0, nullptr);
+  BuildScheduler scheduler({nullptr, nullptr}, /*max_queue=*/0, kNoTenantCap, /*memory_budget_bytes=*/0, nullptr);
   for (int i = 0; i < 2; ++i) {
-    ASSERT_THAT(scheduler.Submit(size_t{1} << 50,
+    ASSERT_THAT(scheduler.Submit("", size_t{1} << 50,
                                  [&](const BuildSlot&, bool) {
                                    if (++started == 2) both_started.Open();
                                    both_started.Wait();
@@ -368,8 +372,8 @@ TEST(BuildSchedulerTest, StopDrainsQueuedJobsAndRefusesNewOnes) {
   std::future<void> third_done_future = third_done.get_future();
   std::atomic<int> late_calls{0};
   {
-    BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/2, /*memory_budget_bytes=*/0, &recorder);
-    ASSERT_THAT(scheduler.Submit(0,
+    BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/2, kNoTenantCap, /*memory_budget_bytes=*/0, &recorder);
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot& slot, bool draining) {
                                    first = JobRun{slot, draining, first.calls + 1};
                                    first_started.Open();
@@ -377,12 +381,12 @@ TEST(BuildSchedulerTest, StopDrainsQueuedJobsAndRefusesNewOnes) {
                                  }),
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
-    ASSERT_THAT(scheduler.Submit(0,
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot& slot, bool draining) {
                                    second = JobRun{slot, draining, second.calls + 1};
                                  }),
                 IsOk());
-    ASSERT_THAT(scheduler.Submit(0,
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot& slot, bool draining) {
                                    third = JobRun{slot, draining, third.calls + 1};
                                    third_done.set_value();
@@ -391,13 +395,13 @@ TEST(BuildSchedulerTest, StopDrainsQueuedJobsAndRefusesNewOnes) {
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.queued == 2 && l.running == 1; }));
 
     scheduler.Stop();  // returns at once, with the first job still running
-    const absl::Status refused = scheduler.Submit(0, [&](const BuildSlot&, bool) { ++late_calls; });
+    const absl::Status refused = scheduler.Submit("", 0, [&](const BuildSlot&, bool) { ++late_calls; });
     EXPECT_THAT(refused, StatusIs(absl::StatusCode::kUnavailable));
     EXPECT_EQ(first.calls, 1);
 
     release_first.Open();
     ASSERT_EQ(third_done_future.wait_for(kDeadlock), std::future_status::ready);
-    EXPECT_THAT(scheduler.Submit(0, [&](const BuildSlot&, bool) { ++late_calls; }),
+    EXPECT_THAT(scheduler.Submit("", 0, [&](const BuildSlot&, bool) { ++late_calls; }),
                 StatusIs(absl::StatusCode::kUnavailable));
   }
   EXPECT_EQ(first.calls, 1);
@@ -418,9 +422,9 @@ TEST(BuildSchedulerTest, StopWakesJobsWaitingForMemory) {
   std::promise<bool> second_draining;
   std::future<bool> second_future = second_draining.get_future();
   {
-    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/2, /*memory_budget_bytes=*/100,
-                             &recorder);
-    ASSERT_THAT(scheduler.Submit(60,
+    BuildScheduler scheduler({FakeStream(0x10), FakeStream(0x20)}, /*max_queue=*/2, kNoTenantCap,
+                             /*memory_budget_bytes=*/100, &recorder);
+    ASSERT_THAT(scheduler.Submit("", 60,
                                  [&](const BuildSlot&, bool draining) {
                                    EXPECT_FALSE(draining);
                                    first_started.Open();
@@ -428,7 +432,7 @@ TEST(BuildSchedulerTest, StopWakesJobsWaitingForMemory) {
                                  }),
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
-    ASSERT_THAT(scheduler.Submit(60,
+    ASSERT_THAT(scheduler.Submit("", 60,
                                  [&](const BuildSlot& slot, bool draining) {
                                    EXPECT_NE(slot.cuda_stream, nullptr);
                                    second_draining.set_value(draining);
@@ -450,8 +454,8 @@ TEST(BuildSchedulerTest, DestructorRunsEveryAcceptedJobOnce) {
   std::vector<std::atomic<int>> calls(kJobs);
   Gate first_started, release_first;
   {
-    BuildScheduler scheduler({nullptr}, /*max_queue=*/kJobs, /*memory_budget_bytes=*/0, &recorder);
-    ASSERT_THAT(scheduler.Submit(0,
+    BuildScheduler scheduler({nullptr}, /*max_queue=*/kJobs, kNoTenantCap, /*memory_budget_bytes=*/0, &recorder);
+    ASSERT_THAT(scheduler.Submit("", 0,
                                  [&](const BuildSlot&, bool) {
                                    ++calls[0];
                                    first_started.Open();
@@ -460,7 +464,7 @@ TEST(BuildSchedulerTest, DestructorRunsEveryAcceptedJobOnce) {
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
     for (int i = 1; i < kJobs; ++i) {
-      ASSERT_THAT(scheduler.Submit(0, [&, i](const BuildSlot&, bool) { ++calls[static_cast<size_t>(i)]; }), IsOk());
+      ASSERT_THAT(scheduler.Submit("", 0, [&, i](const BuildSlot&, bool) { ++calls[static_cast<size_t>(i)]; }), IsOk());
     }
     release_first.Open();
   }
@@ -472,8 +476,8 @@ TEST(BuildSchedulerTest, ObserverSeesTheLoadRiseAndFall) {
   LoadRecorder recorder;
   Gate first_started, release_first, second_done;
   {
-    BuildScheduler scheduler({nullptr}, /*max_queue=*/1, /*memory_budget_bytes=*/1000, &recorder);
-    ASSERT_THAT(scheduler.Submit(300,
+    BuildScheduler scheduler({nullptr}, /*max_queue=*/1, kNoTenantCap, /*memory_budget_bytes=*/1000, &recorder);
+    ASSERT_THAT(scheduler.Submit("", 300,
                                  [&](const BuildSlot&, bool) {
                                    first_started.Open();
                                    release_first.Wait();
@@ -481,7 +485,7 @@ TEST(BuildSchedulerTest, ObserverSeesTheLoadRiseAndFall) {
                 IsOk());
     ASSERT_TRUE(first_started.Wait());
     ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.running == 1 && l.admitted_bytes == 300; }));
-    ASSERT_THAT(scheduler.Submit(200, [&](const BuildSlot&, bool) { second_done.Open(); }), IsOk());
+    ASSERT_THAT(scheduler.Submit("", 200, [&](const BuildSlot&, bool) { second_done.Open(); }), IsOk());
     ASSERT_TRUE(
         recorder.WaitFor([](const Load& l) { return l.queued == 1 && l.running == 1 && l.admitted_bytes == 300; }));
     release_first.Open();
@@ -492,6 +496,53 @@ TEST(BuildSchedulerTest, ObserverSeesTheLoadRiseAndFall) {
   EXPECT_EQ(recorder.max_running(), 1u);
   EXPECT_EQ(recorder.max_admitted(), 300u);
   ExpectIdle(recorder);
+}
+
+TEST(BuildSchedulerTest, OneTenantCannotFillTheQueue) {
+  LoadRecorder recorder;
+  Gate first_started, release_first;
+  std::atomic<int> ran{0};
+  {
+    BuildScheduler scheduler({FakeStream(0x10)}, /*max_queue=*/4, /*max_queue_per_tenant=*/2,
+                             /*memory_budget_bytes=*/0, &recorder);
+    ASSERT_THAT(scheduler.Submit("a", 0,
+                                 [&](const BuildSlot&, bool) {
+                                   ++ran;
+                                   first_started.Open();
+                                   release_first.Wait();
+                                 }),
+                IsOk());
+    ASSERT_TRUE(first_started.Wait());
+    // The running job is not waiting: tenant a may still queue two.
+    ASSERT_THAT(scheduler.Submit("a", 0, [&](const BuildSlot&, bool) { ++ran; }), IsOk());
+    ASSERT_THAT(scheduler.Submit("a", 0, [&](const BuildSlot&, bool) { ++ran; }), IsOk());
+    const absl::Status refused = scheduler.Submit("a", 0, [&](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
+    EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted,
+                                  ::testing::HasSubstr("tenant 'a' already has 2 builds waiting")));
+    EXPECT_THAT(refused.message(), ::testing::HasSubstr("--max_tenant_queued_builds"));
+    EXPECT_EQ(RefusalLabelOf(refused), "tenant_queued_builds");
+    // Another tenant still has room in the shared queue, up to its size.
+    ASSERT_THAT(scheduler.Submit("b", 0, [&](const BuildSlot&, bool) { ++ran; }), IsOk());
+    ASSERT_THAT(scheduler.Submit("", 0, [&](const BuildSlot&, bool) { ++ran; }), IsOk());
+    const absl::Status full = scheduler.Submit("b", 0, [&](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
+    EXPECT_THAT(full, StatusIs(absl::StatusCode::kResourceExhausted, ::testing::HasSubstr("--max_queued_builds")));
+    EXPECT_EQ(RefusalLabelOf(full), "queue_full");
+    EXPECT_EQ(recorder.last().queued, 4u);
+    release_first.Open();
+    ASSERT_TRUE(recorder.WaitFor([](const Load& l) { return l.queued == 0 && l.running == 0; }));
+  }
+  EXPECT_EQ(ran.load(), 5);
+}
+
+TEST(BuildSchedulerTest, RefusalsAreTaggedWithTheirReason) {
+  BuildScheduler scheduler({nullptr}, /*max_queue=*/1, kNoTenantCap, /*memory_budget_bytes=*/100, nullptr);
+  const absl::Status too_big = scheduler.Submit("", 101, [](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
+  EXPECT_THAT(too_big, StatusIs(absl::StatusCode::kResourceExhausted, ::testing::HasSubstr("--build_memory_bytes")));
+  EXPECT_EQ(RefusalLabelOf(too_big), "build_memory");
+  scheduler.Stop();
+  const absl::Status stopped = scheduler.Submit("", 1, [](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
+  EXPECT_THAT(stopped, StatusIs(absl::StatusCode::kUnavailable));
+  EXPECT_EQ(RefusalLabelOf(stopped), "draining");
 }
 
 }  // namespace

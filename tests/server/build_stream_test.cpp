@@ -17,6 +17,7 @@
 #include "absl/types/span.h"
 #include "core/io/point_set_handle.hpp"
 #include "gtest/gtest.h"
+#include "server/build_refusal.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
 
@@ -186,6 +187,15 @@ TEST(BuildStreamDecoderTest, AnnouncedCountOverTheLimitIsRefusedAtTheHeader) {
   EXPECT_THAT(at_limit.Add(Header(100)), IsOk());
 }
 
+TEST(BuildStreamDecoderTest, NameLongerThanTheLimitIsRefusedByName) {
+  BuildStreamDecoder at_limit(BuildStreamLimits{}, nullptr);
+  EXPECT_THAT(at_limit.Add(Header(0, std::string(kMaxBuildNameBytes, 'n'))), IsOk());
+  BuildStreamDecoder over(BuildStreamLimits{}, nullptr);
+  EXPECT_THAT(over.Add(Header(0, std::string(kMaxBuildNameBytes + 1, 'n'))),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("name is 257 bytes long; a name is "
+                                                                                "at most 256 bytes")));
+}
+
 TEST(BuildStreamDecoderTest, UnannouncedCountOverTheLimitIsRefusedAtTheChunk) {
   BuildStreamLimits limits;
   limits.max_points = 5;
@@ -340,51 +350,96 @@ TEST(BuildStreamDecoderTest, PointsAreDecodedBitForBit) {
 TEST(InFlightBytesTest, ReservesUpToTheLimit) {
   InFlightBytes in_flight(100);
   EXPECT_EQ(in_flight.limit(), 100u);
-  EXPECT_TRUE(in_flight.TryReserve(60));
-  EXPECT_FALSE(in_flight.TryReserve(41));
+  EXPECT_THAT(in_flight.Reserve("", 60), IsOk());
+  const absl::Status refused = in_flight.Reserve("", 41);
+  EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted, ::testing::HasSubstr("--max_in_flight_bytes")));
+  EXPECT_EQ(RefusalLabelOf(refused), "in_flight_bytes");
   EXPECT_EQ(in_flight.held(), 60u) << "a refused reservation holds nothing";
-  EXPECT_TRUE(in_flight.TryReserve(40));
+  EXPECT_THAT(in_flight.Reserve("", 40), IsOk());
   EXPECT_EQ(in_flight.held(), 100u);
-  in_flight.Release(100);
+  in_flight.Release("", 100);
   EXPECT_EQ(in_flight.held(), 0u);
 }
 
 TEST(InFlightBytesTest, ZeroLimitAdmitsEverything) {
   InFlightBytes in_flight(0);
-  EXPECT_TRUE(in_flight.TryReserve(size_t{1} << 40));
-  EXPECT_TRUE(in_flight.TryReserve(size_t{1} << 40));
+  EXPECT_THAT(in_flight.Reserve("", size_t{1} << 40), IsOk());
+  EXPECT_THAT(in_flight.Reserve("", size_t{1} << 40), IsOk());
   EXPECT_EQ(in_flight.held(), size_t{2} << 40);
 }
 
-TEST(InFlightBytesTest, AnnouncedStreamOverTheLimitIsRefusedAndReleasePointsFreesTheBytes) {
+TEST(InFlightBytesTest, EachTenantHasItsOwnLimitWithinTheServers) {
+  InFlightBytes in_flight(/*limit=*/100, /*tenant_limit=*/60);
+  EXPECT_THAT(in_flight.Reserve("a", 60), IsOk());
+  const absl::Status refused = in_flight.Reserve("a", 1);
+  EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted, ::testing::HasSubstr("tenant 'a' holds 60")));
+  EXPECT_THAT(refused.message(), ::testing::HasSubstr("--max_tenant_in_flight_bytes"));
+  EXPECT_EQ(RefusalLabelOf(refused), "tenant_in_flight_bytes");
+  EXPECT_THAT(in_flight.Reserve("b", 40), IsOk()) << "another tenant is not held back by a's bytes";
+  EXPECT_EQ(RefusalLabelOf(in_flight.Reserve("b", 1)), "in_flight_bytes") << "the server's limit still holds";
+  EXPECT_EQ(in_flight.held_by("a"), 60u);
+  EXPECT_EQ(in_flight.held_by("b"), 40u);
+  in_flight.Release("a", 60);
+  EXPECT_EQ(in_flight.held_by("a"), 0u);
+  EXPECT_EQ(in_flight.held(), 40u);
+
+  // Without authentication every caller is one tenant, "".
+  InFlightBytes anonymous(/*limit=*/0, /*tenant_limit=*/10);
+  EXPECT_THAT(anonymous.Reserve("", 11).message(), ::testing::HasSubstr("the anonymous tenant"));
+}
+
+TEST(InFlightBytesTest, AnnouncedSizeReservesNothingUntilThePointsArrive) {
   InFlightBytes in_flight(100 * sizeof(Point2));
   auto first = std::make_unique<BuildStreamDecoder>(BuildStreamLimits{}, &in_flight);
   ASSERT_THAT(first->Add(Header(60)), IsOk());
-  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "the announced size is reserved up front";
+  EXPECT_EQ(in_flight.held(), 0u) << "a header alone holds nothing";
 
+  // A second announcement that fits the limit on its own is accepted whatever the first holds.
   BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
-  const absl::Status refused = second.Add(Header(60));
+  ASSERT_THAT(second.Add(Header(60)), IsOk());
+  EXPECT_EQ(in_flight.held(), 0u);
+
+  const std::vector<Point2> points = gen::Uniform(60, 15);
+  ASSERT_THAT(first->Add(Chunk(absl::MakeConstSpan(points).subspan(0, 20))), IsOk());
+  EXPECT_EQ(in_flight.held(), 20 * sizeof(Point2)) << "the bytes that arrived";
+  ASSERT_THAT(first->Add(Chunk(absl::MakeConstSpan(points).subspan(20))), IsOk());
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2));
+  const absl::StatusOr<DecodedBuild*> decoded = first->Finish();
+  ASSERT_THAT(decoded, IsOk());
+  EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
+  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "Finish keeps the reservation";
+
+  // The second stream's points do not fit next to the first's: refused at the chunk.
+  const absl::Status refused = second.Add(Chunk(gen::Uniform(60, 16)));
   EXPECT_THAT(refused, StatusIs(absl::StatusCode::kResourceExhausted));
   EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2));
 
-  const std::vector<Point2> points = gen::Uniform(60, 15);
-  ASSERT_THAT(first->Add(Chunk(points)), IsOk());
-  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "announced chunks reserve nothing more";
-  const absl::StatusOr<DecodedBuild*> decoded = first->Finish();
-  ASSERT_THAT(decoded, IsOk());
-  EXPECT_EQ(in_flight.held(), 60 * sizeof(Point2)) << "Finish keeps the reservation";
   first->ReleasePoints();
   EXPECT_EQ(in_flight.held(), 0u);
   EXPECT_TRUE((*decoded)->points.empty());
   first.reset();
   EXPECT_EQ(in_flight.held(), 0u) << "the destructor does not release twice";
+}
 
-  BuildStreamDecoder third(BuildStreamLimits{}, &in_flight);
-  ASSERT_THAT(third.Add(Header(60)), IsOk());
-  ASSERT_THAT(third.Add(Chunk(points)), IsOk());
-  const absl::StatusOr<DecodedBuild*> third_decoded = third.Finish();
-  ASSERT_THAT(third_decoded, IsOk());
-  EXPECT_EQ((*third_decoded)->handle, PointSetHandle(points));
+TEST(InFlightBytesTest, AnnouncementNoLimitCouldHoldIsRefusedAtTheHeader) {
+  InFlightBytes in_flight(/*limit=*/100 * sizeof(Point2), /*tenant_limit=*/50 * sizeof(Point2));
+  BuildStreamDecoder server_wide(BuildStreamLimits{}, &in_flight, "a");
+  const absl::Status over_server = server_wide.Add(Header(101));
+  EXPECT_THAT(over_server,
+              StatusIs(absl::StatusCode::kResourceExhausted, ::testing::HasSubstr("--max_in_flight_bytes")));
+  EXPECT_EQ(RefusalLabelOf(over_server), "in_flight_bytes");
+  BuildStreamDecoder tenant(BuildStreamLimits{}, &in_flight, "a");
+  const absl::Status over_tenant = tenant.Add(Header(51));
+  EXPECT_THAT(over_tenant,
+              StatusIs(absl::StatusCode::kResourceExhausted, ::testing::HasSubstr("--max_tenant_in_flight_bytes")));
+  EXPECT_EQ(RefusalLabelOf(over_tenant), "tenant_in_flight_bytes");
+  BuildStreamDecoder fits(BuildStreamLimits{}, &in_flight, "a");
+  EXPECT_THAT(fits.Add(Header(50)), IsOk());
+  BuildStreamDecoder huge(BuildStreamLimits{std::numeric_limits<uint64_t>::max()}, &in_flight, "a");
+  EXPECT_THAT(huge.Add(Header(std::numeric_limits<uint64_t>::max() / 2)),
+              StatusIs(absl::StatusCode::kResourceExhausted))
+      << "the announced bytes do not wrap around";
+  EXPECT_EQ(in_flight.held(), 0u);
 }
 
 TEST(InFlightBytesTest, DestructorFreesTheBytes) {
@@ -395,12 +450,14 @@ TEST(InFlightBytesTest, DestructorFreesTheBytes) {
     ASSERT_THAT(first.Add(Chunk(gen::Uniform(70, 16))), IsOk());
     ASSERT_THAT(first.Finish(), IsOk());
     BuildStreamDecoder second(BuildStreamLimits{}, &in_flight);
-    EXPECT_THAT(second.Add(Header(70)), StatusIs(absl::StatusCode::kResourceExhausted));
+    ASSERT_THAT(second.Add(Header(70)), IsOk());
+    EXPECT_THAT(second.Add(Chunk(gen::Uniform(70, 17))), StatusIs(absl::StatusCode::kResourceExhausted));
     EXPECT_EQ(in_flight.held(), 70 * sizeof(Point2));
   }
   EXPECT_EQ(in_flight.held(), 0u);
   BuildStreamDecoder third(BuildStreamLimits{}, &in_flight);
-  EXPECT_THAT(third.Add(Header(70)), IsOk());
+  ASSERT_THAT(third.Add(Header(70)), IsOk());
+  EXPECT_THAT(third.Add(Chunk(gen::Uniform(70, 18))), IsOk());
 }
 
 TEST(InFlightBytesTest, UnannouncedChunksReserveAsTheyArrive) {

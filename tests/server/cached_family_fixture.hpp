@@ -13,7 +13,8 @@
 
 namespace galpha::server::testing {
 
-/// The family of `points` as the service caches it; null (and a test failure) when the build fails.
+/// The family of `points` as the service caches it; null (and a test failure naming `name`) when
+/// the build fails.
 inline std::shared_ptr<const CachedFamily> MakeCachedFamily(const std::vector<Point2>& points,
                                                             const std::string& name) {
   BuildOptions options;
@@ -23,7 +24,7 @@ inline std::shared_ptr<const CachedFamily> MakeCachedFamily(const std::vector<Po
     ADD_FAILURE() << name << ": " << family.status();
     return nullptr;
   }
-  return std::make_shared<const CachedFamily>(*std::move(family), name);
+  return std::make_shared<const CachedFamily>(*std::move(family));
 }
 
 }  // namespace galpha::server::testing

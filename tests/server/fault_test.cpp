@@ -162,7 +162,7 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
   EXPECT_EQ(ok + exhausted, kBurst);
   EXPECT_GE(ok, 3);
   EXPECT_GE(exhausted, 1);
-  EXPECT_EQ(Metric(server, "galpha_builds_rejected_total{reason=\"queue_or_memory\"}"), static_cast<double>(exhausted));
+  EXPECT_EQ(Metric(server, "galpha_builds_rejected_total{reason=\"queue_full\"}"), static_cast<double>(exhausted));
 
   // Malformed bytes where a request belongs, and a message over the limit.
   auto client = ClientOf(server);
@@ -238,6 +238,49 @@ TEST(FaultTest, ASlowReaderDoesNotHoldUpOthers) {
   ASSERT_THAT(client->Release(built->handle), IsOk());
   EXPECT_EQ(testing::HealthOf(client->channel(), "galpha.v1.AlphaShapes"), "SERVING");
   ExpectBackToBaseline(server, baseline);
+}
+
+// The upload limits as the process's flags set them: a stalled client's upload is ended after
+// --upload_idle_timeout_ms (it used to hold its points until it disconnected), and a header
+// announcing more than --max_tenant_in_flight_bytes is refused before the upload.
+TEST(FaultTest, UploadLimitsFollowTheirFlags) {
+  ServerProcess server(GALPHA_SERVER,
+                       "--drain_notice_ms 0 --upload_idle_timeout_ms 300 --max_tenant_in_flight_bytes 1048576");
+  ASSERT_GT(server.port(), 0) << server.log();
+  EXPECT_EQ(Metric(server, "galpha_builds_rejected_total{reason=\"idle_timeout\"}"), 0.0);
+  auto client = ClientOf(server);
+
+  grpc::ClientContext stalled;
+  stalled.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(20));
+  v1::BuildResponse response;
+  auto writer = client->stub().Build(&stalled, &response);
+  v1::BuildRequest header;
+  header.mutable_header()->set_expected_points(1000);
+  ASSERT_TRUE(writer->Write(header));
+  v1::BuildRequest chunk;
+  for (const Point2& p : gen::Uniform(500, 60)) {
+    chunk.mutable_points()->add_coordinates(p.x);
+    chunk.mutable_points()->add_coordinates(p.y);
+  }
+  ASSERT_TRUE(writer->Write(chunk));
+  // The client sends nothing more and never ends the stream: the server does.
+  const grpc::Status ended = writer->Finish();
+  EXPECT_EQ(ended.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED) << ended.error_message();
+  EXPECT_NE(ended.error_message().find("--upload_idle_timeout_ms"), std::string::npos) << ended.error_message();
+  EXPECT_NE(ended.error_message().find("300 ms"), std::string::npos) << ended.error_message();
+  EXPECT_EQ(Metric(server, "galpha_builds_rejected_total{reason=\"idle_timeout\"}"), 1.0);
+
+  grpc::ClientContext announcing;
+  auto too_large = client->stub().Build(&announcing, &response);
+  header.mutable_header()->set_expected_points(70000);  // 1.12 MB
+  too_large->Write(header);
+  const grpc::Status refused = too_large->Finish();
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << refused.error_message();
+  EXPECT_NE(refused.error_message().find("--max_tenant_in_flight_bytes"), std::string::npos) << refused.error_message();
+  EXPECT_EQ(Metric(server, "galpha_builds_rejected_total{reason=\"tenant_in_flight_bytes\"}"), 1.0);
+
+  EXPECT_THAT(client->Build(gen::Uniform(1000, 61), Upload()), IsOk()) << "the server is still up";
+  EXPECT_EQ(server.Signal(SIGTERM, 30), 0) << server.log();
 }
 
 }  // namespace

@@ -104,8 +104,8 @@ void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::
   ASSERT_FALSE(messages.empty());
 
   const int64_t level = ResolveLevel(family, request.threshold())->level;
-  const ClassifyMode mode = ToClassifyMode(request.mode());
-  const Classification classes = family.ClassifyAll(level, mode, ToVertexRule(request.vertex_rule()));
+  const ClassifyMode mode = *ToClassifyMode(request.mode());
+  const Classification classes = family.ClassifyAll(level, mode, *ToVertexRule(request.vertex_rule()));
 
   ASSERT_EQ(messages[0].part_case(), v1::ClassifyResponse::kSummary);
   const v1::ClassifySummary& summary = messages[0].summary();

@@ -40,7 +40,7 @@ TEST(QueryAnswersTest, ShapeTextFormatsMatchTheWriters) {
       for (const v1::ClassifyMode mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
         SCOPED_TRACE(absl::StrCat(threshold.ShortDebugString(), " mode ", mode));
         const int64_t level = ResolveLevel(family, threshold)->level;
-        const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, ToClassifyMode(mode)));
+        const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, *ToClassifyMode(mode)));
         ASSERT_THAT(shape, IsOk());
         const std::pair<v1::ShapeFormat, std::string> formats[] = {
             {v1::SHAPE_FORMAT_GEOJSON, ShapeToGeoJson(*shape, family.points())},
@@ -148,7 +148,7 @@ TEST(QueryAnswersTest, ShapeRingsReproduceTheGeometry) {
       for (const v1::ClassifyMode mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
         SCOPED_TRACE(absl::StrCat(threshold.ShortDebugString(), " mode ", mode));
         const int64_t level = ResolveLevel(family, threshold)->level;
-        const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, ToClassifyMode(mode)));
+        const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, *ToClassifyMode(mode)));
         ASSERT_THAT(shape, IsOk());
         v1::ShapeRequest request;
         *request.mutable_threshold() = threshold;

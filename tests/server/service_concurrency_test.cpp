@@ -81,7 +81,7 @@ TEST(ServiceTest, FullQueueAnswersResourceExhausted) {
   EXPECT_NE(second.status().message().find("queue is full"), std::string::npos);
   runner.join();
   EXPECT_THAT(first, IsOk());
-  EXPECT_EQ(ScrapeMetric(*server, "galpha_builds_rejected_total{reason=\"queue_or_memory\"}"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_builds_rejected_total{reason=\"queue_full\"}"), 1.0);
 }
 
 TEST(ServiceTest, CancellationMidStreamFreesTheUpload) {

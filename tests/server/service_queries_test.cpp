@@ -225,12 +225,21 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
   ASSERT_THAT(first, IsOk());
   EXPECT_FALSE(first->cached);
   EXPECT_TRUE(first->uploaded);
-  // The same points again: a cache hit, nothing recomputed (the summary is the first build's).
-  auto again = client->Build(points, no_skip);
+  EXPECT_EQ(first->summary.name(), "first");
+  // The same points again under another name: a cache hit, nothing recomputed (the summary is the
+  // first build's), answered with this call's own name, never the first caller's.
+  client::BuildCallOptions second_call = no_skip;
+  second_call.name = "second";
+  auto again = client->Build(points, second_call);
   ASSERT_THAT(again, IsOk());
   EXPECT_TRUE(again->cached);
   EXPECT_EQ(again->handle, first->handle);
-  EXPECT_EQ(again->summary.SerializeAsString(), first->summary.SerializeAsString());
+  EXPECT_EQ(again->summary.name(), "second");
+  v1::BuildSummary first_unnamed = first->summary;
+  first_unnamed.clear_name();
+  v1::BuildSummary again_unnamed = again->summary;
+  again_unnamed.clear_name();
+  EXPECT_EQ(again_unnamed.SerializeAsString(), first_unnamed.SerializeAsString());
   // The client hashes locally and skips the upload.
   client::BuildCallOptions skip;
   skip.name = "third";
@@ -240,7 +249,7 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
   EXPECT_FALSE(skipped->uploaded);
   auto described = client->Describe(first->handle);
   ASSERT_THAT(described, IsOk());
-  EXPECT_EQ(described->summary().name(), "first");
+  EXPECT_EQ(described->summary().name(), "") << "a name is its Build call's label; the family keeps none";
   EXPECT_EQ(server->service().cache().GetStats().entries, 1u);
 
   auto released = client->Release(first->handle);
