@@ -147,6 +147,9 @@ int Run(const Options& options) {
   server_options.service.max_queued_builds = 256;
   server_options.service.cache_bytes = size_t{64} << 30;
   server_options.service.max_in_flight_bytes = size_t{64} << 30;
+  // The bench's clients are one anonymous tenant: its share must not be what limits them.
+  server_options.service.max_tenant_queued_builds = 256;
+  server_options.service.max_tenant_in_flight_bytes = size_t{64} << 30;
   server_options.drain_notice = std::chrono::milliseconds(0);
   auto server = server::GalphaServer::Start(server_options);
   if (!server.ok()) {
