@@ -1,0 +1,112 @@
+#include "python/engine/build_call.hpp"
+
+#include <optional>
+#include <string_view>
+#include <utility>
+
+#include <pybind11/numpy.h>
+
+#include "absl/strings/str_cat.h"
+#include "absl/types/span.h"
+#include "core/base/point.hpp"
+#include "core/io/point_set_handle.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "python/engine/engine_error.hpp"
+
+namespace py = pybind11;
+
+namespace galpha::python {
+namespace {
+
+static_assert(sizeof(Point2) == 2 * sizeof(double), "Point2 is two packed doubles: an (N, 2) array is N points");
+
+// forcecast: a float32, integer or non-contiguous input is converted (one copy, by NumPy); a
+// C-contiguous float64 array is used as it is.
+using PointArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+PointArray AsPointArray(const py::object& points) {
+  PointArray array = PointArray::ensure(points);
+  if (!array) {
+    PyErr_Clear();
+    throw StatusError(absl::InvalidArgumentError(
+        absl::StrCat("points must be an (N, 2) array of numbers, got ", std::string(py::str(py::type::of(points))))));
+  }
+  if (array.ndim() != 2 || array.shape(1) != 2) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < array.ndim(); ++d) absl::StrAppend(&shape, d ? ", " : "", array.shape(d));
+    absl::StrAppend(&shape, array.ndim() == 1 ? ",)" : ")");
+    throw StatusError(absl::InvalidArgumentError(absl::StrCat("points must have shape (N, 2), got ", shape)));
+  }
+  return array;
+}
+
+absl::Span<const Point2> PointsOf(const PointArray& array) {
+  return {reinterpret_cast<const Point2*>(array.data()), static_cast<size_t>(array.shape(0))};
+}
+
+Backend ParseBackend(const std::string& backend) {
+  if (backend == "auto") return Backend::kAuto;
+  if (backend == "cpu") return Backend::kCpu;
+  if (backend == "cuda") return Backend::kCuda;
+  throw StatusError(
+      absl::InvalidArgumentError(absl::StrCat("unknown backend '", backend, "' (expected auto, cpu or cuda)")));
+}
+
+// What the engine's callbacks share with the caller: the first Python exception raised in them.
+// The engine cannot carry a Python exception through its own code, so a callback that meets one
+// keeps it, and cancelled() then answers true: the build stops at its next check and the caller
+// re-raises the kept exception instead of the engine's Cancelled status.
+struct PythonCallbacks {
+  py::object progress;
+  std::optional<py::error_already_set> error;
+};
+
+}  // namespace
+
+std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const std::string& backend,
+                                               const py::object& progress, const std::string& name) {
+  const PointArray array = AsPointArray(points);
+  const absl::Span<const Point2> span = PointsOf(array);
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+    throw StatusError(absl::InvalidArgumentError("progress must be None or a callable (phase, fraction)"));
+  }
+
+  PythonCallbacks callbacks{progress, std::nullopt};
+  BuildOptions options;
+  options.backend = ParseBackend(backend);
+  if (!progress.is_none()) {
+    options.progress = [&callbacks](std::string_view phase, double fraction) {
+      py::gil_scoped_acquire gil;
+      if (callbacks.error) return;
+      try {
+        callbacks.progress(py::str(phase.data(), phase.size()), fraction);
+      } catch (py::error_already_set& e) {
+        callbacks.error = std::move(e);
+      }
+    };
+  }
+  // Python runs signal handlers only when the interpreter runs: the engine asks between phases,
+  // so that Ctrl-C stops a long build (KeyboardInterrupt from the default SIGINT handler).
+  options.cancelled = [&callbacks] {
+    py::gil_scoped_acquire gil;
+    if (!callbacks.error && PyErr_CheckSignals() != 0) callbacks.error.emplace();
+    return callbacks.error.has_value();
+  };
+
+  std::optional<absl::StatusOr<AlphaFamily>> built;
+  {
+    py::gil_scoped_release release;
+    built.emplace(BuildAlphaFamily(span, options));
+  }
+  if (callbacks.error) throw std::move(*callbacks.error);
+  return std::make_shared<const FamilyState>(ValueOrThrow(*std::move(built)), name);
+}
+
+std::string HandleOf(const py::object& points) {
+  const PointArray array = AsPointArray(points);
+  const absl::Span<const Point2> span = PointsOf(array);
+  py::gil_scoped_release release;
+  return PointSetHandle(span);
+}
+
+}  // namespace galpha::python

@@ -1,0 +1,26 @@
+// galpha._engine.build and .handle: points from NumPy to the engine. The points cross without a
+// copy when they are a C-contiguous (N, 2) float64 array (galpha::Point2 is two doubles); the
+// engine runs with the GIL released and copies them into the family, which owns all it needs.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <pybind11/pybind11.h>
+
+#include "python/engine/family_state.hpp"
+
+namespace galpha::python {
+
+/// Builds the family of `points` (anything NumPy turns into an (N, 2) float64 array) on `backend`
+/// ("auto", "cpu" or "cuda"), labelled `name`. `progress`, when not None, is called as
+/// progress(phase, fraction) after each engine phase, with the GIL. Between phases the build
+/// checks for signals: Ctrl-C (or any exception from `progress`) stops it, frees what it held and
+/// raises that exception. Engine errors raise EngineError.
+std::shared_ptr<const FamilyState> BuildFamily(const pybind11::object& points, const std::string& backend,
+                                               const pybind11::object& progress, const std::string& name);
+
+/// The content handle of `points` (core/io/point_set_handle.hpp), hashed with the GIL released.
+std::string HandleOf(const pybind11::object& points);
+
+}  // namespace galpha::python

@@ -1,0 +1,229 @@
+#include "python/engine/family_answers.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace galpha::python {
+namespace {
+
+// The squared radius a level stands for: the spectrum value of its rank (0 for level 0 and -1).
+double PublishedAlphaSq(const AlphaFamily& family, int64_t level) {
+  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
+}
+
+// classes[order[i]] in wire numbers, for every i: the classes in the canonical order. Parallel:
+// at a million points these gathers are most of a classification's cost after ClassifyAll.
+std::vector<uint8_t> GatherClasses(const std::vector<SimplexClass>& classes, const std::vector<uint32_t>& order) {
+  std::vector<uint8_t> out(order.size());
+  const auto n = static_cast<int64_t>(order.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < n; ++i) out[static_cast<size_t>(i)] = WireClass(classes[order[static_cast<size_t>(i)]]);
+  return out;
+}
+
+// The non-exterior simplices of one kind, in the canonical order: `arity` indices each.
+void KeepNonExterior(const std::vector<SimplexClass>& classes, const std::vector<uint32_t>& order,
+                     const std::vector<uint32_t>& vertices_in_order, size_t arity, std::vector<uint32_t>* kept,
+                     std::vector<uint8_t>* kept_classes) {
+  for (size_t i = 0; i < order.size(); ++i) {
+    const SimplexClass c = classes[order[i]];
+    if (c == SimplexClass::kExterior) continue;
+    kept->insert(kept->end(), vertices_in_order.begin() + static_cast<std::ptrdiff_t>(i * arity),
+                 vertices_in_order.begin() + static_cast<std::ptrdiff_t>((i + 1) * arity));
+    kept_classes->push_back(WireClass(c));
+  }
+}
+
+std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+}  // namespace
+
+absl::StatusOr<Threshold::Kind> ParseThresholdKind(absl::string_view kind) {
+  if (kind == "alpha_sq") return Threshold::Kind::kAlphaSq;
+  if (kind == "alpha") return Threshold::Kind::kAlpha;
+  if (kind == "rank") return Threshold::Kind::kRank;
+  return absl::InvalidArgumentError(absl::StrCat("unknown threshold kind '", kind, "': give alpha_sq, alpha or rank"));
+}
+
+absl::StatusOr<ClassifyMode> ParseMode(absl::string_view mode) {
+  if (mode == "general") return ClassifyMode::kGeneral;
+  if (mode == "regularized") return ClassifyMode::kRegularized;
+  return absl::InvalidArgumentError(absl::StrCat("mode '", mode, "' is not a mode (general or regularized)"));
+}
+
+absl::StatusOr<VertexRule> ParseVertexRule(absl::string_view rule) {
+  if (rule == "report") return VertexRule::kReport;
+  if (rule == "cgal") return VertexRule::kCgal;
+  return absl::InvalidArgumentError(absl::StrCat("vertex_rule '", rule, "' is not a vertex rule (report or cgal)"));
+}
+
+absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const Threshold& threshold) {
+  ResolvedLevel resolved;
+  absl::StatusOr<int64_t> level;
+  switch (threshold.kind) {
+    case Threshold::Kind::kRank:
+      level = family.LevelForRank(threshold.rank);
+      // The service's code and words: a rank outside 0..K is a bad argument of the request.
+      if (!level.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("rank ", threshold.rank, " is outside 0..", family.max_level(),
+                                                       " (the spectrum has ", family.max_level(), " values)"));
+      }
+      resolved.alpha_sq = PublishedAlphaSq(family, *level);
+      break;
+    case Threshold::Kind::kAlphaSq:
+      level = family.LevelForAlphaSq(threshold.value);
+      resolved.alpha_sq = threshold.value;
+      break;
+    case Threshold::Kind::kAlpha:
+      level = family.LevelForAlpha(threshold.value);
+      resolved.alpha_sq = threshold.value * threshold.value;
+      break;
+  }
+  if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
+  resolved.level = *level;
+  return resolved;
+}
+
+absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Threshold& threshold, ClassifyMode mode,
+                                              VertexRule rule, bool non_exterior_only, bool summary_only) {
+  const AlphaFamily& family = state.family();
+  ClassifyAnswer answer;
+  auto level = ResolveLevel(family, threshold);
+  if (!level.ok()) return level.status();
+  answer.level = *level;
+  const Classification classes = family.ClassifyAll(level->level, mode, rule);
+  answer.counts = SummarizeClassification(family, classes);
+  answer.components = family.Components(level->level);
+  answer.solid_components = family.SolidComponents(level->level);
+  answer.summary_only = summary_only;
+  if (summary_only) return answer;
+
+  const std::vector<uint32_t>& distinct = state.DistinctVertices();
+  if (!non_exterior_only) {
+    answer.vertex_classes = GatherClasses(classes.vertices, distinct);
+    answer.edge_classes = GatherClasses(classes.edges, state.EdgeOrder());
+    answer.triangle_classes = GatherClasses(classes.triangles, state.TriangleOrder());
+    return answer;
+  }
+  answer.filtered = true;
+  KeepNonExterior(classes.vertices, distinct, distinct, 1, &answer.vertices, &answer.vertex_classes);
+  KeepNonExterior(classes.edges, state.EdgeOrder(), state.EdgeVerticesInOrder(), 2, &answer.edges,
+                  &answer.edge_classes);
+  KeepNonExterior(classes.triangles, state.TriangleOrder(), state.TriangleVerticesInOrder(), 3, &answer.triangles,
+                  &answer.triangle_classes);
+  return answer;
+}
+
+absl::StatusOr<ShapeGeometry> AnswerShape(const AlphaFamily& family, const Threshold& threshold, ClassifyMode mode) {
+  auto level = ResolveLevel(family, threshold);
+  if (!level.ok()) return level.status();
+  return AssembleShape(family.ComplexAt(level->level, mode));
+}
+
+absl::StatusOr<std::pair<size_t, size_t>> AnswerSpectrumRange(const AlphaFamily& family, int64_t first_rank,
+                                                              int64_t count) {
+  const int64_t k = family.max_level();
+  if (first_rank < 1 || first_rank > k + 1) {
+    return absl::InvalidArgumentError(absl::StrCat("first_rank ", first_rank, " is outside 1..", k + 1));
+  }
+  if (count < 0) return absl::InvalidArgumentError(absl::StrCat("count ", count, " is negative"));
+  const int64_t end = first_rank - 1 + std::min(count, k - (first_rank - 1));  // one past the last position
+  return std::pair<size_t, size_t>{static_cast<size_t>(first_rank - 1), static_cast<size_t>(end)};
+}
+
+absl::StatusOr<int64_t> AnswerRankLowerBound(const AlphaFamily& family, double alpha_sq) {
+  if (std::isnan(alpha_sq)) return absl::InvalidArgumentError("at_least_alpha_sq is NaN");
+  return family.RankLowerBound(alpha_sq);
+}
+
+absl::StatusOr<MasterListAnswer> AnswerMasterList(const AlphaFamily& family, int64_t first_rank, int64_t last_rank) {
+  const int64_t k = family.max_level();
+  const int64_t first = first_rank;
+  const int64_t last = last_rank == 0 ? first : last_rank;
+  if (k == 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rank ", first, " is out of range: the spectrum is empty, the master list has no ranks"));
+  }
+  if (first < 1 || first > k) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("first_rank ", first, " is outside 1..", k, " (the spectrum has ", k, " values)"));
+  }
+  if (last < first || last > k) {
+    return absl::InvalidArgumentError(absl::StrCat("last_rank ", last, " is outside ", first, "..", k));
+  }
+  const auto& begin = family.ranks().master_begin;
+  const auto& master = family.ranks().master;
+  const size_t from = begin[static_cast<size_t>(first)], to = begin[static_cast<size_t>(last) + 1];
+  MasterListAnswer answer;
+  answer.ranks.reserve(to - from);
+  answer.kinds.reserve(to - from);
+  answer.endpoints.reserve(to - from);
+  answer.vertex_indices.reserve(3 * (to - from));
+  int64_t rank = first;
+  for (size_t i = from; i < to; ++i) {
+    while (i >= begin[static_cast<size_t>(rank) + 1]) ++rank;
+    const MasterEntry entry = master[i];
+    answer.ranks.push_back(rank);
+    answer.kinds.push_back(static_cast<uint8_t>(static_cast<int>(entry.kind()) + 1));
+    answer.endpoints.push_back(static_cast<uint8_t>(static_cast<int>(entry.endpoint()) + 1));
+    switch (entry.kind()) {
+      case SimplexKind::kVertex:
+        answer.vertex_indices.push_back(entry.id());
+        break;
+      case SimplexKind::kEdge: {
+        const auto& e = family.edges()[entry.id()];
+        answer.vertex_indices.push_back(std::min(e[0], e[1]));
+        answer.vertex_indices.push_back(std::max(e[0], e[1]));
+        break;
+      }
+      case SimplexKind::kTriangle:
+        for (uint32_t v : SortedTriangle(family.triangles()[entry.id()])) answer.vertex_indices.push_back(v);
+        break;
+    }
+  }
+  return answer;
+}
+
+absl::StatusOr<ComponentsAnswer> AnswerComponents(const AlphaFamily& family, int64_t first_level, int64_t last_level) {
+  const int64_t k = family.max_level();
+  if (first_level < 0 || last_level > k || last_level < first_level) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rank range ", first_level, "..", last_level, " is not within 0..", k, " (first <= last)"));
+  }
+  ComponentsAnswer answer;
+  answer.first_level = first_level;
+  answer.components.reserve(static_cast<size_t>(last_level - first_level + 1));
+  answer.solid_components.reserve(static_cast<size_t>(last_level - first_level + 1));
+  for (int64_t level = first_level; level <= last_level; ++level) {
+    answer.components.push_back(family.Components(level));
+    answer.solid_components.push_back(family.SolidComponents(level));
+  }
+  return answer;
+}
+
+absl::StatusOr<OptimalAnswer> AnswerOptimal(const AlphaFamily& family, int64_t max_components) {
+  if (max_components < 1) return absl::InvalidArgumentError("max_components must be at least 1");
+  if (max_components > std::numeric_limits<uint32_t>::max()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_components ", max_components, " exceeds ", std::numeric_limits<uint32_t>::max()));
+  }
+  const auto n = static_cast<uint32_t>(max_components);
+  OptimalAnswer answer;
+  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(n)) {
+    answer.regularized = OptimalLevel{*level, PublishedAlphaSq(family, *level), family.SolidComponents(*level)};
+  }
+  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(n)) {
+    answer.general = OptimalLevel{*level, PublishedAlphaSq(family, *level), family.Components(*level)};
+  }
+  return answer;
+}
+
+}  // namespace galpha::python

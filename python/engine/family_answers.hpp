@@ -1,0 +1,106 @@
+// The answers of galpha._engine.Family in plain C++ (no Python, so they run with the GIL
+// released): the galpha service's semantics (server/query_answers.cpp) over a FamilyState, the same
+// threshold resolution, bounds, errors and orders, without the wire format. Results are
+// std::vectors that the binding hands to NumPy without copying (numpy_arrays.hpp).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+#include "absl/strings/string_view.h"
+
+#include "absl/status/statusor.h"
+#include "core/family/alpha_family.hpp"
+#include "core/family/classification_summary.hpp"
+#include "core/geometry/shape.hpp"
+#include "python/engine/family_state.hpp"
+
+namespace galpha::python {
+
+/// A threshold as the caller gave it: a squared radius, a radius, or a rank of the spectrum.
+struct Threshold {
+  enum class Kind { kAlphaSq, kAlpha, kRank };
+  Kind kind = Kind::kAlphaSq;
+  double value = 0.0;  ///< alpha_sq or alpha
+  int64_t rank = 0;    ///< for kRank
+};
+
+/// A threshold resolved to a level (the number of spectrum values <= it) and the squared radius
+/// reported with it: the given one, or for a rank the spectrum value it stands for (0 at rank 0).
+struct ResolvedLevel {
+  int64_t level = 0;
+  double alpha_sq = 0.0;
+};
+
+/// "alpha_sq", "alpha" or "rank"; InvalidArgument otherwise.
+absl::StatusOr<Threshold::Kind> ParseThresholdKind(absl::string_view kind);
+/// "general" or "regularized"; InvalidArgument otherwise.
+absl::StatusOr<ClassifyMode> ParseMode(absl::string_view mode);
+/// "report" or "cgal"; InvalidArgument otherwise.
+absl::StatusOr<VertexRule> ParseVertexRule(absl::string_view rule);
+
+/// The service's ResolveLevel: InvalidArgument for a rank outside 0..K, a NaN, a negative alpha.
+absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const Threshold& threshold);
+
+/// Classes as the wire protocol numbers them: EXTERIOR = 1 .. INTERIOR = 4.
+inline uint8_t WireClass(SimplexClass c) { return static_cast<uint8_t>(static_cast<int>(c) + 1); }
+
+/// Every simplex's class at one threshold. Without `filtered` the simplices are the state's
+/// canonical arrays (DistinctVertices, EdgeVerticesInOrder, TriangleVerticesInOrder) and only the
+/// classes are here; with it (non_exterior_only) the kept simplices are copied too.
+struct ClassifyAnswer {
+  ResolvedLevel level;
+  ClassificationSummary counts;
+  uint32_t components = 0;
+  uint32_t solid_components = 0;
+  bool summary_only = false;
+  bool filtered = false;
+  std::vector<uint32_t> vertices, edges, triangles;  // only when filtered
+  std::vector<uint8_t> vertex_classes, edge_classes, triangle_classes;
+};
+absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Threshold& threshold, ClassifyMode mode,
+                                              VertexRule rule, bool non_exterior_only, bool summary_only);
+
+/// The shape at one threshold (core/geometry/shape.hpp's AssembleShape of the complex there).
+absl::StatusOr<ShapeGeometry> AnswerShape(const AlphaFamily& family, const Threshold& threshold, ClassifyMode mode);
+
+/// Spectrum ranks first_rank .. first_rank + count - 1, clipped at K, as [begin, end) positions in
+/// family.spectrum(). InvalidArgument for first_rank outside 1..K+1 or a negative count.
+absl::StatusOr<std::pair<size_t, size_t>> AnswerSpectrumRange(const AlphaFamily& family, int64_t first_rank,
+                                                              int64_t count);
+
+/// CGAL's alpha_lower_bound (the first rank whose threshold is >= alpha_sq; K + 1 when none is).
+/// InvalidArgument for NaN.
+absl::StatusOr<int64_t> AnswerRankLowerBound(const AlphaFamily& family, double alpha_sq);
+
+/// Master-list entries of ranks first_rank .. last_rank (last_rank 0: first_rank alone), in rank
+/// order; vertex_indices holds 1, 2 or 3 ascending indices per entry by its kind. Kinds and end
+/// points are the wire's numbers (VERTEX = 1, EDGE, TRIANGLE; RHO = 1, MU_LOW, MU_HIGH).
+struct MasterListAnswer {
+  std::vector<int64_t> ranks;
+  std::vector<uint8_t> kinds, endpoints;
+  std::vector<uint32_t> vertex_indices;
+};
+absl::StatusOr<MasterListAnswer> AnswerMasterList(const AlphaFamily& family, int64_t first_rank, int64_t last_rank);
+
+/// Components and solid components at levels first_level .. last_level (within 0..K).
+struct ComponentsAnswer {
+  int64_t first_level = 0;
+  std::vector<uint32_t> components, solid_components;
+};
+absl::StatusOr<ComponentsAnswer> AnswerComponents(const AlphaFamily& family, int64_t first_level, int64_t last_level);
+
+/// The smallest rank with at most N components, in the regularized sense and the general one.
+struct OptimalLevel {
+  int64_t rank = 0;
+  double alpha_sq = 0.0;
+  uint32_t components = 0;
+};
+struct OptimalAnswer {
+  std::optional<OptimalLevel> regularized, general;
+};
+/// InvalidArgument unless 1 <= max_components <= 2^32 - 1 (the wire's uint32).
+absl::StatusOr<OptimalAnswer> AnswerOptimal(const AlphaFamily& family, int64_t max_components);
+
+}  // namespace galpha::python

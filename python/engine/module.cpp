@@ -1,0 +1,31 @@
+// galpha._engine: the embedded engine for the galpha Python package (python/src/galpha/_local.py
+// adapts it to the package's types). Every error is galpha._engine.EngineError with the absl code.
+#include <string>
+
+#include <pybind11/pybind11.h>
+
+#include "gpu/system/backend.hpp"
+#include "python/engine/build_call.hpp"
+#include "python/engine/engine_error.hpp"
+#include "python/engine/family_binding.hpp"
+
+namespace py = pybind11;
+
+PYBIND11_MODULE(_engine, module) {
+  module.doc() = "The galpha engine in this process: build(points) -> Family; handle(points).";
+  galpha::python::RegisterEngineError(module);
+  galpha::python::RegisterFamily(module);
+  module.def(
+      "build",
+      [](const py::object& points, const std::string& backend, const py::object& progress, const std::string& name) {
+        return galpha::python::FamilyObject(galpha::python::BuildFamily(points, backend, progress, name));
+      },
+      py::arg("points"), py::arg("backend") = "auto", py::arg("progress") = py::none(), py::arg("name") = "",
+      "Builds the exact alpha family of an (N, 2) float64 array (used without a copy when C-contiguous) on "
+      "backend 'auto', 'cpu' or 'cuda', with the GIL released. progress(phase, fraction) is called after each "
+      "phase; Ctrl-C or an exception in progress stops the build between phases and is raised.");
+  module.def("handle", &galpha::python::HandleOf, py::arg("points"),
+             "The content handle of an (N, 2) float64 array, as the server and the C++ client compute it.");
+  module.def("cuda_available", &galpha::CudaBackendAvailable,
+             "Whether this build has the CUDA backend and a GPU is visible now.");
+}
