@@ -1,0 +1,44 @@
+"""The protocol both backends implement: what :class:`galpha.Family` needs from a built family.
+
+``galpha.connect`` answers it over gRPC (``_network.py``), ``galpha.local`` from the embedded
+engine (``_local.py`` over the ``galpha._engine`` extension). :class:`galpha.Family` adds the
+user-facing conveniences (threshold keywords, shapely geometry, GeoDataFrames) once, on top.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from ._types import BuildSummary, Classification, ComponentCurve, MasterList, Mode, Optimal, ShapeRings, Threshold, VertexRule
+
+
+class FamilyBackend(Protocol):
+    @property
+    def handle(self) -> str:
+        """"sha256-" and 64 hex digits: the content handle (the same on both backends)."""
+
+    def summary(self) -> BuildSummary: ...
+
+    def spectrum(self, first_rank: int, count: int) -> np.ndarray:
+        """Spectrum values of ranks first_rank .. first_rank + count - 1 (clipped at K), float64."""
+
+    def rank_lower_bound(self, alpha_sq: float) -> int:
+        """The first rank whose exact threshold is >= alpha_sq (K + 1 when none is)."""
+
+    def classify(
+        self, threshold: Threshold, mode: Mode, vertex_rule: VertexRule, non_exterior_only: bool, summary_only: bool
+    ) -> Classification: ...
+
+    def shape_rings(self, threshold: Threshold, mode: Mode) -> ShapeRings: ...
+
+    def master_list(self, first_rank: int, last_rank: int) -> MasterList: ...
+
+    def components(self, first_level: int, last_level: int) -> ComponentCurve:
+        """Levels first_level .. last_level (0 .. K), inclusive."""
+
+    def optimal(self, max_components: int) -> Optimal: ...
+
+    def release(self) -> bool:
+        """Frees the family (network: drops it from the server's cache); True when it was held."""

@@ -1,0 +1,173 @@
+"""The two clients behind one protocol: ``connect`` (a galpha server over gRPC) and ``local`` (the
+embedded engine in this process, CUDA when there is a GPU, else the CPU's cores)."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Optional, Protocol, Union
+
+
+
+from ._errors import InvalidInput
+from ._family import Family
+from ._points import as_points
+
+#: ``progress``: None (quiet), True (a tqdm bar on standard error), or a callable receiving
+#: (stage, fraction done in [0, 1]).
+Progress = Union[None, bool, Callable[[str, float], None]]
+
+#: Point sets below this size get no bar even with progress=True (they take milliseconds).
+PROGRESS_BAR_MIN_POINTS = 100_000
+
+
+class Client(Protocol):
+    def build(self, points: Any, *, name: str = "", progress: Progress = None) -> Family: ...
+
+    def close(self) -> None: ...
+
+    def __enter__(self) -> "Client": ...
+
+    def __exit__(self, *exc: Any) -> None: ...
+
+
+class _TqdmStages:
+    """A tqdm bar per stage, fed fractions."""
+
+    def __init__(self, total_points: int) -> None:
+        self._bar: Any = None
+        self._stage = ""
+        self._points = total_points
+
+    def __call__(self, stage: str, fraction: float) -> None:
+        from tqdm import tqdm
+
+        if stage != self._stage:
+            self.close()
+            self._stage = stage
+            self._bar = tqdm(total=1000, desc=f"galpha {stage} ({self._points:,} points)", unit="‰", leave=False)
+        self._bar.n = int(round(1000 * min(max(fraction, 0.0), 1.0)))
+        self._bar.refresh()
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+
+def progress_callback(progress: Progress, points: int) -> tuple:
+    """(callable or None, closer or None) for a ``progress`` argument."""
+    if progress is None or progress is False:
+        return None, None
+    if progress is True:
+        if points < PROGRESS_BAR_MIN_POINTS:
+            return None, None
+        bar = _TqdmStages(points)
+        return bar, bar.close
+    if callable(progress):
+        return progress, None
+    raise InvalidInput(f"progress must be None, True or a callable (stage, fraction), got {progress!r}")
+
+
+class NetworkClient:
+    """A connection to a galpha server (``galpha.connect``)."""
+
+    def __init__(self, target: str, *, token: Optional[str], tls_ca: Optional[str], timeout: Optional[float]) -> None:
+        from . import _network
+
+        self._network = _network
+        self.target = target
+        self._channel = _network.channel_for(target, tls_ca)
+        self._calls = _network.Calls(self._channel, token, timeout)
+
+    def __repr__(self) -> str:
+        return f"<galpha.NetworkClient {self.target}>"
+
+    def build(self, points: Any, *, name: str = "", progress: Progress = None) -> Family:
+        """Uploads the points (unless the server already holds them) and returns their family."""
+        array, crs = as_points(points)
+        callback, close = progress_callback(progress, len(array))
+        total = max(len(array), 1)
+        try:
+            sent = None if callback is None else (lambda n: callback("upload", n / total))
+            backend = self._network.build_on_server(self._calls, array, name, sent)
+        finally:
+            if close is not None:
+                close()
+        return Family(backend, array, crs)
+
+    def family(self, handle: str, points: Any) -> Family:
+        """The family the server holds under ``handle`` for these points (NotFound if it holds
+        none); the points give the answers' coordinates and must be the ones the handle names."""
+        from ._errors import NotFound
+        from ._handle import point_set_handle
+
+        array, crs = as_points(points)
+        if point_set_handle(array) != handle:
+            raise InvalidInput(f"these points have another handle than {handle}")
+        summary = self._network.find_cached(self._calls, handle)
+        if summary is None:
+            raise NotFound(f"the server holds no family under {handle}")
+        return Family(self._network.NetworkFamilyBackend(self._calls, handle, summary), array, crs)
+
+    def close(self) -> None:
+        self._channel.close()
+
+    def __enter__(self) -> "NetworkClient":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+class LocalClient:
+    """The embedded engine in this process (``galpha.local``): no server, no GPU needed."""
+
+    def __init__(self, backend: str) -> None:
+        if backend not in ("auto", "cpu", "cuda"):
+            raise InvalidInput(f"unknown backend {backend!r} (expected 'auto', 'cpu' or 'cuda')")
+        from . import _local  # imports the compiled extension: fail here, not at the first build
+
+        self._local = _local
+        self.backend = backend
+
+    def __repr__(self) -> str:
+        return f"<galpha.LocalClient backend={self.backend}>"
+
+    def build(self, points: Any, *, name: str = "", progress: Progress = None) -> Family:
+        """Builds the family in this process (the GIL is released while the engine runs)."""
+        array, crs = as_points(points)
+        callback, close = progress_callback(progress, len(array))
+        try:
+            backend = self._local.build_local(array, self.backend, callback, name=name)
+        finally:
+            if close is not None:
+                close()
+        return Family(backend, array, crs)
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self) -> "LocalClient":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+
+def connect(
+    target: str, *, token: Optional[str] = None, tls_ca: Optional[str] = None, timeout: Optional[float] = None
+) -> NetworkClient:
+    """A client of the galpha server at ``target`` ("host:port").
+
+    ``token``: the bearer token, when the server requires one. ``tls_ca``: a PEM file of root
+    certificates, which turns TLS on. ``timeout``: seconds per call (None: no deadline). gRPC
+    connects lazily: an unreachable server shows as :class:`galpha.Unavailable` on the first call.
+    """
+    return NetworkClient(target, token=token, tls_ca=tls_ca, timeout=timeout)
+
+
+def local(backend: str = "auto") -> LocalClient:
+    """A client of the engine embedded in this process: ``"auto"`` (CUDA when a GPU is visible,
+    else the CPU), ``"cpu"`` or ``"cuda"``."""
+    return LocalClient(backend)
+
+

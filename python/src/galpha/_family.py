@@ -1,0 +1,248 @@
+"""Family: one built family of alpha shapes and every query over it, the same on both backends.
+
+Thresholds are explicit keywords, as in ``alphactl``: ``alpha`` (a radius), ``alpha_sq`` (a squared
+radius) or ``rank`` (0..K, the complex at ``spectrum[rank - 1]``). Geometry answers are shapely
+geometries (valid OGC, holes included) in the points' coordinates, or GeoDataFrames carrying the
+points' CRS.
+"""
+
+from __future__ import annotations
+
+from typing import Any, List, Optional, Union
+
+import numpy as np
+
+from ._backend import FamilyBackend
+from ._errors import InvalidInput
+from ._types import (
+    BuildSummary,
+    Classification,
+    ComponentCurve,
+    MasterList,
+    Mode,
+    Optimal,
+    ShapeRings,
+    Threshold,
+    VertexRule,
+)
+
+
+def threshold_from(alpha: Optional[float], alpha_sq: Optional[float], rank: Optional[int]) -> Threshold:
+    """The one threshold among the keywords; InvalidInput unless exactly one is given."""
+    given = [(k, v) for k, v in (("alpha", alpha), ("alpha_sq", alpha_sq), ("rank", rank)) if v is not None]
+    if len(given) != 1:
+        names = ", ".join(k for k, _ in given) or "none"
+        raise InvalidInput(f"give exactly one of alpha=, alpha_sq= or rank= (got {names})")
+    kind, value = given[0]
+    if kind == "rank":
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+            raise InvalidInput(f"rank must be an integer, got {value!r}")
+        return Threshold("rank", int(value))
+    try:
+        return Threshold(kind, float(value))
+    except (TypeError, ValueError):
+        raise InvalidInput(f"{kind} must be a number, got {value!r}") from None
+
+
+def radius_from_alphashape(alpha: float) -> float:
+    """The galpha radius ``alpha`` for the ``alpha`` parameter of the Python ``alphashape`` package.
+
+    ``alphashape`` keeps a triangle when its circumradius is below ``1 / alpha`` (its parameter is
+    an inverse radius; 0 gives the convex hull). galpha's ``alpha`` is the radius itself, and a
+    simplex is in the complex when its threshold is at or below it, decided exactly. So
+    ``family.shape(alpha=radius_from_alphashape(a))`` is the exact counterpart of
+    ``alphashape.alphashape(points, a)`` (the two differ only on triangles whose circumradius is
+    exactly ``1 / a``, and where alphashape's floating point misjudges one). ``a = 0`` gives
+    ``inf``: every simplex, the convex hull.
+    """
+    a = float(alpha)
+    if a < 0 or a != a:
+        raise InvalidInput(f"alphashape's alpha must be >= 0, got {alpha!r}")
+    return float("inf") if a == 0 else 1.0 / a
+
+
+def _mode(mode: Union[str, Mode]) -> Mode:
+    try:
+        return Mode(mode)
+    except ValueError:
+        raise InvalidInput(f"unknown mode {mode!r} (expected 'general' or 'regularized')") from None
+
+
+def _rule(rule: Union[str, VertexRule]) -> VertexRule:
+    try:
+        return VertexRule(rule)
+    except ValueError:
+        raise InvalidInput(f"unknown vertex_rule {rule!r} (expected 'report' or 'cgal')") from None
+
+
+def rings_to_shapely(rings: ShapeRings, points: np.ndarray, mode: Mode) -> Any:
+    """A MultiPolygon (regularized), or a GeometryCollection of the MultiPolygon, the singular edges
+    as a MultiLineString and the isolated points as a MultiPoint, each present when not empty
+    (general)."""
+    import shapely.wkt
+    from shapely.geometry import GeometryCollection, MultiLineString, MultiPoint, MultiPolygon, Polygon
+
+    polygons = [Polygon(points[p.outer], [points[h] for h in p.holes]) for p in rings.polygons]
+    # Typed even when empty (shapely 1.8 turns MultiPolygon([]) into a GeometryCollection).
+    multipolygon = MultiPolygon(polygons) if polygons else shapely.wkt.loads("MULTIPOLYGON EMPTY")
+    if mode == Mode.REGULARIZED:
+        return multipolygon
+    parts: List[Any] = [multipolygon] if polygons else []
+    if len(rings.singular_edges):
+        parts.append(MultiLineString([points[e] for e in rings.singular_edges]))
+    if len(rings.isolated_points):
+        parts.append(MultiPoint(points[rings.isolated_points]))
+    return GeometryCollection(parts)
+
+
+class Family:
+    """The exact family of alpha shapes of one point set (every alpha at once).
+
+    Made by ``Client.build``; the queries run on the backend that built it (the server's cache, or
+    this process). Use it as a context manager to release it when done.
+    """
+
+    def __init__(self, backend: FamilyBackend, points: np.ndarray, crs: Any = None) -> None:
+        self._backend = backend
+        self._points = points
+        self.crs = crs  #: the CRS of the GeoSeries/GeoDataFrame it was built from, or None
+
+    def __repr__(self) -> str:
+        s = self.summary
+        return f"<galpha.Family {self.handle[:19]}... {s.points} points, K={s.spectrum_size}, {s.backend}>"
+
+    def __enter__(self) -> "Family":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.release()
+
+    @property
+    def handle(self) -> str:
+        """The content handle ("sha256-..."), the same for equal point arrays everywhere."""
+        return self._backend.handle
+
+    @property
+    def points(self) -> np.ndarray:
+        """The (N, 2) float64 points, as given; indices in every answer name their rows."""
+        return self._points
+
+    @property
+    def summary(self) -> BuildSummary:
+        return self._backend.summary()
+
+    @property
+    def spectrum_size(self) -> int:
+        """K: the number of distinct thresholds; ranks run 0..K."""
+        return self._backend.summary().spectrum_size
+
+    def spectrum(self, first_rank: int = 1, count: Optional[int] = None) -> np.ndarray:
+        """The distinct squared thresholds (nearest doubles of the exact values), ascending: ranks
+        first_rank .. first_rank + count - 1 (all to K by default)."""
+        k = self.spectrum_size
+        if first_rank < 1 or first_rank > k + 1:
+            raise InvalidInput(f"first_rank {first_rank} is outside 1..{k + 1}")
+        if count is None:
+            count = k + 1 - first_rank
+        if count < 0:
+            raise InvalidInput(f"count must be >= 0, got {count}")
+        return self._backend.spectrum(first_rank, count) if count else np.empty(0, dtype=np.float64)
+
+    def rank_lower_bound(self, alpha_sq: float) -> int:
+        """The first rank whose exact threshold is >= alpha_sq (K + 1 when none is; CGAL's
+        alpha_lower_bound)."""
+        return self._backend.rank_lower_bound(float(alpha_sq))
+
+    def classify(
+        self,
+        *,
+        alpha: Optional[float] = None,
+        alpha_sq: Optional[float] = None,
+        rank: Optional[int] = None,
+        mode: Union[str, Mode] = Mode.GENERAL,
+        vertex_rule: Union[str, VertexRule] = VertexRule.REPORT,
+        non_exterior_only: bool = False,
+        summary_only: bool = False,
+    ) -> Classification:
+        """The class of every simplex at one threshold, as NumPy arrays (see Classification)."""
+        return self._backend.classify(
+            threshold_from(alpha, alpha_sq, rank), _mode(mode), _rule(vertex_rule), non_exterior_only, summary_only
+        )
+
+    def shape_rings(
+        self,
+        *,
+        alpha: Optional[float] = None,
+        alpha_sq: Optional[float] = None,
+        rank: Optional[int] = None,
+        mode: Union[str, Mode] = Mode.REGULARIZED,
+    ) -> ShapeRings:
+        """The shape by input indices: polygons (outer ring and holes), singular edges, isolated
+        points, area."""
+        return self._backend.shape_rings(threshold_from(alpha, alpha_sq, rank), _mode(mode))
+
+    def shape(
+        self,
+        *,
+        alpha: Optional[float] = None,
+        alpha_sq: Optional[float] = None,
+        rank: Optional[int] = None,
+        mode: Union[str, Mode] = Mode.REGULARIZED,
+        as_geodataframe: bool = False,
+    ) -> Any:
+        """The alpha shape at one threshold as shapely geometry (valid, holes included).
+
+        ``mode="regularized"`` (the default, what GIS users call the concave hull) gives a
+        MultiPolygon; ``mode="general"`` a GeometryCollection that also holds the singular edges
+        (MultiLineString) and isolated points (MultiPoint). With ``as_geodataframe=True``: a
+        GeoDataFrame with one row per polygon (``kind="polygon"``, ``area``), then one row for the
+        singular edges and one for the isolated points where present, in the points' CRS.
+        """
+        m = _mode(mode)
+        rings = self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m)
+        if not as_geodataframe:
+            return rings_to_shapely(rings, self._points, m)
+        return self._geodataframe(rings)
+
+    def _geodataframe(self, rings: ShapeRings) -> Any:
+        import geopandas
+        from shapely.geometry import MultiLineString, MultiPoint, Polygon
+
+        kinds: List[str] = []
+        geometries: List[Any] = []
+        for p in rings.polygons:
+            kinds.append("polygon")
+            geometries.append(Polygon(self._points[p.outer], [self._points[h] for h in p.holes]))
+        if len(rings.singular_edges):
+            kinds.append("singular_edges")
+            geometries.append(MultiLineString([self._points[e] for e in rings.singular_edges]))
+        if len(rings.isolated_points):
+            kinds.append("isolated_points")
+            geometries.append(MultiPoint(self._points[rings.isolated_points]))
+        frame = geopandas.GeoDataFrame({"kind": kinds}, geometry=geometries, crs=self.crs)
+        frame["area"] = [g.area if k == "polygon" else 0.0 for k, g in zip(kinds, geometries)]
+        return frame
+
+    def master_list(self, rank: int, last_rank: Optional[int] = None) -> MasterList:
+        """Master-list entries of ranks rank .. last_rank (1..K; last_rank defaults to rank)."""
+        return self._backend.master_list(int(rank), int(rank if last_rank is None else last_rank))
+
+    def components(self, first_level: int = 0, last_level: Optional[int] = None) -> ComponentCurve:
+        """Connected and solid components at every level first_level .. last_level (0..K; all by
+        default): the curve over all ranks."""
+        k = self.spectrum_size
+        last = k if last_level is None else int(last_level)
+        if not 0 <= first_level <= last <= k:
+            raise InvalidInput(f"levels {first_level}..{last} are not within 0..{k}")
+        return self._backend.components(int(first_level), last)
+
+    def optimal(self, components: int = 1) -> Optimal:
+        """The smallest rank with at most ``components`` components (CGAL's regularized sense and
+        the general one)."""
+        if isinstance(components, bool) or int(components) < 1:
+            raise InvalidInput(f"components must be >= 1, got {components!r}")
+        return self._backend.optimal(int(components))
+
+    def release(self) -> bool:
+        """Frees the family (on a server: drops it from the cache). True when it was held."""
+        return self._backend.release()

@@ -1,0 +1,405 @@
+"""The network backend: galpha.v1.AlphaShapes over gRPC, with the bulk arrays of the Build upload
+and of Classify, MasterList and Spectrum answers encoded and decoded by hand (``_wire.py``), and
+every failure raised as a :mod:`galpha` exception carrying the server's code and message.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
+
+import grpc
+import numpy as np
+
+from . import _wire
+from ._errors import GalphaError, InvalidInput, error_for_code
+from ._handle import point_set_handle
+from ._types import (
+    BuildSummary,
+    ClassCounts,
+    Classification,
+    ComponentCurve,
+    MasterList,
+    Mode,
+    Optimal,
+    OptimalLevel,
+    ShapePolygon,
+    ShapeRings,
+    Threshold,
+    VertexRule,
+)
+from .v1 import alpha_shapes_pb2 as pb
+
+SERVICE = "/galpha.v1.AlphaShapes/"
+#: Points per Build chunk: 1 MiB of doubles, as the C++ client sends.
+POINTS_PER_CHUNK = 65536
+#: The request header a gRPC-aware load balancer hashes on (deploy/k8s/envoy.yaml).
+HANDLE_HEADER = "x-galpha-handle"
+#: Receive limit: answers are paged well below it; generous for shape text of large sets.
+MAX_RECEIVE_BYTES = 256 << 20
+#: Spectrum values per page (the server's cap).
+SPECTRUM_PAGE = 262144
+#: Levels per Components call (the server's cap).
+COMPONENTS_PAGE = 262144
+
+_MODES = {Mode.GENERAL: pb.CLASSIFY_MODE_GENERAL, Mode.REGULARIZED: pb.CLASSIFY_MODE_REGULARIZED}
+_RULES = {VertexRule.REPORT: pb.VERTEX_RULE_REPORT, VertexRule.CGAL: pb.VERTEX_RULE_CGAL}
+
+
+def raise_from_rpc(error: grpc.RpcError) -> GalphaError:
+    """The galpha exception for a failed call (to be raised ``from None``)."""
+    code = error.code() if hasattr(error, "code") else grpc.StatusCode.UNKNOWN
+    details = error.details() if hasattr(error, "details") else str(error)
+    return error_for_code(code.value[0], details or code.name)
+
+
+def channel_for(target: str, tls_ca: Optional[str]) -> grpc.Channel:
+    options = [("grpc.max_receive_message_length", MAX_RECEIVE_BYTES)]
+    if tls_ca is None:
+        return grpc.insecure_channel(target, options=options)
+    with open(tls_ca, "rb") as f:
+        credentials = grpc.ssl_channel_credentials(root_certificates=f.read())
+    return grpc.secure_channel(target, credentials, options=options)
+
+
+def threshold_message(threshold: Threshold) -> pb.Threshold:
+    if threshold.kind == "rank":
+        return pb.Threshold(rank=int(threshold.value))
+    if threshold.kind == "alpha":
+        return pb.Threshold(alpha=float(threshold.value))
+    return pb.Threshold(alpha_sq=float(threshold.value))
+
+
+def summary_from(message: pb.BuildSummary, cached: bool) -> BuildSummary:
+    return BuildSummary(
+        name=message.name,
+        points=message.points,
+        distinct_points=message.distinct_points,
+        duplicates=message.duplicates,
+        triangles=message.triangles,
+        edges=message.edges,
+        spectrum_size=message.spectrum_size,
+        backend=message.backend,
+        stage_times={s.stage: s.seconds for s in message.stage_times},
+        comparisons={
+            "filter": message.comparisons.filter,
+            "device_exact": message.comparisons.device_exact,
+            "cpu_fallback": message.comparisons.cpu_fallback,
+        },
+        peak_memory_bytes=message.peak_memory_bytes,
+        family_bytes=message.family_bytes,
+        cached=cached,
+    )
+
+
+def _counts(c: pb.ClassCounts) -> ClassCounts:
+    return ClassCounts(exterior=c.exterior, singular=c.singular, regular=c.regular, interior=c.interior)
+
+
+class ClassifyAssembler:
+    """Collects a Classify stream (one summary, then chunks by kind) into a Classification."""
+
+    def __init__(self) -> None:
+        self.summary: Optional[pb.ClassifySummary] = None
+        self.parts: dict = {1: ([], []), 2: ([], []), 3: ([], [])}
+
+    def add(self, raw: bytes) -> None:
+        number, payload = _wire.split_oneof(raw)
+        if number == 1:
+            self.summary = pb.ClassifySummary.FromString(bytes(payload))
+        elif number == 2:
+            kind, indices, classes = _wire.decode_simplex_chunk(payload)
+            if kind in self.parts:
+                self.parts[kind][0].append(indices)
+                self.parts[kind][1].append(classes)
+
+    def result(self) -> Classification:
+        if self.summary is None:
+            raise GalphaError("the server's Classify answer had no summary", code="DATA_LOSS", code_number=15)
+
+        def joined(kind: int, width: int) -> Tuple[np.ndarray, np.ndarray]:
+            idx, cls = self.parts[kind]
+            indices = np.concatenate(idx) if idx else np.empty(0, dtype=np.uint32)
+            classes = np.concatenate(cls) if cls else np.empty(0, dtype=np.uint8)
+            indices = indices.astype(np.uint32, copy=False)
+            return (indices if width == 1 else indices.reshape(-1, width)), classes
+
+        vertices, vertex_classes = joined(1, 1)
+        edges, edge_classes = joined(2, 2)
+        triangles, triangle_classes = joined(3, 3)
+        s = self.summary
+        return Classification(
+            level=s.level,
+            alpha_sq=s.alpha_sq,
+            vertex_counts=_counts(s.vertices),
+            edge_counts=_counts(s.edges),
+            triangle_counts=_counts(s.triangles),
+            components=s.components,
+            solid_components=s.solid_components,
+            interior_area=s.interior_area,
+            vertices=vertices,
+            vertex_classes=vertex_classes,
+            edges=edges,
+            edge_classes=edge_classes,
+            triangles=triangles,
+            triangle_classes=triangle_classes,
+        )
+
+
+def shape_rings_from(pieces: Sequence[pb.ShapeResponse]) -> ShapeRings:
+    polygons: List[ShapePolygon] = []
+    singular: List[np.ndarray] = []
+    isolated: List[np.ndarray] = []
+    area = 0.0
+    for i, piece in enumerate(pieces):
+        rings = piece.rings
+        if i == 0:
+            area = rings.area
+        for polygon in rings.polygons:
+            polygons.append(
+                ShapePolygon(
+                    outer=np.array(polygon.outer, dtype=np.uint32),
+                    holes=[np.array(h.vertex_indices, dtype=np.uint32) for h in polygon.holes],
+                )
+            )
+        singular.append(np.array(rings.singular_edges, dtype=np.uint32))
+        isolated.append(np.array(rings.isolated_points, dtype=np.uint32))
+    return ShapeRings(
+        polygons=polygons,
+        singular_edges=(np.concatenate(singular) if singular else np.empty(0, np.uint32)).reshape(-1, 2),
+        isolated_points=np.concatenate(isolated) if isolated else np.empty(0, np.uint32),
+        area=area,
+    )
+
+
+def optimal_from(message: pb.OptimalAlphaResponse) -> Optimal:
+    def level(field: str) -> Optional[OptimalLevel]:
+        if not message.HasField(field):
+            return None
+        m = getattr(message, field)
+        return OptimalLevel(rank=m.rank, alpha_sq=m.alpha_sq, components=m.components)
+
+    return Optimal(regularized=level("regularized"), general=level("general"))
+
+
+def master_list_from(pages: Sequence[bytes]) -> MasterList:
+    decoded = [_wire.decode_master_list_page(p) for p in pages]
+
+    def joined(key: str, dtype: Any) -> np.ndarray:
+        arrays = [d[key] for d in decoded]
+        return np.concatenate(arrays).astype(dtype, copy=False) if arrays else np.empty(0, dtype=dtype)
+
+    return MasterList(
+        ranks=joined("ranks", np.int64),
+        kinds=joined("kinds", np.uint8),
+        endpoints=joined("endpoints", np.uint8),
+        vertex_indices=joined("vertex_indices", np.uint32),
+    )
+
+
+def upload_messages(name: str, points: np.ndarray, progress: Optional[Callable[[int], None]]) -> Iterator[bytes]:
+    """The Build stream as serialized messages: a header, then 1 MiB point chunks."""
+    yield pb.BuildRequest(header=pb.BuildHeader(name=name, expected_points=len(points))).SerializeToString()
+    for begin in range(0, len(points), POINTS_PER_CHUNK):
+        chunk = points[begin : begin + POINTS_PER_CHUNK]
+        yield _wire.encode_point_chunk_request(chunk)
+        if progress is not None:
+            progress(begin + len(chunk))
+
+
+def _identity(b: bytes) -> bytes:
+    return b
+
+
+class Calls:
+    """The service's methods on one channel, with the token and the routing header attached."""
+
+    def __init__(self, channel: Any, token: Optional[str], timeout: Optional[float]) -> None:
+        self.channel = channel
+        self.token = token
+        self.timeout = timeout
+        def unary(name: str, request_type: Any, response_type: Any) -> Any:
+            return channel.unary_unary(
+                SERVICE + name, request_serializer=request_type.SerializeToString, response_deserializer=response_type.FromString
+            )
+
+        self.describe = unary("Describe", pb.DescribeRequest, pb.DescribeResponse)
+        self.release = unary("Release", pb.ReleaseRequest, pb.ReleaseResponse)
+        self.components = unary("Components", pb.ComponentsRequest, pb.ComponentsResponse)
+        self.optimal = unary("OptimalAlpha", pb.OptimalAlphaRequest, pb.OptimalAlphaResponse)
+        self.spectrum = channel.unary_unary(
+            SERVICE + "Spectrum", request_serializer=pb.SpectrumRequest.SerializeToString, response_deserializer=_identity
+        )
+        self.build = channel.stream_unary(SERVICE + "Build", request_serializer=_identity, response_deserializer=pb.BuildResponse.FromString)
+        self.classify = channel.unary_stream(
+            SERVICE + "Classify", request_serializer=pb.ClassifyRequest.SerializeToString, response_deserializer=_identity
+        )
+        self.master_list = channel.unary_stream(
+            SERVICE + "MasterList", request_serializer=pb.MasterListRequest.SerializeToString, response_deserializer=_identity
+        )
+        self.shape = channel.unary_stream(
+            SERVICE + "Shape", request_serializer=pb.ShapeRequest.SerializeToString, response_deserializer=pb.ShapeResponse.FromString
+        )
+
+    def metadata(self, handle: Optional[str] = None) -> List[Tuple[str, str]]:
+        out = []
+        if self.token:
+            out.append(("authorization", f"Bearer {self.token}"))
+        if handle:
+            out.append((HANDLE_HEADER, handle))
+        return out
+
+
+class NetworkFamilyBackend:
+    """A family cached on a galpha server, named by its handle."""
+
+    def __init__(self, calls: Calls, handle: str, summary: BuildSummary) -> None:
+        self._calls = calls
+        self._handle = handle
+        self._summary = summary
+
+    def _call(self, method: Any, request: Any) -> Any:
+        try:
+            return method(request, timeout=self._calls.timeout, metadata=self._calls.metadata(self._handle))
+        except grpc.RpcError as e:
+            raise raise_from_rpc(e) from None
+
+    def _stream(self, method: Any, request: Any) -> List[Any]:
+        try:
+            return list(method(request, timeout=self._calls.timeout, metadata=self._calls.metadata(self._handle)))
+        except grpc.RpcError as e:
+            raise raise_from_rpc(e) from None
+
+    @property
+    def handle(self) -> str:
+        return self._handle
+
+    def summary(self) -> BuildSummary:
+        return self._summary
+
+    def spectrum(self, first_rank: int, count: int) -> np.ndarray:
+        pages: List[np.ndarray] = []
+        rank, remaining = first_rank, count
+        while remaining > 0:
+            size = min(remaining, SPECTRUM_PAGE)
+            raw = self._call(self._calls.spectrum, pb.SpectrumRequest(handle=self._handle, first_rank=rank, page_size=size))
+            _, values, next_rank, _ = _wire.decode_spectrum_page(raw)
+            pages.append(values)
+            remaining -= len(values)
+            if next_rank == 0 or len(values) == 0:
+                break
+            rank = next_rank
+        return np.concatenate(pages) if len(pages) != 1 else pages[0]
+
+    def rank_lower_bound(self, alpha_sq: float) -> int:
+        raw = self._call(self._calls.spectrum, pb.SpectrumRequest(handle=self._handle, at_least_alpha_sq=alpha_sq, page_size=1))
+        first_rank, _, _, _ = _wire.decode_spectrum_page(raw)
+        return first_rank
+
+    def classify(
+        self, threshold: Threshold, mode: Mode, vertex_rule: VertexRule, non_exterior_only: bool, summary_only: bool
+    ) -> Classification:
+        request = pb.ClassifyRequest(
+            handle=self._handle,
+            threshold=threshold_message(threshold),
+            mode=_MODES[mode],
+            vertex_rule=_RULES[vertex_rule],
+            non_exterior_only=non_exterior_only,
+            summary_only=summary_only,
+        )
+        assembler = ClassifyAssembler()
+        for raw in self._stream(self._calls.classify, request):
+            assembler.add(raw)
+        return assembler.result()
+
+    def shape_rings(self, threshold: Threshold, mode: Mode) -> ShapeRings:
+        request = pb.ShapeRequest(
+            handle=self._handle, threshold=threshold_message(threshold), mode=_MODES[mode], format=pb.SHAPE_FORMAT_RINGS
+        )
+        return shape_rings_from(self._stream(self._calls.shape, request))
+
+    def master_list(self, first_rank: int, last_rank: int) -> MasterList:
+        request = pb.MasterListRequest(handle=self._handle, first_rank=first_rank, last_rank=last_rank)
+        return master_list_from(self._stream(self._calls.master_list, request))
+
+    def components(self, first_level: int, last_level: int) -> ComponentCurve:
+        comps: List[np.ndarray] = []
+        solid: List[np.ndarray] = []
+        level = first_level
+        while level <= last_level:
+            last = min(last_level, level + COMPONENTS_PAGE - 1)
+            answer = self._call(
+                self._calls.components,
+                pb.ComponentsRequest(handle=self._handle, ranks=pb.RankRange(first=level, last=last)),
+            )
+            comps.append(np.array(answer.components, dtype=np.uint32))
+            solid.append(np.array(answer.solid_components, dtype=np.uint32))
+            level = last + 1
+        return ComponentCurve(
+            first_level=first_level,
+            components=np.concatenate(comps) if comps else np.empty(0, np.uint32),
+            solid_components=np.concatenate(solid) if solid else np.empty(0, np.uint32),
+        )
+
+    def optimal(self, max_components: int) -> Optimal:
+        return optimal_from(
+            self._call(self._calls.optimal, pb.OptimalAlphaRequest(handle=self._handle, max_components=max_components))
+        )
+
+    def release(self) -> bool:
+        return self._call(self._calls.release, pb.ReleaseRequest(handle=self._handle)).released
+
+
+def find_cached(calls: Calls, handle: str) -> Optional[BuildSummary]:
+    """The summary of the family the server holds under `handle`, or None."""
+    try:
+        answer = calls.describe(pb.DescribeRequest(handle=handle), timeout=calls.timeout, metadata=calls.metadata(handle))
+    except grpc.RpcError as e:
+        if e.code() == grpc.StatusCode.NOT_FOUND:
+            return None
+        raise raise_from_rpc(e) from None
+    return summary_from(answer.summary, cached=True)
+
+
+def build_on_server(
+    calls: Calls, points: np.ndarray, name: str, progress: Optional[Callable[[int], None]]
+) -> NetworkFamilyBackend:
+    """Uploads `points` unless the server already holds their handle, and waits for the build.
+
+    The upload runs as a future polled from this thread, so that Ctrl-C (KeyboardInterrupt)
+    arrives here at once: the call is then cancelled, and the server drops the partial upload and
+    its reservation (nothing is left behind), before the interrupt propagates.
+    """
+    handle = point_set_handle(points)
+    cached = find_cached(calls, handle)
+    if cached is not None:
+        # The server keeps no name with a family (a name is the caller's label for its call).
+        cached = dataclasses.replace(cached, name=name)
+        if progress is not None:
+            progress(len(points))
+        return NetworkFamilyBackend(calls, handle, cached)
+    future = calls.build.future(
+        upload_messages(name, points, progress), timeout=calls.timeout, metadata=calls.metadata(handle)
+    )
+    try:
+        while True:
+            try:
+                answer = future.result(timeout=0.1)
+                break
+            except grpc.FutureTimeoutError:
+                continue
+    except grpc.RpcError as e:
+        raise raise_from_rpc(e) from None
+    except BaseException:
+        future.cancel()
+        raise
+    if answer.handle != handle:
+        raise InvalidInput(f"the server named the family {answer.handle}, the client computed {handle}")
+    return NetworkFamilyBackend(calls, answer.handle, summary_from(answer.summary, cached=answer.cached))
+
+
+def wait_for_server(calls: Calls, deadline_s: float) -> None:
+    """Blocks until the channel is ready (used by tests and examples that start a server)."""
+    end = time.monotonic() + deadline_s
+    grpc.channel_ready_future(calls.channel).result(timeout=max(0.0, end - time.monotonic()))

@@ -1,0 +1,200 @@
+"""The values galpha's queries return, shared by the network and the in-process backends.
+
+Every array is a NumPy array (no per-simplex Python objects). Index arrays hold input indices
+(``uint32``): the position of a point in the array given to ``Client.build``. Semantics follow the
+project's docs/design.md, "Semantics": a threshold is a squared radius ``alpha_sq`` (or a radius
+``alpha``, or a rank of the spectrum); the level of a threshold is the number of spectrum values at
+or below it; rank ``r`` (1..K) stands for the complex at ``spectrum[r - 1]``, rank 0 for alpha = 0.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+from typing import Dict, List, Optional
+
+import numpy as np
+
+__all__ = [
+    "SimplexClass",
+    "SimplexKind",
+    "Endpoint",
+    "Mode",
+    "VertexRule",
+    "Threshold",
+    "BuildSummary",
+    "ClassCounts",
+    "Classification",
+    "ShapePolygon",
+    "ShapeRings",
+    "MasterList",
+    "ComponentCurve",
+    "OptimalLevel",
+    "Optimal",
+]
+
+
+class SimplexClass(enum.IntEnum):
+    """A simplex's class at one threshold (the numbers of the wire protocol's SimplexClass)."""
+
+    EXTERIOR = 1
+    SINGULAR = 2
+    REGULAR = 3
+    INTERIOR = 4
+
+
+class SimplexKind(enum.IntEnum):
+    VERTEX = 1
+    EDGE = 2
+    TRIANGLE = 3
+
+
+class Endpoint(enum.IntEnum):
+    """Which end of a simplex's interval a master-list entry is."""
+
+    RHO = 1  #: the simplex enters (singular; a triangle enters interior)
+    MU_LOW = 2  #: it becomes regular
+    MU_HIGH = 3  #: it becomes interior
+
+
+class Mode(str, enum.Enum):
+    """``general`` keeps singular simplices; ``regularized`` only what bounds or fills triangles."""
+
+    GENERAL = "general"
+    REGULARIZED = "regularized"
+
+
+class VertexRule(str, enum.Enum):
+    """Vertex classes from incident edges (the report's rule) or incident triangles (CGAL's)."""
+
+    REPORT = "report"
+    CGAL = "cgal"
+
+
+@dataclasses.dataclass(frozen=True)
+class Threshold:
+    """Exactly one of a squared radius, a radius, or a rank; built by :func:`threshold_from`."""
+
+    kind: str  # "alpha_sq", "alpha" or "rank"
+    value: float  # an int for "rank"
+
+    def __post_init__(self) -> None:
+        if self.kind not in ("alpha_sq", "alpha", "rank"):
+            raise ValueError(f"unknown threshold kind {self.kind!r}")
+
+
+@dataclasses.dataclass(frozen=True)
+class ClassCounts:
+    exterior: int
+    singular: int
+    regular: int
+    interior: int
+
+
+@dataclasses.dataclass(frozen=True)
+class BuildSummary:
+    """What a build produced and measured (the wire protocol's BuildSummary)."""
+
+    name: str
+    points: int  #: points as given
+    distinct_points: int
+    duplicates: int  #: points equal to an earlier one
+    triangles: int
+    edges: int
+    spectrum_size: int  #: K: ranks run 0..K
+    backend: str  #: "cuda" or "cpu"
+    stage_times: Dict[str, float]  #: seconds per pipeline stage
+    comparisons: Dict[str, int]  #: exact radius comparisons: "filter", "device_exact", "cpu_fallback"
+    peak_memory_bytes: int
+    family_bytes: int
+    cached: bool = False  #: the server already held the family (nothing was computed)
+
+
+@dataclasses.dataclass(frozen=True)
+class Classification:
+    """Every simplex's class at one threshold.
+
+    Vertices are the distinct points in ascending input index (a duplicate shares its first
+    occurrence's class and is not listed); edges ``(E, 2)`` and triangles ``(T, 3)`` hold ascending
+    index pairs and triples, sorted lexicographically. Classes are :class:`SimplexClass` numbers
+    (``uint8``). With ``non_exterior_only`` the exterior simplices are left out (the counts still
+    count them); with ``summary_only`` the arrays are empty.
+    """
+
+    level: int  #: spectrum values <= the threshold (-1 for a negative alpha_sq)
+    alpha_sq: float  #: the threshold as a squared radius
+    vertex_counts: ClassCounts
+    edge_counts: ClassCounts
+    triangle_counts: ClassCounts
+    components: int
+    solid_components: int
+    interior_area: float
+    vertices: np.ndarray  #: (V,) uint32
+    vertex_classes: np.ndarray  #: (V,) uint8
+    edges: np.ndarray  #: (E, 2) uint32
+    edge_classes: np.ndarray  #: (E,) uint8
+    triangles: np.ndarray  #: (T, 3) uint32
+    triangle_classes: np.ndarray  #: (T,) uint8
+
+
+@dataclasses.dataclass(frozen=True)
+class ShapePolygon:
+    """A counter-clockwise outer ring and clockwise holes, as input indices; rings are not closed."""
+
+    outer: np.ndarray  #: (n,) uint32
+    holes: List[np.ndarray]
+
+
+@dataclasses.dataclass(frozen=True)
+class ShapeRings:
+    """The alpha shape at one threshold by input indices (canonical order, as the C++ core gives)."""
+
+    polygons: List[ShapePolygon]
+    singular_edges: np.ndarray  #: (k, 2) uint32, (smaller, larger)
+    isolated_points: np.ndarray  #: (j,) uint32
+    area: float
+
+
+@dataclasses.dataclass(frozen=True)
+class MasterList:
+    """Master-list entries in rank order, vertex < edge < triangle within a rank.
+
+    ``vertex_indices`` is flat: 1, 2 or 3 indices per entry by its kind; ``offsets`` (length
+    entries + 1) delimits each entry's run.
+    """
+
+    ranks: np.ndarray  #: (M,) int64
+    kinds: np.ndarray  #: (M,) uint8, SimplexKind numbers
+    endpoints: np.ndarray  #: (M,) uint8, Endpoint numbers
+    vertex_indices: np.ndarray  #: (sum of kinds,) uint32
+
+    @property
+    def offsets(self) -> np.ndarray:
+        out = np.zeros(len(self.kinds) + 1, dtype=np.int64)
+        np.cumsum(self.kinds, out=out[1:])
+        return out
+
+
+@dataclasses.dataclass(frozen=True)
+class ComponentCurve:
+    """Components at each level ``first_level .. first_level + len - 1``."""
+
+    first_level: int
+    components: np.ndarray  #: uint32, connected components (general sense)
+    solid_components: np.ndarray  #: uint32, interior triangles joined through edges
+
+
+@dataclasses.dataclass(frozen=True)
+class OptimalLevel:
+    rank: int
+    alpha_sq: float
+    components: int
+
+
+@dataclasses.dataclass(frozen=True)
+class Optimal:
+    """The smallest rank with at most N components: in CGAL's regularized sense (every point on an
+    interior triangle) and in the general sense; ``None`` where no rank qualifies."""
+
+    regularized: Optional[OptimalLevel]
+    general: Optional[OptimalLevel]
