@@ -422,26 +422,38 @@ def test_an_exception_in_progress_stops_the_build() -> None:
 
 
 def test_ctrl_c_during_a_long_build_stops_it() -> None:
-    """SIGINT while the engine runs (the GIL released) is seen at the engine's next check."""
+    """SIGINT while the engine runs (the GIL released) is seen at the engine's next check between
+    phases. The progress callback is a builtin (dict.__setitem__), which runs no bytecode, so
+    Python's handler can run only in the engine's check (PyErr_CheckSignals), not in the callback."""
     if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         pytest.skip("SIGINT is not Python's default handler here")
     points = random_points(1_000_000, seed=4)
-    phases: List[str] = []
+    seen: Dict[str, float] = {}
     main = threading.main_thread().ident
-    timer = threading.Timer(0.1, lambda: signal.pthread_kill(main, signal.SIGINT))
+    fired = []
+
+    def interrupt() -> None:
+        fired.append(time.monotonic())
+        signal.pthread_kill(main, signal.SIGINT)
+
+    timer = threading.Timer(0.1, interrupt)
     start = time.monotonic()
     timer.start()
     try:
-        _engine.build(points, "cpu", lambda phase, fraction: phases.append(phase))
+        try:
+            _engine.build(points, "cpu", seen.__setitem__)
+        finally:
+            end = time.monotonic()
+            timer.join()
     except KeyboardInterrupt:
-        assert "components" not in phases, phases
+        if "components" in seen:  # the build ran to its end: fine only if the signal came late
+            assert fired[0] - start > 0.5 * (end - start), f"SIGINT at {fired[0] - start:.2f} s went unseen"
+            pytest.skip("the signal came during the build's last phase")
+        assert "triangulation" in seen or "alpha" not in seen
     else:
         try:  # the build won the race: take the signal here and say so
-            timer.join()
             time.sleep(1)
         except KeyboardInterrupt:
             pass
-        pytest.skip(f"the build finished in {time.monotonic() - start:.2f} s, before the signal")
-    finally:
-        timer.cancel()
+        pytest.skip(f"the build finished in {end - start:.2f} s, before the signal")
     assert build(OBTUSE).summary()["spectrum_size"] == 3  # the interpreter and the engine go on
