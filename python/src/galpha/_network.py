@@ -6,6 +6,7 @@ every failure raised as a :mod:`galpha` exception carrying the server's code and
 from __future__ import annotations
 
 import dataclasses
+import threading
 import time
 from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
 
@@ -362,6 +363,26 @@ def find_cached(calls: Calls, handle: str) -> Optional[BuildSummary]:
     return summary_from(answer.summary, cached=True)
 
 
+class _UploadProgress:
+    """Runs the caller's progress callback inside gRPC's request thread and carries an exception
+    it raises (Ctrl-C included) back to the calling thread, holding the stream open meanwhile:
+    the caller then cancels the call rather than ending the stream short."""
+
+    def __init__(self, callback: Optional[Callable[[int], None]]) -> None:
+        self.callback = callback
+        self.failure: Optional[BaseException] = None
+        self.released = threading.Event()
+
+    def __call__(self, sent: int) -> None:
+        if self.callback is None or self.failure is not None:
+            return
+        try:
+            self.callback(sent)
+        except BaseException as e:  # noqa: B902 -- a KeyboardInterrupt must reach the caller too
+            self.failure = e
+            self.released.wait()
+
+
 def build_on_server(
     calls: Calls, points: np.ndarray, name: str, progress: Optional[Callable[[int], None]]
 ) -> NetworkFamilyBackend:
@@ -369,7 +390,8 @@ def build_on_server(
 
     The upload runs as a future polled from this thread, so that Ctrl-C (KeyboardInterrupt)
     arrives here at once: the call is then cancelled, and the server drops the partial upload and
-    its reservation (nothing is left behind), before the interrupt propagates.
+    its reservation (nothing is left behind), before the interrupt propagates. An exception raised
+    by the progress callback is handled the same way.
     """
     handle = point_set_handle(points)
     cached = find_cached(calls, handle)
@@ -379,13 +401,16 @@ def build_on_server(
         if progress is not None:
             progress(len(points))
         return NetworkFamilyBackend(calls, handle, cached)
+    reporter = _UploadProgress(progress)
     future = calls.build.future(
-        upload_messages(name, points, progress), timeout=calls.timeout, metadata=calls.metadata(handle)
+        upload_messages(name, points, reporter), timeout=calls.timeout, metadata=calls.metadata(handle)
     )
     try:
         while True:
+            if reporter.failure is not None:
+                raise reporter.failure
             try:
-                answer = future.result(timeout=0.1)
+                answer = future.result(timeout=0.05)
                 break
             except grpc.FutureTimeoutError:
                 continue
@@ -394,6 +419,8 @@ def build_on_server(
     except BaseException:
         future.cancel()
         raise
+    finally:
+        reporter.released.set()
     if answer.handle != handle:
         raise InvalidInput(f"the server named the family {answer.handle}, the client computed {handle}")
     return NetworkFamilyBackend(calls, answer.handle, summary_from(answer.summary, cached=answer.cached))

@@ -1,0 +1,190 @@
+"""The network client against real galpha_server processes: every error class with the server's
+code and message, the upload skipped for a set the server holds, Ctrl-C during an upload leaving
+nothing behind, and the asyncio client giving the blocking client's answers."""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import re
+import signal
+import socket
+
+import numpy as np
+import pytest
+from conftest import DATA_SETS, read_bin
+
+import galpha
+import galpha.aio
+
+
+def square_with_center() -> np.ndarray:
+    return np.array([[0, 0], [2, 0], [2, 2], [0, 2], [1, 1]], dtype=np.float64)
+
+
+def test_invalid_input_names_the_point(client) -> None:
+    with pytest.raises(galpha.InvalidInput) as e:
+        client.build(np.array([[0, 0], [1, 0], [0, np.nan]]))
+    assert e.value.code == "INVALID_ARGUMENT" and e.value.code_number == 3
+    assert "point 2" in e.value.message
+    # Outside the input domain: refused by the engine, named by the server's answer.
+    with pytest.raises(galpha.InvalidInput, match=r"point 3 .*2\^500"):
+        client.build(np.array([[0, 0], [1, 0], [0, 1], [1e308, 1e308]]))
+    family = client.build(square_with_center())
+    with pytest.raises(galpha.InvalidInput, match="rank 9 is outside 0..2"):
+        family.classify(rank=9)
+    with pytest.raises(galpha.InvalidInput, match="exactly one of"):
+        family.classify(rank=1, alpha=2.0)
+    with pytest.raises(galpha.InvalidInput, match="unknown mode"):
+        family.classify(rank=1, mode="solid")
+    with pytest.raises(galpha.InvalidInput, match=r"shape \(N, 2\)"):
+        client.build(np.zeros((4, 3)))
+
+
+def test_not_found_after_release(client) -> None:
+    family = client.build(square_with_center() + 10.0)
+    assert family.release() is True
+    assert family.release() is False  # idempotent
+    with pytest.raises(galpha.NotFound) as e:
+        family.classify(rank=1)
+    assert e.value.code == "NOT_FOUND"
+    assert isinstance(e.value, KeyError) and isinstance(e.value, galpha.GalphaError)
+
+
+def test_resource_exhausted_names_the_limit(start_server) -> None:
+    server = start_server("--max_points_per_build=100")
+    with galpha.connect(server.address, timeout=60) as c:
+        with pytest.raises(galpha.ResourceExhausted, match="100"):
+            c.build(np.random.default_rng(1).random((150, 2)))
+        assert c.build(np.random.default_rng(1).random((100, 2))).summary.points == 100
+
+
+def test_unauthenticated_without_the_token(start_server, tmp_path) -> None:
+    tokens = tmp_path / "tokens"
+    tokens.write_text("s3cret team-a\n")
+    server = start_server(f"--token_file={tokens}")
+    with galpha.connect(server.address, timeout=60) as c:
+        with pytest.raises(galpha.Unauthenticated):
+            c.build(square_with_center())
+    with galpha.connect(server.address, token="wrong", timeout=60) as c:
+        with pytest.raises(galpha.Unauthenticated):
+            c.build(square_with_center())
+    with galpha.connect(server.address, token="s3cret", timeout=60) as c:
+        assert c.build(square_with_center()).spectrum().tolist() == [0.5, 1.0]
+
+
+def test_unavailable_when_nobody_listens() -> None:
+    with socket.socket() as s:  # a port that was free a moment ago, now closed
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    with galpha.connect(f"127.0.0.1:{port}", timeout=5) as c:
+        with pytest.raises(galpha.Unavailable):
+            c.build(square_with_center())
+
+
+def test_deadline_exceeded(server) -> None:
+    points = np.random.default_rng(7).random((400_000, 2))
+    with galpha.connect(server.address, timeout=0.001) as c:
+        with pytest.raises(galpha.DeadlineExceeded):
+            c.build(points)
+
+
+def test_every_code_has_its_class() -> None:
+    for number, cls in [
+        (1, galpha.Cancelled),
+        (3, galpha.InvalidInput),
+        (4, galpha.DeadlineExceeded),
+        (5, galpha.NotFound),
+        (7, galpha.PermissionDenied),
+        (8, galpha.ResourceExhausted),
+        (9, galpha.FailedPrecondition),
+        (11, galpha.OutOfRange),
+        (13, galpha.Internal),
+        (14, galpha.Unavailable),
+        (16, galpha.Unauthenticated),
+    ]:
+        error = galpha._errors.error_for_code(number, "why")
+        assert type(error) is cls and error.code_number == number and error.message == "why"
+    unknown = galpha._errors.error_for_code(12, "no")
+    assert type(unknown) is galpha.GalphaError and unknown.code == "UNIMPLEMENTED"
+
+
+def test_a_set_the_server_holds_is_not_uploaded_again(client) -> None:
+    points = np.random.default_rng(3).random((70_000, 2))
+    first = client.build(points, name="first")
+    assert first.summary.cached is False and first.summary.name == "first"
+    stages = []
+    second = client.build(points.copy(), name="second", progress=lambda stage, f: stages.append(stage))
+    assert second.handle == first.handle == galpha.point_set_handle(points)
+    assert second.summary.cached is True and second.summary.name == "second"
+    assert "upload" in stages and len(stages) == 1  # one report: nothing was streamed
+
+
+def test_ctrl_c_during_an_upload_leaves_nothing_behind(start_server) -> None:
+    # Room for one 200K-point set (3.2 MB) in flight, not two: a leaked reservation would refuse
+    # the second upload.
+    server = start_server("--max_in_flight_bytes=4000000", "--max_tenant_in_flight_bytes=0")
+    rng = np.random.default_rng(11)
+    interrupted = rng.random((200_000, 2))
+
+    def interrupt(stage: str, fraction: float) -> None:
+        # A real Ctrl-C: SIGINT to this process, delivered to the main thread mid-upload.
+        if fraction > 0.3 and not sent[0]:
+            sent[0] = True
+            os.kill(os.getpid(), signal.SIGINT)
+
+    sent = [False]
+
+    with galpha.connect(server.address, timeout=60) as c:
+        with pytest.raises(KeyboardInterrupt):
+            c.build(interrupted, progress=interrupt)
+        with pytest.raises(galpha.NotFound):
+            c.family(galpha.point_set_handle(interrupted), interrupted)
+        other = c.build(rng.random((200_000, 2)))
+        assert other.summary.points == 200_000
+    assert re.search(r'galpha_rpcs_total\{code="CANCELLED",method="Build"\} 1', server.metrics())
+
+
+def test_a_raising_progress_callback_cancels_the_upload(server) -> None:
+    points = np.random.default_rng(12).random((300_000, 2))
+
+    def fail(stage: str, fraction: float) -> None:
+        raise RuntimeError("stop here")
+
+    with galpha.connect(server.address, timeout=60) as c:
+        with pytest.raises(RuntimeError, match="stop here"):
+            c.build(points, progress=fail)
+        with pytest.raises(galpha.NotFound):
+            c.family(galpha.point_set_handle(points), points)
+
+
+def test_asyncio_client_gives_the_same_answers(server) -> None:
+    points = read_bin(DATA_SETS[0])
+
+    async def run() -> tuple:
+        async with galpha.aio.connect(server.address, timeout=60) as c:
+            family = await c.build(points)
+            k = family.summary.spectrum_size
+            return (
+                family.handle,
+                await family.spectrum(),
+                await family.classify(rank=k // 2),
+                await family.shape(rank=k // 2),
+                await family.master_list(k // 3),
+                await family.components(),
+                await family.optimal(2),
+            )
+
+    handle, spectrum, classes, shape, master, curve, optimal = asyncio.run(run())
+    with galpha.connect(server.address, timeout=60) as c:
+        family = c.build(points)
+        k = family.spectrum_size
+        assert handle == family.handle
+        np.testing.assert_array_equal(spectrum, family.spectrum())
+        sync = family.classify(rank=k // 2)
+        for field in ("vertices", "vertex_classes", "edges", "edge_classes", "triangles", "triangle_classes"):
+            np.testing.assert_array_equal(getattr(classes, field), getattr(sync, field))
+        assert shape.equals(family.shape(rank=k // 2))
+        np.testing.assert_array_equal(master.vertex_indices, family.master_list(k // 3).vertex_indices)
+        np.testing.assert_array_equal(curve.components, family.components().components)
+        assert optimal == family.optimal(2)
