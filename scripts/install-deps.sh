@@ -25,6 +25,11 @@ test_packages=(
   curl                   # the README's service walk-through scrapes /metrics
   clang libclang-rt-14-dev  # libFuzzer: the fuzz targets run briefly in CI
   clang-format clang-tidy   # scripts/lint.sh: the format check and static analysis, as errors
+  pybind11-dev python3-dev python3-numpy python3-pytest  # galpha._engine (GALPHA_BUILD_PYTHON) and its tests
+  python3-grpcio python3-protobuf  # the Python package's network client (stubs: protobuf-compiler-grpc above)
+  python3-shapely python3-geopandas python3-pyproj python3-tqdm  # its geometry answers, CRSs, progress bars
+  python3-matplotlib     # python/examples: the plot of a shape over its points
+  python3-pip python3-venv python3-setuptools  # the package's pip install (tested by its tests)
 )
 
 profile=all
