@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's second command, and what CI runs: installs what is needed, builds every target
-# (the CUDA backend too when nvcc is present, for one architecture) and runs the whole test suite.
+# (the CUDA backend too when nvcc is present, for one architecture, and the Python package's
+# compiled parts: GALPHA_BUILD_PYTHON) and runs the whole test suite, pytest's included.
 # Tests that need a GPU skip themselves on machines without one. Then the format check and
 # clang-tidy (scripts/lint.sh), the sanitizer builds of the CPU backend (scripts/sanitize.sh), the
 # fuzz targets briefly, the Kubernetes manifests' validation and the container image's build steps.
@@ -9,7 +10,7 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 preset=cpu
 if [ -x /usr/local/cuda/bin/nvcc ] || command -v nvcc >/dev/null; then preset=cuda; fi
-cmake --preset "$preset"
+cmake --preset "$preset" -DGALPHA_BUILD_PYTHON=ON
 cmake --build --preset "$preset" -j"$(nproc)"
 ctest --preset "$preset"
 # Formatting and static analysis, as errors (.clang-format, .clang-tidy).

@@ -29,7 +29,8 @@ void RegisterEngineError(py::module_& module) {
       PyExc_Exception, nullptr);
   if (engine_error_type == nullptr) throw py::error_already_set();
   module.attr("EngineError") = py::reinterpret_borrow<py::object>(engine_error_type);
-  py::register_exception_translator([](std::exception_ptr thrown) {
+  // pybind11 fixes the signature (ExceptionTranslator takes the pointer by value).
+  py::register_exception_translator([](std::exception_ptr thrown) {  // NOLINT(performance-unnecessary-value-param)
     if (!thrown) return;
     try {
       std::rethrow_exception(thrown);
