@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""The Python package's overhead, measured against the C++ tools in the same run (not a test):
+
+  * network: NumPy points to a usable family on a galpha_server, galpha.connect().build() vs the
+    C++ client (alphactl --server ... bench: the same Build call, after a Release each time);
+  * in process: galpha.local().build() vs the engine's own time for the same build in alphactl
+    bench (the sum of its stage times, best of --repeat);
+  * classify at one alpha: NumPy arrays per second, both clients.
+
+    /usr/bin/python3 bench/python_bench.py [--points 1000000] [--repeat 3] [--backend cpu]
+        [--build-dir build/cpu] [--server HOST:PORT]
+
+Without --server it starts build-dir's galpha_server on a free loopback port (same backend).
+Prints one table and the ratios (Python / C++).
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+
+
+def alphactl_bench(alphactl: str, file: str, repeat: int, extra: list) -> dict:
+    out = subprocess.run([alphactl, *extra, "bench", file, f"--repeat={repeat}"], check=True, capture_output=True, text=True)
+    rows = {}
+    for line in out.stdout.splitlines():
+        if m := re.match(r"^(\w+)\s+([-\d.e+]+)$", line.strip()):
+            rows[m.group(1)] = float(m.group(2))
+    return rows
+
+
+def classify_rate(family, alpha: float) -> tuple:
+    best = float("inf")
+    for _ in range(3):
+        start = time.perf_counter()
+        c = family.classify(alpha=alpha)
+        best = min(best, time.perf_counter() - start)
+    size = sum(a.nbytes for a in (c.vertices, c.vertex_classes, c.edges, c.edge_classes, c.triangles, c.triangle_classes))
+    return best, size / best / 1e9
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--points", type=int, default=1_000_000)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--backend", default="cpu", choices=["auto", "cpu", "cuda"])
+    parser.add_argument("--build-dir", default=str(REPO / "build" / "cpu"))
+    parser.add_argument("--server", help="an already running galpha_server (default: start one)")
+    args = parser.parse_args()
+    build = pathlib.Path(args.build_dir).resolve()
+    sys.path[:0] = [str(REPO / "python" / "src"), str(build / "python")]
+    import galpha
+
+    alphactl = str(build / "client" / "alphactl")
+    points = np.random.default_rng(2024).random((args.points, 2))
+    alpha = float(np.sqrt(3.0 / args.points))  # a few neighbours' distance: a mixed classification
+    with tempfile.TemporaryDirectory() as tmp:
+        file = str(pathlib.Path(tmp) / "uniform.bin")
+        with open(file, "wb") as f:
+            f.write(np.uint64(args.points).tobytes())
+            f.write(points.astype("<f8").tobytes())
+
+        # In process.
+        cpp_local = alphactl_bench(alphactl, file, args.repeat, [f"--backend={args.backend}"])
+        client = galpha.local(args.backend)
+        py_wall, py_engine = float("inf"), float("inf")
+        for _ in range(args.repeat):
+            start = time.perf_counter()
+            family = client.build(points)
+            py_wall = min(py_wall, time.perf_counter() - start)
+            py_engine = min(py_engine, sum(family.summary.stage_times.values()))
+        local_classify = classify_rate(family, alpha)
+
+        # Over the network.
+        server_process = None
+        target = args.server
+        if target is None:
+            server_process = subprocess.Popen(
+                [str(build / "server" / "galpha_server"), "--listen=127.0.0.1:0", "--metrics_listen=", f"--backend={args.backend}"],
+                stdout=subprocess.PIPE,
+                text=True,
+            )
+            line = server_process.stdout.readline()
+            target = "127.0.0.1:" + re.search(r"listening on port (\d+)", line).group(1)
+        try:
+            cpp_net = alphactl_bench(alphactl, file, args.repeat, [f"--server={target}"])
+            net = galpha.connect(target, timeout=600)
+            net_wall = float("inf")
+            handle = galpha.point_set_handle(points)
+            for _ in range(args.repeat):
+                try:
+                    net.family(handle, points).release()
+                except galpha.NotFound:
+                    pass
+                start = time.perf_counter()
+                remote = net.build(points)
+                net_wall = min(net_wall, time.perf_counter() - start)
+            net_classify = classify_rate(remote, alpha)
+            remote.release()
+            net.close()
+        finally:
+            if server_process is not None:
+                server_process.terminate()
+                server_process.wait(timeout=60)
+
+    ms = lambda s: f"{s * 1e3:10.1f}"  # noqa: E731
+    print(f"# {args.points:,} uniform points, backend {args.backend}, best of {args.repeat}")
+    print(f"{'measure':44}{'ms':>10}")
+    print(f"{'in process: alphactl bench, engine stages':44}{cpp_local['total']:10.1f}")
+    print(f"{'in process: galpha.local().build(), wall':44}{ms(py_wall)}")
+    print(f"{'in process: galpha.local().build(), stages':44}{ms(py_engine)}")
+    print(f"{'network: C++ client Build (alphactl bench)':44}{cpp_net['rpc_total']:10.1f}")
+    print(f"{'network: galpha.connect().build(), wall':44}{ms(net_wall)}")
+    print(f"{'classify, local: ms / GB/s':44}{ms(local_classify[0])}  {local_classify[1]:.2f} GB/s")
+    print(f"{'classify, network: ms / GB/s':44}{ms(net_classify[0])}  {net_classify[1]:.2f} GB/s")
+    print(f"ratio local (Python wall / C++ engine stages): {py_wall * 1e3 / cpp_local['total']:.3f}  (target <= 1.05)")
+    print(f"ratio network (Python / C++ client):           {net_wall * 1e3 / cpp_net['rpc_total']:.3f}  (target <= 1.10)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
