@@ -13,7 +13,7 @@ protoc --proto_path=proto --cpp_out="$out/gen" galpha/v1/alpha_shapes.proto
 flags=(-std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -I. -I"$out/gen")
 libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthread)
 
-clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp core/io/point_set_handle.cpp \
+clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
   "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}"
 clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp \
   -o "$out/point_formats_fuzzer" "${libs[@]}"
