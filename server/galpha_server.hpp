@@ -39,7 +39,7 @@ struct ServerOptions {
   /// before it stops accepting calls, so that load balancers move traffic away first.
   std::chrono::milliseconds drain_notice{5000};
   /// How long a drain then waits for running calls before cancelling them.
-  std::chrono::milliseconds drain_grace{30000};
+  std::chrono::milliseconds drain_grace{25000};  // the flag's default (main.cpp)
   ServiceOptions service;
 };
 
