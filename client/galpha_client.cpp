@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/point_set_handle.hpp"
+#include "proto/codec/point_chunk_codec.hpp"
 
 namespace galpha::client {
 
@@ -45,6 +47,39 @@ void AlphaClient::PrepareContext(grpc::ClientContext* context, const std::string
   if (options_.deadline.count() > 0) context->set_deadline(std::chrono::system_clock::now() + options_.deadline);
 }
 
+namespace {
+
+// One chunk of `points` as `encoding` says, into `message` (its points or encoded_points).
+absl::Status EncodeChunk(absl::Span<const Point2> points, PointEncoding encoding, wire::PointChunkEncoder* encoder,
+                         v1::BuildRequest* message) {
+  if (encoding == PointEncoding::kAuto) {
+    encoder->EncodeSmallest(points, message);
+    return absl::OkStatus();
+  }
+  if (encoding == PointEncoding::kRaw) {
+    message->mutable_points()->mutable_coordinates()->Assign(&points[0].x, &points[0].x + 2 * points.size());
+    return absl::OkStatus();
+  }
+  wire::ChunkEncoding chunk;
+  if (encoding != PointEncoding::kFloat64Compressed) {
+    std::optional<wire::ScaledAxes> scaled = wire::FindScaledIntegers(points);
+    if (!scaled) {
+      return absl::InvalidArgumentError(
+          "the points are not exact scaled integers (offset + scale * X or X / 10^k on each axis) in every chunk");
+    }
+    chunk.value_type = scaled->value_type;
+    chunk.x_scale = scaled->x;
+    chunk.y_scale = scaled->y;
+  }
+  if (encoding != PointEncoding::kScaledIntegers) {
+    chunk.compression = v1::POINT_COMPRESSION_ZSTD;
+    chunk.transform = encoder->ChooseTransform(points, chunk);
+  }
+  return encoder->Encode(points, chunk, message->mutable_encoded_points());
+}
+
+}  // namespace
+
 absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, const BuildCallOptions& options) {
   BuildResult result;
   // The handle before the upload: to skip it when the server holds the family, and to route the
@@ -68,13 +103,20 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   message.mutable_header()->set_name(options.name);
   message.mutable_header()->set_expected_points(points.size());
   bool open = writer->Write(message);
+  wire::PointChunkEncoder encoder(options.zstd_level);
+  absl::Status encoded;
   for (size_t begin = 0; open && begin < points.size(); begin += kPointsPerChunk) {
     const size_t count = std::min(kPointsPerChunk, points.size() - begin);
-    auto* coordinates = message.mutable_points()->mutable_coordinates();
-    const double* data = &points[begin].x;
-    coordinates->Assign(data, data + 2 * count);
+    encoded = EncodeChunk(points.subspan(begin, count), options.encoding, &encoder, &message);
+    if (!encoded.ok()) break;
+    result.upload_bytes += message.ByteSizeLong();
     open = writer->Write(message);
     if (open && options.progress) options.progress(begin + count);
+  }
+  if (!encoded.ok()) {
+    context.TryCancel();
+    writer->Finish();
+    return encoded;
   }
   // A write fails when the server has already answered (an error): Finish returns that answer.
   if (open) writer->WritesDone();

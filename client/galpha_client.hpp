@@ -35,12 +35,31 @@ inline constexpr char kHandleHeader[] = "x-galpha-handle";
 /// Points per Build chunk: 1 MiB of doubles, well under gRPC's 4 MiB message limit.
 inline constexpr size_t kPointsPerChunk = 65536;
 
+/// How Build sends the points (proto/galpha/v1/alpha_shapes.proto, EncodedPointChunk). Every
+/// choice decodes to the same doubles, so the handle and the family are the same.
+enum class PointEncoding {
+  /// Per chunk, the smallest: exact scaled integers where the data has them, else float64, each
+  /// with the transform that compresses best, zstd-compressed unless that grows it; else raw.
+  kAuto,
+  /// PointChunk doubles (16 bytes a point): what servers older than EncodedPointChunk accept.
+  kRaw,
+  /// Float64 bit patterns, the best transform, zstd.
+  kFloat64Compressed,
+  /// Exact scaled integers, uncompressed (InvalidArgument when a chunk's points have none).
+  kScaledIntegers,
+  /// Exact scaled integers, the best transform, zstd (InvalidArgument as kScaledIntegers).
+  kScaledIntegersCompressed,
+};
+
 struct BuildResult {
   std::string handle;
   /// The server already held the family (nothing was computed).
   bool cached = false;
   /// The points were streamed (false when the handle was found before any upload).
   bool uploaded = false;
+  /// Bytes of the stream's point messages as sent (their protobuf encoding, without gRPC's
+  /// framing); 0 without an upload.
+  uint64_t upload_bytes = 0;
   galpha::v1::BuildSummary summary;
 };
 
@@ -50,6 +69,9 @@ struct BuildCallOptions {
   bool skip_upload_if_cached = true;
   /// Called after each chunk with the number of points sent.
   std::function<void(uint64_t sent)> progress;
+  PointEncoding encoding = PointEncoding::kAuto;
+  /// zstd's level for compressed encodings (1..19; higher: smaller and slower to encode).
+  int zstd_level = 3;
 };
 
 /// gRPC status to absl::Status (the codes are the same numbers).

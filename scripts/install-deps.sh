@@ -12,6 +12,7 @@ server_packages=(
   libgmp-dev             # exact rational fallback of the radius comparisons
   nlohmann-json3-dev     # GeoJSON point files
   libssl-dev             # SHA-256 of point sets: content-derived handles
+  libzstd-dev            # zstd-compressed point chunks on the wire (proto/codec)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # the gRPC service
   prometheus-cpp-dev libcivetweb-dev  # the metrics exporter
 )
@@ -27,6 +28,7 @@ test_packages=(
   clang-format clang-tidy   # scripts/lint.sh: the format check and static analysis, as errors
   pybind11-dev python3-dev python3-numpy python3-pytest  # galpha._engine (GALPHA_BUILD_PYTHON) and its tests
   python3-grpcio python3-protobuf  # the Python package's network client (stubs: protobuf-compiler-grpc above)
+  python3-zstandard      # its compressed point chunks (EncodedPointChunk)
   python3-shapely python3-geopandas python3-pyproj python3-tqdm  # its geometry answers, CRSs, progress bars
   python3-matplotlib     # python/examples: the plot of a shape over its points
   python3-pip python3-venv python3-setuptools  # the package's pip install (tested by its tests)

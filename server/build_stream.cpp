@@ -98,6 +98,37 @@ absl::Status BuildStreamDecoder::Reserve(size_t bytes) {
   return absl::OkStatus();
 }
 
+absl::Status BuildStreamDecoder::CheckPointCount(uint64_t after) const {
+  if (after > limits_.max_points) {
+    return TagRefusal(absl::ResourceExhaustedError(absl::StrCat("the stream carries more than ", limits_.max_points,
+                                                                " points, this server's limit per build "
+                                                                "(--max_points_per_build)")),
+                      BuildRefusal::kPointsPerBuild);
+  }
+  const uint64_t expected = decoded_.header.expected_points();
+  if (expected > 0 && after > expected) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("the stream carries more points than the ", expected, " its header announced"));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status BuildStreamDecoder::Grow(uint64_t count) {
+  if (absl::Status s = Reserve(count * sizeof(Point2)); !s.ok()) return s;
+  const size_t after = decoded_.points.size() + count;
+  if (after > decoded_.points.capacity()) {
+    // Capacity grows with the bytes that arrived (doubling, as a vector does, but never past an
+    // announced count), not with the announcement: an announced 100M points would otherwise
+    // map 1.6 GB per stream before a single point arrives.
+    const uint64_t expected = decoded_.header.expected_points();
+    size_t capacity = std::max<size_t>(after, 2 * decoded_.points.capacity());
+    if (expected > 0) capacity = std::min<size_t>(capacity, expected);
+    decoded_.points.reserve(capacity);
+  }
+  decoded_.points.resize(after);
+  return absl::OkStatus();
+}
+
 absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
   if (finished_) return absl::FailedPreconditionError("the build stream already ended");
   switch (message.part_case()) {
@@ -122,29 +153,18 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       if (in_flight_ == nullptr) return absl::OkStatus();
       const uint64_t most = std::numeric_limits<uint64_t>::max();
       return in_flight_->CheckCanEverFit(tenant_, expected > most / sizeof(Point2) ? most : expected * sizeof(Point2));
-      return absl::OkStatus();
     }
     case galpha::v1::BuildRequest::kPoints: {
       if (!has_header_) return absl::InvalidArgumentError("the build stream must start with a header");
       const auto& coordinates = message.points().coordinates();
       const size_t count = static_cast<size_t>(coordinates.size());
       const uint64_t before = decoded_.points.size();
+      ++chunks_;
       if (count % 2 != 0) {
         return absl::InvalidArgumentError(absl::StrCat("a point chunk holds an odd number of doubles (", count,
                                                        ") after point ", before, ": send x, y pairs"));
       }
-      const uint64_t after = before + count / 2;
-      if (after > limits_.max_points) {
-        return TagRefusal(absl::ResourceExhaustedError(absl::StrCat("the stream carries more than ", limits_.max_points,
-                                                                    " points, this server's limit per build "
-                                                                    "(--max_points_per_build)")),
-                          BuildRefusal::kPointsPerBuild);
-      }
-      const uint64_t expected = decoded_.header.expected_points();
-      if (expected > 0 && after > expected) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("the stream carries more points than the ", expected, " its header announced"));
-      }
+      if (absl::Status s = CheckPointCount(before + count / 2); !s.ok()) return s;
       // One branch-free pass over the chunk (it vectorises); the index only when one is bad.
       const double* values = coordinates.data();
       bool all_finite = true;
@@ -156,21 +176,29 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
                                                        std::isnan(values[i]) ? "NaN" : "infinite", " ",
                                                        i % 2 == 0 ? "x" : "y", " coordinate"));
       }
-      if (absl::Status s = Reserve(count * sizeof(double)); !s.ok()) return s;
-      if (after > decoded_.points.capacity()) {
-        // Capacity grows with the bytes that arrived (doubling, as a vector does, but never past an
-        // announced count), not with the announcement: an announced 100M points would otherwise
-        // map 1.6 GB per stream before a single point arrives.
-        size_t capacity = std::max<size_t>(after, 2 * decoded_.points.capacity());
-        if (expected > 0) capacity = std::min<size_t>(capacity, expected);
-        decoded_.points.reserve(capacity);
-      }
-      decoded_.points.resize(after);
+      if (absl::Status s = Grow(count / 2); !s.ok()) return s;
       if (count > 0) std::memcpy(&decoded_.points[before], coordinates.data(), count * sizeof(double));
       return absl::OkStatus();
     }
+    case galpha::v1::BuildRequest::kEncodedPoints: {
+      if (!has_header_) return absl::InvalidArgumentError("the build stream must start with a header");
+      const galpha::v1::EncodedPointChunk& chunk = message.encoded_points();
+      const uint64_t before = decoded_.points.size();
+      const wire::ChunkPosition at{chunks_++, before};
+      // Every limit applies to the decoded points, checked before anything is decompressed: the
+      // stated count against the limits, its decoded bytes reserved, then the decoder writes at
+      // most that many points.
+      if (absl::Status s = wire::CheckEncodedChunkShape(chunk, at); !s.ok()) return s;
+      const uint64_t count = chunk.point_count();
+      if (absl::Status s = CheckPointCount(before + count); !s.ok()) return s;
+      if (absl::Status s = Grow(count); !s.ok()) return s;
+      absl::Status decoded = chunk_decoder_.Decode(chunk, at, &decoded_.points[before]);
+      if (!decoded.ok()) decoded_.points.resize(before);
+      return decoded;
+    }
     case galpha::v1::BuildRequest::PART_NOT_SET:
-      return absl::InvalidArgumentError("a build stream message has neither a header nor points");
+      return absl::InvalidArgumentError(
+          "a build stream message has neither a header nor points (a newer client's kind of chunk?)");
   }
   return absl::InvalidArgumentError("a build stream message of unknown kind");
 }

@@ -16,6 +16,7 @@
 #include "core/base/point.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
+#include "proto/codec/point_chunk_codec.hpp"
 
 namespace galpha::server {
 
@@ -78,9 +79,12 @@ class BuildStreamDecoder {
 
   /// One message. InvalidArgument: a chunk before the header, a second header, a name longer than
   /// kMaxBuildNameBytes, an odd number of coordinates, NaN or infinity (naming the point's index in
-  /// the whole stream), more points than the header announced. ResourceExhausted (tagged with its
-  /// BuildRefusal): more points than the limit, more bytes in flight than the server's or the
-  /// tenant's limit (a header announcing more than a limit could ever hold is refused at once).
+  /// the whole stream), more points than the header announced, a malformed EncodedPointChunk (naming
+  /// the chunk: wire::PointChunkDecoder::Decode). ResourceExhausted (tagged with its BuildRefusal):
+  /// more points than the limit, more bytes in flight than the server's or the tenant's limit (a
+  /// header announcing more than a limit could ever hold is refused at once). Every limit counts
+  /// decoded points, 16 bytes each: an encoded chunk's stated count is checked and its decoded bytes
+  /// reserved before it is decompressed.
   absl::Status Add(const galpha::v1::BuildRequest& message);
 
   /// The end of the stream. InvalidArgument: no header (an empty stream), or fewer points than
@@ -95,6 +99,10 @@ class BuildStreamDecoder {
 
  private:
   absl::Status Reserve(size_t bytes);
+  // The point limits for a stream of `after` points: ResourceExhausted or InvalidArgument.
+  absl::Status CheckPointCount(uint64_t after) const;
+  // `count` more points at the end of decoded_.points, their bytes reserved first.
+  absl::Status Grow(uint64_t count);
 
   const BuildStreamLimits limits_;
   InFlightBytes* const in_flight_;
@@ -102,7 +110,9 @@ class BuildStreamDecoder {
   size_t reserved_ = 0;
   bool has_header_ = false;
   bool finished_ = false;
+  uint64_t chunks_ = 0;  // point chunks so far, raw and encoded (errors name encoded ones by index)
   DecodedBuild decoded_;
+  wire::PointChunkDecoder chunk_decoder_;
 };
 
 }  // namespace galpha::server

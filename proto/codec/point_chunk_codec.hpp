@@ -1,0 +1,125 @@
+// Compact, lossless encodings of a Build stream's points (galpha.v1.EncodedPointChunk, defined in
+// proto/galpha/v1/alpha_shapes.proto): the server's decoder and the client's encoder in one module,
+// so that both sides read the format from one place. Free of gRPC (only the protobuf messages), so
+// the fuzz target and the unit tests drive it directly.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/types/span.h"
+#include "core/base/point.hpp"
+#include "galpha/v1/alpha_shapes.pb.h"
+
+struct ZSTD_CCtx_s;
+struct ZSTD_DCtx_s;
+
+namespace galpha::wire {
+
+/// Most points one EncodedPointChunk may state: bounds the decoder's scratch memory (16 MiB) and
+/// the work of one message.
+inline constexpr uint64_t kMaxPointsPerEncodedChunk = uint64_t{1} << 20;
+
+/// Where a chunk sits in its Build stream, for the messages that name it.
+struct ChunkPosition {
+  uint64_t chunk_index = 0;  // among the stream's point chunks, from 0
+  uint64_t first_point = 0;  // index of its first point in the whole stream
+};
+
+/// InvalidArgument naming the chunk for what can be checked without decoding: point_count 0 or over
+/// kMaxPointsPerEncodedChunk, an unspecified or undefined value type, transform or compression,
+/// a scale on a FLOAT64 chunk, a missing, zero, NaN or infinite scale (or divisor) or a non-finite
+/// offset on an integer chunk. O(1).
+absl::Status CheckEncodedChunkShape(const galpha::v1::EncodedPointChunk& chunk, const ChunkPosition& at);
+
+/// Decodes EncodedPointChunks. Holds a zstd context and a scratch buffer reused from chunk to chunk;
+/// one per stream, not thread-safe.
+class PointChunkDecoder {
+ public:
+  PointChunkDecoder();
+  ~PointChunkDecoder();
+  PointChunkDecoder(const PointChunkDecoder&) = delete;
+  PointChunkDecoder& operator=(const PointChunkDecoder&) = delete;
+
+  /// Decodes `chunk` into out[0, point_count). InvalidArgument naming the chunk: everything
+  /// CheckEncodedChunkShape refuses, data that is not exactly one zstd frame, data whose decoded
+  /// size differs from point_count's (decompression is bounded by that size: nothing more is ever
+  /// written), an INT64 value over 2^53 in magnitude, a NaN or infinite coordinate (naming the
+  /// point's index in the stream). On an error `out` holds unspecified values. O(point_count).
+  absl::Status Decode(const galpha::v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out);
+
+ private:
+  std::unique_ptr<ZSTD_DCtx_s, void (*)(ZSTD_DCtx_s*)> zstd_;
+  std::unique_ptr<unsigned char[]> scratch_;  // decompressed data, never zero-filled first
+  size_t scratch_bytes_ = 0;
+  std::vector<uint64_t> words64_;
+  std::vector<uint32_t> words32_;
+};
+
+/// The double an integer X of an axis decodes to: `offset + scale * X` or `offset + X / divisor`,
+/// two IEEE roundings, never fused (this module is built with -ffp-contract=off).
+double ScaledValue(const galpha::v1::AxisScale& scale, int64_t x);
+
+/// Per-axis scales under which every coordinate of a point set is an integer, exactly.
+struct ScaledAxes {
+  galpha::v1::PointValueType value_type = galpha::v1::POINT_VALUE_TYPE_INT64;  // INT32 when every X fits
+  galpha::v1::AxisScale x;
+  galpha::v1::AxisScale y;
+};
+
+/// Finds, per axis, the first of fl(10^-k) * X and X / 10^k (k = 0..22, offset 0: LAS with a zero
+/// offset, decimal text), offset + fl(10^-k) * X (k = 0..9, offset the axis's minimum rounded
+/// down to a multiple of 10^j, j = 0..7: LAS offsets) and 2^-k * X that reproduces every
+/// coordinate bit for bit with |X| <= 2^53; nullopt when an axis has none (or a coordinate is -0.0, NaN or infinite).
+/// Verified point by point with ScaledValue, so the server decodes exactly these doubles. O(n) per
+/// candidate tried, stopping at the first coordinate that fails.
+std::optional<ScaledAxes> FindScaledIntegers(absl::Span<const Point2> points);
+
+/// How to encode one chunk.
+struct ChunkEncoding {
+  galpha::v1::PointValueType value_type = galpha::v1::POINT_VALUE_TYPE_FLOAT64;
+  galpha::v1::AxisScale x_scale;  // integer value types only
+  galpha::v1::AxisScale y_scale;
+  galpha::v1::PointTransform transform = galpha::v1::POINT_TRANSFORM_NONE;
+  galpha::v1::PointCompression compression = galpha::v1::POINT_COMPRESSION_NONE;
+};
+
+/// Encodes chunks. Holds a zstd context reused from chunk to chunk; not thread-safe.
+class PointChunkEncoder {
+ public:
+  /// `zstd_level`: zstd's compression level (1..19; 3 is zstd's default).
+  explicit PointChunkEncoder(int zstd_level = 3);
+  ~PointChunkEncoder();
+  PointChunkEncoder(const PointChunkEncoder&) = delete;
+  PointChunkEncoder& operator=(const PointChunkEncoder&) = delete;
+
+  /// `points` (1 to kMaxPointsPerEncodedChunk) as `encoding` says. InvalidArgument when an integer
+  /// encoding does not reproduce a coordinate exactly (naming it) or a value does not fit the type.
+  absl::Status Encode(absl::Span<const Point2> points, const ChunkEncoding& encoding,
+                      galpha::v1::EncodedPointChunk* out);
+
+  /// The smallest of the forms this module knows for `points` (scaled integers when
+  /// FindScaledIntegers finds them, else float64; each transform tried, zstd-compressed unless that
+  /// grows the data), or a raw PointChunk when nothing beats it. `out` gets `points` or
+  /// `encoded_points`. The transform is chosen on the whole chunk up to 16,384 points, else on its
+  /// first 8,192 points.
+  void EncodeSmallest(absl::Span<const Point2> points, galpha::v1::BuildRequest* out);
+
+  /// The best transform for `points` under `value_type` and scales, chosen as EncodeSmallest
+  /// chooses it, with zstd compression.
+  galpha::v1::PointTransform ChooseTransform(absl::Span<const Point2> points, const ChunkEncoding& encoding);
+
+ private:
+  absl::Status Compress(const std::string& input, std::string* output);
+
+  int level_;
+  std::unique_ptr<ZSTD_CCtx_s, void (*)(ZSTD_CCtx_s*)> zstd_;
+  std::string words_;  // transformed, before compression
+  std::string compressed_;
+};
+
+}  // namespace galpha::wire
