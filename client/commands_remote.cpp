@@ -84,8 +84,14 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
   remote.build = *std::move(built);
   if (verbose) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "alphactl: %s on the server (%.2f s)\n", remote.build.cached ? "family found" : "family built",
-                 seconds);
+    const std::string upload =
+        remote.build.uploaded
+            ? absl::StrFormat("; %llu bytes of points sent, %.2f per point",
+                              static_cast<unsigned long long>(remote.build.upload_bytes),
+                              static_cast<double>(remote.build.upload_bytes) / std::max<double>(1.0, points->size()))
+            : std::string();
+    std::fprintf(stderr, "alphactl: %s on the server (%.2f s%s)\n",
+                 remote.build.cached ? "family found" : "family built", seconds, upload.c_str());
   }
   return remote;
 }

@@ -193,7 +193,14 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       if (absl::Status s = CheckPointCount(before + count); !s.ok()) return s;
       if (absl::Status s = Grow(count); !s.ok()) return s;
       absl::Status decoded = chunk_decoder_.Decode(chunk, at, &decoded_.points[before]);
-      if (!decoded.ok()) decoded_.points.resize(before);
+      if (!decoded.ok()) {
+        // A refused chunk adds nothing and holds nothing.
+        decoded_.points.resize(before);
+        if (in_flight_ != nullptr) {
+          in_flight_->Release(tenant_, count * sizeof(Point2));
+          reserved_ -= count * sizeof(Point2);
+        }
+      }
       return decoded;
     }
     case galpha::v1::BuildRequest::PART_NOT_SET:

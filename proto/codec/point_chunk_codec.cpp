@@ -475,13 +475,22 @@ absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, const Ch
   return absl::OkStatus();
 }
 
-v1::PointTransform PointChunkEncoder::ChooseTransform(absl::Span<const Point2> points, const ChunkEncoding& encoding) {
-  const absl::Span<const Point2> sample = points.size() <= 16384 ? points : points.subspan(0, 8192);
-  v1::PointTransform best = v1::POINT_TRANSFORM_NONE;
+namespace {
+
+// The part of a chunk its encoding is chosen on: all of it up to 16,384 points (then the choice is
+// exact), else its first 8,192 points (eight trial compressions then cost one of the whole chunk).
+absl::Span<const Point2> Sample(absl::Span<const Point2> points) {
+  return points.size() <= 16384 ? points : points.subspan(0, 8192);
+}
+
+}  // namespace
+
+size_t PointChunkEncoder::BestTransform(absl::Span<const Point2> sample, ChunkEncoding* encoding) {
   size_t best_size = std::numeric_limits<size_t>::max();
+  v1::PointTransform best = v1::POINT_TRANSFORM_NONE;
   for (v1::PointTransform transform : {v1::POINT_TRANSFORM_NONE, v1::POINT_TRANSFORM_BYTE_SHUFFLE,
                                        v1::POINT_TRANSFORM_DELTA_SHUFFLE, v1::POINT_TRANSFORM_DELTA2_SHUFFLE}) {
-    ChunkEncoding trial = encoding;
+    ChunkEncoding trial = *encoding;
     trial.transform = transform;
     trial.compression = v1::POINT_COMPRESSION_ZSTD;
     v1::EncodedPointChunk chunk;
@@ -491,7 +500,14 @@ v1::PointTransform PointChunkEncoder::ChooseTransform(absl::Span<const Point2> p
       best = transform;
     }
   }
-  return best;
+  encoding->transform = best;
+  return best_size;
+}
+
+v1::PointTransform PointChunkEncoder::ChooseTransform(absl::Span<const Point2> points, const ChunkEncoding& encoding) {
+  ChunkEncoding chosen = encoding;
+  BestTransform(Sample(points), &chosen);
+  return chosen.transform;
 }
 
 void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, v1::BuildRequest* out) {
@@ -501,14 +517,19 @@ void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, v1::Buil
     if (!points.empty()) coordinates->Add(&points[0].x, &points[0].x + 2 * points.size());
   };
   if (points.empty() || points.size() > kMaxPointsPerEncodedChunk) return send_raw();
+  // Float64 and, where the data has them, scaled integers, each with its best transform on the
+  // sample: integers usually win by far, but power-of-two steps of full-precision doubles (lon/lat
+  // in one binade) are the same bits and can lose by a few bytes.
   ChunkEncoding encoding;
-  if (std::optional<ScaledAxes> scaled = FindScaledIntegers(points)) {
-    encoding.value_type = scaled->value_type;
-    encoding.x_scale = scaled->x;
-    encoding.y_scale = scaled->y;
-  }
   encoding.compression = v1::POINT_COMPRESSION_ZSTD;
-  encoding.transform = ChooseTransform(points, encoding);
+  const size_t float_size = BestTransform(Sample(points), &encoding);
+  if (std::optional<ScaledAxes> scaled = FindScaledIntegers(points)) {
+    ChunkEncoding integers = encoding;
+    integers.value_type = scaled->value_type;
+    integers.x_scale = scaled->x;
+    integers.y_scale = scaled->y;
+    if (BestTransform(Sample(points), &integers) <= float_size) encoding = integers;
+  }
   v1::EncodedPointChunk* chunk = out->mutable_encoded_points();
   if (!Encode(points, encoding, chunk).ok()) return send_raw();
   const size_t uncompressed = 2 * points.size() * WordBytes(encoding.value_type);

@@ -102,11 +102,11 @@ class PointChunkEncoder {
   absl::Status Encode(absl::Span<const Point2> points, const ChunkEncoding& encoding,
                       galpha::v1::EncodedPointChunk* out);
 
-  /// The smallest of the forms this module knows for `points` (scaled integers when
-  /// FindScaledIntegers finds them, else float64; each transform tried, zstd-compressed unless that
-  /// grows the data), or a raw PointChunk when nothing beats it. `out` gets `points` or
-  /// `encoded_points`. The transform is chosen on the whole chunk up to 16,384 points, else on its
-  /// first 8,192 points.
+  /// The smallest of the forms this module knows for `points` (float64 and, when
+  /// FindScaledIntegers finds them, scaled integers; each transform tried, zstd-compressed unless
+  /// that grows the data), or a raw PointChunk when nothing beats it. `out` gets `points` or
+  /// `encoded_points`. The form is chosen on the whole chunk up to 16,384 points, else on its first
+  /// 8,192 points (then it can miss the smallest by a little).
   void EncodeSmallest(absl::Span<const Point2> points, galpha::v1::BuildRequest* out);
 
   /// The best transform for `points` under `value_type` and scales, chosen as EncodeSmallest
@@ -115,6 +115,8 @@ class PointChunkEncoder {
 
  private:
   absl::Status Compress(const std::string& input, std::string* output);
+  // Sets encoding->transform to the one that compresses `sample` best (zstd); that size.
+  size_t BestTransform(absl::Span<const Point2> sample, ChunkEncoding* encoding);
 
   int level_;
   std::unique_ptr<ZSTD_CCtx_s, void (*)(ZSTD_CCtx_s*)> zstd_;

@@ -17,6 +17,7 @@
 #include "absl/types/span.h"
 #include "core/io/point_set_handle.hpp"
 #include "gtest/gtest.h"
+#include "proto/codec/point_chunk_codec.hpp"
 #include "server/build_refusal.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
@@ -483,6 +484,113 @@ TEST(InFlightBytesTest, UnannouncedChunksReserveAsTheyArrive) {
   EXPECT_EQ(second.points_received(), 41u);
   second.ReleasePoints();
   EXPECT_EQ(in_flight.held(), 0u);
+}
+
+// ---- Encoded chunks (EncodedPointChunk) -------------------------------------------------------------
+
+// `points` as float64 bit patterns, delta-transformed and zstd-compressed.
+v1::BuildRequest EncodedChunk(absl::Span<const Point2> points) {
+  wire::PointChunkEncoder encoder;
+  wire::ChunkEncoding encoding;
+  encoding.transform = v1::POINT_TRANSFORM_DELTA_SHUFFLE;
+  encoding.compression = v1::POINT_COMPRESSION_ZSTD;
+  v1::BuildRequest message;
+  EXPECT_THAT(encoder.Encode(points, encoding, message.mutable_encoded_points()), IsOk());
+  return message;
+}
+
+// A chunk that states `points` points but whose data is no zstd frame: refused only when decoded.
+v1::BuildRequest UndecodableChunk(uint64_t points) {
+  v1::BuildRequest message;
+  message.mutable_encoded_points()->set_point_count(points);
+  message.mutable_encoded_points()->set_value_type(v1::POINT_VALUE_TYPE_FLOAT64);
+  message.mutable_encoded_points()->set_compression(v1::POINT_COMPRESSION_ZSTD);
+  message.mutable_encoded_points()->set_data("not zstd");
+  return message;
+}
+
+TEST(BuildStreamDecoderTest, EncodedAndRawChunksMixToTheSamePointsAndHandle) {
+  const std::vector<Point2> points = gen::Uniform(300, 40);
+  const auto all = absl::MakeConstSpan(points);
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(decoder.Add(Header(300)), IsOk());
+  ASSERT_THAT(decoder.Add(EncodedChunk(all.subspan(0, 100))), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(all.subspan(100, 100))), IsOk());
+  ASSERT_THAT(decoder.Add(EncodedChunk(all.subspan(200))), IsOk());
+  absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  ASSERT_THAT(decoded, IsOk());
+  ASSERT_EQ((*decoded)->points.size(), points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
+    ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
+  }
+  EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
+}
+
+TEST(BuildStreamDecoderTest, EncodedChunkCountsItsDecodedPointsAgainstTheLimitBeforeDecoding) {
+  BuildStreamLimits limits;
+  limits.max_points = 100;
+  BuildStreamDecoder decoder(limits, nullptr);
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(EncodedChunk(gen::Uniform(60, 41))), IsOk());
+  // 41 more would pass 100: refused for the limit, not for its undecodable data (never decoded).
+  const absl::Status status = decoder.Add(UndecodableChunk(41));
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kResourceExhausted));
+  EXPECT_EQ(RefusalLabelOf(status), "points_per_build") << status;
+  EXPECT_EQ(decoder.points_received(), 60u);
+}
+
+TEST(BuildStreamDecoderTest, EncodedChunkBeyondTheAnnouncedCountIsRefused) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(decoder.Add(Header(50)), IsOk());
+  const absl::Status status = decoder.Add(EncodedChunk(gen::Uniform(51, 42)));
+  EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the 50 its header")));
+}
+
+TEST(InFlightBytesTest, EncodedChunksReserveTheirDecodedBytes) {
+  // 1,000 points on a grid compress to a few hundred bytes but decode to 16,000: the reservation
+  // is for the decoded bytes.
+  std::vector<Point2> grid;
+  for (int i = 0; i < 1000; ++i) grid.push_back({static_cast<double>(i % 40), static_cast<double>(i / 40)});
+  const v1::BuildRequest chunk = EncodedChunk(grid);
+  ASSERT_LT(chunk.ByteSizeLong(), 2000u);
+  {
+    InFlightBytes in_flight(20000);
+    BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight);
+    ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+    ASSERT_THAT(decoder.Add(chunk), IsOk());
+    EXPECT_EQ(in_flight.held(), 1000 * sizeof(Point2));
+    const absl::Status status = decoder.Add(chunk);
+    EXPECT_THAT(status, StatusIs(absl::StatusCode::kResourceExhausted));
+    EXPECT_EQ(RefusalLabelOf(status), "in_flight_bytes") << status;
+    EXPECT_EQ(in_flight.held(), 1000 * sizeof(Point2));
+  }
+  // A chunk refused while decoding holds nothing afterwards.
+  InFlightBytes in_flight(0);
+  BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight);
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(chunk), IsOk());
+  EXPECT_THAT(decoder.Add(UndecodableChunk(10)), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_EQ(in_flight.held(), 1000 * sizeof(Point2));
+  EXPECT_EQ(decoder.points_received(), 1000u);
+}
+
+TEST(BuildStreamDecoderTest, MalformedEncodedChunkIsNamedByItsIndexAndFirstPoint) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(gen::Uniform(7, 43))), IsOk());
+  ASSERT_THAT(decoder.Add(EncodedChunk(gen::Uniform(5, 44))), IsOk());
+  const absl::Status status = decoder.Add(UndecodableChunk(3));
+  EXPECT_THAT(status,
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       ::testing::HasSubstr("encoded point chunk 2 (from point 12): its data is not a zstd frame")));
+  EXPECT_EQ(decoder.points_received(), 12u) << "a refused chunk adds nothing";
+}
+
+TEST(BuildStreamDecoderTest, EncodedChunkBeforeTheHeaderIsRefused) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  EXPECT_THAT(decoder.Add(EncodedChunk(gen::Uniform(3, 45))),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("must start with a header")));
 }
 
 }  // namespace
