@@ -1,14 +1,74 @@
 // libFuzzer target: arbitrary bytes as a Build stream (length-prefixed serialized BuildRequest
-// messages) through the server's decoder. Besides "no crash, no sanitizer report", it checks the
-// decoder's promises: an accepted stream's points are finite, as many as its chunks carried, and its
-// handle is the handle of those points.
+// messages, raw PointChunks and EncodedPointChunks) through the server's decoder. Besides "no
+// crash, no sanitizer report", it checks the decoder's promises: an accepted stream's points are
+// finite, as many as its chunks carried (an encoded chunk: its point_count), its handle is the
+// handle of those points, and no refused chunk holds bytes in flight. Every accepted raw chunk's
+// points also go through the encoder in every form it can take and must decode bit for bit.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
+#include <optional>
+#include <vector>
 
 #include "core/io/point_set_handle.hpp"
+#include "proto/codec/point_chunk_codec.hpp"
 #include "server/build_stream.hpp"
+
+namespace {
+
+namespace v1 = galpha::v1;
+
+uint64_t Bits(double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits;
+}
+
+// Encodes `points` as `encoding` says (when it can), decodes, and aborts unless the points come
+// back bit for bit.
+void CheckRoundTrip(const std::vector<galpha::Point2>& points, const galpha::wire::ChunkEncoding& encoding) {
+  galpha::wire::PointChunkEncoder encoder(1);
+  v1::EncodedPointChunk chunk;
+  if (!encoder.Encode(points, encoding, &chunk).ok()) return;
+  galpha::wire::PointChunkDecoder decoder;
+  std::vector<galpha::Point2> decoded(points.size());
+  if (!decoder.Decode(chunk, {}, decoded.data()).ok()) std::abort();  // the raw chunk was finite
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (Bits(decoded[i].x) != Bits(points[i].x) || Bits(decoded[i].y) != Bits(points[i].y)) std::abort();
+  }
+}
+
+void CheckEveryEncoding(const v1::PointChunk& raw) {
+  std::vector<galpha::Point2> points(static_cast<size_t>(raw.coordinates_size()) / 2);
+  if (points.empty()) return;
+  std::memcpy(points.data(), raw.coordinates().data(), points.size() * sizeof(galpha::Point2));
+  std::vector<galpha::wire::ChunkEncoding> encodings;
+  galpha::wire::ChunkEncoding encoding;
+  const std::optional<galpha::wire::ScaledAxes> scaled = galpha::wire::FindScaledIntegers(points);
+  for (v1::PointTransform transform : {v1::POINT_TRANSFORM_NONE, v1::POINT_TRANSFORM_BYTE_SHUFFLE,
+                                       v1::POINT_TRANSFORM_DELTA_SHUFFLE, v1::POINT_TRANSFORM_DELTA2_SHUFFLE}) {
+    for (v1::PointCompression compression : {v1::POINT_COMPRESSION_NONE, v1::POINT_COMPRESSION_ZSTD}) {
+      encoding.value_type = v1::POINT_VALUE_TYPE_FLOAT64;
+      encoding.transform = transform;
+      encoding.compression = compression;
+      CheckRoundTrip(points, encoding);
+      if (!scaled) continue;
+      encoding.value_type = scaled->value_type;
+      encoding.x_scale = scaled->x;
+      encoding.y_scale = scaled->y;
+      CheckRoundTrip(points, encoding);  // found scales must reproduce every point: Encode may not fail
+      v1::EncodedPointChunk chunk;
+      galpha::wire::PointChunkEncoder encoder(1);
+      if (!encoder.Encode(points, encoding, &chunk).ok()) std::abort();
+      encoding.x_scale.Clear();
+      encoding.y_scale.Clear();
+    }
+  }
+}
+
+}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   galpha::server::InFlightBytes in_flight(1 << 20);
@@ -30,7 +90,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
       position += length;
       if (message.has_points()) carried += static_cast<uint64_t>(message.points().coordinates_size()) / 2;
+      if (message.has_encoded_points()) carried += message.encoded_points().point_count();
+      const uint64_t before = decoder.points_received();
       failed = !decoder.Add(message).ok();
+      // A refused chunk adds no points (and, below, holds no bytes once the decoder is gone).
+      if (failed && decoder.points_received() != before) std::abort();
+      if (!failed && message.has_points()) CheckEveryEncoding(message.points());
     }
     if (!failed) {
       auto decoded = decoder.Finish();

@@ -10,11 +10,13 @@ seconds=${1:-20}
 out=build/fuzz
 mkdir -p "$out/gen" "$out/corpus"
 protoc --proto_path=proto --cpp_out="$out/gen" galpha/v1/alpha_shapes.proto
-flags=(-std=c++17 -O1 -g -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -I. -I"$out/gen")
+# -ffp-contract=off as in every galpha target: scaled integers decode as offset + scale * X, unfused.
+flags=(-std=c++17 -O1 -g -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -I. -I"$out/gen")
 libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthread)
 
 clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
-  "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}"
+  proto/codec/point_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
+  $(pkg-config --libs libzstd)
 clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp \
   -o "$out/point_formats_fuzzer" "${libs[@]}"
 clang++ "${flags[@]}" tests/fuzz/predicates_fuzzer.cpp core/io/input_validation.cpp \
