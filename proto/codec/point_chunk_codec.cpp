@@ -126,8 +126,10 @@ bool IsPlain(v1::PointTransform transform) {
 }
 
 // Interleaved words (x0, y0, x1, y1, ...) to the transform's bytes (the proto's PointTransform).
+// Plane by plane, so that every pass reads and writes memory in order (it vectorises).
 template <typename Word>
-void TransformWords(const std::vector<Word>& words, v1::PointTransform transform, std::string* bytes) {
+void TransformWords(const std::vector<Word>& words, v1::PointTransform transform, std::vector<Word>* scratch,
+                    std::string* bytes) {
   const size_t count = words.size();
   const size_t n = count / 2;
   bytes->resize(count * sizeof(Word));
@@ -136,42 +138,56 @@ void TransformWords(const std::vector<Word>& words, v1::PointTransform transform
     std::memcpy(out, words.data(), count * sizeof(Word));  // little-endian host (static_assert above)
     return;
   }
+  std::vector<Word>& planar = *scratch;
+  planar.resize(count);
   for (size_t axis = 0; axis < 2; ++axis) {
     Word previous = 0;
     Word before_previous = 0;
+    Word* stored = planar.data() + axis * n;
     for (size_t i = 0; i < n; ++i) {
       const Word w = words[2 * i + axis];
-      const size_t j = axis * n + i;  // planar position
-      const Word stored = transform == v1::POINT_TRANSFORM_BYTE_SHUFFLE
-                              ? w
-                              : ZigZag<Word>(static_cast<Word>(w - Predict(transform, previous, before_previous)));
-      for (size_t b = 0; b < sizeof(Word); ++b) out[b * count + j] = static_cast<unsigned char>(stored >> (8 * b));
+      stored[i] = transform == v1::POINT_TRANSFORM_BYTE_SHUFFLE
+                      ? w
+                      : ZigZag<Word>(static_cast<Word>(w - Predict(transform, previous, before_previous)));
       before_previous = previous;
       previous = w;
     }
   }
+  for (size_t b = 0; b < sizeof(Word); ++b) {
+    unsigned char* plane = out + b * count;
+    for (size_t j = 0; j < count; ++j) plane[j] = static_cast<unsigned char>(planar[j] >> (8 * b));
+  }
 }
 
-// The inverse of TransformWords.
+// The inverse of TransformWords. `planar` is scratch.
 template <typename Word>
-void UntransformWords(const unsigned char* bytes, size_t n, v1::PointTransform transform, std::vector<Word>* words) {
+void UntransformWords(const unsigned char* bytes, size_t n, v1::PointTransform transform, std::vector<Word>* planar,
+                      std::vector<Word>* words) {
   const size_t count = 2 * n;
   words->resize(count);
   if (IsPlain(transform)) {
     std::memcpy(words->data(), bytes, count * sizeof(Word));
     return;
   }
+  planar->resize(count);
+  Word* stored = planar->data();
+  for (size_t j = 0; j < count; ++j) stored[j] = bytes[j];
+  for (size_t b = 1; b < sizeof(Word); ++b) {
+    const unsigned char* plane = bytes + b * count;
+    for (size_t j = 0; j < count; ++j) stored[j] |= static_cast<Word>(Word{plane[j]} << (8 * b));
+  }
+  Word* out = words->data();
   for (size_t axis = 0; axis < 2; ++axis) {
+    const Word* in = stored + axis * n;
+    if (transform == v1::POINT_TRANSFORM_BYTE_SHUFFLE) {
+      for (size_t i = 0; i < n; ++i) out[2 * i + axis] = in[i];
+      continue;
+    }
     Word previous = 0;
     Word before_previous = 0;
     for (size_t i = 0; i < n; ++i) {
-      const size_t j = axis * n + i;
-      Word stored = 0;
-      for (size_t b = 0; b < sizeof(Word); ++b) stored |= static_cast<Word>(Word{bytes[b * count + j]} << (8 * b));
-      const Word w = transform == v1::POINT_TRANSFORM_BYTE_SHUFFLE
-                         ? stored
-                         : static_cast<Word>(UnZigZag(stored) + Predict(transform, previous, before_previous));
-      (*words)[2 * i + axis] = w;
+      const Word w = static_cast<Word>(UnZigZag(in[i]) + Predict(transform, previous, before_previous));
+      out[2 * i + axis] = w;
       before_previous = previous;
       previous = w;
     }
@@ -288,16 +304,19 @@ absl::Status PointChunkDecoder::Decode(const v1::EncodedPointChunk& chunk, const
 
   double* values = &out[0].x;
   if (type == v1::POINT_VALUE_TYPE_FLOAT64) {
-    UntransformWords<uint64_t>(bytes, n, chunk.transform(), &words64_);
+    UntransformWords<uint64_t>(bytes, n, chunk.transform(), &planar64_, &words64_);
     std::memcpy(values, words64_.data(), 2 * n * sizeof(double));
     return CheckFinite(values, 2 * n, at, "");
   }
   const AxisStep steps[2] = {AxisStep(chunk.x_scale()), AxisStep(chunk.y_scale())};
   if (type == v1::POINT_VALUE_TYPE_INT32) {
-    UntransformWords<uint32_t>(bytes, n, chunk.transform(), &words32_);
-    for (size_t i = 0; i < 2 * n; ++i) values[i] = steps[i % 2](static_cast<int32_t>(words32_[i]));
+    UntransformWords<uint32_t>(bytes, n, chunk.transform(), &planar32_, &words32_);
+    for (size_t axis = 0; axis < 2; ++axis) {
+      const AxisStep step = steps[axis];
+      for (size_t i = axis; i < 2 * n; i += 2) values[i] = step(static_cast<int32_t>(words32_[i]));
+    }
   } else {
-    UntransformWords<uint64_t>(bytes, n, chunk.transform(), &words64_);
+    UntransformWords<uint64_t>(bytes, n, chunk.transform(), &planar64_, &words64_);
     for (size_t i = 0; i < 2 * n; ++i) {
       const auto x = static_cast<int64_t>(words64_[i]);
       if (x > kMaxExactInteger || x < -kMaxExactInteger) {
@@ -412,11 +431,14 @@ PointChunkEncoder::PointChunkEncoder(int zstd_level)
 PointChunkEncoder::~PointChunkEncoder() = default;
 
 absl::Status PointChunkEncoder::Compress(const std::string& input, std::string* output) {
-  output->resize(ZSTD_compressBound(input.size()));
-  const size_t size =
-      ZSTD_compressCCtx(zstd_.get(), output->data(), output->size(), input.data(), input.size(), level_);
+  const size_t bound = ZSTD_compressBound(input.size());
+  if (compressed_bytes_ < bound) {  // a buffer of its own: a string would be zero-filled on every resize
+    compressed_.reset(new char[bound]);
+    compressed_bytes_ = bound;
+  }
+  const size_t size = ZSTD_compressCCtx(zstd_.get(), compressed_.get(), bound, input.data(), input.size(), level_);
   if (ZSTD_isError(size)) return absl::InternalError(absl::StrCat("zstd: ", ZSTD_getErrorName(size)));
-  output->resize(size);
+  output->assign(compressed_.get(), size);
   return absl::OkStatus();
 }
 
@@ -433,16 +455,21 @@ absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, const Ch
   out->set_transform(encoding.transform);
   out->set_compression(encoding.compression);
   if (encoding.value_type == v1::POINT_VALUE_TYPE_FLOAT64) {
-    std::vector<uint64_t> words(2 * n);
-    std::memcpy(words.data(), &points[0].x, 2 * n * sizeof(double));
-    TransformWords(words, encoding.transform, &words_);
+    words64_.resize(2 * n);
+    std::memcpy(words64_.data(), &points[0].x, 2 * n * sizeof(double));
+    TransformWords(words64_, encoding.transform, &planar64_, &words_);
   } else {
     *out->mutable_x_scale() = encoding.x_scale;
     *out->mutable_y_scale() = encoding.y_scale;
     const AxisStep steps[2] = {AxisStep(encoding.x_scale), AxisStep(encoding.y_scale)};
     const bool narrow = encoding.value_type == v1::POINT_VALUE_TYPE_INT32;
-    std::vector<uint64_t> words64(narrow ? 0 : 2 * n);
-    std::vector<uint32_t> words32(narrow ? 2 * n : 0);
+    std::vector<uint64_t>& words64 = words64_;
+    std::vector<uint32_t>& words32 = words32_;
+    if (narrow) {
+      words32.resize(2 * n);
+    } else {
+      words64.resize(2 * n);
+    }
     for (size_t i = 0; i < 2 * n; ++i) {
       const double v = i % 2 == 0 ? points[i / 2].x : points[i / 2].y;
       const std::optional<int64_t> x = steps[i % 2].Invert(v);
@@ -461,18 +488,16 @@ absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, const Ch
       }
     }
     if (narrow) {
-      TransformWords(words32, encoding.transform, &words_);
+      TransformWords(words32, encoding.transform, &planar32_, &words_);
     } else {
-      TransformWords(words64, encoding.transform, &words_);
+      TransformWords(words64, encoding.transform, &planar64_, &words_);
     }
   }
   if (encoding.compression != v1::POINT_COMPRESSION_ZSTD) {
     out->set_data(words_);
     return absl::OkStatus();
   }
-  if (absl::Status s = Compress(words_, &compressed_); !s.ok()) return s;
-  out->set_data(compressed_);
-  return absl::OkStatus();
+  return Compress(words_, out->mutable_data());
 }
 
 namespace {

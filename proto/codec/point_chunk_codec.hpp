@@ -56,8 +56,8 @@ class PointChunkDecoder {
   std::unique_ptr<ZSTD_DCtx_s, void (*)(ZSTD_DCtx_s*)> zstd_;
   std::unique_ptr<unsigned char[]> scratch_;  // decompressed data, never zero-filled first
   size_t scratch_bytes_ = 0;
-  std::vector<uint64_t> words64_;
-  std::vector<uint32_t> words32_;
+  std::vector<uint64_t> words64_, planar64_;
+  std::vector<uint32_t> words32_, planar32_;
 };
 
 /// The double an integer X of an axis decodes to: `offset + scale * X` or `offset + X / divisor`,
@@ -121,7 +121,10 @@ class PointChunkEncoder {
   int level_;
   std::unique_ptr<ZSTD_CCtx_s, void (*)(ZSTD_CCtx_s*)> zstd_;
   std::string words_;  // transformed, before compression
-  std::string compressed_;
+  std::unique_ptr<char[]> compressed_;
+  size_t compressed_bytes_ = 0;
+  std::vector<uint64_t> words64_, planar64_;
+  std::vector<uint32_t> words32_, planar32_;
 };
 
 }  // namespace galpha::wire
