@@ -107,6 +107,26 @@ TEST(AlphactlRemoteTest, ServerMayComeBeforeTheCommand) {
   EXPECT_NE(twice.err.find("--server given twice"), std::string::npos) << twice.err;
 }
 
+// alphactl sends the smallest encoding on its own (EncodedPointChunk; docs/design.md, "Wire
+// encodings of points"): Autzen's LiDAR, 0.01 ft integers, goes up in under 4 bytes a point (raw
+// doubles would be 16), and the remote answer is the local one.
+TEST(AlphactlRemoteTest, UploadsInTheSmallestEncoding) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  const std::string file = galpha::testdata::DataDir() + "/lidar_autzen.bin";
+  const CommandResult local = Alphactl("summary " + file + " --rank 1000");
+  const CommandResult remote = Alphactl("--server " + server.address() + " summary " + file + " --rank 1000");
+  ASSERT_EQ(remote.exit_code, 0) << remote.err;
+  EXPECT_EQ(remote.out, local.out);
+  // "alphactl: family built on the server (0.52 s; 214512 bytes of points sent, 1.95 per point)"
+  const size_t at = remote.err.find(" bytes of points sent, ");
+  ASSERT_NE(at, std::string::npos) << remote.err;
+  const double per_point =
+      std::strtod(remote.err.c_str() + at + std::string(" bytes of points sent, ").size(), nullptr);
+  EXPECT_GT(per_point, 0.5) << remote.err;
+  EXPECT_LE(per_point, 4.0) << remote.err;
+}
+
 TEST(AlphactlRemoteTest, ErrorsKeepTheLocalExitCodes) {
   ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
