@@ -213,6 +213,7 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
 absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
   if (finished_) return absl::FailedPreconditionError("the build stream already ended");
   finished_ = true;
+  chunk_decoder_.ReleaseScratch();  // the decoder outlives the stream while the build runs
   if (!has_header_) return absl::InvalidArgumentError("the build stream is empty: it needs a header, then points");
   const uint64_t expected = decoded_.header.expected_points();
   if (expected > 0 && decoded_.points.size() != expected) {

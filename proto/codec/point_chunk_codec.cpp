@@ -259,6 +259,15 @@ PointChunkDecoder::PointChunkDecoder()
 
 PointChunkDecoder::~PointChunkDecoder() = default;
 
+void PointChunkDecoder::ReleaseScratch() {
+  scratch_.reset();
+  scratch_bytes_ = 0;
+  std::vector<uint64_t>().swap(words64_);
+  std::vector<uint64_t>().swap(planar64_);
+  std::vector<uint32_t>().swap(words32_);
+  std::vector<uint32_t>().swap(planar32_);
+}
+
 absl::Status PointChunkDecoder::Decode(const v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out) {
   if (absl::Status s = CheckEncodedChunkShape(chunk, at); !s.ok()) return s;
   const size_t n = chunk.point_count();

@@ -20,9 +20,10 @@ struct ZSTD_DCtx_s;
 
 namespace galpha::wire {
 
-/// Most points one EncodedPointChunk may state: bounds the decoder's scratch memory (16 MiB) and
-/// the work of one message.
-inline constexpr uint64_t kMaxPointsPerEncodedChunk = uint64_t{1} << 20;
+/// Most points one EncodedPointChunk may state (4 MiB of decoded doubles, gRPC's default message
+/// size): bounds the work of one message and the decoder's scratch memory, which the in-flight
+/// limits do not count (at most three buffers of that size per stream, freed when the stream ends).
+inline constexpr uint64_t kMaxPointsPerEncodedChunk = uint64_t{1} << 18;
 
 /// Where a chunk sits in its Build stream, for the messages that name it.
 struct ChunkPosition {
@@ -51,6 +52,9 @@ class PointChunkDecoder {
   /// written), an INT64 value over 2^53 in magnitude, a NaN or infinite coordinate (naming the
   /// point's index in the stream). On an error `out` holds unspecified values. O(point_count).
   absl::Status Decode(const galpha::v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out);
+
+  /// Frees the scratch buffers (they grow to the largest chunk decoded); decoding again regrows them.
+  void ReleaseScratch();
 
  private:
   std::unique_ptr<ZSTD_DCtx_s, void (*)(ZSTD_DCtx_s*)> zstd_;

@@ -330,7 +330,7 @@ TEST(PointChunkCodec, MalformedChunksAreRefusedNamingTheChunk) {
   };
   const std::vector<Case> cases = {
       {"no points", [](auto* c) { c->set_point_count(0); }, "states no points"},
-      {"too many points", [](auto* c) { c->set_point_count(kMaxPointsPerEncodedChunk + 1); }, "at most 1048576"},
+      {"too many points", [](auto* c) { c->set_point_count(kMaxPointsPerEncodedChunk + 1); }, "at most 262144"},
       {"no value type", [](auto* c) { c->set_value_type(v1::POINT_VALUE_TYPE_UNSPECIFIED); }, "no value_type"},
       {"undefined value type", [](auto* c) { c->set_value_type(static_cast<v1::PointValueType>(9)); },
        "value_type 9 is not"},
