@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <limits>
 #include <optional>
+#include <thread>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/point_set_handle.hpp"
@@ -103,15 +105,35 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   message.mutable_header()->set_name(options.name);
   message.mutable_header()->set_expected_points(points.size());
   bool open = writer->Write(message);
-  wire::PointChunkEncoder encoder(options.zstd_level);
+  // Chunks are encoded in batches, one thread a chunk (each with its own encoder), then written in
+  // order: encoding costs 4-16 ms a 1 MiB chunk on one core, as much as sending it over 1 Gb/s.
+  const size_t batch = options.encoding == PointEncoding::kRaw
+                           ? 1
+                           : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads);
+  std::vector<std::unique_ptr<wire::PointChunkEncoder>> encoders;
+  for (size_t i = 0; i < batch; ++i) encoders.push_back(std::make_unique<wire::PointChunkEncoder>(options.zstd_level));
+  std::vector<v1::BuildRequest> messages(batch);
+  std::vector<absl::Status> statuses(batch);
   absl::Status encoded;
-  for (size_t begin = 0; open && begin < points.size(); begin += kPointsPerChunk) {
-    const size_t count = std::min(kPointsPerChunk, points.size() - begin);
-    encoded = EncodeChunk(points.subspan(begin, count), options.encoding, &encoder, &message);
-    if (!encoded.ok()) break;
-    result.upload_bytes += message.ByteSizeLong();
-    open = writer->Write(message);
-    if (open && options.progress) options.progress(begin + count);
+  for (size_t first = 0; open && encoded.ok() && first < points.size(); first += batch * kPointsPerChunk) {
+    const size_t chunks = std::min(batch, (points.size() - first + kPointsPerChunk - 1) / kPointsPerChunk);
+    const auto encode = [&](size_t i) {
+      const size_t begin = first + i * kPointsPerChunk;
+      const size_t count = std::min(kPointsPerChunk, points.size() - begin);
+      statuses[i] = EncodeChunk(points.subspan(begin, count), options.encoding, encoders[i].get(), &messages[i]);
+    };
+    std::vector<std::thread> threads;
+    for (size_t i = 1; i < chunks; ++i) threads.emplace_back(encode, i);
+    encode(0);
+    for (std::thread& thread : threads) thread.join();
+    for (size_t i = 0; i < chunks && open; ++i) {
+      encoded = statuses[i];
+      if (!encoded.ok()) break;
+      result.upload_bytes += messages[i].ByteSizeLong();
+      open = writer->Write(messages[i]);
+      const size_t sent = std::min(points.size(), first + (i + 1) * kPointsPerChunk);
+      if (open && options.progress) options.progress(sent);
+    }
   }
   if (!encoded.ok()) {
     context.TryCancel();

@@ -35,6 +35,9 @@ inline constexpr char kHandleHeader[] = "x-galpha-handle";
 /// Points per Build chunk: 1 MiB of doubles, well under gRPC's 4 MiB message limit.
 inline constexpr size_t kPointsPerChunk = 65536;
 
+/// Most threads Build encodes chunks on at once (one chunk each).
+inline constexpr size_t kMaxEncodingThreads = 8;
+
 /// How Build sends the points (proto/galpha/v1/alpha_shapes.proto, EncodedPointChunk). Every
 /// choice decodes to the same doubles, so the handle and the family are the same.
 enum class PointEncoding {

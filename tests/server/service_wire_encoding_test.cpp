@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -132,6 +133,29 @@ TEST(ServiceWireEncodingTest, EveryEncodingIsTheSameFamilyUnderTheSameHandle) {
     EXPECT_LE(static_cast<double>(automatic), 1.01 * static_cast<double>(smallest))
         << "the automatic choice sends the fewest bytes";
   }
+}
+
+// More chunks than the client encodes at once (8 threads): they arrive in order, the progress
+// callback counts up to every point, and the server's handle is the local one.
+TEST(ServiceWireEncodingTest, ManyChunksEncodedInParallelArriveInOrder) {
+  auto server = StartServer(TestServerOptions());
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  // 11 chunks of 65,536 points, the last one short; integers on a 1/8 grid (scaled integers).
+  std::vector<Point2> points = gen::Uniform(10 * client::kPointsPerChunk + 1234, 11);
+  for (Point2& p : points) p = {std::round(p.x * 8000) / 8, std::round(p.y * 8000) / 8};
+  client::BuildCallOptions options;
+  options.skip_upload_if_cached = false;
+  std::vector<uint64_t> progress;
+  options.progress = [&](uint64_t sent) { progress.push_back(sent); };
+  absl::StatusOr<client::BuildResult> built = client->Build(points, options);
+  ASSERT_THAT(built.status(), IsOk());
+  EXPECT_EQ(built->handle, PointSetHandle(points));
+  EXPECT_EQ(built->summary.points(), points.size());
+  ASSERT_EQ(progress.size(), 11u);
+  for (size_t i = 0; i + 1 < progress.size(); ++i) EXPECT_EQ(progress[i], (i + 1) * client::kPointsPerChunk);
+  EXPECT_EQ(progress.back(), points.size());
+  EXPECT_LT(built->upload_bytes, 6 * points.size()) << "scaled integers, not raw doubles";
 }
 
 TEST(ServiceWireEncodingTest, MalformedEncodedChunkIsInvalidArgumentNamingTheChunk) {
