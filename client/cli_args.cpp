@@ -45,6 +45,9 @@ const char kUsage[] =
     "  --server HOST:PORT          run on a galpha server instead: FILE is hashed locally and uploaded\n"
     "                              only when the server does not hold it; same output (not triangulate)\n"
     "  --tls-ca FILE               with --server: talk TLS, trusting the PEM roots in FILE\n"
+    "  --encoding auto|raw         with --server: how points go up (default auto: per chunk the smallest\n"
+    "                              lossless encoding, scaled integers or float64, zstd-compressed;\n"
+    "                              raw: 16-byte doubles, for servers older than encoded chunks)\n"
     "  --max-points N              read at most N points (default 100000000, a default server's limit;\n"
     "                              at most 1073741824, the engine's)\n"
     "  -h, --help                  this text\n"
@@ -69,7 +72,7 @@ const char kUsage[] =
 static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && InputOptions{}.max_line_bytes == 65536,
               "update kUsage");
 
-const absl::string_view kGlobalOptions[4] = {"backend", "server", "tls-ca", "max-points"};
+const absl::string_view kGlobalOptions[5] = {"backend", "server", "tls-ca", "encoding", "max-points"};
 
 namespace {
 

@@ -76,6 +76,13 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
     if (common.server.empty()) return absl::InvalidArgumentError("--tls-ca needs --server");
     common.tls_ca_file = *ca;
   }
+  if (const std::string* encoding = line->Find("encoding")) {
+    if (common.server.empty()) return absl::InvalidArgumentError("--encoding needs --server");
+    if (*encoding != "auto" && *encoding != "raw") {
+      return absl::InvalidArgumentError(absl::StrCat("unknown --encoding '", *encoding, "' (expected auto or raw)"));
+    }
+    common.raw_upload = *encoding == "raw";
+  }
   common.line = *std::move(line);
   return common;
 }

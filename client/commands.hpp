@@ -49,6 +49,9 @@ struct CommonArgs {
   std::string server;
   /// --tls-ca FILE: PEM roots; talk TLS to the server.
   std::string tls_ca_file;
+  /// --encoding raw: send PointChunk doubles (servers older than EncodedPointChunk refuse the
+  /// compact chunks that the default, auto, picks).
+  bool raw_upload = false;
   /// How FILE is read: --max-points.
   InputOptions input;
 };

@@ -67,6 +67,7 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
   client::BuildCallOptions options;
   options.name = common.file;
   options.skip_upload_if_cached = skip_upload_if_cached;
+  if (common.raw_upload) options.encoding = client::PointEncoding::kRaw;
   const bool verbose = points->size() >= kProgressMinPoints;
   const auto start = std::chrono::steady_clock::now();
   if (verbose) {
@@ -341,6 +342,7 @@ int RemoteBench(const CommonArgs& common, int64_t repeat) {
     client::BuildCallOptions options;
     options.name = common.file;
     options.skip_upload_if_cached = false;
+    if (common.raw_upload) options.encoding = client::PointEncoding::kRaw;
     const auto start = std::chrono::steady_clock::now();
     auto built = (*connected)->Build(*points, options);
     const double rpc = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

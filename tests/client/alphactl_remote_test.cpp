@@ -127,6 +127,27 @@ TEST(AlphactlRemoteTest, UploadsInTheSmallestEncoding) {
   EXPECT_LE(per_point, 4.0) << remote.err;
 }
 
+// --encoding raw sends 16-byte doubles (what servers older than encoded chunks accept): the same
+// answers, 16 bytes a point; the option needs --server and a known value.
+TEST(AlphactlRemoteTest, RawEncodingSendsDoubles) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  const std::string file = galpha::testdata::DataDir() + "/lidar_autzen.bin";
+  const CommandResult local = Alphactl("summary " + file + " --rank 1000");
+  const CommandResult remote =
+      Alphactl("--encoding raw --server " + server.address() + " summary " + file + " --rank 1000");
+  ASSERT_EQ(remote.exit_code, 0) << remote.err;
+  EXPECT_EQ(remote.out, local.out);
+  EXPECT_NE(remote.err.find(" bytes of points sent, 16.00 per point"), std::string::npos) << remote.err;
+  const CommandResult unknown =
+      Alphactl("--server " + server.address() + " summary " + file + " --rank 1 --encoding zip");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown --encoding 'zip' (expected auto or raw)"), std::string::npos) << unknown.err;
+  const CommandResult local_encoding = Alphactl("summary " + file + " --rank 1 --encoding raw");
+  EXPECT_EQ(local_encoding.exit_code, 2);
+  EXPECT_NE(local_encoding.err.find("--encoding needs --server"), std::string::npos) << local_encoding.err;
+}
+
 TEST(AlphactlRemoteTest, ErrorsKeepTheLocalExitCodes) {
   ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
