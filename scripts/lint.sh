@@ -40,7 +40,7 @@ for step in "${steps[@]}"; do
       fi
       # Our translation units only: not the generated protobuf code under the build folder.
       root=$(pwd)
-      run-clang-tidy -p "$build_dir" -quiet -j"$(nproc)" "^${root}/(core|gpu|server|client|bench|tests|python)/.*\\.cpp\$" \
+      run-clang-tidy -p "$build_dir" -quiet -j"$(nproc)" "^${root}/(core|gpu|server|client|bench|tests|python|proto)/.*\\.cpp\$" \
         > "$build_dir/clang-tidy.log" 2>&1 || {
         grep -E 'error:|warning:' "$build_dir/clang-tidy.log" | sort -u
         echo "lint: clang-tidy found problems (whole log: $build_dir/clang-tidy.log)" >&2
