@@ -653,8 +653,9 @@ TEST(AlphactlTest, GlobalOptionsComeBeforeOrAfterTheCommand) {
   ASSERT_EQ(triangulate.exit_code, 0) << triangulate.err;
   EXPECT_EQ(nlohmann::json::parse(triangulate.out)["backend"], "cpu");
 
-  ExpectError(Alphactl("--rank 1 summary " + square), 2,
-              "unknown option '--rank' before the command (only --backend, --server, --tls-ca, --encoding, --max-points");
+  ExpectError(
+      Alphactl("--rank 1 summary " + square), 2,
+      "unknown option '--rank' before the command (only --backend, --server, --tls-ca, --encoding, --max-points");
   ExpectError(Alphactl("--frobnicate summary " + square), 2, "unknown option '--frobnicate' before the command");
   ExpectError(Alphactl("-x summary " + square), 2, "unknown option '-x' before the command");
   ExpectError(Alphactl("--backend cpu summary " + square + " --rank 1 --backend cpu"), 2, "--backend given twice");
