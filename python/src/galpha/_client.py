@@ -7,6 +7,7 @@ from typing import Any, Callable, Optional, Protocol, Union
 
 
 
+from ._encoding import check_encoding
 from ._errors import InvalidInput
 from ._family import Family
 from ._points import as_points
@@ -20,7 +21,7 @@ PROGRESS_BAR_MIN_POINTS = 100_000
 
 
 class Client(Protocol):
-    def build(self, points: Any, *, name: str = "", progress: Progress = None) -> Family: ...
+    def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> Family: ...
 
     def close(self) -> None: ...
 
@@ -81,14 +82,22 @@ class NetworkClient:
     def __repr__(self) -> str:
         return f"<galpha.NetworkClient {self.target}>"
 
-    def build(self, points: Any, *, name: str = "", progress: Progress = None) -> Family:
-        """Uploads the points (unless the server already holds them) and returns their family."""
+    def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> Family:
+        """Uploads the points (unless the server already holds them) and returns their family.
+
+        ``encoding``: ``"auto"`` sends each 65,536-point chunk in its smallest lossless form (exact
+        scaled integers or float64, a transform, zstd; raw doubles when nothing is smaller);
+        ``"raw"`` sends packed doubles, 16 bytes a point, which servers older than the compact
+        encodings need (they refuse encoded chunks with InvalidInput: "neither a header nor
+        points"). Either way the server builds the same family under the same handle.
+        """
+        encoding = check_encoding(encoding)
         array, crs = as_points(points)
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         try:
             sent = None if callback is None else (lambda n: callback("upload", n / total))
-            backend = self._network.build_on_server(self._calls, array, name, sent)
+            backend = self._network.build_on_server(self._calls, array, name, sent, encoding)
         finally:
             if close is not None:
                 close()
@@ -132,8 +141,11 @@ class LocalClient:
     def __repr__(self) -> str:
         return f"<galpha.LocalClient backend={self.backend}>"
 
-    def build(self, points: Any, *, name: str = "", progress: Progress = None) -> Family:
-        """Builds the family in this process (the GIL is released while the engine runs)."""
+    def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> Family:
+        """Builds the family in this process (the GIL is released while the engine runs).
+        ``encoding`` ("auto" or "raw") is checked and ignored: nothing is uploaded, and code can
+        switch between the clients unchanged."""
+        check_encoding(encoding)
         array, crs = as_points(points)
         callback, close = progress_callback(progress, len(array))
         try:

@@ -5,7 +5,10 @@ every failure raised as a :mod:`galpha` exception carrying the server's code and
 
 from __future__ import annotations
 
+import collections
+import concurrent.futures
 import dataclasses
+import os
 import threading
 import time
 from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
@@ -13,7 +16,7 @@ from typing import Any, Callable, Iterator, List, Optional, Sequence, Tuple
 import grpc
 import numpy as np
 
-from . import _wire
+from . import _encoding, _wire
 from ._errors import GalphaError, InvalidInput, error_for_code
 from ._handle import point_set_handle
 from ._types import (
@@ -35,6 +38,8 @@ from .v1 import alpha_shapes_pb2 as pb
 SERVICE = "/galpha.v1.AlphaShapes/"
 #: Points per Build chunk: 1 MiB of doubles, as the C++ client sends.
 POINTS_PER_CHUNK = 65536
+#: Threads that encode chunks ahead of the one being sent (numpy and zstd release the GIL).
+ENCODE_THREADS = max(1, min(4, os.cpu_count() or 1))
 #: The request header a gRPC-aware load balancer hashes on (deploy/k8s/envoy.yaml).
 HANDLE_HEADER = "x-galpha-handle"
 #: Receive limit: answers are paged well below it; generous for shape text of large sets.
@@ -199,14 +204,75 @@ def master_list_from(pages: Sequence[bytes]) -> MasterList:
     )
 
 
-def upload_messages(name: str, points: np.ndarray, progress: Optional[Callable[[int], None]]) -> Iterator[bytes]:
-    """The Build stream as serialized messages: a header, then 1 MiB point chunks."""
-    yield pb.BuildRequest(header=pb.BuildHeader(name=name, expected_points=len(points))).SerializeToString()
-    for begin in range(0, len(points), POINTS_PER_CHUNK):
-        chunk = points[begin : begin + POINTS_PER_CHUNK]
-        yield _wire.encode_point_chunk_request(chunk)
+class UploadCounter:
+    """Bytes of point messages an upload has produced so far (BuildSummary.upload_bytes)."""
+
+    def __init__(self) -> None:
+        self.bytes = 0
+
+
+def header_message(name: str, points: np.ndarray) -> bytes:
+    return pb.BuildRequest(header=pb.BuildHeader(name=name, expected_points=len(points))).SerializeToString()
+
+
+def chunk_message(chunk: np.ndarray, encoding: str) -> bytes:
+    """One chunk's BuildRequest: its smallest encoding ("auto") or packed doubles ("raw")."""
+    if encoding == "raw":
+        return _wire.encode_point_chunk_request(chunk)
+    return _encoding.encode_smallest(chunk)
+
+
+def chunk_bounds(points: np.ndarray) -> List[Tuple[int, int]]:
+    return [(b, min(b + POINTS_PER_CHUNK, len(points))) for b in range(0, len(points), POINTS_PER_CHUNK)]
+
+
+def _chunk_messages(points: np.ndarray, encoding: str) -> Iterator[bytes]:
+    """The chunks' messages in order; "auto" encodes up to ENCODE_THREADS chunks ahead on a pool
+    (the send of one overlaps the encoding of the next), which is shut down when the stream ends
+    or is abandoned (a cancelled call)."""
+    bounds = chunk_bounds(points)
+    if encoding == "raw" or len(bounds) <= 1 or ENCODE_THREADS == 1:
+        for begin, end in bounds:
+            yield chunk_message(points[begin:end], encoding)
+        return
+    pool = concurrent.futures.ThreadPoolExecutor(ENCODE_THREADS, thread_name_prefix="galpha-encode")
+    pending: collections.deque = collections.deque()
+    try:
+        upcoming = iter(bounds)
+        for begin, end in upcoming:
+            pending.append(pool.submit(chunk_message, points[begin:end], encoding))
+            if len(pending) > ENCODE_THREADS:
+                break
+        while pending:
+            message = pending.popleft().result()
+            for begin, end in upcoming:
+                pending.append(pool.submit(chunk_message, points[begin:end], encoding))
+                break
+            yield message
+    finally:
+        for future in pending:
+            future.cancel()
+        pool.shutdown(wait=False)
+
+
+def upload_messages(
+    name: str,
+    points: np.ndarray,
+    progress: Optional[Callable[[int], None]],
+    encoding: str = "auto",
+    counter: Optional[UploadCounter] = None,
+) -> Iterator[bytes]:
+    """The Build stream as serialized messages: a header, then 65,536-point chunks in `encoding`
+    ("auto": each chunk's smallest form; "raw": packed doubles, 1 MiB a chunk)."""
+    yield header_message(name, points)
+    sent = 0
+    for message in _chunk_messages(points, encoding):
+        if counter is not None:
+            counter.bytes += len(message)
+        yield message
+        sent = min(sent + POINTS_PER_CHUNK, len(points))
         if progress is not None:
-            progress(begin + len(chunk))
+            progress(sent)
 
 
 def _identity(b: bytes) -> bytes:
@@ -384,14 +450,15 @@ class _UploadProgress:
 
 
 def build_on_server(
-    calls: Calls, points: np.ndarray, name: str, progress: Optional[Callable[[int], None]]
+    calls: Calls, points: np.ndarray, name: str, progress: Optional[Callable[[int], None]], encoding: str = "auto"
 ) -> NetworkFamilyBackend:
     """Uploads `points` unless the server already holds their handle, and waits for the build.
 
     The upload runs as a future polled from this thread, so that Ctrl-C (KeyboardInterrupt)
     arrives here at once: the call is then cancelled, and the server drops the partial upload and
     its reservation (nothing is left behind), before the interrupt propagates. An exception raised
-    by the progress callback is handled the same way.
+    by the progress callback is handled the same way. `encoding`: "auto" or "raw" (checked by the
+    caller), as :func:`upload_messages` takes it; the chunks are encoded on other threads.
     """
     handle = point_set_handle(points)
     cached = find_cached(calls, handle)
@@ -402,8 +469,9 @@ def build_on_server(
             progress(len(points))
         return NetworkFamilyBackend(calls, handle, cached)
     reporter = _UploadProgress(progress)
+    counter = UploadCounter()
     future = calls.build.future(
-        upload_messages(name, points, reporter), timeout=calls.timeout, metadata=calls.metadata(handle)
+        upload_messages(name, points, reporter, encoding, counter), timeout=calls.timeout, metadata=calls.metadata(handle)
     )
     try:
         while True:
@@ -423,7 +491,8 @@ def build_on_server(
         reporter.released.set()
     if answer.handle != handle:
         raise InvalidInput(f"the server named the family {answer.handle}, the client computed {handle}")
-    return NetworkFamilyBackend(calls, answer.handle, summary_from(answer.summary, cached=answer.cached))
+    summary = dataclasses.replace(summary_from(answer.summary, cached=answer.cached), upload_bytes=counter.bytes)
+    return NetworkFamilyBackend(calls, answer.handle, summary)
 
 
 def wait_for_server(calls: Calls, deadline_s: float) -> None:

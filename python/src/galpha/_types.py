@@ -108,6 +108,9 @@ class BuildSummary:
     peak_memory_bytes: int
     family_bytes: int
     cached: bool = False  #: the server already held the family (nothing was computed)
+    #: Bytes of the point messages this call uploaded (protobuf encoding, without gRPC's framing;
+    #: raw doubles are 16 a point): 0 when nothing was uploaded (a family the server held, the local engine).
+    upload_bytes: int = 0
 
 
 @dataclasses.dataclass(frozen=True)

@@ -8,13 +8,15 @@ decoded by the same code as the blocking client's (``_network.py``, ``_wire.py``
 from __future__ import annotations
 
 import asyncio
-from typing import Any, Callable, List, Optional, Union
+import dataclasses
+from typing import Any, AsyncIterator, Callable, List, Optional, Union
 
 import grpc
 import numpy as np
 
 from . import _network, _wire
 from ._client import Progress, progress_callback
+from ._encoding import check_encoding
 from ._errors import InvalidInput
 from ._family import _mode, _rule, rings_to_shapely, threshold_from
 from ._handle import point_set_handle
@@ -171,6 +173,37 @@ class AsyncFamily:
         return (await self._call(self._calls.release, pb.ReleaseRequest(handle=self.handle))).released
 
 
+async def _upload_messages(
+    name: str,
+    points: np.ndarray,
+    progress: Optional[Callable[[int], None]],
+    encoding: str,
+    counter: _network.UploadCounter,
+) -> AsyncIterator[bytes]:
+    """_network.upload_messages for grpc.aio: grpc.aio iterates a plain iterator on the event loop,
+    so the chunks are encoded in the loop's executor instead, the next while one is sent."""
+    loop = asyncio.get_running_loop()
+    yield _network.header_message(name, points)
+    bounds = _network.chunk_bounds(points)
+
+    def encode(i: int) -> "asyncio.Future[bytes]":
+        begin, end = bounds[i]
+        return loop.run_in_executor(None, _network.chunk_message, points[begin:end], encoding)
+
+    upcoming = encode(0) if bounds else None
+    try:
+        for i, (_, end) in enumerate(bounds):
+            message = await upcoming  # type: ignore[misc]
+            upcoming = encode(i + 1) if i + 1 < len(bounds) else None
+            counter.bytes += len(message)
+            yield message
+            if progress is not None:
+                progress(end)
+    finally:
+        if upcoming is not None:
+            upcoming.cancel()
+
+
 class AsyncClient:
     """A grpc.aio connection to a galpha server (``galpha.aio.connect``)."""
 
@@ -188,9 +221,12 @@ class AsyncClient:
     async def close(self) -> None:
         await self._channel.close()
 
-    async def build(self, points: Any, *, name: str = "", progress: Progress = None) -> AsyncFamily:
+    async def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> AsyncFamily:
         """Uploads the points (unless the server holds them) and awaits the build. Cancelling the
-        task cancels the upload; the server then drops what it had received."""
+        task cancels the upload; the server then drops what it had received. ``encoding``: "auto"
+        or "raw", as :meth:`galpha.NetworkClient.build` takes it (chunks are encoded off the event
+        loop, in its default executor)."""
+        encoding = check_encoding(encoding)
         array, crs = as_points(points)
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
@@ -207,16 +243,18 @@ class AsyncClient:
             except grpc.RpcError as e:
                 if e.code() != grpc.StatusCode.NOT_FOUND:
                     raise _network.raise_from_rpc(e) from None
+            counter = _network.UploadCounter()
             try:
                 answer = await self._calls.build(
-                    _network.upload_messages(name, array, sent), timeout=self._calls.timeout, metadata=metadata
+                    _upload_messages(name, array, sent, encoding, counter), timeout=self._calls.timeout, metadata=metadata
                 )
             except grpc.RpcError as e:
                 raise _network.raise_from_rpc(e) from None
         finally:
             if close is not None:
                 close()
-        return AsyncFamily(self._calls, answer.handle, _network.summary_from(answer.summary, answer.cached), array, crs)
+        summary = dataclasses.replace(_network.summary_from(answer.summary, answer.cached), upload_bytes=counter.bytes)
+        return AsyncFamily(self._calls, answer.handle, summary, array, crs)
 
 
 def connect(
