@@ -59,7 +59,10 @@ client::BuildCallOptions Upload() {
 /// released its handles). glibc returns freed memory lazily: allow a little slack.
 void ExpectBackToBaseline(const ServerProcess& server, size_t baseline) {
   ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_builds_in_flight") == 0.0; }, 60));
-  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_cache_entries") == 0.0; }, 10));
+  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_cache_entries") == 0.0; }, 10))
+      << "the server's metrics:\n"
+      << testing::HttpGet(server.metrics_port(), "/metrics") << "\nits log:\n"
+      << server.log();
   const size_t slack = std::max<size_t>(64u << 20, baseline / 2);
   size_t now = 0;
   // Connections and their buffers go away a little after their calls end.
