@@ -27,4 +27,5 @@ proto/lint.sh
 # Deployment: the manifests against their schemas, and the container image's build steps (no
 # Docker engine here: deploy/build-server.sh is what the Dockerfile runs).
 deploy/k8s/validate.sh
-deploy/build-server.sh build/image-root
+# The image's CUDA code only where it can be tested, as for the preset above.
+GALPHA_IMAGE_WITH_CUDA=$([ "$preset" = cuda ] && echo AUTO || echo OFF) deploy/build-server.sh build/image-root
