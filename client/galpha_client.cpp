@@ -93,6 +93,9 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
       result.handle = handle;
       result.cached = true;
       result.summary = described->summary();
+      // The server keeps no name with a family (proto: BuildHeader.name): the caller's label is
+      // this call's, as a Build answer would carry it.
+      result.summary.set_name(options.name);
       return result;
     }
     if (!absl::IsNotFound(described.status())) return described.status();

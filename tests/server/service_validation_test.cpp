@@ -108,6 +108,15 @@ TEST(ServiceValidationTest, NamesHaveALimitAndBelongToTheirCaller) {
   auto described = other->Describe(first->handle);
   ASSERT_THAT(described, IsOk());
   EXPECT_EQ(described->summary().name(), "") << "Describe has no caller's name to answer with";
+  // The client library finds the family with Describe and skips the upload: the answer still
+  // carries this caller's name, as the Build answer would.
+  client::BuildCallOptions found;
+  found.name = "found without an upload";
+  auto skipped = other->Build(points, found);
+  ASSERT_THAT(skipped, IsOk());
+  EXPECT_TRUE(skipped->cached);
+  EXPECT_FALSE(skipped->uploaded);
+  EXPECT_EQ(skipped->summary.name(), "found without an upload");
 }
 
 TEST(ServiceValidationTest, SpectrumPagesAreCapped) {
