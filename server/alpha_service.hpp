@@ -14,6 +14,7 @@
 #include "gpu/triangulation/delaunay.hpp"
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
+#include "server/build_time_limit.hpp"
 #include "server/family_cache.hpp"
 #include "server/metrics.hpp"
 #include "server/tenant_tokens.hpp"
@@ -48,6 +49,9 @@ struct ServiceOptions {
   /// A Build stream with no message for this long is ended (DEADLINE_EXCEEDED) and its points
   /// dropped; zero: never.
   std::chrono::milliseconds upload_idle_timeout{30000};
+  /// How long one build may run (server/build_time_limit.hpp); past it the build stops at its
+  /// next phase boundary and answers DEADLINE_EXCEEDED.
+  BuildTimeLimitOptions build_time;
   /// Byte budget of the family cache.
   size_t cache_bytes = size_t{8} << 30;
   TenantTokens tokens;

@@ -4,12 +4,14 @@
 
 #include <chrono>
 #include <memory>
+#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "server/alpha_service.hpp"
 #include "server/build_refusal.hpp"
+#include "server/build_time_limit.hpp"
 #include "server/grpc_status.hpp"
 #include "server/query_answers.hpp"
 
@@ -140,13 +142,27 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   BuildOptions options;
   options.backend = service_->backend_;
   options.cuda_stream = slot.cuda_stream;
-  options.cancelled = [this] { return cancelled_.load(); };
+  // The time limit counts from the start on a slot (queueing is the service's doing, not the
+  // input's); the engine polls between its phases, so a build stops at the next boundary.
+  const bool cuda = service_->backend_name_ == "cuda";
+  const unsigned cores = std::thread::hardware_concurrency();
+  const size_t points = build_->points.size();
+  const auto limit = BuildTimeLimit(points, cuda, cores, service_->options_.build_time);
   const auto start = Clock::now();
+  const bool limited = limit.count() > 0;
+  const auto deadline = start + std::chrono::duration_cast<Clock::duration>(limit);
+  options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
   absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(build_->points, options);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   decoder_.ReleasePoints();
   if (!family.ok()) {
     ReturnFreedMemory();
+    if (absl::IsCancelled(family.status()) && !cancelled_ && limited && Clock::now() > deadline) {
+      Respond(TagRefusal(
+          absl::DeadlineExceededError(BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time)),
+          BuildRefusal::kBuildTime));
+      return;
+    }
     Respond(family.status());
     return;
   }

@@ -32,6 +32,8 @@ std::string_view RefusalLabel(BuildRefusal reason) {
       return "cache_bytes";
     case BuildRefusal::kDraining:
       return "draining";
+    case BuildRefusal::kBuildTime:
+      return "build_time";
   }
   return "unknown";
 }

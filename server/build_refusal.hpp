@@ -22,13 +22,15 @@ enum class BuildRefusal {
   kBuildMemory,          // --build_memory_bytes
   kCacheBytes,           // --cache_bytes
   kDraining,             // SIGTERM
+  kBuildTime,            // --build_time_multiple, --build_time_floor_ms
 };
 
 /// Every reason, so that the metrics export each series from the start (at 0).
-inline constexpr std::array<BuildRefusal, 9> kAllBuildRefusals = {
+inline constexpr std::array<BuildRefusal, 10> kAllBuildRefusals = {
     BuildRefusal::kPointsPerBuild, BuildRefusal::kInFlightBytes, BuildRefusal::kTenantInFlightBytes,
     BuildRefusal::kIdleTimeout,    BuildRefusal::kQueueFull,     BuildRefusal::kTenantQueuedBuilds,
-    BuildRefusal::kBuildMemory,    BuildRefusal::kCacheBytes,    BuildRefusal::kDraining};
+    BuildRefusal::kBuildMemory,    BuildRefusal::kCacheBytes,    BuildRefusal::kDraining,
+    BuildRefusal::kBuildTime};
 
 /// The metric label of `reason` ("points_per_build", "in_flight_bytes", ...).
 std::string_view RefusalLabel(BuildRefusal reason);

@@ -35,6 +35,10 @@ ABSL_FLAG(uint64_t, max_tenant_in_flight_bytes, uint64_t{4} << 30,
 ABSL_FLAG(int, upload_idle_timeout_ms, 30000,
           "a Build stream with no message for this long is ended with DEADLINE_EXCEEDED and its points dropped; "
           "0: never");
+ABSL_FLAG(double, build_time_multiple, 50,
+          "a build may run this many times its expected time (60 ns a point on CUDA, 14 us a point over the "
+          "host's cores on the CPU), then stops with DEADLINE_EXCEEDED; 0: no limit");
+ABSL_FLAG(int, build_time_floor_ms, 10000, "the build time limit is never below this");
 ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30, "byte budget of the family cache (LRU eviction)");
 ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
 ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
@@ -103,6 +107,10 @@ int main(int argc, char** argv) {
   options.service.max_tenant_in_flight_bytes = absl::GetFlag(FLAGS_max_tenant_in_flight_bytes);
   if (absl::GetFlag(FLAGS_upload_idle_timeout_ms) < 0) return Fail("--upload_idle_timeout_ms must be >= 0");
   options.service.upload_idle_timeout = std::chrono::milliseconds(absl::GetFlag(FLAGS_upload_idle_timeout_ms));
+  if (!(absl::GetFlag(FLAGS_build_time_multiple) >= 0)) return Fail("--build_time_multiple must be >= 0");
+  if (absl::GetFlag(FLAGS_build_time_floor_ms) < 0) return Fail("--build_time_floor_ms must be >= 0");
+  options.service.build_time.multiple = absl::GetFlag(FLAGS_build_time_multiple);
+  options.service.build_time.floor = std::chrono::milliseconds(absl::GetFlag(FLAGS_build_time_floor_ms));
   options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
   if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
     auto tokens = galpha::server::TenantTokens::ReadFile(path);

@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "core/io/point_set_handle.hpp"
+#include "server/build_time_limit.hpp"
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
@@ -143,6 +145,42 @@ TEST(ServiceLimitsTest, IdleUploadIsEndedAndItsBytesFreed) {
   // Nor is a build that runs (or waits in the queue) for longer than the limit: only uploads idle.
   EXPECT_THAT(client->Build(gen::Uniform(SlowBuildPoints(), 34)), IsOk());
   EXPECT_EQ(ScrapeMetric(*server, Rejected("idle_timeout")), 1.0);
+}
+
+// The build time limit (issue "No slow inputs", item 5): a multiple of the expected time for the
+// size, with a floor; off at 0.
+TEST(BuildTimeLimitTest, IsAMultipleOfTheExpectedTimeWithAFloor) {
+  BuildTimeLimitOptions options;  // 50 x, at least 10 s
+  EXPECT_DOUBLE_EQ(ExpectedBuildSeconds(1'000'000, /*cuda=*/true, 16), 0.06);
+  EXPECT_DOUBLE_EQ(ExpectedBuildSeconds(1'000'000, /*cuda=*/false, 2), 7.0);
+  EXPECT_DOUBLE_EQ(BuildTimeLimit(1'000'000, true, 16, options).count(), 10.0);     // the floor
+  EXPECT_DOUBLE_EQ(BuildTimeLimit(100'000'000, true, 16, options).count(), 300.0);  // 50 x 6 s
+  EXPECT_DOUBLE_EQ(BuildTimeLimit(1'000'000, false, 2, options).count(), 350.0);    // 50 x 7 s
+  EXPECT_DOUBLE_EQ(BuildTimeLimit(1'000'000, false, 0, options).count(), 700.0);    // unknown cores: 1
+  options.multiple = 0;
+  EXPECT_DOUBLE_EQ(BuildTimeLimit(1'000'000, false, 2, options).count(), 0.0);  // off
+}
+
+// A build that runs past its limit stops at the engine's next phase boundary and answers
+// DEADLINE_EXCEEDED naming the limit and its flags; nothing is cached, its points are freed, and
+// the refusal is counted once under its reason.
+TEST(ServiceLimitsTest, ABuildPastItsTimeLimitStops) {
+  ServerOptions options = TestServerOptions();
+  options.service.build_time.multiple = 1e-4;  // a fraction of a millisecond for these points
+  options.service.build_time.floor = std::chrono::milliseconds(0);
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  EXPECT_EQ(ScrapeMetric(*server, Rejected("build_time")), 0.0) << "every reason is exported from the start";
+  auto client = ClientOf(*server);
+  const std::vector<Point2> points = gen::Uniform(SlowBuildPoints(), 41);
+  client::BuildCallOptions call;
+  call.skip_upload_if_cached = false;
+  const auto built = client->Build(points, call);
+  EXPECT_THAT(built.status(), StatusIs(absl::StatusCode::kDeadlineExceeded, HasSubstr("--build_time_multiple")));
+  EXPECT_THAT(built.status().message(), HasSubstr("time limit"));
+  EXPECT_EQ(ScrapeMetric(*server, Rejected("build_time")), 1.0);
+  EXPECT_THAT(client->Describe(PointSetHandle(points)).status(), StatusIs(absl::StatusCode::kNotFound));
+  EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 5));
 }
 
 ServerOptions TwoTenants() {
