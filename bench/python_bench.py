@@ -8,7 +8,10 @@
   * classify at one alpha: NumPy arrays per second, both clients.
 
     /usr/bin/python3 bench/python_bench.py [--points 1000000] [--repeat 3] [--backend cpu]
-        [--build-dir build/cpu] [--server HOST:PORT]
+        [--build-dir build/cpu] [--server HOST:PORT] [--encoding auto|raw]
+
+Both network clients upload in the same --encoding (default auto: each chunk's smallest lossless
+form; uniform doubles compress only to ~13.3 bytes a point, so on loopback raw can be faster).
 
 Without --server it starts build-dir's galpha_server on a free loopback port (same backend).
 Prints one table and the ratios (Python / C++).
@@ -55,6 +58,7 @@ def main() -> int:
     parser.add_argument("--backend", default="cpu", choices=["auto", "cpu", "cuda"])
     parser.add_argument("--build-dir", default=str(REPO / "build" / "cpu"))
     parser.add_argument("--server", help="an already running galpha_server (default: start one)")
+    parser.add_argument("--encoding", default="auto", choices=["auto", "raw"], help="how both network clients upload")
     args = parser.parse_args()
     build = pathlib.Path(args.build_dir).resolve()
     sys.path[:0] = [str(REPO / "python" / "src"), str(build / "python")]
@@ -97,7 +101,7 @@ def main() -> int:
             handle = galpha.point_set_handle(points)
             cpp_rpc = cpp_overhead = net_wall = net_overhead = float("inf")
             for _ in range(args.repeat):
-                rows = alphactl_bench(alphactl, file, 1, [f"--server={target}"])  # releases the handle first
+                rows = alphactl_bench(alphactl, file, 1, [f"--server={target}", f"--encoding={args.encoding}"])  # releases the handle first
                 cpp_rpc = min(cpp_rpc, rows["rpc_total"])
                 cpp_overhead = min(cpp_overhead, rows["rpc_total"] - rows["total"])
                 try:
@@ -105,8 +109,9 @@ def main() -> int:
                 except galpha.NotFound:
                     pass
                 start = time.perf_counter()
-                remote = net.build(points)
+                remote = net.build(points, encoding=args.encoding)
                 wall = time.perf_counter() - start
+                upload_bytes = remote.summary.upload_bytes
                 net_wall = min(net_wall, wall)
                 net_overhead = min(net_overhead, wall - sum(remote.summary.stage_times.values()))
             net_classify = classify_rate(remote, alpha)
@@ -127,6 +132,7 @@ def main() -> int:
     print(f"{'network: C++ client, wall minus server stages':52}{cpp_overhead:10.1f}")
     print(f"{'network: galpha.connect().build(), wall':52}{ms(net_wall)}")
     print(f"{'network: galpha.connect().build(), minus stages':52}{ms(net_overhead)}")
+    print(f"{'network: Python upload, bytes a point (' + args.encoding + ')':52}{upload_bytes / args.points:10.2f}")
     print(f"{'classify, local: ms / GB/s':52}{ms(local_classify[0])}  {local_classify[1]:.2f} GB/s")
     print(f"{'classify, network: ms / GB/s':52}{ms(net_classify[0])}  {net_classify[1]:.2f} GB/s")
     print(f"ratio local (Python wall / C++ engine stages): {py_wall * 1e3 / cpp_local:.3f}  (target <= 1.05)")

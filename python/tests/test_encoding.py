@@ -62,7 +62,9 @@ def las_like() -> np.ndarray:
 def wide_integers() -> np.ndarray:
     """Lon/lat in units of 10^-9 degree: integers past 2^31 (INT64)."""
     rng = np.random.default_rng(8)
-    return np.stack([rng.integers(14_000_000_000, 16_000_000_000, 2000), rng.integers(45_000_000_000, 46_000_000_000, 2000)], axis=1) / 1e9
+    x = rng.integers(14_000_000_000, 16_000_000_000, 2000)
+    y = rng.integers(45_000_000_000, 46_000_000_000, 2000)
+    return np.stack([x, y], axis=1) / 1e9
 
 
 FLOAT_ARRAYS = {
@@ -142,7 +144,8 @@ def test_every_found_scale_reproduces_each_value_with_separate_roundings() -> No
 
 def test_an_integer_encoding_refuses_an_inexact_value() -> None:
     with pytest.raises(galpha.InvalidInput, match=r"point 1's x"):
-        E.encode_chunk(np.array([[0.25, 1.0], [0.3, 2.0]]), E.ChunkEncoding(E.INT32, x_scale=E.AxisScale(0.25), y_scale=E.AxisScale(1.0)))
+        quarters = E.ChunkEncoding(E.INT32, x_scale=E.AxisScale(0.25), y_scale=E.AxisScale(1.0))
+        E.encode_chunk(np.array([[0.25, 1.0], [0.3, 2.0]]), quarters)
 
 
 def test_the_smallest_form_is_raw_when_nothing_beats_16_bytes_a_point() -> None:
@@ -238,3 +241,15 @@ def test_many_chunks_arrive_in_order_with_progress(client) -> None:
             return f.summary.upload_bytes
 
     assert asyncio.run(run()) == expected
+
+
+def test_without_zstd_auto_sends_plain_integers_or_raw_doubles() -> None:
+    saved = E._scratch.compressor
+    E._scratch.compressor = None  # as if the zstandard package were missing
+    try:
+        request = pb.BuildRequest.FromString(E.encode_smallest(las_like()))
+        assert request.encoded_points.value_type == E.INT32 and request.encoded_points.compression == E.UNCOMPRESSED
+        assert pb.BuildRequest.FromString(E.encode_smallest(awkward())).WhichOneof("part") == "points"
+        np.testing.assert_array_equal(bits(E.decode_request(request.SerializeToString())), bits(las_like()))
+    finally:
+        E._scratch.compressor = saved

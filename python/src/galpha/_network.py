@@ -226,33 +226,48 @@ def chunk_bounds(points: np.ndarray) -> List[Tuple[int, int]]:
     return [(b, min(b + POINTS_PER_CHUNK, len(points))) for b in range(0, len(points), POINTS_PER_CHUNK)]
 
 
+_encode_pool: Optional[concurrent.futures.ThreadPoolExecutor] = None
+_encode_pool_lock = threading.Lock()
+
+
+def _encoder_pool() -> concurrent.futures.ThreadPoolExecutor:
+    """The process's chunk encoders, made on first use and kept: each thread keeps its scratch
+    buffers from upload to upload (fresh pages cost more than the encoding on some machines)."""
+    global _encode_pool
+    with _encode_pool_lock:
+        if _encode_pool is None:
+            _encode_pool = concurrent.futures.ThreadPoolExecutor(ENCODE_THREADS, thread_name_prefix="galpha-encode")
+        return _encode_pool
+
+
 def _chunk_messages(points: np.ndarray, encoding: str) -> Iterator[bytes]:
-    """The chunks' messages in order; "auto" encodes up to ENCODE_THREADS chunks ahead on a pool
-    (the send of one overlaps the encoding of the next), which is shut down when the stream ends
-    or is abandoned (a cancelled call)."""
+    """The chunks' messages in order; "auto" encodes up to ENCODE_THREADS + 1 chunks ahead on a
+    pool (the send of one overlaps the encoding of the next); what is still queued when the stream
+    ends or is abandoned (a cancelled call) is cancelled."""
     bounds = chunk_bounds(points)
-    if encoding == "raw" or len(bounds) <= 1 or ENCODE_THREADS == 1:
+    if encoding == "raw" or len(bounds) <= 1:
         for begin, end in bounds:
             yield chunk_message(points[begin:end], encoding)
         return
-    pool = concurrent.futures.ThreadPoolExecutor(ENCODE_THREADS, thread_name_prefix="galpha-encode")
+    pool = _encoder_pool()
     pending: collections.deque = collections.deque()
-    try:
-        upcoming = iter(bounds)
+    upcoming = iter(bounds)
+
+    def submit_next() -> None:
         for begin, end in upcoming:
             pending.append(pool.submit(chunk_message, points[begin:end], encoding))
-            if len(pending) > ENCODE_THREADS:
-                break
+            return
+
+    try:
+        for _ in range(ENCODE_THREADS + 1):
+            submit_next()
         while pending:
             message = pending.popleft().result()
-            for begin, end in upcoming:
-                pending.append(pool.submit(chunk_message, points[begin:end], encoding))
-                break
+            submit_next()
             yield message
     finally:
         for future in pending:
             future.cancel()
-        pool.shutdown(wait=False)
 
 
 def upload_messages(
