@@ -229,9 +229,8 @@ def find_axis_scale(values: np.ndarray, out: Optional[np.ndarray] = None) -> Opt
     steps = np.array([c.step for c in candidates])[:, None]
     divide = np.array([c.divide for c in candidates])[:, None]
     offsets = np.array([c.offset for c in candidates])[:, None]
+    x = _estimate(head[None, :], steps, divide, offsets)
     with np.errstate(all="ignore"):
-        shifted = head[None, :] - offsets
-        x = np.rint(np.where(divide, shifted * steps, shifted / steps))
         back = offsets + np.where(divide, x / steps, steps * x)  # two roundings, as AxisScale.values
     passing = np.all((back.view(np.uint64) == head.view(np.uint64)) & (np.abs(x) <= _MAX_EXACT_INTEGER), axis=1)
     for index in np.flatnonzero(passing):
