@@ -120,6 +120,19 @@ def test_a_set_the_server_holds_is_not_uploaded_again(client) -> None:
     assert "upload" in stages and len(stages) == 1  # one report: nothing was streamed
 
 
+def test_progress_covers_the_upload_and_the_build(client) -> None:
+    points = np.random.default_rng(21).random((300_000, 2))
+    reports = []
+    client.build(points, progress=lambda stage, fraction: reports.append((stage, fraction)))
+    stages = [stage for stage, _ in reports]
+    assert stages[0] == "upload" and ("upload", 1.0) in reports
+    first_build = stages.index("build")
+    assert set(stages[first_build:]) == {"build"}, "the build's reports follow the whole upload"
+    assert reports[-1] == ("build", 1.0)
+    fractions = [f for s, f in reports if s == "upload"]
+    assert fractions == sorted(fractions)
+
+
 def test_ctrl_c_during_an_upload_leaves_nothing_behind(start_server) -> None:
     # Room for one 200K-point set (3.2 MB) in flight, not two: a leaked reservation would refuse
     # the second upload.

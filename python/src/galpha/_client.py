@@ -97,7 +97,9 @@ class NetworkClient:
         total = max(len(array), 1)
         try:
             sent = None if callback is None else (lambda n: callback("upload", n / total))
-            backend = self._network.build_on_server(self._calls, array, name, sent, encoding)
+            # The server's build reports no progress: the bar shows the wait as stage "build".
+            building = None if callback is None else (lambda done: callback("build", 1.0 if done else 0.0))
+            backend = self._network.build_on_server(self._calls, array, name, sent, encoding, building)
         finally:
             if close is not None:
                 close()

@@ -453,8 +453,10 @@ class _UploadProgress:
         self.callback = callback
         self.failure: Optional[BaseException] = None
         self.released = threading.Event()
+        self.sent = 0  # points streamed so far
 
     def __call__(self, sent: int) -> None:
+        self.sent = sent
         if self.callback is None or self.failure is not None:
             return
         try:
@@ -465,7 +467,12 @@ class _UploadProgress:
 
 
 def build_on_server(
-    calls: Calls, points: np.ndarray, name: str, progress: Optional[Callable[[int], None]], encoding: str = "auto"
+    calls: Calls,
+    points: np.ndarray,
+    name: str,
+    progress: Optional[Callable[[int], None]],
+    encoding: str = "auto",
+    building: Optional[Callable[[bool], None]] = None,
 ) -> NetworkFamilyBackend:
     """Uploads `points` unless the server already holds their handle, and waits for the build.
 
@@ -474,6 +481,9 @@ def build_on_server(
     its reservation (nothing is left behind), before the interrupt propagates. An exception raised
     by the progress callback is handled the same way. `encoding`: "auto" or "raw" (checked by the
     caller), as :func:`upload_messages` takes it; the chunks are encoded on other threads.
+    `building(done)` is called from this thread about twice a second once every point is sent
+    (the server builds; the Build answer carries no progress) and once with True at the end, so
+    that a progress bar shows the wait.
     """
     handle = point_set_handle(points)
     cached = find_cached(calls, handle)
@@ -488,10 +498,14 @@ def build_on_server(
     future = calls.build.future(
         upload_messages(name, points, reporter, encoding, counter), timeout=calls.timeout, metadata=calls.metadata(handle)
     )
+    last_report = 0.0
     try:
         while True:
             if reporter.failure is not None:
                 raise reporter.failure
+            if building is not None and reporter.sent == len(points) and time.monotonic() - last_report >= 0.5:
+                last_report = time.monotonic()
+                building(False)
             try:
                 answer = future.result(timeout=0.05)
                 break
@@ -506,6 +520,8 @@ def build_on_server(
         reporter.released.set()
     if answer.handle != handle:
         raise InvalidInput(f"the server named the family {answer.handle}, the client computed {handle}")
+    if building is not None:
+        building(True)
     summary = dataclasses.replace(summary_from(answer.summary, cached=answer.cached), upload_bytes=counter.bytes)
     return NetworkFamilyBackend(calls, answer.handle, summary)
 
