@@ -12,35 +12,13 @@
 #include "absl/strings/str_cat.h"
 #include "client/commands.hpp"
 #include "client/text_output.hpp"
+#include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
 #include "core/geometry/shape.hpp"
 
 namespace galpha::alphactl {
 
 namespace {
-
-/// Edge ids ordered by their (smaller, larger) vertex indices.
-std::vector<std::pair<std::array<uint32_t, 2>, uint32_t>> EdgesInIndexOrder(const AlphaFamily& family) {
-  std::vector<std::pair<std::array<uint32_t, 2>, uint32_t>> order(family.edges().size());
-  for (uint32_t e = 0; e < order.size(); ++e) {
-    const auto& edge = family.edges()[e];
-    order[e] = {{std::min(edge[0], edge[1]), std::max(edge[0], edge[1])}, e};
-  }
-  std::sort(order.begin(), order.end());
-  return order;
-}
-
-/// Triangle ids ordered by their vertex indices, each triple sorted ascending.
-std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> TrianglesInIndexOrder(const AlphaFamily& family) {
-  std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> order(family.triangles().size());
-  for (uint32_t t = 0; t < order.size(); ++t) {
-    std::array<uint32_t, 3> key = family.triangles()[t];
-    std::sort(key.begin(), key.end());
-    order[t] = {key, t};
-  }
-  std::sort(order.begin(), order.end());
-  return order;
-}
 
 int FinishOutput(ChunkedWriter& out) {
   if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
@@ -71,16 +49,19 @@ int RunClassify(Args args) {
     out.Append(SimplexClassName(classes.vertices[v]));
     out.Append('\n');
   }
-  for (const auto& [vertices, e] : EdgesInIndexOrder(*family)) {
-    AppendSimplex(out, 'e', vertices);
+  const CanonicalOrders orders = ComputeCanonicalOrders(*family);
+  for (size_t i = 0; i < orders.edge_order.size(); ++i) {
+    AppendSimplex<2>(out, 'e', {orders.edge_vertices[2 * i], orders.edge_vertices[2 * i + 1]});
     out.Append(' ');
-    out.Append(SimplexClassName(classes.edges[e]));
+    out.Append(SimplexClassName(classes.edges[orders.edge_order[i]]));
     out.Append('\n');
   }
-  for (const auto& [vertices, t] : TrianglesInIndexOrder(*family)) {
-    AppendSimplex(out, 't', vertices);
+  for (size_t i = 0; i < orders.triangle_order.size(); ++i) {
+    AppendSimplex<3>(
+        out, 't',
+        {orders.triangle_vertices[3 * i], orders.triangle_vertices[3 * i + 1], orders.triangle_vertices[3 * i + 2]});
     out.Append(' ');
-    out.Append(SimplexClassName(classes.triangles[t]));
+    out.Append(SimplexClassName(classes.triangles[orders.triangle_order[i]]));
     out.Append('\n');
   }
   return FinishOutput(out);

@@ -1,8 +1,8 @@
 #include "server/cached_family.hpp"
 
-#include <algorithm>
-#include <array>
 #include <utility>
+
+#include "core/family/canonical_order.hpp"
 
 namespace galpha::server {
 
@@ -32,36 +32,11 @@ const std::vector<uint32_t>& CachedFamily::TriangleVerticesInOrder() const {
 }
 
 void CachedFamily::ComputeOrders() const {
-  // Sort 64-bit keys with the id in the low bits where they fit: one pass of std::sort over plain
-  // integers instead of a comparator over indirections.
-  const auto& edges = family_.edges();
-  std::vector<std::pair<uint64_t, uint32_t>> edge_keys(edges.size());
-  for (uint32_t e = 0; e < edges.size(); ++e) {
-    edge_keys[e] = {(uint64_t{std::min(edges[e][0], edges[e][1])} << 32) | std::max(edges[e][0], edges[e][1]), e};
-  }
-  std::sort(edge_keys.begin(), edge_keys.end());
-  edge_order_.resize(edges.size());
-  edge_vertices_.resize(2 * edges.size());
-  for (size_t i = 0; i < edge_keys.size(); ++i) {
-    edge_order_[i] = edge_keys[i].second;
-    edge_vertices_[2 * i] = static_cast<uint32_t>(edge_keys[i].first >> 32);
-    edge_vertices_[2 * i + 1] = static_cast<uint32_t>(edge_keys[i].first);
-  }
-
-  const auto& triangles = family_.triangles();
-  std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> tri_keys(triangles.size());
-  for (uint32_t t = 0; t < triangles.size(); ++t) {
-    std::array<uint32_t, 3> key = triangles[t];
-    std::sort(key.begin(), key.end());
-    tri_keys[t] = {key, t};
-  }
-  std::sort(tri_keys.begin(), tri_keys.end());
-  triangle_order_.resize(triangles.size());
-  triangle_vertices_.resize(3 * triangles.size());
-  for (size_t i = 0; i < tri_keys.size(); ++i) {
-    triangle_order_[i] = tri_keys[i].second;
-    for (size_t k = 0; k < 3; ++k) triangle_vertices_[3 * i + k] = tri_keys[i].first[k];
-  }
+  CanonicalOrders orders = ComputeCanonicalOrders(family_);
+  edge_order_ = std::move(orders.edge_order);
+  edge_vertices_ = std::move(orders.edge_vertices);
+  triangle_order_ = std::move(orders.triangle_order);
+  triangle_vertices_ = std::move(orders.triangle_vertices);
 }
 
 }  // namespace galpha::server

@@ -1,9 +1,8 @@
 #include "python/engine/family_state.hpp"
 
-#include <algorithm>
-#include <array>
 #include <utility>
 
+#include "core/family/canonical_order.hpp"
 #include "core/io/point_set_handle.hpp"
 
 namespace galpha::python {
@@ -52,36 +51,11 @@ void FamilyState::ComputeOrders() const {
     if (representative[v] == v) distinct_vertices_.push_back(v);
   }
 
-  // 64-bit keys (smaller << 32 | larger) sort as the pairs do, in one pass over plain integers.
-  const auto& edges = family_.edges();
-  std::vector<std::pair<uint64_t, uint32_t>> edge_keys(edges.size());
-  for (uint32_t e = 0; e < edges.size(); ++e) {
-    const uint32_t a = std::min(edges[e][0], edges[e][1]), b = std::max(edges[e][0], edges[e][1]);
-    edge_keys[e] = {(uint64_t{a} << 32) | b, e};
-  }
-  std::sort(edge_keys.begin(), edge_keys.end());
-  edge_order_.resize(edges.size());
-  edge_vertices_.resize(2 * edges.size());
-  for (size_t i = 0; i < edge_keys.size(); ++i) {
-    edge_order_[i] = edge_keys[i].second;
-    edge_vertices_[2 * i] = static_cast<uint32_t>(edge_keys[i].first >> 32);
-    edge_vertices_[2 * i + 1] = static_cast<uint32_t>(edge_keys[i].first);
-  }
-
-  const auto& triangles = family_.triangles();
-  std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> triangle_keys(triangles.size());
-  for (uint32_t t = 0; t < triangles.size(); ++t) {
-    std::array<uint32_t, 3> key = triangles[t];
-    std::sort(key.begin(), key.end());
-    triangle_keys[t] = {key, t};
-  }
-  std::sort(triangle_keys.begin(), triangle_keys.end());
-  triangle_order_.resize(triangles.size());
-  triangle_vertices_.resize(3 * triangles.size());
-  for (size_t i = 0; i < triangle_keys.size(); ++i) {
-    triangle_order_[i] = triangle_keys[i].second;
-    for (size_t k = 0; k < 3; ++k) triangle_vertices_[3 * i + k] = triangle_keys[i].first[k];
-  }
+  CanonicalOrders orders = ComputeCanonicalOrders(family_);
+  edge_order_ = std::move(orders.edge_order);
+  edge_vertices_ = std::move(orders.edge_vertices);
+  triangle_order_ = std::move(orders.triangle_order);
+  triangle_vertices_ = std::move(orders.triangle_vertices);
 }
 
 }  // namespace galpha::python

@@ -1,0 +1,24 @@
+// The canonical order in which answers list a family's edges and triangles (the service's
+// Classify order, alphactl's and the Python package's): edges by their (smaller, larger) vertex
+// pair, triangles by their ascending vertex triple, both lexicographically. One computation for
+// every front end, so that they cannot drift apart.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/family/alpha_family.hpp"
+
+namespace galpha {
+
+struct CanonicalOrders {
+  /// Edge ids in canonical order, and their vertex pairs in that order, flat (2 per edge).
+  std::vector<uint32_t> edge_order, edge_vertices;
+  /// Triangle ids in canonical order, and their ascending vertex triples in that order, flat.
+  std::vector<uint32_t> triangle_order, triangle_vertices;
+};
+
+/// O(n log n); the orders depend only on the triangulation, so callers compute them once.
+CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family);
+
+}  // namespace galpha
