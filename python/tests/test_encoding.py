@@ -226,10 +226,12 @@ def test_many_chunks_arrive_in_order_with_progress(client) -> None:
     """11 chunks encoded on the pool: order, progress and bytes as for one thread."""
     rng = np.random.default_rng(13)
     points = np.round(rng.uniform(0, 1000, (11 * 65536 - 7, 2)), 2)
-    seen = []
-    family = client.build(points, progress=lambda stage, f: seen.append(f))
+    reports = []
+    family = client.build(points, progress=lambda stage, f: reports.append((stage, f)))
     assert family.handle == galpha.point_set_handle(points)
+    seen = [f for stage, f in reports if stage == "upload"]
     assert seen == sorted(seen) and seen[-1] == 1.0 and len(seen) == 11
+    assert reports[-1] == ("build", 1.0)  # then the wait for the server's build
     expected = sum(len(E.encode_smallest(points[b:e])) for b, e in _network.chunk_bounds(points))
     assert family.summary.upload_bytes == expected
     family.release()
