@@ -24,6 +24,7 @@
 #include "core/exact/attachment.hpp"
 #include "core/exact/predicates.hpp"
 #include "core/io/input_validation.hpp"
+#include "tests/support/input_domain_oracle.hpp"
 
 namespace {
 
@@ -55,30 +56,8 @@ double FiniteFromBits(uint64_t bits) {
   return d;
 }
 
-mpq_class Pow2(int e) {
-  mpq_class q(1);
-  if (e >= 0) mpz_mul_2exp(q.get_num_mpz_t(), q.get_num_mpz_t(), static_cast<mp_bitcnt_t>(e));
-  if (e < 0) mpz_mul_2exp(q.get_den_mpz_t(), q.get_den_mpz_t(), static_cast<mp_bitcnt_t>(-e));
-  return q;
-}
-
 /// The domain, decided with rationals from its definition.
-bool InDomain(const Point2* p, int n) {
-  mpq_class largest(0), smallest(0);
-  bool any = false;
-  for (int i = 0; i < n; ++i) {
-    for (const double c : {p[i].x, p[i].y}) {
-      mpq_class m = abs(mpq_class(c));
-      if (m >= Pow2(500)) return false;
-      if (m == 0) continue;
-      if (m < Pow2(-1022)) m = Pow2(-1022);
-      if (!any || m > largest) largest = m;
-      if (!any || m < smallest) smallest = m;
-      any = true;
-    }
-  }
-  return !any || largest / smallest < Pow2(437);
-}
+bool InDomain(const Point2* p, int n) { return galpha::testing::InInputDomain(p, static_cast<size_t>(n)); }
 
 int Sign(const mpq_class& q) { return sgn(q); }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/input_domain_oracle.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha {
@@ -20,30 +21,7 @@ namespace {
 using testing::IsOk;
 using testing::StatusIs;
 
-mpq_class Pow2(int e) {
-  mpq_class q(1);
-  if (e >= 0) mpz_mul_2exp(q.get_num_mpz_t(), q.get_num_mpz_t(), static_cast<mp_bitcnt_t>(e));
-  if (e < 0) mpz_mul_2exp(q.get_den_mpz_t(), q.get_den_mpz_t(), static_cast<mp_bitcnt_t>(-e));
-  return q;
-}
-
-bool InDomainOracle(const std::vector<Point2>& points) {
-  mpq_class largest(0), smallest(0);
-  bool any = false;
-  for (const Point2& p : points) {
-    for (const double c : {p.x, p.y}) {
-      if (!std::isfinite(c)) return false;
-      mpq_class m = abs(mpq_class(c));
-      if (m >= Pow2(500)) return false;
-      if (m == 0) continue;
-      if (m < Pow2(-1022)) m = Pow2(-1022);
-      if (!any || m > largest) largest = m;
-      if (!any || m < smallest) smallest = m;
-      any = true;
-    }
-  }
-  return !any || largest / smallest < Pow2(437);
-}
+bool InDomainOracle(const std::vector<Point2>& points) { return testing::InInputDomain(points.data(), points.size()); }
 
 void ExpectRefusedNaming(const std::vector<Point2>& points, size_t index, const std::string& bound) {
   const absl::Status status = ValidatePoints(points);
