@@ -130,10 +130,6 @@ absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_p
   return BuildFamily(common, *points);
 }
 
-double LevelAlphaSq(const AlphaFamily& family, int64_t level) {
-  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
-}
-
 absl::Status CheckThresholdRank(int64_t rank, int64_t k) {
   if (rank >= 0 && rank <= k) return absl::OkStatus();
   return absl::InvalidArgumentError(
@@ -151,26 +147,23 @@ absl::Status CheckMasterListRank(int64_t rank, int64_t k) {
 }
 
 absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const ThresholdArg& threshold) {
-  ResolvedThreshold resolved;
-  absl::StatusOr<int64_t> level;
+  Threshold resolved_from;
   switch (threshold.kind) {
     case ThresholdArg::Kind::kRank:
       if (absl::Status s = CheckThresholdRank(threshold.rank, family.max_level()); !s.ok()) return s;
-      level = family.LevelForRank(threshold.rank);
-      resolved.alpha_sq = LevelAlphaSq(family, *level);
+      resolved_from.kind = Threshold::Kind::kRank;
+      resolved_from.rank = threshold.rank;
       break;
     case ThresholdArg::Kind::kAlphaSq:
-      level = family.LevelForAlphaSq(threshold.value);
-      resolved.alpha_sq = threshold.value;
+      resolved_from.kind = Threshold::Kind::kAlphaSq;
+      resolved_from.value = threshold.value;
       break;
     case ThresholdArg::Kind::kAlpha:
-      level = family.LevelForAlpha(threshold.value);
-      resolved.alpha_sq = threshold.value * threshold.value;
+      resolved_from.kind = Threshold::Kind::kAlpha;
+      resolved_from.value = threshold.value;
       break;
   }
-  if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
-  resolved.level = *level;
-  return resolved;
+  return ::galpha::ResolveThreshold(family, resolved_from);
 }
 
 int PrintBenchTable(const std::string& file, size_t input_points, uint64_t distinct_points, int64_t repeat,

@@ -16,6 +16,7 @@
 #include "client/point_input.hpp"
 #include "core/base/point.hpp"
 #include "core/family/alpha_family.hpp"
+#include "core/family/threshold.hpp"
 
 namespace galpha::alphactl {
 
@@ -79,14 +80,11 @@ absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vec
 /// ReadPoints, then BuildFamily. `input_points` receives the number of points read.
 absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points);
 
-/// A threshold resolved against a family: its level, and the alpha_sq it stands for (for a rank
-/// K > 0 the published spectrum double spectrum[K-1]; 0 for rank 0; the given value for --alpha-sq;
-/// R*R rounded to a double for --alpha R).
-struct ResolvedThreshold {
-  int64_t level = 0;
-  double alpha_sq = 0.0;
-};
-/// Errors (InvalidArgument, for ArgumentError): a rank outside 0..K.
+/// A threshold resolved against a family (core/family/threshold.hpp).
+using ResolvedThreshold = ::galpha::ResolvedThreshold;
+/// core/family/threshold.hpp's resolution of --alpha-sq, --alpha or --rank, with a rank outside
+/// 0..K reported in alphactl's words (naming --rank).
+/// Errors (InvalidArgument, for ArgumentError).
 absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const ThresholdArg& threshold);
 
 /// bench's table: a header line, then rows of (stage, ms) and, from row `first_measure` on,
@@ -99,9 +97,6 @@ int PrintBenchTable(const std::string& file, size_t input_points, uint64_t disti
 /// rank in 1..K. OK, or InvalidArgument (for ArgumentError).
 absl::Status CheckThresholdRank(int64_t rank, int64_t k);
 absl::Status CheckMasterListRank(int64_t rank, int64_t k);
-
-/// The alpha_sq of level `level` >= 0 as published: spectrum[level - 1], 0 for level 0.
-double LevelAlphaSq(const AlphaFamily& family, int64_t level);
 
 // ---- the same commands against a server (commands_remote.cpp), same output formats ----
 

@@ -183,14 +183,14 @@ int RunOptimal(Args args) {
   const uint32_t n = static_cast<uint32_t>(std::min<int64_t>(*components, std::numeric_limits<uint32_t>::max()));
   std::string json = absl::StrCat("{\"components\":", *components, ",\"regularized\":");
   if (const std::optional<int64_t> level = family->OptimalLevelRegularized(n)) {
-    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(LevelAlphaSq(*family, *level)),
+    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(PublishedAlphaSq(*family, *level)),
                     ",\"solid_components\":", family->SolidComponents(*level), "}");
   } else {
     json += "null";
   }
   json += ",\"general\":";
   if (const std::optional<int64_t> level = family->OptimalLevelGeneral(n)) {
-    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(LevelAlphaSq(*family, *level)),
+    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(PublishedAlphaSq(*family, *level)),
                     ",\"components\":", family->Components(*level), "}");
   } else {
     json += "null";

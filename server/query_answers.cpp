@@ -16,10 +16,6 @@ namespace v1 = galpha::v1;
 
 namespace {
 
-double PublishedAlphaSq(const AlphaFamily& family, int64_t level) {
-  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
-}
-
 v1::ClassCounts ToClassCounts(const std::array<uint64_t, 4>& counts) {
   v1::ClassCounts out;
   out.set_exterior(counts[0]);
@@ -288,31 +284,24 @@ class ShapeRingsSource final : public ChunkSource<v1::ShapeResponse> {
 }  // namespace
 
 absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::Threshold& threshold) {
-  ResolvedLevel resolved;
-  absl::StatusOr<int64_t> level;
+  Threshold t;
   switch (threshold.value_case()) {
     case v1::Threshold::kRank:
-      level = family.LevelForRank(threshold.rank());
-      if (!level.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("rank ", threshold.rank(), " is outside 0..", family.max_level(),
-                                                       " (the spectrum has ", family.max_level(), " values)"));
-      }
-      resolved.alpha_sq = PublishedAlphaSq(family, *level);
+      t.kind = Threshold::Kind::kRank;
+      t.rank = threshold.rank();
       break;
     case v1::Threshold::kAlphaSq:
-      level = family.LevelForAlphaSq(threshold.alpha_sq());
-      resolved.alpha_sq = threshold.alpha_sq();
+      t.kind = Threshold::Kind::kAlphaSq;
+      t.value = threshold.alpha_sq();
       break;
     case v1::Threshold::kAlpha:
-      level = family.LevelForAlpha(threshold.alpha());
-      resolved.alpha_sq = threshold.alpha() * threshold.alpha();
+      t.kind = Threshold::Kind::kAlpha;
+      t.value = threshold.alpha();
       break;
     case v1::Threshold::VALUE_NOT_SET:
       return absl::InvalidArgumentError("the request has no threshold: set alpha_sq, alpha or rank");
   }
-  if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
-  resolved.level = *level;
-  return resolved;
+  return ResolveThreshold(family, t);
 }
 
 absl::StatusOr<ClassifyMode> ToClassifyMode(v1::ClassifyMode mode) {

@@ -9,6 +9,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/family/alpha_family.hpp"
+#include "core/family/threshold.hpp"
 #include "core/geometry/shape.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "server/cached_family.hpp"
@@ -29,11 +30,8 @@ inline constexpr uint32_t kDefaultSpectrumPage = 65536;
 inline constexpr uint32_t kMaxSpectrumPage = 262144;
 inline constexpr int64_t kMaxComponentLevels = 262144;
 
-/// A threshold resolved against a family: its level and the alpha_sq it stands for.
-struct ResolvedLevel {
-  int64_t level = 0;
-  double alpha_sq = 0.0;
-};
+/// A threshold resolved against a family (core/family/threshold.hpp).
+using ResolvedLevel = ResolvedThreshold;
 /// InvalidArgument: no threshold set, NaN, a negative alpha, a rank outside 0..K.
 absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const galpha::v1::Threshold& threshold);
 

@@ -11,11 +11,6 @@
 namespace galpha::python {
 namespace {
 
-// The squared radius a level stands for: the spectrum value of its rank (0 for level 0 and -1).
-double PublishedAlphaSq(const AlphaFamily& family, int64_t level) {
-  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
-}
-
 // classes[order[i]] in wire numbers, for every i: the classes in the canonical order. Parallel:
 // at a million points these gathers are most of a classification's cost after ClassifyAll.
 std::vector<uint8_t> GatherClasses(const std::vector<SimplexClass>& classes, const std::vector<uint32_t>& order) {
@@ -63,33 +58,6 @@ absl::StatusOr<VertexRule> ParseVertexRule(absl::string_view rule) {
   if (rule == "report") return VertexRule::kReport;
   if (rule == "cgal") return VertexRule::kCgal;
   return absl::InvalidArgumentError(absl::StrCat("vertex_rule '", rule, "' is not a vertex rule (report or cgal)"));
-}
-
-absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const Threshold& threshold) {
-  ResolvedLevel resolved;
-  absl::StatusOr<int64_t> level;
-  switch (threshold.kind) {
-    case Threshold::Kind::kRank:
-      level = family.LevelForRank(threshold.rank);
-      // The service's code and words: a rank outside 0..K is a bad argument of the request.
-      if (!level.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("rank ", threshold.rank, " is outside 0..", family.max_level(),
-                                                       " (the spectrum has ", family.max_level(), " values)"));
-      }
-      resolved.alpha_sq = PublishedAlphaSq(family, *level);
-      break;
-    case Threshold::Kind::kAlphaSq:
-      level = family.LevelForAlphaSq(threshold.value);
-      resolved.alpha_sq = threshold.value;
-      break;
-    case Threshold::Kind::kAlpha:
-      level = family.LevelForAlpha(threshold.value);
-      resolved.alpha_sq = threshold.value * threshold.value;
-      break;
-  }
-  if (!level.ok()) return absl::InvalidArgumentError(level.status().message());
-  resolved.level = *level;
-  return resolved;
 }
 
 absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Threshold& threshold, ClassifyMode mode,

@@ -13,25 +13,15 @@
 #include "absl/status/statusor.h"
 #include "core/family/alpha_family.hpp"
 #include "core/family/classification_summary.hpp"
+#include "core/family/threshold.hpp"
 #include "core/geometry/shape.hpp"
 #include "python/engine/family_state.hpp"
 
 namespace galpha::python {
 
-/// A threshold as the caller gave it: a squared radius, a radius, or a rank of the spectrum.
-struct Threshold {
-  enum class Kind { kAlphaSq, kAlpha, kRank };
-  Kind kind = Kind::kAlphaSq;
-  double value = 0.0;  ///< alpha_sq or alpha
-  int64_t rank = 0;    ///< for kRank
-};
-
-/// A threshold resolved to a level (the number of spectrum values <= it) and the squared radius
-/// reported with it: the given one, or for a rank the spectrum value it stands for (0 at rank 0).
-struct ResolvedLevel {
-  int64_t level = 0;
-  double alpha_sq = 0.0;
-};
+/// Thresholds and their resolution are the core's (core/family/threshold.hpp), as the service's.
+using Threshold = galpha::Threshold;
+using ResolvedLevel = galpha::ResolvedThreshold;
 
 /// "alpha_sq", "alpha" or "rank"; InvalidArgument otherwise.
 absl::StatusOr<Threshold::Kind> ParseThresholdKind(absl::string_view kind);
@@ -40,8 +30,10 @@ absl::StatusOr<ClassifyMode> ParseMode(absl::string_view mode);
 /// "report" or "cgal"; InvalidArgument otherwise.
 absl::StatusOr<VertexRule> ParseVertexRule(absl::string_view rule);
 
-/// The service's ResolveLevel: InvalidArgument for a rank outside 0..K, a NaN, a negative alpha.
-absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const Threshold& threshold);
+/// core/family/threshold.hpp's ResolveThreshold, under the name the answers use.
+inline absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const Threshold& threshold) {
+  return ResolveThreshold(family, threshold);
+}
 
 /// Classes as the wire protocol numbers them: EXTERIOR = 1 .. INTERIOR = 4.
 inline uint8_t WireClass(SimplexClass c) { return static_cast<uint8_t>(static_cast<int>(c) + 1); }

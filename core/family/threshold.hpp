@@ -1,0 +1,35 @@
+// A threshold as every front end takes it (a squared radius, a radius or a rank) and its
+// resolution against a family: one definition for the service, alphactl and the Python module,
+// so that their levels, published alpha_sq values and messages cannot drift apart.
+#pragma once
+
+#include <cstdint>
+
+#include "absl/status/statusor.h"
+#include "core/family/alpha_family.hpp"
+
+namespace galpha {
+
+struct Threshold {
+  enum class Kind { kAlphaSq, kAlpha, kRank };
+  Kind kind = Kind::kAlphaSq;
+  double value = 0.0;  ///< alpha_sq or alpha
+  int64_t rank = 0;    ///< for kRank
+};
+
+/// A threshold resolved to a level (the number of spectrum values <= it) and the squared radius
+/// it stands for: the given alpha_sq, alpha * alpha rounded, or for a rank the published spectrum
+/// value (0 at rank 0).
+struct ResolvedThreshold {
+  int64_t level = 0;
+  double alpha_sq = 0.0;
+};
+
+/// The published squared radius of `level`: spectrum[level - 1], 0 for levels 0 and -1.
+double PublishedAlphaSq(const AlphaFamily& family, int64_t level);
+
+/// InvalidArgument for a NaN, a negative alpha, and a rank outside 0..K ("rank R is outside 0..K
+/// (the spectrum has K values)").
+absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const Threshold& threshold);
+
+}  // namespace galpha
