@@ -187,22 +187,37 @@ uint32_t AlphaFamily::SolidComponents(int64_t level) const {
   return parts_.ranks.solid_components[static_cast<size_t>(std::min(level, max_level()))];
 }
 
-std::optional<int64_t> AlphaFamily::OptimalLevelRegularized(uint32_t n) const {
+uint32_t AlphaFamily::Holes(int64_t level, ClassifyMode mode) const {
+  if (level < 0) return 0;
+  const HostVector<uint32_t>& curve =
+      mode == ClassifyMode::kGeneral ? parts_.ranks.holes : parts_.ranks.regularized_holes;
+  return curve[static_cast<size_t>(std::min(level, max_level()))];
+}
+
+std::optional<int64_t> AlphaFamily::OptimalLevelRegularized(uint32_t n, std::optional<uint32_t> max_holes) const {
   if (!solid_level_) return std::nullopt;
-  // Solid components are not monotone in alpha: a scan from the level where every point is
-  // covered (O(K), once per query).
+  // Solid components and holes are not monotone in alpha: a scan from the level where every point
+  // is covered (O(K), once per query).
+  const AlphaRanks& r = parts_.ranks;
   for (int64_t level = *solid_level_; level <= max_level(); ++level) {
-    if (parts_.ranks.solid_components[static_cast<size_t>(level)] <= n) return level;
+    const auto at = static_cast<size_t>(level);
+    if (r.solid_components[at] <= n && (!max_holes || r.regularized_holes[at] <= *max_holes)) return level;
   }
   return std::nullopt;
 }
 
-std::optional<int64_t> AlphaFamily::OptimalLevelGeneral(uint32_t n) const {
+std::optional<int64_t> AlphaFamily::OptimalLevelGeneral(uint32_t n, std::optional<uint32_t> max_holes) const {
   // Components never increase with alpha: binary search for the first level with at most n.
-  if (parts_.ranks.components.back() > n) return std::nullopt;
-  const auto it = std::partition_point(parts_.ranks.components.begin(), parts_.ranks.components.end(),
-                                       [n](uint32_t c) { return c > n; });
-  return static_cast<int64_t>(it - parts_.ranks.components.begin());
+  const AlphaRanks& r = parts_.ranks;
+  if (r.components.back() > n) return std::nullopt;
+  const auto it = std::partition_point(r.components.begin(), r.components.end(), [n](uint32_t c) { return c > n; });
+  int64_t level = it - r.components.begin();
+  if (!max_holes) return level;
+  // Holes do not shrink monotonically (a loop closes, then fills): the first level from there.
+  for (; level <= max_level(); ++level) {
+    if (r.holes[static_cast<size_t>(level)] <= *max_holes) return level;
+  }
+  return std::nullopt;
 }
 
 ShapeComplex AlphaFamily::ComplexAt(int64_t level, ClassifyMode mode) const {
@@ -240,7 +255,7 @@ size_t AlphaFamily::HostBytes() const {
          VectorBytes(r.edge_mu_low) + VectorBytes(r.edge_mu_high) + VectorBytes(r.edge_triangles) +
          VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) + VectorBytes(r.vertex_tri_low) +
          VectorBytes(r.master_begin) + VectorBytes(r.master) + VectorBytes(r.components) +
-         VectorBytes(r.solid_components);
+         VectorBytes(r.solid_components) + VectorBytes(r.holes) + VectorBytes(r.regularized_holes);
 }
 
 }  // namespace galpha

@@ -104,14 +104,20 @@ class AlphaFamily {
   uint32_t Components(int64_t level) const;
   /// CGAL's solid components: interior triangles connected through shared edges. O(1).
   uint32_t SolidComponents(int64_t level) const;
+  /// Holes of the complex at `level` (its first Betti number b1: the bounded components of its
+  /// complement; GENERAL: of the whole complex, REGULARIZED: of its closed interior triangles). O(1).
+  uint32_t Holes(int64_t level, ClassifyMode mode) const;
   /// Smallest level at which every point lies on an interior triangle (CGAL's find_alpha_solid);
   /// nullopt when no level does (fewer than 3 points or collinear input).
   std::optional<int64_t> SolidLevel() const { return solid_level_; }
   /// Smallest level with at most `n` solid components and every point on a triangle (the sense of
-  /// CGAL's find_optimal_alpha, as documented; CGAL's implementation answers one rank later).
-  std::optional<int64_t> OptimalLevelRegularized(uint32_t n) const;
-  /// Smallest level with at most `n` components in the GENERAL sense (binary search).
-  std::optional<int64_t> OptimalLevelGeneral(uint32_t n) const;
+  /// CGAL's find_optimal_alpha, as documented; CGAL's implementation answers one rank later), and,
+  /// when `max_holes` is given, at most that many holes of the regularized complex.
+  std::optional<int64_t> OptimalLevelRegularized(uint32_t n, std::optional<uint32_t> max_holes = std::nullopt) const;
+  /// Smallest level with at most `n` components in the GENERAL sense (binary search), and, when
+  /// `max_holes` is given, at most that many holes of the general complex (a scan from there: holes
+  /// come and go as alpha grows).
+  std::optional<int64_t> OptimalLevelGeneral(uint32_t n, std::optional<uint32_t> max_holes = std::nullopt) const;
 
   /// The complex at `level` as geometry input: triangles in, singular edges and isolated points
   /// (GENERAL mode only).

@@ -170,11 +170,13 @@ struct MasterListCsr {
   uint32_t num_master;
 };
 
-/// The component curves: the number of components at every level 0..K.
+/// The component and hole curves: their values at every level 0..K.
 template <class System>
 struct ComponentCounts {
   Buffer<uint32_t, System> components;
   Buffer<uint32_t, System> solid_components;
+  Buffer<uint32_t, System> holes;
+  Buffer<uint32_t, System> regularized_holes;
 };
 
 // ---- The stages, in order ---------------------------------------------------------------------------------
@@ -572,17 +574,19 @@ MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, con
   return {std::move(master_begin), std::move(master_entries), num_master};
 }
 
-/// Component curves over all levels (Borůvka spanning forests, component_curve.cuh).
+/// Component and hole curves over all levels (Borůvka spanning forests, component_curve.cuh).
 template <class System>
 ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                                         const Buffer<EdgeTris, System>& edge_tris, const SpectrumRanks<System>& ranks,
                                         const IntervalRanks<System>& iv) {
-  const uint32_t num_ranks = ranks.num_ranks;
-  ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, static_cast<size_t>(num_ranks) + 1),
-                                 Buffer<uint32_t, System>(sys, static_cast<size_t>(num_ranks) + 1)};
-  ComponentCurves(sys, mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, num_ranks, mesh.edges, edge_tris.data(),
-                  ranks.tri_rank.data(), ranks.edge_rho_rank.data(), iv.edge_mu_low.data(), iv.edge_mu_high.data(),
-                  counts.components.data(), counts.solid_components.data());
+  const size_t levels = static_cast<size_t>(ranks.num_ranks) + 1;
+  ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels)};
+  TopologyCurves(sys, mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
+                 edge_tris.data(), ranks.tri_rank.data(), ranks.edge_rho_rank.data(), iv.edge_mu_low.data(),
+                 iv.edge_mu_high.data(),
+                 TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
+                                   counts.regularized_holes.data()});
   return counts;
 }
 
@@ -596,12 +600,16 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
   const uint32_t num_ranks = ranks.num_ranks;
   out->components.resize(static_cast<size_t>(num_ranks) + 1);
   out->solid_components.resize(static_cast<size_t>(num_ranks) + 1);
+  out->holes.resize(static_cast<size_t>(num_ranks) + 1);
+  out->regularized_holes.resize(static_cast<size_t>(num_ranks) + 1);
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
   out->master.resize(master.num_master);
   sys.Download(
       {{out->components.data(), counts.components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->solid_components.data(), counts.solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+       {out->holes.data(), counts.holes.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+       {out->regularized_holes.data(), counts.regularized_holes.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->master_begin.data(), master.begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
        {out->master.data(), master.entries.data(), size_t{master.num_master} * sizeof(uint64_t)}});
   tables_download->Wait();

@@ -1,4 +1,4 @@
-// Component curves by Borůvka's minimum spanning forest, one source for both backends.
+// Component and hole curves by Borůvka's minimum spanning forest, one source for both backends.
 //
 // The number of components of a graph whose edges appear at ranks is, at every rank L, the number
 // of nodes present minus the number of edges of rank <= L in a minimum spanning forest (Kruskal's
@@ -7,6 +7,12 @@
 // made unique by the edge id), hooks to the other side, and pointer jumping flattens the hooks.
 // A union-find in rank order computes the same curve, but sequentially and with a cache miss per
 // step, which made it the slowest stage of a GPU build.
+//
+// Holes (the first Betti number b1) follow from the Euler characteristic: a complex in the plane
+// has no 2-cycles, so V - E + T = b0 - b1, and with b0 = V - F (F: spanning-forest edges present)
+// b1 = E - T - F at every level. The general complex's holes take its edge births and the forest
+// above; the regularized complex (the closed triangles that are in) takes each edge from its first
+// incident triangle (mu-low) and a forest of those edges. Vertices cancel out of both.
 #pragma once
 
 #include <thrust/copy.h>
@@ -265,6 +271,40 @@ struct CountTriangleBirth {
   }
 };
 
+/// The regularized graph: nodes are input indices, an edge appears with its first incident
+/// triangle (never without one).
+struct RegularizedGraphEdge {
+  const EdgeIdx* edges;
+  const uint32_t* mu_low;
+  GALPHA_HD WeightedEdge operator()(uint32_t e) const {
+    return WeightedEdge{edges[e].v[0], edges[e].v[1], (static_cast<uint64_t>(mu_low[e]) << 32) | e};
+  }
+};
+
+/// Counts each edge at its general birth (rho when unattached, else mu-low) and at its regularized
+/// birth (mu-low; never without a triangle).
+struct CountEdgeBirths {
+  const uint32_t* rho;
+  const uint32_t* mu_low;
+  uint32_t* general_at_rank;
+  uint32_t* regularized_at_rank;
+  GALPHA_HD void operator()(uint32_t e) const {
+    const uint32_t birth = rho[e] != 0 ? rho[e] : mu_low[e];
+    if (birth != kNeverRank) AtomicIncrement(&general_at_rank[birth]);
+    if (mu_low[e] != kNeverRank) AtomicIncrement(&regularized_at_rank[mu_low[e]]);
+  }
+};
+
+/// holes[L] = edges[0..L] - triangles[0..L] - forest[0..L] (prefix counts; b1 = E - T - F).
+struct HolesAt {
+  const uint32_t* edges_prefix;
+  const uint32_t* triangles_prefix;
+  const uint32_t* forest_prefix;
+  GALPHA_HD uint32_t operator()(uint32_t level) const {
+    return edges_prefix[level] - triangles_prefix[level] - forest_prefix[level];
+  }
+};
+
 /// curve[L] = base + plus[0..L] - minus[0..L] for L in 0..K (plus may be null: a constant base).
 struct CurveAt {
   const uint32_t* plus_prefix;
@@ -275,34 +315,60 @@ struct CurveAt {
   }
 };
 
-/// Both component curves over levels 0..num_ranks: GENERAL components (every distinct point from
-/// level 0, joined by edges at their births) and solid components (triangles from their births,
-/// joined by edges becoming interior).
+/// The curves of one family over levels 0..num_ranks.
+struct TopologyCurvesOut {
+  uint32_t* components;         ///< GENERAL components (b0 of the complex)
+  uint32_t* solid_components;   ///< interior triangles joined through edges (CGAL's)
+  uint32_t* holes;              ///< b1 of the general complex
+  uint32_t* regularized_holes;  ///< b1 of the regularized complex
+};
+
+/// The component and hole curves over levels 0..num_ranks: GENERAL components (every distinct
+/// point from level 0, joined by edges at their births), solid components (triangles from their
+/// births, joined by edges becoming interior), and holes of the general and regularized complexes
+/// (b1 = E - T - F, above).
 template <class System>
-void ComponentCurves(System& sys, uint32_t num_points, uint32_t num_unique, uint32_t num_tri, uint32_t num_edges,
-                     uint32_t num_ranks, const EdgeIdx* edges, const EdgeTris* edge_tris, const uint32_t* tri_rank,
-                     const uint32_t* edge_rho, const uint32_t* edge_mu_low, const uint32_t* edge_mu_high,
-                     uint32_t* components, uint32_t* solid_components) {
+void TopologyCurves(System& sys, uint32_t num_points, uint32_t num_unique, uint32_t num_tri, uint32_t num_edges,
+                    uint32_t num_ranks, const EdgeIdx* edges, const EdgeTris* edge_tris, const uint32_t* tri_rank,
+                    const uint32_t* edge_rho, const uint32_t* edge_mu_low, const uint32_t* edge_mu_high,
+                    const TopologyCurvesOut& out) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t levels = num_ranks + 1;
   Buffer<WeightedEdge, System> graph(sys, num_edges);
-  Buffer<uint32_t, System> merges(sys, levels), births(sys, levels);
-  // General.
+  Buffer<uint32_t, System> merges(sys, levels), births(sys, levels), edge_births(sys, levels),
+      regularized_edge_births(sys, levels);
+  // Edges and triangles present at each level (prefix counts).
+  thrust::fill_n(policy, births.data(), levels, 0u);
+  thrust::for_each_n(policy, zero, num_tri, CountTriangleBirth{tri_rank, births.data()});
+  thrust::inclusive_scan(policy, births.data(), births.data() + levels, births.data());
+  thrust::fill_n(policy, edge_births.data(), levels, 0u);
+  thrust::fill_n(policy, regularized_edge_births.data(), levels, 0u);
+  thrust::for_each_n(policy, zero, num_edges,
+                     CountEdgeBirths{edge_rho, edge_mu_low, edge_births.data(), regularized_edge_births.data()});
+  thrust::inclusive_scan(policy, edge_births.data(), edge_births.data() + levels, edge_births.data());
+  thrust::inclusive_scan(policy, regularized_edge_births.data(), regularized_edge_births.data() + levels,
+                         regularized_edge_births.data());
+  // General: components and holes from one forest.
   thrust::transform(policy, zero, zero + num_edges, graph.data(), GeneralGraphEdge{edges, edge_rho, edge_mu_low});
   thrust::fill_n(policy, merges.data(), levels, 0u);
   CountForestEdgesByRank(sys, graph.data(), num_edges, num_points, merges.data());
   thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
-  thrust::transform(policy, zero, zero + levels, components, CurveAt{nullptr, merges.data(), num_unique});
+  thrust::transform(policy, zero, zero + levels, out.components, CurveAt{nullptr, merges.data(), num_unique});
+  thrust::transform(policy, zero, zero + levels, out.holes, HolesAt{edge_births.data(), births.data(), merges.data()});
+  // Regularized holes: the forest of edges taken with their first triangle.
+  thrust::transform(policy, zero, zero + num_edges, graph.data(), RegularizedGraphEdge{edges, edge_mu_low});
+  thrust::fill_n(policy, merges.data(), levels, 0u);
+  CountForestEdgesByRank(sys, graph.data(), num_edges, num_points, merges.data());
+  thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
+  thrust::transform(policy, zero, zero + levels, out.regularized_holes,
+                    HolesAt{regularized_edge_births.data(), births.data(), merges.data()});
   // Solid.
   thrust::transform(policy, zero, zero + num_edges, graph.data(), SolidGraphEdge{edge_tris, edge_mu_high});
   thrust::fill_n(policy, merges.data(), levels, 0u);
   CountForestEdgesByRank(sys, graph.data(), num_edges, num_tri, merges.data());
   thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
-  thrust::fill_n(policy, births.data(), levels, 0u);
-  thrust::for_each_n(policy, zero, num_tri, CountTriangleBirth{tri_rank, births.data()});
-  thrust::inclusive_scan(policy, births.data(), births.data() + levels, births.data());
-  thrust::transform(policy, zero, zero + levels, solid_components, CurveAt{births.data(), merges.data(), 0u});
+  thrust::transform(policy, zero, zero + levels, out.solid_components, CurveAt{births.data(), merges.data(), 0u});
 }
 
 }  // namespace galpha::detail

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -306,6 +307,64 @@ uint32_t BruteSolidComponents(const BruteFamily& b, const mpq_class& A) {
   uint32_t count = 0;
   for (uint32_t t = 0; t < b.tris.size(); ++t) count += b.tri_birth[t] <= A && sets.Find(t) == t;
   return count;
+}
+
+namespace {
+
+/// Rank over GF(2) of the vectors `rows` (bit sets of `width` bits), by Gaussian elimination.
+uint32_t RankGf2(std::vector<std::vector<uint64_t>> rows, size_t width) {
+  uint32_t rank = 0;
+  for (size_t bit = 0; bit < width && rank < rows.size(); ++bit) {
+    const size_t word = bit / 64;
+    const uint64_t mask = uint64_t{1} << (bit % 64);
+    size_t pivot = rank;
+    while (pivot < rows.size() && (rows[pivot][word] & mask) == 0) ++pivot;
+    if (pivot == rows.size()) continue;
+    std::swap(rows[rank], rows[pivot]);
+    for (size_t i = 0; i < rows.size(); ++i) {
+      if (i != rank && (rows[i][word] & mask) != 0) {
+        for (size_t w = 0; w < rows[i].size(); ++w) rows[i][w] ^= rows[rank][w];
+      }
+    }
+    ++rank;
+  }
+  return rank;
+}
+
+std::vector<uint64_t> BitRow(size_t width, std::initializer_list<size_t> bits) {
+  std::vector<uint64_t> row((width + 63) / 64, 0);
+  for (size_t bit : bits) row[bit / 64] ^= uint64_t{1} << (bit % 64);
+  return row;
+}
+
+}  // namespace
+
+uint32_t BruteHoles(const BruteFamily& b, const mpq_class& A, ClassifyMode mode) {
+  if (sgn(A) < 0) return 0;
+  std::vector<bool> tri_in(b.tris.size()), edge_in(b.edges.size());
+  for (size_t t = 0; t < b.tris.size(); ++t) tri_in[t] = b.tri_birth[t] <= A;
+  for (size_t e = 0; e < b.edges.size(); ++e) {
+    if (mode == ClassifyMode::kGeneral) {
+      edge_in[e] = b.edge_birth[e] <= A;
+    } else {
+      for (uint32_t t : b.edge_tris[e]) edge_in[e] = edge_in[e] || tri_in[t];
+    }
+  }
+  // d1: one row per edge over the vertices; d2: one row per triangle over the edges.
+  std::map<BruteEdge, size_t> edge_index;
+  for (size_t e = 0; e < b.edges.size(); ++e) edge_index[b.edges[e]] = e;
+  std::vector<std::vector<uint64_t>> d1, d2;
+  for (size_t e = 0; e < b.edges.size(); ++e) {
+    if (edge_in[e]) d1.push_back(BitRow(b.points.size(), {b.edges[e][0], b.edges[e][1]}));
+  }
+  for (size_t t = 0; t < b.tris.size(); ++t) {
+    if (!tri_in[t]) continue;
+    const BruteTri& tri = b.tris[t];
+    d2.push_back(BitRow(b.edges.size(), {edge_index.at({tri[0], tri[1]}), edge_index.at({tri[0], tri[2]}),
+                                         edge_index.at({tri[1], tri[2]})}));
+  }
+  const auto edges_in = static_cast<uint32_t>(d1.size());
+  return edges_in - RankGf2(std::move(d1), b.points.size()) - RankGf2(std::move(d2), b.edges.size());
 }
 
 bool EveryPointOnATriangle(const BruteFamily& b, const mpq_class& A) {

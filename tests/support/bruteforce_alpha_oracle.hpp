@@ -104,6 +104,11 @@ uint32_t BruteComponents(const BruteFamily& b, const mpq_class& A);
 /// Edge-connected components of the interior triangles at alpha_sq = A.
 uint32_t BruteSolidComponents(const BruteFamily& b, const mpq_class& A);
 
+/// Holes (b1) of the complex at alpha_sq = A by the definition of homology over GF(2):
+/// dim ker d1 - rank d2, with both ranks by Gaussian elimination (no planarity or Euler argument).
+/// GENERAL: the whole complex; REGULARIZED: the closed triangles born at A or before.
+uint32_t BruteHoles(const BruteFamily& b, const mpq_class& A, ClassifyMode mode);
+
 /// Whether every distinct point is a vertex of a triangle born at A or before.
 bool EveryPointOnATriangle(const BruteFamily& b, const mpq_class& A);
 

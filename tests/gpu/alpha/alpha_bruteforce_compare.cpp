@@ -18,6 +18,7 @@
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/bruteforce_alpha_oracle.hpp"
+#include "tests/support/persistence_consistency.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha::testing {
@@ -251,7 +252,11 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
     }
     ASSERT_EQ(f.Components(level), BruteComponents(b, A)) << "level " << level;
     ASSERT_EQ(f.SolidComponents(level), BruteSolidComponents(b, A)) << "level " << level;
+    ASSERT_EQ(f.Holes(level, ClassifyMode::kGeneral), BruteHoles(b, A, ClassifyMode::kGeneral)) << "level " << level;
+    ASSERT_EQ(f.Holes(level, ClassifyMode::kRegularized), BruteHoles(b, A, ClassifyMode::kRegularized))
+        << "level " << level;
   }
+  ExpectPersistenceMatchesCurves(f);
 
   // Optimal levels, by their definitions in core/family/alpha_family.hpp, over all levels 0..K.
   std::optional<int64_t> solid;

@@ -1,0 +1,150 @@
+#include "core/family/persistence.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <tuple>
+
+#include "absl/strings/str_cat.h"
+
+namespace galpha {
+namespace {
+
+/// Union-find with path halving; each root keeps a representative chosen by the caller (the
+/// eldest member under the elder rule).
+class ElderForest {
+ public:
+  explicit ElderForest(size_t n) : parent_(n), eldest_(n) {
+    std::iota(parent_.begin(), parent_.end(), uint32_t{0});
+    std::iota(eldest_.begin(), eldest_.end(), uint32_t{0});
+  }
+  uint32_t Find(uint32_t x) {
+    while (parent_[x] != x) {
+      parent_[x] = parent_[parent_[x]];
+      x = parent_[x];
+    }
+    return x;
+  }
+  uint32_t eldest(uint32_t root) const { return eldest_[root]; }
+  /// Joins two roots; the joined component's eldest is `eldest`.
+  void Join(uint32_t survivor, uint32_t other, uint32_t eldest) {
+    parent_[other] = survivor;
+    eldest_[survivor] = eldest;
+  }
+
+ private:
+  std::vector<uint32_t> parent_, eldest_;
+};
+
+/// Ids in filtration order within ranks: `order` lists ids in canonical order; the result lists
+/// them by rank (kNeverRank last), canonical order within a rank (a stable counting sort).
+template <class RankOf>
+std::vector<uint32_t> SortByRank(const std::vector<uint32_t>& order, size_t num_ranks, RankOf rank_of) {
+  // Bucket K + 1 holds kNeverRank.
+  std::vector<uint32_t> start(num_ranks + 3, 0);
+  auto bucket = [&](uint32_t id) -> size_t {
+    const uint32_t r = rank_of(id);
+    return r == kNeverRank ? num_ranks + 1 : r;
+  };
+  for (uint32_t id : order) ++start[bucket(id) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<uint32_t> sorted(order.size());
+  for (uint32_t id : order) sorted[start[bucket(id)]++] = id;
+  return sorted;
+}
+
+}  // namespace
+
+double RankValue(const AlphaFamily& family, uint32_t rank) {
+  if (rank == kNeverRank) return std::numeric_limits<double>::infinity();
+  if (rank == 0) return 0.0;
+  return family.spectrum()[rank - 1];
+}
+
+absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, const CanonicalOrders& orders) {
+  const AlphaRanks& r = family.ranks();
+  const auto num_points = static_cast<uint32_t>(family.points().size());
+  const auto num_edges = static_cast<uint32_t>(family.edges().size());
+  const auto num_tri = static_cast<uint32_t>(family.triangles().size());
+  const size_t num_ranks = r.spectrum.size();
+  PersistenceDiagram diagram;
+  std::vector<PersistencePair>& pairs = diagram.pairs;
+
+  // Canonical positions break ties between simplices of one rank and dimension.
+  std::vector<uint32_t> edge_position(num_edges), triangle_position(num_tri);
+  for (uint32_t i = 0; i < num_edges; ++i) edge_position[orders.edge_order[i]] = i;
+  for (uint32_t i = 0; i < num_tri; ++i) triangle_position[orders.triangle_order[i]] = i;
+  const std::vector<uint32_t> edges_in_order =
+      SortByRank(orders.edge_order, num_ranks, [&](uint32_t e) { return EdgeBirthRank(r, e); });
+
+  // H0: every distinct point is born at rank 0; an edge joining two components kills the one whose
+  // oldest vertex (lowest index: vertices of one rank are ordered by index) comes later. An edge
+  // inside one component closes a loop: it creates an H1 class.
+  std::vector<uint8_t> closes_loop(num_edges, 0);
+  {
+    ElderForest forest(num_points);
+    for (uint32_t e : edges_in_order) {
+      const uint32_t a = forest.Find(family.edges()[e][0]), b = forest.Find(family.edges()[e][1]);
+      if (a == b) {
+        closes_loop[e] = 1;
+        continue;
+      }
+      const uint32_t oldest_a = forest.eldest(a), oldest_b = forest.eldest(b);
+      const uint32_t young = oldest_a < oldest_b ? b : a, old = young == a ? b : a;
+      const uint32_t birth = 0, death = EdgeBirthRank(r, e);
+      if (death > birth) pairs.push_back({0, birth, death, forest.eldest(young), e});
+      forest.Join(old, young, forest.eldest(old));
+    }
+    for (uint32_t v = 0; v < num_points; ++v) {
+      if (family.representative()[v] == v && forest.Find(v) == v) pairs.push_back({0, 0, kNeverRank, v, kNoSimplex});
+    }
+  }
+  const size_t num_h0 = pairs.size();
+
+  // H1 through the dual: nodes are the triangles and the outer face (node num_tri), joined in
+  // reverse filtration order by the edges that close loops. Of two joining components the one
+  // whose eldest member (in reverse order: the latest triangle; the outer face before all) comes
+  // first in the filtration dies: the loop the edge made is filled last by that triangle.
+  {
+    const uint32_t outer = num_tri;
+    ElderForest forest(size_t{num_tri} + 1);
+    // Filtration key of a dual node; the outer face is never filled.
+    auto key = [&](uint32_t node) {
+      if (node == outer) return std::make_tuple(uint64_t{1} << 33, uint32_t{0});
+      return std::make_tuple(uint64_t{r.tri_rank[node]}, triangle_position[node]);
+    };
+    for (auto it = edges_in_order.rbegin(); it != edges_in_order.rend(); ++it) {
+      const uint32_t e = *it;
+      if (!closes_loop[e]) continue;
+      const auto sides = r.edge_triangles[e];
+      const uint32_t a = forest.Find(sides[0] < 0 ? outer : static_cast<uint32_t>(sides[0]));
+      const uint32_t b = forest.Find(sides[1] < 0 ? outer : static_cast<uint32_t>(sides[1]));
+      if (a == b) {
+        // Alexander duality: an edge closes a loop exactly when its sides are apart in the dual.
+        return absl::InternalError(absl::StrCat("persistence: edge ", e, " closes a loop but its two sides are one ",
+                                                "component of the complement"));
+      }
+      const bool a_elder = key(forest.eldest(a)) > key(forest.eldest(b));
+      const uint32_t old = a_elder ? a : b, young = a_elder ? b : a;
+      const uint32_t killer = forest.eldest(young);
+      const uint32_t birth = EdgeBirthRank(r, e), death = r.tri_rank[killer];
+      if (death > birth) pairs.push_back({1, birth, death, e, death == kNeverRank ? kNoSimplex : killer});
+      forest.Join(old, young, forest.eldest(old));
+    }
+  }
+
+  // Dimension, birth, death (kNeverRank sorts last), creator's canonical position.
+  auto position = [&](const PersistencePair& p) { return p.dimension == 0 ? p.creator : edge_position[p.creator]; };
+  auto by_key = [&](const PersistencePair& x, const PersistencePair& y) {
+    return std::make_tuple(x.birth_rank, x.death_rank, position(x)) <
+           std::make_tuple(y.birth_rank, y.death_rank, position(y));
+  };
+  std::sort(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(num_h0), by_key);
+  std::sort(pairs.begin() + static_cast<std::ptrdiff_t>(num_h0), pairs.end(), by_key);
+  diagram.dimension_begin[0] = 0;
+  diagram.dimension_begin[1] = num_h0;
+  diagram.dimension_begin[2] = pairs.size();
+  return diagram;
+}
+
+}  // namespace galpha

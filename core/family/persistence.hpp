@@ -1,0 +1,59 @@
+// Persistent homology of the alpha filtration (H0 and H1) from a built family: which simplex
+// creates each component and hole, which one ends it, and at which exact thresholds.
+//
+// The filtration orders simplices by birth rank, then dimension (vertex < edge < triangle), then
+// their canonical position (core/family/canonical_order.hpp: vertex index, edge vertex pair,
+// ascending triangle triple), so the diagram depends only on the points, never on the backend that
+// built the family. H0 pairs come from a union-find over the edges in that order (elder rule: of
+// two merging components, the one whose oldest vertex comes later dies). In the plane, H1 is dual
+// to H0 of the complement (Alexander duality): a union-find over the triangles and the outer face
+// in reverse order, joined by the edges that close a loop, pairs each such edge with the triangle
+// that fills the hole it made last (the elder rule again, in reverse). Semantics: docs/design.md,
+// "Holes and persistence".
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "core/family/alpha_family.hpp"
+#include "core/family/canonical_order.hpp"
+
+namespace galpha {
+
+/// No simplex: the killer of an essential class (one that never dies).
+constexpr uint32_t kNoSimplex = 0xFFFFFFFFu;
+
+/// One class of the diagram, by ranks (exact: rank r is the spectrum's r-th threshold, rank 0 is
+/// alpha = 0) and by the simplices that create and kill it (family ids: H0 creator a vertex's input
+/// index and killer an edge id; H1 creator an edge id and killer a triangle id).
+struct PersistencePair {
+  uint32_t dimension = 0;
+  uint32_t birth_rank = 0;
+  /// kNeverRank: essential (death = infinity).
+  uint32_t death_rank = kNeverRank;
+  uint32_t creator = 0;
+  /// kNoSimplex when essential.
+  uint32_t killer = kNoSimplex;
+
+  bool essential() const { return death_rank == kNeverRank; }
+};
+
+/// Every class of positive persistence (death rank > birth rank; classes born and killed at the
+/// same threshold are not listed, as in GUDHI's default), ordered by dimension, birth rank, death
+/// rank (essential last), then the creator's canonical position.
+struct PersistenceDiagram {
+  std::vector<PersistencePair> pairs;
+  /// pairs of dimension 0 are pairs[0, dimension_begin[1]), of dimension 1 the rest.
+  size_t dimension_begin[3] = {0, 0, 0};
+};
+
+/// O((V + E + T) log n) after O(E + T + K) counting sorts; `orders` from
+/// ComputeCanonicalOrders(family). Internal error only if the family contradicts planar duality.
+absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, const CanonicalOrders& orders);
+
+/// The value of a rank as the family reports it: 0 for rank 0, the spectrum's nearest double for
+/// 1..K, +infinity for kNeverRank.
+double RankValue(const AlphaFamily& family, uint32_t rank);
+
+}  // namespace galpha
