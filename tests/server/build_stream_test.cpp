@@ -551,7 +551,10 @@ TEST(InFlightBytesTest, EncodedChunksReserveTheirDecodedBytes) {
   // 1,000 points on a grid compress to a few hundred bytes but decode to 16,000: the reservation
   // is for the decoded bytes.
   std::vector<Point2> grid;
-  for (int i = 0; i < 1000; ++i) grid.push_back({static_cast<double>(i % 40), static_cast<double>(i / 40)});
+  grid.reserve(1000);
+  for (int row = 0; row < 25; ++row) {
+    for (int column = 0; column < 40; ++column) grid.push_back({static_cast<double>(column), static_cast<double>(row)});
+  }
   const v1::BuildRequest chunk = EncodedChunk(grid);
   ASSERT_LT(chunk.ByteSizeLong(), 2000u);
   {
