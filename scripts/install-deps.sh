@@ -22,6 +22,8 @@ test_packages=(
   libbenchmark-dev
   libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
   libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
+  libgdal-dev            # alphactl reads Shapefile, GeoPackage and FlatGeobuf point layers (GALPHA_WITH_GDAL);
+                         # the server image builds without it (deploy/build-server.sh: -DGALPHA_WITH_GDAL=OFF)
   openssl                # the TLS tests make a self-signed certificate
   curl                   # the README's service walk-through scrapes /metrics
   clang libclang-rt-14-dev  # libFuzzer: the fuzz targets run briefly in CI

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -15,7 +16,9 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/io/las_reader.hpp"
 #include "core/io/point_io.hpp"
+#include "core/io/vector_points.hpp"
 #include "nlohmann/json.hpp"
 
 namespace galpha {
@@ -252,6 +255,20 @@ absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
     return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' is a directory"));
   }
   if (extension == ".bin") return ReadPointsBin(path);
+  if (extension == ".las") {
+    absl::StatusOr<GeoreferencedPoints> las = ReadLasPoints(path);
+    if (!las.ok()) return las.status();
+    return std::move(las->points);
+  }
+  if (extension == ".laz") {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points file '", path, "' is compressed LAS (LAZ), which is not read: decompress it to .las"));
+  }
+  if (IsVectorPointsExtension(extension)) {
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path,
+                                                   "' is a GDAL vector source: read it with ReadVectorPoints "
+                                                   "(core/io/vector_points.hpp, the galpha_vector_io library)"));
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open points file '", path, "'"));
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

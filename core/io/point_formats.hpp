@@ -1,7 +1,8 @@
 // Point files in the formats users bring (docs/design.md, "Formats"), next to the raw `.bin` format
-// of point_io.hpp: delimited text (CSV, TSV, whitespace), NumPy `.npy` arrays and GeoJSON. Nothing is
-// deduplicated or validated for finiteness here: the engine's validation layer does that, naming
-// the point's index (its row among the data rows).
+// of point_io.hpp: delimited text (CSV, TSV, whitespace), NumPy `.npy` arrays and GeoJSON (LAS in
+// las_reader.hpp, GDAL vector sources in vector_points.hpp). Nothing is deduplicated or validated
+// for finiteness here: the engine's validation layer does that, naming the point's index (its row
+// among the data rows).
 #pragma once
 
 #include <string>
@@ -40,8 +41,11 @@ absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, cons
 absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source);
 
 /// Reads a point file, choosing the format by extension: `.bin` (raw, point_io.hpp), `.npy`,
-/// `.geojson` or `.json`, anything else as delimited text. Errors name the file: NotFound when it does not exist, the
-/// errno-derived code when it cannot be read, and the parsers' errors above.
+/// `.geojson` or `.json`, `.las` (las_reader.hpp, without its CRS), anything else as delimited text
+/// except the formats refused by name: `.laz` (compressed LAS) and the GDAL vector sources of
+/// vector_points.hpp (`.shp`, `.gpkg`, `.fgb`: InvalidArgument; ReadVectorPoints reads them). Errors
+/// name the file: NotFound when it does not exist, the errno-derived code when it cannot be read, and
+/// the parsers' errors above.
 absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path);
 
 }  // namespace galpha

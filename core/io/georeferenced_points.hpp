@@ -1,0 +1,22 @@
+// Points read from a file that may state their coordinate reference system (LAS point clouds,
+// GDAL vector sources): the points, and the CRS carried along as the file states it.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/point.hpp"
+
+namespace galpha {
+
+/// The points of a georeferenced file and its CRS.
+struct GeoreferencedPoints {
+  /// In file order, x and y as stored (no reprojection, no axis swap).
+  std::vector<Point2> points;
+  /// The CRS as the file states it: OGC WKT, or "AUTHORITY:CODE" (as "EPSG:32610") where the
+  /// reader knows the code; nullopt when the file states none. Carried, not interpreted.
+  std::optional<std::string> crs;
+};
+
+}  // namespace galpha
