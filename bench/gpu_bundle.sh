@@ -14,6 +14,7 @@ bins=()
 # By name, wherever the build tree puts them (it mirrors the source folders).
 for name in predicates_test predicates_device_test delaunay_test delaunay_cgal_test triangulation_checks_test \
             radius_test alpha_family_cgal_test alpha_family_test alpha_bruteforce_test alpha_backend_identity_test \
+            persistence_gudhi_test \
             shape_test delaunay_bench alpha_bench alphactl service_bench galpha_server service_test; do
   b=$(find build/cuda -name "$name" -type f -perm -u+x -not -path '*/CMakeFiles/*' | head -n 1)
   if [ -n "$b" ]; then cp "$b" .carry/bin/; bins+=(".carry/bin/$name"); fi

@@ -21,6 +21,8 @@ test_packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   libcgal-dev libmpfr-dev  # CGAL: test oracle and benchmark competitor
+  libgudhi-dev libeigen3-dev  # GUDHI's exact alpha-complex persistence: the persistence oracle and competitor
+  python3-gudhi          # the same oracle for the Python package's persistence tests
   libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
   libgdal-dev            # alphactl reads Shapefile, GeoPackage and FlatGeobuf point layers (GALPHA_WITH_GDAL);
                          # the server image builds without it (deploy/build-server.sh: -DGALPHA_WITH_GDAL=OFF)

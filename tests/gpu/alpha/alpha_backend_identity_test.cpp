@@ -1,8 +1,8 @@
 // The CUDA and CPU backends build identical families: the same spectrum (bit for bit), the same
 // ranks and intervals for every triangle and edge (named by their vertices, so that the test does
 // not depend on the order in which each backend emits them), the same vertex intervals, the same
-// master list rank by rank, the same component curves. Skipped without a GPU; run on one by
-// bench/gpu_run.sh test.
+// master list rank by rank, the same component and hole curves, the same persistence pairs. Skipped without a GPU; run
+// on one by bench/gpu_run.sh test.
 #include <algorithm>
 #include <array>
 #include <map>
@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "core/family/alpha_family.hpp"
+#include "core/family/canonical_order.hpp"
+#include "core/family/persistence.hpp"
 #include "core/io/point_formats.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
@@ -56,6 +58,25 @@ std::vector<std::tuple<int, Simplex, int>> MasterAt(const AlphaFamily& f, int64_
   return out;
 }
 
+// The diagram's pairs with their simplices named by vertices.
+std::vector<std::tuple<uint32_t, uint32_t, uint32_t, Simplex, Simplex>> PersistenceByVertices(const AlphaFamily& f) {
+  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(f, ComputeCanonicalOrders(f));
+  EXPECT_THAT(diagram, IsOk());
+  std::vector<std::tuple<uint32_t, uint32_t, uint32_t, Simplex, Simplex>> out;
+  if (!diagram.ok()) return out;
+  for (const PersistencePair& p : diagram->pairs) {
+    const Simplex none{~0u, ~0u, ~0u};
+    if (p.dimension == 0) {
+      out.emplace_back(0, p.birth_rank, p.death_rank, Simplex{p.creator, ~0u, ~0u},
+                       p.essential() ? none : EdgeKey(f, p.killer));
+    } else {
+      out.emplace_back(1, p.birth_rank, p.death_rank, EdgeKey(f, p.creator),
+                       p.essential() ? none : TriangleKey(f, p.killer));
+    }
+  }
+  return out;
+}
+
 void ExpectIdentical(const std::vector<Point2>& points, const std::string& where) {
   BuildOptions cpu_options, cuda_options;
   cpu_options.backend = Backend::kCpu;
@@ -78,7 +99,12 @@ void ExpectIdentical(const std::vector<Point2>& points, const std::string& where
   for (int64_t level = 0; level <= cpu->max_level(); ++level) {
     ASSERT_EQ(cpu->Components(level), cuda->Components(level)) << where << " level " << level;
     ASSERT_EQ(cpu->SolidComponents(level), cuda->SolidComponents(level)) << where << " level " << level;
+    for (ClassifyMode mode : {ClassifyMode::kGeneral, ClassifyMode::kRegularized}) {
+      ASSERT_EQ(cpu->Holes(level, mode), cuda->Holes(level, mode)) << where << " level " << level;
+    }
   }
+  // The persistence diagram: the same classes with the same creating and killing simplices.
+  ASSERT_EQ(PersistenceByVertices(*cpu), PersistenceByVertices(*cuda)) << where;
   EXPECT_EQ(cuda->report().comparisons.cpu_fallback, 0u) << where;
 }
 
