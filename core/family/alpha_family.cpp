@@ -187,6 +187,11 @@ uint32_t AlphaFamily::SolidComponents(int64_t level) const {
   return parts_.ranks.solid_components[static_cast<size_t>(std::min(level, max_level()))];
 }
 
+uint32_t AlphaFamily::RegularizedComponents(int64_t level) const {
+  if (level < 0) return 0;
+  return parts_.ranks.regularized_components[static_cast<size_t>(std::min(level, max_level()))];
+}
+
 uint32_t AlphaFamily::Holes(int64_t level, ClassifyMode mode) const {
   if (level < 0) return 0;
   const HostVector<uint32_t>& curve =
@@ -255,7 +260,8 @@ size_t AlphaFamily::HostBytes() const {
          VectorBytes(r.edge_mu_low) + VectorBytes(r.edge_mu_high) + VectorBytes(r.edge_triangles) +
          VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) + VectorBytes(r.vertex_tri_low) +
          VectorBytes(r.master_begin) + VectorBytes(r.master) + VectorBytes(r.components) +
-         VectorBytes(r.solid_components) + VectorBytes(r.holes) + VectorBytes(r.regularized_holes);
+         VectorBytes(r.solid_components) + VectorBytes(r.holes) + VectorBytes(r.regularized_components) +
+         VectorBytes(r.regularized_holes);
 }
 
 }  // namespace galpha

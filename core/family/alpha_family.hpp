@@ -104,6 +104,9 @@ class AlphaFamily {
   uint32_t Components(int64_t level) const;
   /// CGAL's solid components: interior triangles connected through shared edges. O(1).
   uint32_t SolidComponents(int64_t level) const;
+  /// Components of the regularized complex at `level` (its b0: closed interior triangles connect
+  /// through shared vertices; unlike SolidComponents, which needs a shared edge). O(1).
+  uint32_t RegularizedComponents(int64_t level) const;
   /// Holes of the complex at `level` (its first Betti number b1: the bounded components of its
   /// complement; GENERAL: of the whole complex, REGULARIZED: of its closed interior triangles). O(1).
   uint32_t Holes(int64_t level, ClassifyMode mode) const;

@@ -82,8 +82,9 @@ struct AlphaRanks {
   /// connected through shared edges, CGAL's number_of_solid_components).
   HostVector<uint32_t> components, solid_components;
   /// Per level 0..K: holes (the first Betti number b1: bounded components of the complement) of
-  /// the general complex and of the regularized one (the closed triangles that are in).
-  HostVector<uint32_t> holes, regularized_holes;
+  /// the general complex; components (b0: triangles sharing a vertex connect) and holes of the
+  /// regularized one (the closed triangles that are in).
+  HostVector<uint32_t> holes, regularized_components, regularized_holes;
 
   ComparisonCounts comparisons;
 };

@@ -176,6 +176,7 @@ struct ComponentCounts {
   Buffer<uint32_t, System> components;
   Buffer<uint32_t, System> solid_components;
   Buffer<uint32_t, System> holes;
+  Buffer<uint32_t, System> regularized_components;
   Buffer<uint32_t, System> regularized_holes;
 };
 
@@ -581,12 +582,15 @@ ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                                         const IntervalRanks<System>& iv) {
   const size_t levels = static_cast<size_t>(ranks.num_ranks) + 1;
   ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels),
-                                 Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels)};
-  TopologyCurves(sys, mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
-                 edge_tris.data(), ranks.tri_rank.data(), ranks.edge_rho_rank.data(), iv.edge_mu_low.data(),
-                 iv.edge_mu_high.data(),
-                 TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
-                                   counts.regularized_holes.data()});
+                                 Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<uint32_t, System>(sys, levels)};
+  TopologyCurves(
+      sys,
+      TopologyCurvesIn{mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
+                       edge_tris.data(), mesh.representative, ranks.tri_rank.data(), ranks.edge_rho_rank.data(),
+                       iv.edge_mu_low.data(), iv.edge_mu_high.data(), iv.vertex_tri_low.data()},
+      TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
+                        counts.regularized_components.data(), counts.regularized_holes.data()});
   return counts;
 }
 
@@ -601,6 +605,7 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
   out->components.resize(static_cast<size_t>(num_ranks) + 1);
   out->solid_components.resize(static_cast<size_t>(num_ranks) + 1);
   out->holes.resize(static_cast<size_t>(num_ranks) + 1);
+  out->regularized_components.resize(static_cast<size_t>(num_ranks) + 1);
   out->regularized_holes.resize(static_cast<size_t>(num_ranks) + 1);
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
@@ -609,6 +614,8 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
       {{out->components.data(), counts.components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->solid_components.data(), counts.solid_components.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->holes.data(), counts.holes.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+       {out->regularized_components.data(), counts.regularized_components.data(),
+        (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->regularized_holes.data(), counts.regularized_holes.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->master_begin.data(), master.begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
        {out->master.data(), master.entries.data(), size_t{master.num_master} * sizeof(uint64_t)}});

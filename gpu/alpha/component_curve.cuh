@@ -315,59 +315,88 @@ struct CurveAt {
   }
 };
 
+/// Counts each distinct point at the rank of its first incident triangle (when it has one): the
+/// vertices of the regularized complex.
+struct CountRegularizedVertex {
+  const uint32_t* representative;
+  const uint32_t* vertex_tri_low;
+  uint32_t* at_rank;
+  GALPHA_HD void operator()(uint32_t v) const {
+    if (representative[v] == v && vertex_tri_low[v] != kNeverRank) AtomicIncrement(&at_rank[vertex_tri_low[v]]);
+  }
+};
+
+/// What the curves are computed from (device or host arrays of the system).
+struct TopologyCurvesIn {
+  uint32_t num_points, num_unique, num_tri, num_edges, num_ranks;
+  const EdgeIdx* edges;
+  const EdgeTris* edge_tris;
+  const uint32_t* representative;
+  const uint32_t* tri_rank;
+  const uint32_t* edge_rho;
+  const uint32_t* edge_mu_low;
+  const uint32_t* edge_mu_high;
+  const uint32_t* vertex_tri_low;
+};
+
 /// The curves of one family over levels 0..num_ranks.
 struct TopologyCurvesOut {
-  uint32_t* components;         ///< GENERAL components (b0 of the complex)
-  uint32_t* solid_components;   ///< interior triangles joined through edges (CGAL's)
-  uint32_t* holes;              ///< b1 of the general complex
-  uint32_t* regularized_holes;  ///< b1 of the regularized complex
+  uint32_t* components;              ///< b0 of the general complex
+  uint32_t* solid_components;        ///< interior triangles joined through edges (CGAL's)
+  uint32_t* holes;                   ///< b1 of the general complex
+  uint32_t* regularized_components;  ///< b0 of the regularized complex (triangles joined at vertices)
+  uint32_t* regularized_holes;       ///< b1 of the regularized complex
 };
 
 /// The component and hole curves over levels 0..num_ranks: GENERAL components (every distinct
 /// point from level 0, joined by edges at their births), solid components (triangles from their
-/// births, joined by edges becoming interior), and holes of the general and regularized complexes
-/// (b1 = E - T - F, above).
+/// births, joined by edges becoming interior), and the components and holes of the regularized
+/// complex (its vertices and edges arrive with their first triangle); holes by b1 = E - T - F.
 template <class System>
-void TopologyCurves(System& sys, uint32_t num_points, uint32_t num_unique, uint32_t num_tri, uint32_t num_edges,
-                    uint32_t num_ranks, const EdgeIdx* edges, const EdgeTris* edge_tris, const uint32_t* tri_rank,
-                    const uint32_t* edge_rho, const uint32_t* edge_mu_low, const uint32_t* edge_mu_high,
-                    const TopologyCurvesOut& out) {
+void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurvesOut& out) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
-  const uint32_t levels = num_ranks + 1;
-  Buffer<WeightedEdge, System> graph(sys, num_edges);
+  const uint32_t levels = in.num_ranks + 1;
+  Buffer<WeightedEdge, System> graph(sys, in.num_edges);
   Buffer<uint32_t, System> merges(sys, levels), births(sys, levels), edge_births(sys, levels),
-      regularized_edge_births(sys, levels);
-  // Edges and triangles present at each level (prefix counts).
+      regularized_edge_births(sys, levels), regularized_vertices(sys, levels);
+  auto prefix = [&](uint32_t* counts) { thrust::inclusive_scan(policy, counts, counts + levels, counts); };
+  // Triangles, edges (both senses) and regularized vertices present at each level (prefix counts).
   thrust::fill_n(policy, births.data(), levels, 0u);
-  thrust::for_each_n(policy, zero, num_tri, CountTriangleBirth{tri_rank, births.data()});
-  thrust::inclusive_scan(policy, births.data(), births.data() + levels, births.data());
   thrust::fill_n(policy, edge_births.data(), levels, 0u);
   thrust::fill_n(policy, regularized_edge_births.data(), levels, 0u);
-  thrust::for_each_n(policy, zero, num_edges,
-                     CountEdgeBirths{edge_rho, edge_mu_low, edge_births.data(), regularized_edge_births.data()});
-  thrust::inclusive_scan(policy, edge_births.data(), edge_births.data() + levels, edge_births.data());
-  thrust::inclusive_scan(policy, regularized_edge_births.data(), regularized_edge_births.data() + levels,
-                         regularized_edge_births.data());
+  thrust::fill_n(policy, regularized_vertices.data(), levels, 0u);
+  thrust::for_each_n(policy, zero, in.num_tri, CountTriangleBirth{in.tri_rank, births.data()});
+  thrust::for_each_n(policy, zero, in.num_edges,
+                     CountEdgeBirths{in.edge_rho, in.edge_mu_low, edge_births.data(), regularized_edge_births.data()});
+  thrust::for_each_n(policy, zero, in.num_points,
+                     CountRegularizedVertex{in.representative, in.vertex_tri_low, regularized_vertices.data()});
+  prefix(births.data());
+  prefix(edge_births.data());
+  prefix(regularized_edge_births.data());
+  prefix(regularized_vertices.data());
   // General: components and holes from one forest.
-  thrust::transform(policy, zero, zero + num_edges, graph.data(), GeneralGraphEdge{edges, edge_rho, edge_mu_low});
+  thrust::transform(policy, zero, zero + in.num_edges, graph.data(),
+                    GeneralGraphEdge{in.edges, in.edge_rho, in.edge_mu_low});
   thrust::fill_n(policy, merges.data(), levels, 0u);
-  CountForestEdgesByRank(sys, graph.data(), num_edges, num_points, merges.data());
-  thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
-  thrust::transform(policy, zero, zero + levels, out.components, CurveAt{nullptr, merges.data(), num_unique});
+  CountForestEdgesByRank(sys, graph.data(), in.num_edges, in.num_points, merges.data());
+  prefix(merges.data());
+  thrust::transform(policy, zero, zero + levels, out.components, CurveAt{nullptr, merges.data(), in.num_unique});
   thrust::transform(policy, zero, zero + levels, out.holes, HolesAt{edge_births.data(), births.data(), merges.data()});
-  // Regularized holes: the forest of edges taken with their first triangle.
-  thrust::transform(policy, zero, zero + num_edges, graph.data(), RegularizedGraphEdge{edges, edge_mu_low});
+  // Regularized: the forest of edges taken with their first triangle.
+  thrust::transform(policy, zero, zero + in.num_edges, graph.data(), RegularizedGraphEdge{in.edges, in.edge_mu_low});
   thrust::fill_n(policy, merges.data(), levels, 0u);
-  CountForestEdgesByRank(sys, graph.data(), num_edges, num_points, merges.data());
-  thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
+  CountForestEdgesByRank(sys, graph.data(), in.num_edges, in.num_points, merges.data());
+  prefix(merges.data());
+  thrust::transform(policy, zero, zero + levels, out.regularized_components,
+                    CurveAt{regularized_vertices.data(), merges.data(), 0u});
   thrust::transform(policy, zero, zero + levels, out.regularized_holes,
                     HolesAt{regularized_edge_births.data(), births.data(), merges.data()});
   // Solid.
-  thrust::transform(policy, zero, zero + num_edges, graph.data(), SolidGraphEdge{edge_tris, edge_mu_high});
+  thrust::transform(policy, zero, zero + in.num_edges, graph.data(), SolidGraphEdge{in.edge_tris, in.edge_mu_high});
   thrust::fill_n(policy, merges.data(), levels, 0u);
-  CountForestEdgesByRank(sys, graph.data(), num_edges, num_tri, merges.data());
-  thrust::inclusive_scan(policy, merges.data(), merges.data() + levels, merges.data());
+  CountForestEdgesByRank(sys, graph.data(), in.num_edges, in.num_tri, merges.data());
+  prefix(merges.data());
   thrust::transform(policy, zero, zero + levels, out.solid_components, CurveAt{births.data(), merges.data(), 0u});
 }
 

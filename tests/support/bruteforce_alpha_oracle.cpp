@@ -309,6 +309,20 @@ uint32_t BruteSolidComponents(const BruteFamily& b, const mpq_class& A) {
   return count;
 }
 
+uint32_t BruteRegularizedComponents(const BruteFamily& b, const mpq_class& A) {
+  DisjointSets sets(b.points.size());
+  std::vector<bool> covered(b.points.size());
+  for (size_t t = 0; t < b.tris.size(); ++t) {
+    if (b.tri_birth[t] > A) continue;
+    for (uint32_t v : b.tris[t]) covered[v] = true;
+    sets.Union(b.tris[t][0], b.tris[t][1]);
+    sets.Union(b.tris[t][0], b.tris[t][2]);
+  }
+  uint32_t count = 0;
+  for (uint32_t v : b.uniq) count += covered[v] && sets.Find(v) == v;
+  return count;
+}
+
 namespace {
 
 /// Rank over GF(2) of the vectors `rows` (bit sets of `width` bits), by Gaussian elimination.

@@ -104,6 +104,10 @@ uint32_t BruteComponents(const BruteFamily& b, const mpq_class& A);
 /// Edge-connected components of the interior triangles at alpha_sq = A.
 uint32_t BruteSolidComponents(const BruteFamily& b, const mpq_class& A);
 
+/// Connected components of the regularized complex at alpha_sq = A: the closed triangles born at
+/// A or before, joined where they share a vertex.
+uint32_t BruteRegularizedComponents(const BruteFamily& b, const mpq_class& A);
+
 /// Holes (b1) of the complex at alpha_sq = A by the definition of homology over GF(2):
 /// dim ker d1 - rank d2, with both ranks by Gaussian elimination (no planarity or Euler argument).
 /// GENERAL: the whole complex; REGULARIZED: the closed triangles born at A or before.

@@ -99,6 +99,7 @@ void ExpectIdentical(const std::vector<Point2>& points, const std::string& where
   for (int64_t level = 0; level <= cpu->max_level(); ++level) {
     ASSERT_EQ(cpu->Components(level), cuda->Components(level)) << where << " level " << level;
     ASSERT_EQ(cpu->SolidComponents(level), cuda->SolidComponents(level)) << where << " level " << level;
+    ASSERT_EQ(cpu->RegularizedComponents(level), cuda->RegularizedComponents(level)) << where << " level " << level;
     for (ClassifyMode mode : {ClassifyMode::kGeneral, ClassifyMode::kRegularized}) {
       ASSERT_EQ(cpu->Holes(level, mode), cuda->Holes(level, mode)) << where << " level " << level;
     }

@@ -252,6 +252,7 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
     }
     ASSERT_EQ(f.Components(level), BruteComponents(b, A)) << "level " << level;
     ASSERT_EQ(f.SolidComponents(level), BruteSolidComponents(b, A)) << "level " << level;
+    ASSERT_EQ(f.RegularizedComponents(level), BruteRegularizedComponents(b, A)) << "level " << level;
     ASSERT_EQ(f.Holes(level, ClassifyMode::kGeneral), BruteHoles(b, A, ClassifyMode::kGeneral)) << "level " << level;
     ASSERT_EQ(f.Holes(level, ClassifyMode::kRegularized), BruteHoles(b, A, ClassifyMode::kRegularized))
         << "level " << level;
