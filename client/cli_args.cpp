@@ -50,6 +50,7 @@ const char kUsage[] =
     "                              raw: 16-byte doubles, for servers older than encoded chunks)\n"
     "  --max-points N              read at most N points (default 100000000, a default server's limit;\n"
     "                              at most 1073741824, the engine's)\n"
+    "  --layer NAME                the layer of a .shp, .gpkg or .fgb FILE to read (default: its first)\n"
     "  -h, --help                  this text\n"
     "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
     "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
@@ -58,7 +59,9 @@ const char kUsage[] =
     "is named by its first occurrence.\n"
     "\n"
     "FILE: .bin (little-endian uint64 N, then N pairs of float64 x, y), .npy (float64, N x 2),\n"
-    "      .geojson/.json (Point, MultiPoint), or delimited text (CSV, TSV, whitespace: x and y\n"
+    "      .geojson/.json (Point, MultiPoint), .las (LAS 1.0-1.4 point clouds, uncompressed: x and\n"
+    "      y of every point; .laz is refused), .shp, .gpkg, .fgb (Shapefile, GeoPackage, FlatGeobuf\n"
+    "      point layers, read with GDAL; --layer), or delimited text (CSV, TSV, whitespace: x and y\n"
     "      first, optional header line, at most 65536 bytes a line). A regular file, or delimited\n"
     "      text from a named pipe (mkfifo, /dev/stdin) or from '-', standard input; devices,\n"
     "      directories and sockets are refused.\n"
@@ -69,10 +72,10 @@ const char kUsage[] =
     "environment: GALPHA_TOKEN, the bearer token a server with authentication expects.\n";
 
 // kUsage quotes these numbers.
-static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && InputOptions{}.max_line_bytes == 65536,
+static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && kDefaultMaxLineBytes == 65536,
               "update kUsage");
 
-const absl::string_view kGlobalOptions[5] = {"backend", "server", "tls-ca", "encoding", "max-points"};
+const absl::string_view kGlobalOptions[6] = {"backend", "server", "tls-ca", "encoding", "max-points", "layer"};
 
 namespace {
 

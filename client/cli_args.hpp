@@ -25,8 +25,8 @@ constexpr int kExitUsage = 2;
 extern const char kUsage[];
 
 /// The options that apply to every command, accepted before the command too (as git's and
-/// kubectl's are): --backend, --server, --tls-ca, --max-points.
-extern const absl::string_view kGlobalOptions[5];
+/// kubectl's are): --backend, --server, --tls-ca, --encoding, --max-points, --layer.
+extern const absl::string_view kGlobalOptions[6];
 
 /// The command line split at its command.
 struct Invocation {

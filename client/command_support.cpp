@@ -64,6 +64,10 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
   auto max_points = ParseMaxPoints(*line);
   if (!max_points.ok()) return max_points.status();
   common.input.max_points = *max_points;
+  if (const std::string* layer = line->Find("layer")) {
+    if (layer->empty()) return absl::InvalidArgumentError("--layer needs a layer's name");
+    common.input.layer = *layer;
+  }
   if (const std::string* server = line->Find("server")) {
     if (server->empty()) return absl::InvalidArgumentError("--server needs HOST:PORT");
     if (line->Find("backend") != nullptr) {

@@ -53,7 +53,7 @@ struct CommonArgs {
   /// --encoding raw: send PointChunk doubles (servers older than EncodedPointChunk refuse the
   /// compact chunks that the default, auto, picks).
   bool raw_upload = false;
-  /// How FILE is read: --max-points.
+  /// How FILE is read: --max-points, --layer.
   InputOptions input;
 };
 /// ParseCommandLine with `allowed` and kGlobalOptions, then exactly one positional FILE and valid

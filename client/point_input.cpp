@@ -15,7 +15,9 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "core/base/status_macros.hpp"
+#include "core/io/las_reader.hpp"
 #include "core/io/point_formats.hpp"
+#include "core/io/vector_points.hpp"
 
 namespace galpha::alphactl {
 
@@ -146,6 +148,18 @@ const char* KindOf(mode_t mode) {
 
 bool IsReadable(mode_t mode) { return S_ISREG(mode) || S_ISFIFO(mode); }
 
+// The readers that stop at the limit themselves say "the limit"; alphactl names its option.
+absl::Status WithMaxPointsHint(const absl::Status& status) {
+  if (status.code() != absl::StatusCode::kResourceExhausted) return status;
+  return absl::ResourceExhaustedError(absl::StrCat(status.message(), " (--max-points raises it)"));
+}
+
+template <typename T>
+absl::StatusOr<T> WithMaxPointsHint(absl::StatusOr<T> read) {
+  if (read.ok()) return read;
+  return WithMaxPointsHint(read.status());
+}
+
 absl::StatusOr<std::vector<Point2>> CheckCount(absl::StatusOr<std::vector<Point2>> points, const std::string& source,
                                                uint64_t max_points) {
   if (points.ok() && points->size() > max_points) return TooManyPoints(source, max_points);
@@ -168,7 +182,19 @@ absl::StatusOr<std::vector<Point2>> ReadTextPoints(int fd, const std::string& so
 }
 
 absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, const InputOptions& options) {
+  GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadInputPointsAndCrs(file, options));
+  return std::move(read.points);
+}
+
+absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& file, const InputOptions& options) {
+  const std::string extension = absl::AsciiStrToLower(std::filesystem::path(file).extension().string());
+  if (!options.layer.empty() && (file == "-" || !IsVectorPointsExtension(extension))) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--layer applies to Shapefiles, GeoPackages and FlatGeobuf files (.shp, .gpkg, .fgb), not to ",
+                     file == "-" ? "standard input" : absl::StrCat("'", file, "'")));
+  }
   struct stat info {};
+  GeoreferencedPoints read;
   if (file == "-") {
     const std::string source = "standard input";
     if (fstat(STDIN_FILENO, &info) != 0) return absl::ErrnoToStatus(errno, "cannot inspect standard input");
@@ -177,7 +203,8 @@ absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, con
       return absl::InvalidArgumentError(
           absl::StrCat("standard input is ", KindOf(info.st_mode), ": pipe the points in, or name a file"));
     }
-    return ReadTextPoints(STDIN_FILENO, source, options);
+    GALPHA_ASSIGN_OR_RETURN(read.points, ReadTextPoints(STDIN_FILENO, source, options));
+    return read;
   }
 
   const std::string named = absl::StrCat("points file '", file, "'");
@@ -191,13 +218,24 @@ absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, con
                                                    ": alphactl reads regular files, named pipes and '-' "
                                                    "(standard input)"));
   }
-  const std::string extension = absl::AsciiStrToLower(std::filesystem::path(file).extension().string());
-  const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json";
+  const bool las = extension == ".las" || extension == ".laz";
+  const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json" &&
+                    !las && !IsVectorPointsExtension(extension);
   if (S_ISFIFO(info.st_mode) && !text) {
-    // Their readers need the whole input at once: only a file's size bounds it in advance.
-    return absl::InvalidArgumentError(absl::StrCat(
-        named,
-        " is a named pipe: only delimited text is read from pipes (.bin, .npy and GeoJSON need a regular file)"));
+    // Their readers need the whole input at once, or seek: only a file's size bounds it in advance.
+    return absl::InvalidArgumentError(absl::StrCat(named,
+                                                   " is a named pipe: only delimited text is read from pipes (.bin, "
+                                                   ".npy, GeoJSON, LAS and GDAL sources need a regular file)"));
+  }
+  if (extension == ".laz") {
+    return absl::InvalidArgumentError(
+        absl::StrCat(named,
+                     " is compressed LAS (LAZ), which is not read: decompress it to .las first (laszip, pdal "
+                     "translate)"));
+  }
+  if (las) return WithMaxPointsHint(ReadLasPoints(file, options.max_points));
+  if (IsVectorPointsExtension(extension)) {
+    return WithMaxPointsHint(ReadVectorPoints(file, options.layer, options.max_points));
   }
   if (text) {
     OwnedFd fd(open(file.c_str(), O_RDONLY | O_CLOEXEC));
@@ -205,7 +243,8 @@ absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, con
     // The path may have changed since stat(): what was opened is what counts.
     if (fstat(fd.get(), &info) != 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
     if (!IsReadable(info.st_mode)) return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info.st_mode)));
-    return ReadTextPoints(fd.get(), file, options);
+    GALPHA_ASSIGN_OR_RETURN(read.points, ReadTextPoints(fd.get(), file, options));
+    return read;
   }
   // A .bin holds its points in 16 bytes each after an 8-byte header (and ReadPointsFile checks
   // that its header agrees): its size alone shows that it is over the limit.
@@ -215,7 +254,8 @@ absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, con
         named, " has ", info.st_size, " bytes, room for ", (static_cast<uint64_t>(info.st_size) - 8) / sizeof(Point2),
         " points: more than ", options.max_points, ", the limit (--max-points raises it)"));
   }
-  return CheckCount(ReadPointsFile(file), named, options.max_points);
+  GALPHA_ASSIGN_OR_RETURN(read.points, CheckCount(ReadPointsFile(file), named, options.max_points));
+  return read;
 }
 
 }  // namespace galpha::alphactl

@@ -1,8 +1,9 @@
 // What alphactl reads its points from, and how much of it: every input is bounded, so that a
 // device or a pipe that never ends (/dev/zero, `yes`) ends in an error rather than in all of memory.
 //
-//   regular files   read in their format (point_formats.hpp); a .bin larger than the point limit
-//                   allows is refused from its size, before it is read
+//   regular files   read in their format (point_formats.hpp, las_reader.hpp, vector_points.hpp); a
+//                   .bin or a LAS file with more points than the limit allows is refused from its
+//                   size or header, before its points are read; GDAL vector sources stop at the limit
 //   named pipes     (mkfifo, /dev/stdin, <(cmd)) and '-' (standard input, a pipe or a redirected
 //                   file): delimited text only, which is parsed as it streams
 //   anything else   (character and block devices, directories, sockets) is refused, naming it
@@ -20,6 +21,7 @@
 
 #include "absl/status/statusor.h"
 #include "core/base/point.hpp"
+#include "core/io/georeferenced_points.hpp"
 
 namespace galpha::alphactl {
 
@@ -27,15 +29,21 @@ namespace galpha::alphactl {
 /// more than a default server would build.
 inline constexpr uint64_t kDefaultMaxPoints = 100'000'000;
 
+/// The default longest line of delimited text (InputOptions::max_line_bytes).
+inline constexpr size_t kDefaultMaxLineBytes = size_t{64} << 10;
+
 /// How an input is read and bounded.
 struct InputOptions {
   /// More points than this is ResourceExhausted (the command line's --max-points).
   uint64_t max_points = kDefaultMaxPoints;
   /// The longest line of delimited text in bytes, its '\n' apart: a line holds one point and its
   /// attributes, so anything longer is not point data.
-  size_t max_line_bytes = size_t{64} << 10;
+  size_t max_line_bytes = kDefaultMaxLineBytes;
   /// Text is parsed in batches of whole lines of about this many bytes (memory, not a limit).
   size_t batch_bytes = size_t{1} << 20;
+  /// The layer of a GDAL vector source to read (--layer); empty: its first. Given with any other
+  /// input, it is an error.
+  std::string layer;
 };
 
 /// Reads the points of `file`, or of standard input when `file` is "-", as the header comment
@@ -47,6 +55,11 @@ struct InputOptions {
 /// the line's number and byte offset); errno-derived codes when it cannot be opened or read; the
 /// parsers' errors (point_formats.hpp).
 absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, const InputOptions& options);
+
+/// ReadInputPoints, with the CRS of the files that state one (LAS, GDAL vector sources); nullopt
+/// for the others. Errors as ReadInputPoints's, and InvalidArgument for options.layer with an input
+/// that is not a GDAL vector source or for a compressed LAS (.laz) file.
+absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& file, const InputOptions& options);
 
 /// Parses the delimited text (ParsePointsText's format) read from descriptor `fd` until its end, in
 /// batches of whole lines; `source` names it in errors, whose line numbers count from the start of

@@ -49,6 +49,13 @@ class QuietGdalErrors {
 std::optional<std::string> CrsOf(OGRLayer& layer) {
   const OGRSpatialReference* srs = layer.GetSpatialRef();
   if (srs == nullptr) return std::nullopt;
+  // A GeoPackage layer without a CRS references srs_id 0 or -1, the "undefined" geographic and
+  // Cartesian entries its specification requires, which GDAL reports under these names.
+  const char* name = srs->GetName();
+  if (name != nullptr &&
+      (absl::string_view(name) == "Undefined geographic SRS" || absl::string_view(name) == "Undefined Cartesian SRS")) {
+    return std::nullopt;
+  }
   const char* authority = srs->GetAuthorityName(nullptr);
   const char* code = srs->GetAuthorityCode(nullptr);
   if (authority != nullptr && code != nullptr) return absl::StrCat(authority, ":", code);

@@ -22,6 +22,8 @@
 
 #include "nlohmann/json.hpp"
 #include "tests/support/data_files.hpp"
+#include "tests/support/las_bytes.hpp"
+#include "tests/support/vector_file_writer.hpp"
 
 namespace {
 
@@ -669,6 +671,61 @@ TEST(AlphactlTest, GlobalOptionsComeBeforeOrAfterTheCommand) {
   const CommandResult help = Alphactl("--backend cpu help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("GLOBAL OPTIONS"), std::string::npos);
+}
+
+// The same points as a LAS point cloud, a GeoPackage (with GDAL) and delimited text: the same
+// spectrum and classification. The LAS doubles are computed here as offset + scale * X with the
+// product stored first (never fused), and written to the text with 17 significant digits.
+TEST(AlphactlTest, LasAndGeoPackageGiveWhatTheSameCsvGives) {
+  galpha::testing::LasSpec spec;
+  spec.format = 1;
+  spec.scale[0] = 0.01;
+  spec.scale[1] = 0.001;
+  spec.offset[0] = 637000.0;
+  spec.offset[1] = 849000.0;
+  uint32_t state = 12345;
+  const auto next = [&state] { return static_cast<int32_t>((state = state * 1664525u + 1013904223u) >> 12) - 500000; };
+  for (int i = 0; i < 60; ++i) spec.xy.emplace_back(next(), next());
+  std::vector<galpha::Point2> points;
+  std::string csv = "x,y\n";
+  for (const auto& [x, y] : spec.xy) {
+    volatile double x_product = spec.scale[0] * x, y_product = spec.scale[1] * y;
+    points.push_back({x_product + spec.offset[0], y_product + spec.offset[1]});
+    char line[80];
+    std::snprintf(line, sizeof line, "%.17g,%.17g\n", points.back().x, points.back().y);
+    csv += line;
+  }
+  const std::string csv_path = WriteFile("alphactl_cloud.csv", csv);
+  const std::string las_path = WriteFile("alphactl_cloud.las", galpha::testing::LasFileBytes(spec));
+  const std::string spectrum = Succeeds("spectrum", csv_path, "");
+  ASSERT_GT(SplitLines(spectrum).size(), 10u);
+  EXPECT_EQ(Succeeds("spectrum", las_path, ""), spectrum);
+  EXPECT_EQ(Succeeds("classify", las_path, "--rank 7"), Succeeds("classify", csv_path, "--rank 7"));
+  ExpectError(Alphactl("--max-points 59 spectrum " + Quote(las_path)), 1,
+              "has 60 points: more than 59, the limit (--max-points raises it)");
+  ExpectError(Alphactl("spectrum " + Quote(las_path) + " --layer points"), 1,
+              "--layer applies to Shapefiles, GeoPackages and FlatGeobuf files (.shp, .gpkg, .fgb), not to");
+  const std::string laz_path = WriteFile("alphactl_cloud.laz", galpha::testing::LasFileBytes(spec));
+  ExpectError(Alphactl("spectrum " + Quote(laz_path)), 1, "is compressed LAS (LAZ), which is not read");
+
+  const std::string gpkg_path = std::filesystem::temp_directory_path() / "alphactl_cloud.gpkg";
+  if (galpha::testing::VectorWriterAvailable()) {
+    std::vector<galpha::testing::VectorFeature> features;
+    features.reserve(points.size());
+    for (const galpha::Point2& p : points) features.push_back({galpha::testing::VectorGeometry::kPoint, {p}});
+    ASSERT_TRUE(
+        galpha::testing::WriteVectorFile(gpkg_path, "GPKG", {{"empty", {}, ""}, {"cloud", features, "EPSG:32610"}})
+            .ok());
+    EXPECT_EQ(Succeeds("spectrum", gpkg_path, "--layer cloud"), spectrum);
+    EXPECT_EQ(Succeeds("classify", gpkg_path, "--rank 7 --layer=cloud"), Succeeds("classify", csv_path, "--rank 7"));
+    ExpectError(Alphactl("--layer nope spectrum " + Quote(gpkg_path)), 1, "has no layer 'nope' (its layers: ");
+    ExpectError(Alphactl("--layer cloud --max-points 10 spectrum " + Quote(gpkg_path)), 1,
+                "layer 'cloud': more than 10 points, the limit (--max-points raises it)");
+  } else {
+    WriteFile("alphactl_cloud.gpkg", "not read");
+    ExpectError(Alphactl("spectrum " + Quote(gpkg_path)), 1, "this build has no GDAL");
+  }
+  for (const std::string& path : {csv_path, las_path, laz_path, gpkg_path}) std::filesystem::remove(path);
 }
 
 }  // namespace
