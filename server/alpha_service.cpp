@@ -11,6 +11,7 @@
 #include "gpu/alpha/alpha_engine.hpp"
 #include "server/build_reactor.hpp"
 #include "server/grpc_status.hpp"
+#include "server/persistence_answers.hpp"
 #include "server/query_answers.hpp"
 #include "server/rpc_record.hpp"
 
@@ -250,6 +251,11 @@ grpc::ServerUnaryReactor* AlphaService::OptimalAlpha(grpc::CallbackServerContext
                      UnaryReply(context, response));
 }
 
+grpc::ServerUnaryReactor* AlphaService::Betti(grpc::CallbackServerContext* context, const v1::BettiRequest* request,
+                                              v1::BettiResponse* response) {
+  return AnswerQuery(context, "Betti", *request, FromAlphaFamily(AnswerBetti), UnaryReply(context, response));
+}
+
 grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* context, const v1::ReleaseRequest* request,
                                                 v1::ReleaseResponse* response) {
   return AnswerUnary(context, metrics_, "Release", [&]() -> absl::Status {
@@ -277,6 +283,11 @@ grpc::ServerWriteReactor<v1::MasterListResponse>* AlphaService::MasterList(grpc:
 grpc::ServerWriteReactor<v1::ShapeResponse>* AlphaService::Shape(grpc::CallbackServerContext* context,
                                                                  const v1::ShapeRequest* request) {
   return AnswerQuery(context, "Shape", *request, MakeShapeSource, StreamedReply<v1::ShapeResponse>());
+}
+
+grpc::ServerWriteReactor<v1::PersistenceResponse>* AlphaService::Persistence(grpc::CallbackServerContext* context,
+                                                                             const v1::PersistenceRequest* request) {
+  return AnswerQuery(context, "Persistence", *request, MakePersistenceSource, StreamedReply<v1::PersistenceResponse>());
 }
 
 }  // namespace galpha::server

@@ -95,6 +95,10 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   grpc::ServerUnaryReactor* OptimalAlpha(grpc::CallbackServerContext* context,
                                          const galpha::v1::OptimalAlphaRequest* request,
                                          galpha::v1::OptimalAlphaResponse* response) override;
+  grpc::ServerUnaryReactor* Betti(grpc::CallbackServerContext* context, const galpha::v1::BettiRequest* request,
+                                  galpha::v1::BettiResponse* response) override;
+  grpc::ServerWriteReactor<galpha::v1::PersistenceResponse>* Persistence(
+      grpc::CallbackServerContext* context, const galpha::v1::PersistenceRequest* request) override;
   grpc::ServerUnaryReactor* Release(grpc::CallbackServerContext* context, const galpha::v1::ReleaseRequest* request,
                                     galpha::v1::ReleaseResponse* response) override;
 

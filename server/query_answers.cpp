@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
 
 namespace galpha::server {
@@ -27,23 +28,15 @@ v1::ClassCounts ToClassCounts(const std::array<uint64_t, 4>& counts) {
 
 char ClassByte(SimplexClass c) { return static_cast<char>(static_cast<int>(c) + 1); }
 
-std::array<uint32_t, 2> SortedEdge(const std::array<uint32_t, 2>& e) {
-  return {std::min(e[0], e[1]), std::max(e[0], e[1])};
-}
-
-std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
-  std::sort(t.begin(), t.end());
-  return t;
-}
-
 class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
  public:
   ClassifySource(std::shared_ptr<const CachedFamily> cached, Classification classes, ClassificationSummary counts,
-                 ResolvedLevel level, bool non_exterior_only, bool summary_only)
+                 ResolvedLevel level, ClassifyMode mode, bool non_exterior_only, bool summary_only)
       : cached_(std::move(cached)),
         classes_(std::move(classes)),
         counts_(counts),
         level_(level),
+        mode_(mode),
         non_exterior_only_(non_exterior_only),
         phase_(summary_only ? Phase::kLastSummary : Phase::kSummary) {}
 
@@ -108,6 +101,7 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
     summary->set_components(family.Components(level_.level));
     summary->set_solid_components(family.SolidComponents(level_.level));
     summary->set_interior_area(counts_.interior_area);
+    summary->set_holes(family.Holes(level_.level, mode_));
   }
 
   // Fills one chunk of edges or triangles from position_ on: the ordered vertices are copied in a
@@ -171,6 +165,7 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
   Classification classes_;
   ClassificationSummary counts_;
   ResolvedLevel level_;
+  ClassifyMode mode_;
   bool non_exterior_only_;
   Phase phase_;
   size_t position_ = 0;
@@ -363,7 +358,7 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifyS
   if (!level.ok()) return level.status();
   Classification classes = family.ClassifyAll(level->level, *mode, *rule);
   const ClassificationSummary counts = SummarizeClassification(family, classes);
-  return std::make_unique<ClassifySource>(std::move(cached), std::move(classes), counts, *level,
+  return std::make_unique<ClassifySource>(std::move(cached), std::move(classes), counts, *level, *mode,
                                           request.non_exterior_only(), request.summary_only());
 }
 
@@ -451,38 +446,59 @@ absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family, c
   return response;
 }
 
+namespace {
+
+/// Levels first..last of a request for a threshold or a rank range (Components, Betti).
+struct LevelRange {
+  int64_t first = 0, last = 0;
+};
+
+template <typename Request>
+absl::StatusOr<LevelRange> ResolveLevelRange(const AlphaFamily& family, const Request& request) {
+  if (request.has_threshold()) {
+    auto level = ResolveLevel(family, request.threshold());
+    if (!level.ok()) return level.status();
+    return LevelRange{level->level, level->level};
+  }
+  if (!request.has_ranks()) return absl::InvalidArgumentError("the request has neither a threshold nor a rank range");
+  const int64_t k = family.max_level();
+  const int64_t first = request.ranks().first(), last = request.ranks().last();
+  if (first < 0 || last > k || last < first) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("rank range ", first, "..", last, " is not within 0..", k, " (first <= last)"));
+  }
+  if (last - first + 1 > kMaxComponentLevels) {
+    return absl::InvalidArgumentError(absl::StrCat("rank range ", first, "..", last, " holds more than ",
+                                                   kMaxComponentLevels, " ranks: ask in pieces"));
+  }
+  return LevelRange{first, last};
+}
+
+}  // namespace
+
 absl::StatusOr<v1::ComponentsResponse> AnswerComponents(const AlphaFamily& family,
                                                         const v1::ComponentsRequest& request) {
+  const absl::StatusOr<LevelRange> range = ResolveLevelRange(family, request);
+  if (!range.ok()) return range.status();
   v1::ComponentsResponse response;
-  int64_t first = 0, last = 0;
-  switch (request.at_case()) {
-    case v1::ComponentsRequest::kThreshold: {
-      auto level = ResolveLevel(family, request.threshold());
-      if (!level.ok()) return level.status();
-      first = last = level->level;
-      break;
-    }
-    case v1::ComponentsRequest::kRanks: {
-      const int64_t k = family.max_level();
-      first = request.ranks().first();
-      last = request.ranks().last();
-      if (first < 0 || last > k || last < first) {
-        return absl::InvalidArgumentError(
-            absl::StrCat("rank range ", first, "..", last, " is not within 0..", k, " (first <= last)"));
-      }
-      if (last - first + 1 > kMaxComponentLevels) {
-        return absl::InvalidArgumentError(absl::StrCat("rank range ", first, "..", last, " holds more than ",
-                                                       kMaxComponentLevels, " ranks: ask in pieces"));
-      }
-      break;
-    }
-    case v1::ComponentsRequest::AT_NOT_SET:
-      return absl::InvalidArgumentError("the request has neither a threshold nor a rank range");
-  }
-  response.set_first_level(first);
-  for (int64_t level = first; level <= last; ++level) {
+  response.set_first_level(range->first);
+  for (int64_t level = range->first; level <= range->last; ++level) {
     response.add_components(family.Components(level));
     response.add_solid_components(family.SolidComponents(level));
+  }
+  return response;
+}
+
+absl::StatusOr<v1::BettiResponse> AnswerBetti(const AlphaFamily& family, const v1::BettiRequest& request) {
+  const absl::StatusOr<LevelRange> range = ResolveLevelRange(family, request);
+  if (!range.ok()) return range.status();
+  v1::BettiResponse response;
+  response.set_first_level(range->first);
+  for (int64_t level = range->first; level <= range->last; ++level) {
+    response.add_components(family.Components(level));
+    response.add_holes(family.Holes(level, ClassifyMode::kGeneral));
+    response.add_regularized_components(family.RegularizedComponents(level));
+    response.add_regularized_holes(family.Holes(level, ClassifyMode::kRegularized));
   }
   return response;
 }
@@ -490,18 +506,22 @@ absl::StatusOr<v1::ComponentsResponse> AnswerComponents(const AlphaFamily& famil
 absl::StatusOr<v1::OptimalAlphaResponse> AnswerOptimalAlpha(const AlphaFamily& family,
                                                             const v1::OptimalAlphaRequest& request) {
   if (request.max_components() < 1) return absl::InvalidArgumentError("max_components must be at least 1");
+  const std::optional<uint32_t> max_holes =
+      request.has_max_holes() ? std::optional<uint32_t>(request.max_holes()) : std::nullopt;
   v1::OptimalAlphaResponse response;
-  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(request.max_components())) {
+  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(request.max_components(), max_holes)) {
     v1::OptimalLevel* out = response.mutable_regularized();
     out->set_rank(*level);
     out->set_alpha_sq(PublishedAlphaSq(family, *level));
     out->set_components(family.SolidComponents(*level));
+    out->set_holes(family.Holes(*level, ClassifyMode::kRegularized));
   }
-  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(request.max_components())) {
+  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(request.max_components(), max_holes)) {
     v1::OptimalLevel* out = response.mutable_general();
     out->set_rank(*level);
     out->set_alpha_sq(PublishedAlphaSq(family, *level));
     out->set_components(family.Components(*level));
+    out->set_holes(family.Holes(*level, ClassifyMode::kGeneral));
   }
   return response;
 }

@@ -71,6 +71,9 @@ absl::StatusOr<galpha::v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& f
                                                             const galpha::v1::SpectrumRequest& request);
 absl::StatusOr<galpha::v1::ComponentsResponse> AnswerComponents(const AlphaFamily& family,
                                                                 const galpha::v1::ComponentsRequest& request);
+/// Betti curves at a threshold or over a rank range (the same limits as Components).
+absl::StatusOr<galpha::v1::BettiResponse> AnswerBetti(const AlphaFamily& family,
+                                                      const galpha::v1::BettiRequest& request);
 absl::StatusOr<galpha::v1::OptimalAlphaResponse> AnswerOptimalAlpha(const AlphaFamily& family,
                                                                     const galpha::v1::OptimalAlphaRequest& request);
 

@@ -4,6 +4,8 @@
 // every front end, so that they cannot drift apart.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -17,6 +19,15 @@ struct CanonicalOrders {
   /// Triangle ids in canonical order, and their ascending vertex triples in that order, flat.
   std::vector<uint32_t> triangle_order, triangle_vertices;
 };
+
+/// How answers name a simplex: its vertices ascending.
+inline std::array<uint32_t, 2> SortedEdge(const std::array<uint32_t, 2>& e) {
+  return {std::min(e[0], e[1]), std::max(e[0], e[1])};
+}
+inline std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
+  std::sort(t.begin(), t.end());
+  return t;
+}
 
 /// O(n log n); the orders depend only on the triangulation, so callers compute them once.
 CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family);

@@ -39,7 +39,7 @@ class ElderForest {
 /// Ids in filtration order within ranks: `order` lists ids in canonical order; the result lists
 /// them by rank (kNeverRank last), canonical order within a rank (a stable counting sort).
 template <class RankOf>
-std::vector<uint32_t> SortByRank(const std::vector<uint32_t>& order, size_t num_ranks, RankOf rank_of) {
+std::vector<uint32_t> SortByRank(absl::Span<const uint32_t> order, size_t num_ranks, RankOf rank_of) {
   // Bucket K + 1 holds kNeverRank.
   std::vector<uint32_t> start(num_ranks + 3, 0);
   auto bucket = [&](uint32_t id) -> size_t {
@@ -61,7 +61,13 @@ double RankValue(const AlphaFamily& family, uint32_t rank) {
   return family.spectrum()[rank - 1];
 }
 
-absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, const CanonicalOrders& orders) {
+absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family) {
+  const CanonicalOrders orders = ComputeCanonicalOrders(family);
+  return ComputePersistence(family, orders.edge_order, orders.triangle_order);
+}
+
+absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, absl::Span<const uint32_t> edge_order,
+                                                      absl::Span<const uint32_t> triangle_order) {
   const AlphaRanks& r = family.ranks();
   const auto num_points = static_cast<uint32_t>(family.points().size());
   const auto num_edges = static_cast<uint32_t>(family.edges().size());
@@ -72,10 +78,10 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
 
   // Canonical positions break ties between simplices of one rank and dimension.
   std::vector<uint32_t> edge_position(num_edges), triangle_position(num_tri);
-  for (uint32_t i = 0; i < num_edges; ++i) edge_position[orders.edge_order[i]] = i;
-  for (uint32_t i = 0; i < num_tri; ++i) triangle_position[orders.triangle_order[i]] = i;
+  for (uint32_t i = 0; i < num_edges; ++i) edge_position[edge_order[i]] = i;
+  for (uint32_t i = 0; i < num_tri; ++i) triangle_position[triangle_order[i]] = i;
   const std::vector<uint32_t> edges_in_order =
-      SortByRank(orders.edge_order, num_ranks, [&](uint32_t e) { return EdgeBirthRank(r, e); });
+      SortByRank(edge_order, num_ranks, [&](uint32_t e) { return EdgeBirthRank(r, e); });
 
   // H0: every distinct point is born at rank 0; an edge joining two components kills the one whose
   // oldest vertex (lowest index: vertices of one rank are ordered by index) comes later. An edge

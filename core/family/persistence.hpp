@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/family/alpha_family.hpp"
 #include "core/family/canonical_order.hpp"
 
@@ -48,9 +49,13 @@ struct PersistenceDiagram {
   size_t dimension_begin[3] = {0, 0, 0};
 };
 
-/// O((V + E + T) log n) after O(E + T + K) counting sorts; `orders` from
-/// ComputeCanonicalOrders(family). Internal error only if the family contradicts planar duality.
-absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, const CanonicalOrders& orders);
+/// O((V + E + T) log n) after O(E + T + K) counting sorts; `edge_order` and `triangle_order` are
+/// the canonical orders (CanonicalOrders' fields). Internal error only if the family contradicts
+/// planar duality.
+absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, absl::Span<const uint32_t> edge_order,
+                                                      absl::Span<const uint32_t> triangle_order);
+/// The same, computing the canonical orders first.
+absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family);
 
 /// The value of a rank as the family reports it: 0 for rank 0, the spectrum's nearest double for
 /// 1..K, +infinity for kNeverRank.

@@ -15,7 +15,7 @@
 namespace galpha::testing {
 
 inline void ExpectPersistenceMatchesCurves(const AlphaFamily& f) {
-  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(f, ComputeCanonicalOrders(f));
+  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(f);
   ASSERT_TRUE(diagram.ok()) << diagram.status();
   const AlphaRanks& r = f.ranks();
   const auto levels = static_cast<size_t>(f.max_level()) + 1;

@@ -60,7 +60,7 @@ std::vector<std::tuple<int, Simplex, int>> MasterAt(const AlphaFamily& f, int64_
 
 // The diagram's pairs with their simplices named by vertices.
 std::vector<std::tuple<uint32_t, uint32_t, uint32_t, Simplex, Simplex>> PersistenceByVertices(const AlphaFamily& f) {
-  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(f, ComputeCanonicalOrders(f));
+  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(f);
   EXPECT_THAT(diagram, IsOk());
   std::vector<std::tuple<uint32_t, uint32_t, uint32_t, Simplex, Simplex>> out;
   if (!diagram.ok()) return out;

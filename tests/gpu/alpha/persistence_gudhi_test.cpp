@@ -97,7 +97,7 @@ class PersistenceGudhiTest : public testing::BackendTest {
     absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(points, options);
     ASSERT_THAT(family, IsOk());
     testing::ExpectPersistenceMatchesCurves(*family);
-    const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(*family, ComputeCanonicalOrders(*family));
+    const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(*family);
     ASSERT_THAT(diagram, IsOk());
     const testing::GudhiDiagram gudhi = testing::GudhiAlphaPersistence(points);
     ASSERT_GT(gudhi.num_simplices, 0u);
@@ -169,7 +169,7 @@ TEST_P(PersistenceGudhiTest, DegenerateSets) {
   options.backend = GetParam();
   absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(ring, options);
   ASSERT_THAT(family, IsOk());
-  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(*family, ComputeCanonicalOrders(*family));
+  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(*family);
   ASSERT_THAT(diagram, IsOk());
   size_t long_lived = 0;
   for (size_t i = diagram->dimension_begin[1]; i < diagram->dimension_begin[2]; ++i) {
