@@ -9,6 +9,9 @@
 #include "absl/strings/string_view.h"
 #include "core/base/status_macros.hpp"
 #include "core/exact/predicates.hpp"
+#include "core/io/json_text.hpp"
+#include "core/io/number_text.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha {
 namespace {
@@ -176,37 +179,57 @@ void RotateToSmallest(std::vector<uint32_t>& ring) {
 
 // ---- Writers ------------------------------------------------------------------------------------
 
-// Appends a coordinate with 17 significant digits, which reads back as the same double.
-void AppendNumber(std::string& out, double value) {
-  char buffer[32];
-  const int len = std::snprintf(buffer, sizeof buffer, "%.17g", value);
-  out.append(buffer, static_cast<size_t>(len));
-}
-
 void AppendWktPoint(std::string& out, const Point2& p) {
-  AppendNumber(out, p.x);
+  AppendShortestDouble(out, p.x);
   out += ' ';
-  AppendNumber(out, p.y);
+  AppendShortestDouble(out, p.y);
 }
 
-void AppendJsonPoint(std::string& out, const Point2& p) {
-  out += '[';
-  AppendNumber(out, p.x);
-  out += ',';
-  AppendNumber(out, p.y);
-  out += ']';
-}
-
-// Appends a ring, closed by repeating its first vertex (both formats ask for that).
-template <typename AppendPoint>
-void AppendRing(std::string& out, const std::vector<uint32_t>& ring, absl::Span<const Point2> points, const char* open,
-                const char* separator, const char* close, AppendPoint append_point) {
-  out += open;
+// Appends a WKT ring, closed by repeating its first vertex, as OGC asks.
+void AppendWktRing(std::string& out, const std::vector<uint32_t>& ring, absl::Span<const Point2> points) {
+  out += '(';
   for (size_t i = 0; i <= ring.size(); ++i) {
-    if (i > 0) out += separator;
-    append_point(out, points[ring[i % ring.size()]]);
+    if (i > 0) out += ", ";
+    AppendWktPoint(out, points[ring[i % ring.size()]]);
   }
-  out += close;
+  out += ')';
+}
+
+// Appends a polygon's rings without a tag: "((outer), (hole), ...)".
+void AppendWktPolygonText(std::string& out, const ShapePolygon& polygon, absl::Span<const Point2> points) {
+  out += '(';
+  AppendWktRing(out, polygon.outer, points);
+  for (const auto& hole : polygon.holes) {
+    out += ", ";
+    AppendWktRing(out, hole, points);
+  }
+  out += ')';
+}
+
+void AppendWktMultiPolygon(std::string& out, const std::vector<ShapePolygon>& polygons,
+                           absl::Span<const Point2> points) {
+  out += "MULTIPOLYGON (";
+  for (size_t p = 0; p < polygons.size(); ++p) {
+    if (p > 0) out += ", ";
+    AppendWktPolygonText(out, polygons[p], points);
+  }
+  out += ')';
+}
+
+nlohmann::ordered_json JsonPosition(const Point2& p) { return nlohmann::ordered_json::array({p.x, p.y}); }
+
+// A GeoJSON linear ring: closed by repeating its first position (RFC 7946 section 3.1.6).
+nlohmann::ordered_json JsonRing(const std::vector<uint32_t>& ring, absl::Span<const Point2> points) {
+  nlohmann::ordered_json positions = nlohmann::ordered_json::array();
+  for (size_t i = 0; i <= ring.size(); ++i) positions.push_back(JsonPosition(points[ring[i % ring.size()]]));
+  return positions;
+}
+
+nlohmann::ordered_json JsonFeature(nlohmann::ordered_json properties, const char* type,
+                                   nlohmann::ordered_json coordinates) {
+  return {{"type", "Feature"},
+          {"properties", std::move(properties)},
+          {"geometry", {{"type", type}, {"coordinates", std::move(coordinates)}}}};
 }
 
 }  // namespace
@@ -310,30 +333,25 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
 }
 
 std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> points) {
-  if (shape.polygons.empty() && shape.singular_edges.empty() && shape.isolated_points.empty()) {
-    return "GEOMETRYCOLLECTION EMPTY";
+  const bool polygons_only = shape.singular_edges.empty() && shape.isolated_points.empty();
+  if (polygons_only) {
+    if (shape.polygons.empty()) return "MULTIPOLYGON EMPTY";
+    if (shape.polygons.size() == 1) {
+      std::string out = "POLYGON ";
+      AppendWktPolygonText(out, shape.polygons[0], points);
+      return out;
+    }
+    std::string out;
+    AppendWktMultiPolygon(out, shape.polygons, points);
+    return out;
   }
   std::string out = "GEOMETRYCOLLECTION (";
-  bool first_part = true;
-  auto begin_part = [&](const char* name) {
-    if (!first_part) out += ", ";
-    first_part = false;
-    out += name;
-  };
   if (!shape.polygons.empty()) {
-    begin_part("MULTIPOLYGON (");
-    for (size_t p = 0; p < shape.polygons.size(); ++p) {
-      out += p > 0 ? ", (" : "(";
-      AppendRing(out, shape.polygons[p].outer, points, "(", ", ", ")", AppendWktPoint);
-      for (const auto& hole : shape.polygons[p].holes) {
-        AppendRing(out, hole, points, ", (", ", ", ")", AppendWktPoint);
-      }
-      out += ')';
-    }
-    out += ')';
+    AppendWktMultiPolygon(out, shape.polygons, points);
+    out += ", ";
   }
   if (!shape.singular_edges.empty()) {
-    begin_part("MULTILINESTRING (");
+    out += "MULTILINESTRING (";
     for (size_t e = 0; e < shape.singular_edges.size(); ++e) {
       out += e > 0 ? ", (" : "(";
       AppendWktPoint(out, points[shape.singular_edges[e][0]]);
@@ -341,68 +359,45 @@ std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> poin
       AppendWktPoint(out, points[shape.singular_edges[e][1]]);
       out += ')';
     }
-    out += ')';
+    out += "), ";
   }
   if (!shape.isolated_points.empty()) {
-    begin_part("MULTIPOINT (");
+    out += "MULTIPOINT (";
     for (size_t i = 0; i < shape.isolated_points.size(); ++i) {
       out += i > 0 ? ", (" : "(";
       AppendWktPoint(out, points[shape.isolated_points[i]]);
       out += ')';
     }
-    out += ')';
+    out += "), ";
   }
-  out += ')';
+  out.replace(out.size() - 2, 2, ")");  // the last part's ", "
   return out;
 }
 
 std::string ShapeToGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points) {
-  std::string out = "{\"type\":\"FeatureCollection\",\"features\":[";
-  bool first_feature = true;
-  auto begin_feature = [&](const char* kind, const char* type, bool with_area) {
-    if (!first_feature) out += ',';
-    first_feature = false;
-    absl::StrAppend(&out, "{\"type\":\"Feature\",\"properties\":{\"kind\":\"", kind, "\"");
-    if (with_area) {
-      out += ",\"area\":";
-      AppendNumber(out, shape.area);
-    }
-    absl::StrAppend(&out, "},\"geometry\":{\"type\":\"", type, "\",\"coordinates\":[");
-  };
-  const char* kEndFeature = "]}}";
+  nlohmann::ordered_json features = nlohmann::ordered_json::array();
   if (!shape.polygons.empty()) {
-    begin_feature("polygons", "MultiPolygon", true);
-    for (size_t p = 0; p < shape.polygons.size(); ++p) {
-      out += p > 0 ? ",[" : "[";
-      AppendRing(out, shape.polygons[p].outer, points, "[", ",", "]", AppendJsonPoint);
-      for (const auto& hole : shape.polygons[p].holes) {
-        AppendRing(out, hole, points, ",[", ",", "]", AppendJsonPoint);
-      }
-      out += ']';
+    nlohmann::ordered_json polygons = nlohmann::ordered_json::array();
+    for (const ShapePolygon& polygon : shape.polygons) {
+      nlohmann::ordered_json rings = nlohmann::ordered_json::array({JsonRing(polygon.outer, points)});
+      for (const auto& hole : polygon.holes) rings.push_back(JsonRing(hole, points));
+      polygons.push_back(std::move(rings));
     }
-    out += kEndFeature;
+    features.push_back(JsonFeature({{"kind", "polygons"}, {"area", shape.area}}, "MultiPolygon", std::move(polygons)));
   }
   if (!shape.singular_edges.empty()) {
-    begin_feature("singular_edges", "MultiLineString", false);
-    for (size_t e = 0; e < shape.singular_edges.size(); ++e) {
-      out += e > 0 ? ",[" : "[";
-      AppendJsonPoint(out, points[shape.singular_edges[e][0]]);
-      out += ',';
-      AppendJsonPoint(out, points[shape.singular_edges[e][1]]);
-      out += ']';
+    nlohmann::ordered_json lines = nlohmann::ordered_json::array();
+    for (const auto& edge : shape.singular_edges) {
+      lines.push_back(nlohmann::ordered_json::array({JsonPosition(points[edge[0]]), JsonPosition(points[edge[1]])}));
     }
-    out += kEndFeature;
+    features.push_back(JsonFeature({{"kind", "singular_edges"}}, "MultiLineString", std::move(lines)));
   }
   if (!shape.isolated_points.empty()) {
-    begin_feature("isolated_points", "MultiPoint", false);
-    for (size_t i = 0; i < shape.isolated_points.size(); ++i) {
-      if (i > 0) out += ',';
-      AppendJsonPoint(out, points[shape.isolated_points[i]]);
-    }
-    out += kEndFeature;
+    nlohmann::ordered_json positions = nlohmann::ordered_json::array();
+    for (uint32_t v : shape.isolated_points) positions.push_back(JsonPosition(points[v]));
+    features.push_back(JsonFeature({{"kind", "isolated_points"}}, "MultiPoint", std::move(positions)));
   }
-  out += "]}";
-  return out;
+  return JsonText({{"type", "FeatureCollection"}, {"features", std::move(features)}});
 }
 
 std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points) {

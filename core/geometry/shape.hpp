@@ -70,19 +70,28 @@ struct ShapeGeometry {
 /// not close into simple rings) — none of which a subset of one triangulation has.
 absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex);
 
-// The writers print coordinates with %.17g, so that every double reads back exactly. They require
-// every index of `shape` to be < points.size() (true of AssembleShape's result for the same
-// points).
+// The writers print coordinates as their shortest decimal that reads back as the same double
+// (core/io/number_text.hpp: "0.1", not %.17g's "0.10000000000000001"). They require every index of
+// `shape` to be < points.size() (true of AssembleShape's result for the same points).
 
 /// GeoJSON (RFC 7946): a FeatureCollection with up to three features, each present only when not
 /// empty: a MultiPolygon (property "kind": "polygons", and "area"; rings closed, outer rings
 /// counter-clockwise, holes clockwise, as RFC 7946 section 3.1.6 asks), a MultiLineString
 /// ("singular_edges") and a MultiPoint ("isolated_points"). An empty shape gives an empty
-/// FeatureCollection.
+/// FeatureCollection. Compact JSON written from an nlohmann-json document (core/io/json_text.hpp);
+/// keys in the order named here ("type", "properties", "geometry"; "type", "coordinates").
 std::string ShapeToGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points);
 
-/// WKT: `GEOMETRYCOLLECTION (MULTIPOLYGON (...), MULTILINESTRING (...), MULTIPOINT (...))` with the
-/// empty parts left out, or `GEOMETRYCOLLECTION EMPTY`.
+/// OGC WKT, the simplest type that holds the shape, so that a reader (GEOS, shapely, PostGIS) gets
+/// a polygon where the shape is one:
+/// - only polygons (always so in REGULARIZED mode, and in GENERAL mode without singular edges or
+///   isolated points): `POLYGON ((...), ...)` for one polygon, `MULTIPOLYGON (((...)), ...)` for
+///   several, `MULTIPOLYGON EMPTY` for none (the empty shape of either mode);
+/// - with singular edges or isolated points (GENERAL mode only):
+///   `GEOMETRYCOLLECTION (MULTIPOLYGON (...), MULTILINESTRING (...), MULTIPOINT (...))`, always in
+///   that order and with the empty parts left out; the polygons stay a MULTIPOLYGON there, even
+///   one, so that each part of the collection has one type.
+/// Rings are closed (the first vertex repeated), outer rings counter-clockwise, holes clockwise.
 std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> points);
 
 /// A standalone SVG document for a browser: the viewBox fits all of `points` (not only the shape's,

@@ -99,7 +99,7 @@ void CheckGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points) {
   ASSERT_EQ(json["features"].size(), parts);
   auto expect_position = [&](const nlohmann::json& position, uint32_t index) {
     ASSERT_EQ(position.size(), 2u);
-    EXPECT_EQ(position[0].get<double>(), points[index].x);  // %.17g reads back exactly
+    EXPECT_EQ(position[0].get<double>(), points[index].x);  // the shortest text reads back exactly
     EXPECT_EQ(position[1].get<double>(), points[index].y);
   };
   auto expect_ring = [&](const nlohmann::json& ring, const std::vector<uint32_t>& want) {
@@ -193,10 +193,26 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
   const Geos::Geom collection = geos.ReadWkt(wkt);
   EXPECT_NE(collection, nullptr) << wkt;
   if (collection == nullptr) return shape;
+  // The simplest type that holds the shape: POLYGON, MULTIPOLYGON (EMPTY when there is nothing),
+  // or a GEOMETRYCOLLECTION of a MULTIPOLYGON, a MULTILINESTRING and a MULTIPOINT when singular
+  // edges or isolated points are present. GEOS treats a single geometry as its own only part.
+  const bool polygons_only = shape.singular_edges.empty() && shape.isolated_points.empty();
+  const int type = GEOSGeomTypeId_r(geos.ctx(), collection.get());
+  if (!polygons_only) {
+    EXPECT_EQ(type, GEOS_GEOMETRYCOLLECTION) << wkt;
+  } else if (shape.polygons.size() == 1) {
+    EXPECT_EQ(type, GEOS_POLYGON) << wkt;
+  } else {
+    EXPECT_EQ(type, GEOS_MULTIPOLYGON) << wkt;
+    EXPECT_EQ(GEOSisEmpty_r(geos.ctx(), collection.get()), shape.polygons.empty() ? 1 : 0) << wkt;
+  }
   int part = 0;
   if (!shape.polygons.empty()) {
-    const GEOSGeometry* multi = GEOSGetGeometryN_r(geos.ctx(), collection.get(), part++);
-    EXPECT_EQ(GEOSGeomTypeId_r(geos.ctx(), multi), GEOS_MULTIPOLYGON);
+    const GEOSGeometry* multi =
+        polygons_only ? collection.get() : GEOSGetGeometryN_r(geos.ctx(), collection.get(), part++);
+    if (!polygons_only) {
+      EXPECT_EQ(GEOSGeomTypeId_r(geos.ctx(), multi), GEOS_MULTIPOLYGON);
+    }
     EXPECT_EQ(GEOSisValid_r(geos.ctx(), multi), 1) << geos.ValidReason(multi) << "\n" << wkt;
     EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), multi), static_cast<int>(shape.polygons.size()));
     double geos_area = 0.0;
@@ -232,7 +248,9 @@ ShapeGeometry CheckShape(absl::Span<const Point2> points, const std::vector<Tri>
     EXPECT_EQ(GEOSGeomTypeId_r(geos.ctx(), multipoint), GEOS_MULTIPOINT);
     EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), multipoint), static_cast<int>(shape.isolated_points.size()));
   }
-  EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), collection.get()), part);
+  if (!polygons_only) {
+    EXPECT_EQ(GEOSGetNumGeometries_r(geos.ctx(), collection.get()), part);
+  }
 
   CheckGeoJson(shape, points);
   CheckSvg(shape, points);
@@ -285,7 +303,7 @@ TEST(AssembleShapeTest, OneTriangleAndTwoSharingAnEdge) {
   ASSERT_EQ(one.polygons.size(), 1u);
   EXPECT_EQ(one.polygons[0].outer, (std::vector<uint32_t>{0, 1, 3}));
   EXPECT_EQ(one.area, 0.5);
-  EXPECT_EQ(ShapeToWkt(one, g.points), "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 0))))");
+  EXPECT_EQ(ShapeToWkt(one, g.points), "POLYGON ((0 0, 1 0, 1 1, 0 0))");
   std::vector<Tri> cell;
   g.AddCell(cell, 0, 0);
   const ShapeGeometry square = CheckShape(g.points, cell, {}, {}, {1, 0});
@@ -367,7 +385,7 @@ TEST(AssembleShapeTest, IslandTouchingTheShoreOfItsLake) {
 TEST(AssembleShapeTest, EmptyAndLowerDimensionalParts) {
   const Grid g(3, 3);
   const ShapeGeometry empty = CheckShape(g.points, {});
-  EXPECT_EQ(ShapeToWkt(empty, g.points), "GEOMETRYCOLLECTION EMPTY");
+  EXPECT_EQ(ShapeToWkt(empty, g.points), "MULTIPOLYGON EMPTY");
   EXPECT_EQ(ShapeToGeoJson(empty, g.points), "{\"type\":\"FeatureCollection\",\"features\":[]}");
   const ShapeGeometry parts = CheckShape(g.points, {{0, 1, 4}}, {{8, 5}, {5, 8}, {6, 7}}, {2, 2});
   EXPECT_EQ(parts.singular_edges, (std::vector<Edge>{{5, 8}, {6, 7}}));
@@ -375,6 +393,36 @@ TEST(AssembleShapeTest, EmptyAndLowerDimensionalParts) {
   EXPECT_EQ(ShapeToWkt(parts, g.points),
             "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 0))), MULTILINESTRING ((2 1, 2 2), "
             "(0 2, 1 2)), MULTIPOINT ((2 0)))");
+  const ShapeGeometry no_polygon = CheckShape(g.points, {}, {{0, 1}}, {});
+  EXPECT_EQ(ShapeToWkt(no_polygon, g.points), "GEOMETRYCOLLECTION (MULTILINESTRING ((0 0, 1 0)))");
+}
+
+TEST(AssembleShapeTest, WktIsPolygonOrMultiPolygonWithoutLowerDimensionalParts) {
+  const Grid g(4, 3);
+  std::vector<Tri> tris;
+  g.AddCell(tris, 0, 0);
+  g.AddCell(tris, 2, 1);  // apart from the first
+  const ShapeGeometry two = CheckShape(g.points, tris, {}, {}, {2, 0});
+  EXPECT_EQ(ShapeToWkt(two, g.points), "MULTIPOLYGON (((0 0, 1 0, 1 1, 0 1, 0 0)), ((2 1, 3 1, 3 2, 2 2, 2 1)))");
+  // The same polygons with an isolated point: a collection, the polygons still a MULTIPOLYGON.
+  const ShapeGeometry with_point = CheckShape(g.points, {tris[0], tris[1]}, {}, {11}, {1, 0});
+  EXPECT_EQ(ShapeToWkt(with_point, g.points),
+            "GEOMETRYCOLLECTION (MULTIPOLYGON (((0 0, 1 0, 1 1, 0 1, 0 0))), MULTIPOINT ((3 2)))");
+}
+
+TEST(AssembleShapeTest, WritersPrintShortestRoundTripCoordinates) {
+  // %.17g wrote 0.1 as 0.10000000000000001 and 1/3 with 17 digits; their shortest texts are
+  // shorter and read back the same. A large offset and a tiny coordinate keep the digits they need.
+  const std::vector<Point2> points = {{0.1, 0.2}, {1.0 / 3.0, 0.2}, {0.1, 1e-300}, {-2.5e15, 4503599627370497.0}};
+  const ShapeGeometry shape = CheckShape(points, {{0, 2, 1}}, {}, {3});
+  ASSERT_EQ(shape.polygons.size(), 1u);
+  EXPECT_EQ(ShapeToWkt(shape, points),
+            "GEOMETRYCOLLECTION (MULTIPOLYGON (((0.1 0.2, 0.1 1e-300, 0.3333333333333333 0.2, 0.1 0.2))), "
+            "MULTIPOINT ((-2.5e+15 4503599627370497)))");
+  const std::string geojson = ShapeToGeoJson(shape, points);
+  EXPECT_NE(geojson.find("[[[[0.1,0.2],[0.1,1e-300],[0.3333333333333333,0.2],[0.1,0.2]]]]"), std::string::npos)
+      << geojson;
+  EXPECT_NE(geojson.find("\"coordinates\":[[-2.5e+15,4503599627370497]]"), std::string::npos) << geojson;
 }
 
 TEST(AssembleShapeTest, BadInputIsInvalidArgumentNamingTheIndex) {
