@@ -160,7 +160,7 @@ BenchResult RunOne(const std::string& name, const std::vector<Point2>& points, c
     auto floor = MeasureSortFloorSeconds(result.sort_pairs, options.backend);
     if (floor.ok()) result.floor_ms = *floor * 1e3;
   }
-  if (points.size() > options.cgal_max) return result;
+  if (points.size() > options.competitor_max) return result;
   std::vector<Kernel::Point_2> cgal_points;
   cgal_points.reserve(points.size());
   for (const Point2& p : points) cgal_points.emplace_back(p.x, p.y);
@@ -271,7 +271,7 @@ void PrintHardness(const std::vector<BenchResult>& results) {
 }
 
 int Main(int argc, char** argv) {
-  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, true);
+  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, "--cgal-max");
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
     return 2;

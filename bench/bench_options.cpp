@@ -7,7 +7,7 @@
 
 namespace galpha {
 
-absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, bool accept_cgal_max) {
+absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, const char* competitor_max_flag) {
   BenchOptions options;
   for (const gen::NamedGenerator& generator : gen::AllDistributions()) options.distributions.push_back(generator.name);
   bool explicit_generated = false;
@@ -33,9 +33,9 @@ absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, bool accept_c
       }
     } else if (const char* v = value_of("--seed")) {
       if (!absl::SimpleAtoi(v, &options.seed)) return absl::InvalidArgumentError(absl::StrCat("bad --seed '", v, "'"));
-    } else if (const char* v = accept_cgal_max ? value_of("--cgal-max") : nullptr) {
-      if (!absl::SimpleAtoi(v, &options.cgal_max)) {
-        return absl::InvalidArgumentError(absl::StrCat("bad --cgal-max '", v, "'"));
+    } else if (const char* v = competitor_max_flag != nullptr ? value_of(competitor_max_flag) : nullptr) {
+      if (!absl::SimpleAtoi(v, &options.competitor_max)) {
+        return absl::InvalidArgumentError(absl::StrCat("bad ", competitor_max_flag, " '", v, "'"));
       }
     } else if (const char* v = value_of("--sizes")) {
       options.sizes.clear();

@@ -1,4 +1,4 @@
-// The command-line options both benchmarks share (delaunay_bench, alpha_bench).
+// The command-line options the benchmarks share (delaunay_bench, alpha_bench, topology_bench).
 #pragma once
 
 #include <cstddef>
@@ -19,12 +19,14 @@ struct BenchOptions {
   std::vector<std::string> distributions;
   uint64_t seed = 1;
   std::vector<std::string> data_files;
-  /// Largest input CGAL runs on (alpha_bench only: CGAL's alpha shapes take tens of seconds at 1M).
-  size_t cgal_max = 1000000;
+  /// Largest input the competitor runs on (alpha_bench's CGAL, --cgal-max; topology_bench's GUDHI,
+  /// --gudhi-max): they take tens of seconds at 1M.
+  size_t competitor_max = 1000000;
 };
 
 /// Parses --backend=, --repeat=, --seed=, --sizes=, --dists=, --data FILE (or --data=FILE) and,
-/// when `accept_cgal_max`, --cgal-max=. With --data and no --sizes/--dists, only the files run.
-absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, bool accept_cgal_max);
+/// when `competitor_max_flag` names one ("--cgal-max"), that flag. With --data and no
+/// --sizes/--dists, only the files run.
+absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, const char* competitor_max_flag);
 
 }  // namespace galpha

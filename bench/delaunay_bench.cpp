@@ -150,7 +150,7 @@ void PrintStageTable(const std::vector<BenchResult>& results) {
 }
 
 int Main(int argc, char** argv) {
-  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, false);
+  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, nullptr);
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
     return 2;

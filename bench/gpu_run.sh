@@ -14,6 +14,8 @@
 #           ulp-perturbed lattices, centimetre LiDAR) at 100K and 1M with CGAL at 100K, at 10M on
 #           the GPU alone, and the CPU backend at 1M on this machine's cores
 #   identity the CUDA/CPU identity test alone
+#   topology topology_bench: Betti curves and persistence diagrams at 1M (GUDHI's exact persistence
+#           in the same run at 1M uniform and at 100K on the hard generators) and 10M uniform
 #   profile Nsight Systems (nsys, when the machine has it) over one 1M-point family build: the
 #           kernels and the CUDA API calls (waits) by total time
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
@@ -102,6 +104,16 @@ for phase in "${phases[@]}"; do
       run_step hard 130 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --repeat=1 --cgal-max=0
       run_step hard 150 .carry/bin/alpha_bench --backend=cpu --sizes=1000000 --repeat=1 --cgal-max=0
       grep -E '^\|' "$out/hard.log" | grep -vE 'stages of the best run|^\| [a-z_0-9]+ \| [0-9]+ \| (validate|upload)'
+      ;;
+    topology)
+      [ -x .carry/bin/topology_bench ] || { echo "no topology_bench in .carry"; status=1; continue; }
+      run_step topology 330 .carry/bin/topology_bench --backend=cuda --sizes=1000000 --dists=uniform --repeat=3 \
+        --gudhi-max=1000000
+      run_step topology 200 .carry/bin/topology_bench --backend=cuda --sizes=100000,1000000 \
+        --dists=grid,circle,two_lines,ulp_lattice,lidar_cm --repeat=3 --gudhi-max=100000
+      run_step topology 90 .carry/bin/topology_bench --backend=cuda --sizes=10000000 --dists=uniform --repeat=2 \
+        --gudhi-max=0
+      grep -E '^\|' "$out/topology.log" | grep -v -- '---'
       ;;
     identity)
       # The CUDA/CPU identity test alone (every generator and data set): the quick correctness

@@ -1,0 +1,157 @@
+// topology_bench: the topology of the whole family (Betti curves of both complexes and the H0/H1
+// persistence diagram) against GUDHI's exact alpha-complex persistence, measured in the same run.
+//   topology_bench [--backend=auto|cpu|cuda] [--repeat=3] [--sizes=100000,1000000]
+//                  [--dists=NAME,...(default: every generator)] [--seed=1] [--gudhi-max=1000000]
+//                  [--data FILE.bin]...
+// Per input: the family build (the engine's stages, the Betti curves among them: the "components"
+// stage computes the component and hole curves of both complexes in one pass), the persistence
+// diagram from the built family (host: canonical orders, then two union-finds), and GUDHI's
+// AlphaComplex (exact) + persistent cohomology over Z/2Z on the same points, with both diagrams'
+// numbers of intervals of positive length (they may differ by a few where GUDHI's doubles reorder
+// near-ties: tests/gpu/alpha/persistence_gudhi_test.cpp compares the diagrams themselves).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench/bench_options.hpp"
+#include "core/family/alpha_family.hpp"
+#include "core/family/persistence.hpp"
+#include "core/io/point_formats.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "tests/support/gudhi_persistence_oracle.hpp"
+#include "tests/support/point_generators.hpp"
+
+namespace galpha {
+namespace {
+
+constexpr char kUsage[] =
+    "usage: topology_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,...] [--dists=NAME,...]\n"
+    "                      [--seed=N] [--gudhi-max=N] [--data FILE.bin]...\n";
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+struct TopologyResult {
+  std::string name;
+  size_t n = 0;
+  std::string backend;
+  double build_ms = std::numeric_limits<double>::infinity();  // the whole BuildAlphaFamily call
+  double curves_ms = 0;                                       // its "components" stage
+  double persistence_ms = std::numeric_limits<double>::infinity();
+  size_t intervals[2] = {0, 0};  // of positive length (as doubles), both dimensions
+  double gudhi_ms = -1;          // not run above --gudhi-max
+  size_t gudhi_intervals[2] = {0, 0};
+  std::string error;
+};
+
+TopologyResult RunOne(const std::string& name, const std::vector<Point2>& points, const BenchOptions& options) {
+  TopologyResult result;
+  result.name = name;
+  result.n = points.size();
+  BuildOptions build;
+  build.backend = options.backend;
+  for (int r = 0; r < options.repeat; ++r) {
+    auto start = std::chrono::steady_clock::now();
+    absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(points, build);
+    const double build_ms = MillisecondsSince(start);
+    if (!family.ok()) {
+      result.error = family.status().ToString();
+      return result;
+    }
+    if (build_ms < result.build_ms) {
+      result.build_ms = build_ms;
+      result.backend = family->report().backend;
+      for (const StageTime& s : family->report().stage_times) {
+        if (s.stage == "components") result.curves_ms = s.seconds * 1e3;
+      }
+    }
+    start = std::chrono::steady_clock::now();
+    absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(*family);
+    const double persistence_ms = MillisecondsSince(start);
+    if (!diagram.ok()) {
+      result.error = diagram.status().ToString();
+      return result;
+    }
+    result.persistence_ms = std::min(result.persistence_ms, persistence_ms);
+    for (int d = 0; d < 2; ++d) {
+      result.intervals[d] = 0;
+      for (size_t i = diagram->dimension_begin[d]; i < diagram->dimension_begin[d + 1]; ++i) {
+        const PersistencePair& p = diagram->pairs[i];
+        result.intervals[d] += RankValue(*family, p.death_rank) > RankValue(*family, p.birth_rank);
+      }
+    }
+  }
+  if (points.size() <= options.competitor_max) {
+    // GUDHI takes seconds at 1M points: one run.
+    const auto start = std::chrono::steady_clock::now();
+    const testing::GudhiDiagram gudhi = testing::GudhiAlphaPersistence(points);
+    result.gudhi_ms = MillisecondsSince(start);
+    for (int d = 0; d < 2; ++d) result.gudhi_intervals[d] = gudhi.intervals[d].size();
+  }
+  return result;
+}
+
+void PrintRow(const TopologyResult& r) {
+  if (!r.error.empty()) {
+    std::printf("| %s | %zu | error: %s |\n", r.name.c_str(), r.n, r.error.c_str());
+    return;
+  }
+  std::string gudhi = "-", ratio = "-", gudhi_counts = "-";
+  char text[64];
+  if (r.gudhi_ms >= 0) {
+    std::snprintf(text, sizeof text, "%.1f", r.gudhi_ms);
+    gudhi = text;
+    std::snprintf(text, sizeof text, "%.0fx", r.gudhi_ms / (r.curves_ms + r.persistence_ms));
+    ratio = text;
+    std::snprintf(text, sizeof text, "%zu / %zu", r.gudhi_intervals[0], r.gudhi_intervals[1]);
+    gudhi_counts = text;
+  }
+  std::printf("| %s | %zu | %s | %.1f | %.2f | %.1f | %zu / %zu | %s | %s | %s |\n", r.name.c_str(), r.n,
+              r.backend.c_str(), r.build_ms, r.curves_ms, r.persistence_ms, r.intervals[0], r.intervals[1],
+              gudhi_counts.c_str(), gudhi.c_str(), ratio.c_str());
+  std::fflush(stdout);
+}
+
+int Main(int argc, char** argv) {
+  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, "--gudhi-max");
+  if (!options.ok()) {
+    std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
+    return 2;
+  }
+  std::printf("topology_bench: backend %s requested (CUDA %s), galpha best of %d, GUDHI once, %u host threads\n\n",
+              BackendName(options->backend), CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
+              std::thread::hardware_concurrency());
+  std::printf(
+      "| input | n | backend | family build ms | Betti curves ms (components stage) | persistence ms (host) | "
+      "H0 / H1 intervals | GUDHI's H0 / H1 intervals | GUDHI exact ms | GUDHI / (curves + persistence) |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  bool failed = false;
+  auto run = [&](const std::string& name, const std::vector<Point2>& points) {
+    std::fprintf(stderr, "running %s n=%zu\n", name.c_str(), points.size());
+    const TopologyResult r = RunOne(name, points, *options);
+    failed |= !r.error.empty();
+    PrintRow(r);
+  };
+  for (const std::string& name : options->distributions) {
+    for (size_t n : options->sizes) run(name, gen::FindDistribution(name)->generate(n, options->seed));
+  }
+  for (const std::string& file : options->data_files) {
+    absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
+    if (!points.ok()) {
+      std::fprintf(stderr, "%s\n", points.status().ToString().c_str());
+      return 1;
+    }
+    run(file.substr(file.find_last_of('/') + 1), *points);
+  }
+  return failed ? 1 : 0;
+}
+
+}  // namespace
+}  // namespace galpha
+
+int main(int argc, char** argv) { return galpha::Main(argc, argv); }
