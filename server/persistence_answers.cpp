@@ -36,9 +36,8 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
       uint32_t count = 0;
       for (; position_ < end && count < kPersistencePairsPerChunk; ++position_) {
         const PersistencePair& p = diagram_.pairs[position_];
-        const double birth = RankValue(family, p.birth_rank), death = RankValue(family, p.death_rank);
-        if (!p.essential() && !(death - birth >= min_persistence_)) continue;
-        Append(family, p, birth, death, message);
+        if (!PersistsAtLeast(family, p, min_persistence_)) continue;
+        Append(family, p, RankValue(family, p.birth_rank), RankValue(family, p.death_rank), message);
         ++count;
       }
       if (count > 0) {

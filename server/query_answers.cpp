@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
+#include "core/geometry/shape_holes.hpp"
 
 namespace galpha::server {
 
@@ -394,9 +395,15 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
   const AlphaFamily& family = cached->family();
   auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
+  const double min_hole_area = request.min_hole_area();
+  if (std::isnan(min_hole_area) || min_hole_area < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_hole_area ", min_hole_area, " is not an area: give 0 (keep every hole) or more"));
+  }
   auto shape = AssembleShape(family.ComplexAt(level->level, *mode));
   if (!shape.ok()) return shape.status();
   const absl::Span<const Point2> points = family.points();
+  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, points, min_hole_area);
   switch (request.format()) {
     case v1::SHAPE_FORMAT_GEOJSON:
       return std::make_unique<ShapeTextSource>(ShapeToGeoJson(*shape, points));

@@ -61,6 +61,10 @@ double RankValue(const AlphaFamily& family, uint32_t rank) {
   return family.spectrum()[rank - 1];
 }
 
+bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence) {
+  return pair.essential() || RankValue(family, pair.death_rank) - RankValue(family, pair.birth_rank) >= min_persistence;
+}
+
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family) {
   const CanonicalOrders orders = ComputeCanonicalOrders(family);
   return ComputePersistence(family, orders.edge_order, orders.triangle_order);

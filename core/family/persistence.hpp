@@ -57,6 +57,10 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
 /// The same, computing the canonical orders first.
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family);
 
+/// Whether `pair` is listed under a minimum persistence (alpha_sq units, on the published values:
+/// RankValue(death) - RankValue(birth) >= min_persistence, in double); essential classes always are.
+bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence);
+
 /// The value of a rank as the family reports it: 0 for rank 0, the spectrum's nearest double for
 /// 1..K, +infinity for kNeverRank.
 double RankValue(const AlphaFamily& family, uint32_t rank);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/family/canonical_order.hpp"
@@ -15,6 +16,7 @@
 #include "gtest/gtest.h"
 #include "server/persistence_answers.hpp"
 #include "server/query_answers.hpp"
+#include "tests/server/cached_family_fixture.hpp"
 #include "tests/server/query_answers_fixture.hpp"
 #include "tests/support/status_matchers.hpp"
 
@@ -208,6 +210,41 @@ TEST(QueryAnswersTopologyTest, PersistenceFiltersByDimensionAndPersistence) {
               StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("min_persistence")));
   negative.set_min_persistence(std::nan(""));
   EXPECT_THAT(MakePersistenceSource(cached, negative).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+}
+
+// A 12 x 12 integer grid without a 3 x 3 block: at alpha_sq 0.5 every unit square is in, and the
+// block leaves one octagonal hole (a 4 x 4 square less the four corner triangles that are in at
+// 0.5: area 14); min_hole_area fills it above 14.
+TEST(QueryAnswersTopologyTest, ShapeFillsHolesBelowMinHoleArea) {
+  std::vector<Point2> points;
+  for (int i = 0; i < 12; ++i) {
+    for (int j = 0; j < 12; ++j) {
+      if (i >= 4 && i <= 6 && j >= 4 && j <= 6) continue;
+      points.push_back({static_cast<double>(i), static_cast<double>(j)});
+    }
+  }
+  const std::shared_ptr<const CachedFamily> cached = testing::MakeCachedFamily(points, "holed grid");
+  ASSERT_NE(cached, nullptr);
+  auto wkt = [&](double min_hole_area) -> std::string {
+    v1::ShapeRequest request;
+    *request.mutable_threshold() = testing::AlphaSq(0.5);
+    request.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+    request.set_format(v1::SHAPE_FORMAT_WKT);
+    request.set_min_hole_area(min_hole_area);
+    auto source = MakeShapeSource(cached, request);
+    if (!source.ok()) return std::string(source.status().message());
+    std::string text;
+    for (const v1::ShapeResponse& m : Drain(**source)) text += m.text();
+    return text;
+  };
+  const std::string kept = wkt(0), also_kept = wkt(14), filled = wkt(14.5);
+  EXPECT_EQ(kept.rfind("POLYGON ((", 0), 0u) << kept;
+  EXPECT_NE(kept.find("), ("), std::string::npos) << "one hole ring: " << kept;
+  EXPECT_EQ(also_kept, kept);
+  EXPECT_EQ(filled.find("), ("), std::string::npos) << "no hole ring: " << filled;
+  EXPECT_EQ(cached->family().Holes(cached->family().LevelForAlphaSq(0.5).value(), ClassifyMode::kRegularized), 1u);
+  EXPECT_NE(wkt(-1).find("min_hole_area"), std::string::npos);
+  EXPECT_NE(wkt(std::nan("")).find("min_hole_area"), std::string::npos);
 }
 
 }  // namespace
