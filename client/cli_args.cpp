@@ -19,7 +19,7 @@ const char kUsage[] =
     "\n"
     "commands:\n"
     "  triangulate FILE            the Delaunay triangulation's counts and stage times, one JSON line\n"
-    "  spectrum FILE               the spectrum: one alpha_sq per line, ascending (%.17g)\n"
+    "  spectrum FILE               the spectrum: one alpha_sq per line, ascending (shortest round-trip decimals)\n"
     "  classify FILE THRESHOLD [--mode general|regularized] [--vertex-rule report|cgal]\n"
     "                              every simplex at THRESHOLD: 'v i CLASS' (one per distinct point),\n"
     "                              'e i j CLASS', 't i j k CLASS' (indices ascending), in that order\n"

@@ -15,6 +15,7 @@
 #include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
 #include "core/geometry/shape.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha::alphactl {
 
@@ -83,17 +84,23 @@ int RunSummary(Args args) {
   const ClassificationSummary counts = SummarizeClassification(*family, classes);
 
   const int64_t level = threshold->level;
-  const std::string json = absl::StrCat(
-      "{\"file\":", JsonString(common->file), ",\"points\":", input_points,
-      ",\"distinct_points\":", family->num_unique(), ",\"duplicates\":", family->num_duplicates(),
-      ",\"spectrum_size\":", family->spectrum().size(), ",\"level\":", level,
-      ",\"alpha_sq\":", JsonNumber(threshold->alpha_sq), ",\"mode\":\"", ModeName(options->mode),
-      "\",\"vertex_rule\":\"", VertexRuleName(options->rule), "\",\"vertices\":", ClassCountsJson(counts.vertices),
-      ",\"edges\":", ClassCountsJson(counts.edges), ",\"triangles\":", ClassCountsJson(counts.triangles),
-      ",\"components\":", family->Components(level), ",\"solid_components\":", family->SolidComponents(level),
-      ",\"interior_area\":", JsonNumber(counts.interior_area), ",\"backend\":", JsonString(family->report().backend),
-      "}\n");
-  std::fputs(json.c_str(), stdout);
+  const nlohmann::ordered_json json = {{"file", common->file},
+                                       {"points", input_points},
+                                       {"distinct_points", family->num_unique()},
+                                       {"duplicates", family->num_duplicates()},
+                                       {"spectrum_size", family->spectrum().size()},
+                                       {"level", level},
+                                       {"alpha_sq", threshold->alpha_sq},
+                                       {"mode", ModeName(options->mode)},
+                                       {"vertex_rule", VertexRuleName(options->rule)},
+                                       {"vertices", ClassCountsJson(counts.vertices)},
+                                       {"edges", ClassCountsJson(counts.edges)},
+                                       {"triangles", ClassCountsJson(counts.triangles)},
+                                       {"components", family->Components(level)},
+                                       {"solid_components", family->SolidComponents(level)},
+                                       {"interior_area", counts.interior_area},
+                                       {"backend", family->report().backend}};
+  std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
 }
 
@@ -181,22 +188,17 @@ int RunOptimal(Args args) {
 
   // Counts are 32-bit: "at most N" for any larger N means the same as for the largest count.
   const uint32_t n = static_cast<uint32_t>(std::min<int64_t>(*components, std::numeric_limits<uint32_t>::max()));
-  std::string json = absl::StrCat("{\"components\":", *components, ",\"regularized\":");
+  nlohmann::ordered_json json = {{"components", *components}, {"regularized", nullptr}, {"general", nullptr}};
   if (const std::optional<int64_t> level = family->OptimalLevelRegularized(n)) {
-    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(PublishedAlphaSq(*family, *level)),
-                    ",\"solid_components\":", family->SolidComponents(*level), "}");
-  } else {
-    json += "null";
+    json["regularized"] = {{"rank", *level},
+                           {"alpha_sq", PublishedAlphaSq(*family, *level)},
+                           {"solid_components", family->SolidComponents(*level)}};
   }
-  json += ",\"general\":";
   if (const std::optional<int64_t> level = family->OptimalLevelGeneral(n)) {
-    absl::StrAppend(&json, "{\"rank\":", *level, ",\"alpha_sq\":", JsonNumber(PublishedAlphaSq(*family, *level)),
-                    ",\"components\":", family->Components(*level), "}");
-  } else {
-    json += "null";
+    json["general"] = {
+        {"rank", *level}, {"alpha_sq", PublishedAlphaSq(*family, *level)}, {"components", family->Components(*level)}};
   }
-  json += "}\n";
-  std::fputs(json.c_str(), stdout);
+  std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
 }
 

@@ -21,6 +21,7 @@
 #include "client/galpha_client.hpp"
 #include "client/text_output.hpp"
 #include "core/io/point_set_handle.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha::alphactl {
 
@@ -220,17 +221,23 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
   });
   if (!status.ok()) return QueryError(common, status);
   const v1::BuildSummary& build = remote->build.summary;
-  const std::string json = absl::StrCat(
-      "{\"file\":", JsonString(common.file), ",\"points\":", remote->input_points,
-      ",\"distinct_points\":", build.distinct_points(), ",\"duplicates\":", build.duplicates(),
-      ",\"spectrum_size\":", build.spectrum_size(), ",\"level\":", summary.level(),
-      ",\"alpha_sq\":", JsonNumber(summary.alpha_sq()), ",\"mode\":\"", ModeName(options.mode), "\",\"vertex_rule\":\"",
-      VertexRuleName(options.rule), "\",\"vertices\":", ClassCountsJson(FromProto(summary.vertices())),
-      ",\"edges\":", ClassCountsJson(FromProto(summary.edges())),
-      ",\"triangles\":", ClassCountsJson(FromProto(summary.triangles())), ",\"components\":", summary.components(),
-      ",\"solid_components\":", summary.solid_components(), ",\"interior_area\":", JsonNumber(summary.interior_area()),
-      ",\"backend\":", JsonString(build.backend()), "}\n");
-  std::fputs(json.c_str(), stdout);
+  const nlohmann::ordered_json json = {{"file", common.file},
+                                       {"points", remote->input_points},
+                                       {"distinct_points", build.distinct_points()},
+                                       {"duplicates", build.duplicates()},
+                                       {"spectrum_size", build.spectrum_size()},
+                                       {"level", summary.level()},
+                                       {"alpha_sq", summary.alpha_sq()},
+                                       {"mode", ModeName(options.mode)},
+                                       {"vertex_rule", VertexRuleName(options.rule)},
+                                       {"vertices", ClassCountsJson(FromProto(summary.vertices()))},
+                                       {"edges", ClassCountsJson(FromProto(summary.edges()))},
+                                       {"triangles", ClassCountsJson(FromProto(summary.triangles()))},
+                                       {"components", summary.components()},
+                                       {"solid_components", summary.solid_components()},
+                                       {"interior_area", summary.interior_area()},
+                                       {"backend", build.backend()}};
+  std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
 }
 
@@ -304,24 +311,18 @@ int RemoteOptimal(const CommonArgs& common, int64_t components) {
       static_cast<uint32_t>(std::min<int64_t>(components, std::numeric_limits<uint32_t>::max())));
   auto answer = remote->client->OptimalAlpha(request);
   if (!answer.ok()) return QueryError(common, answer.status());
-  std::string json = absl::StrCat("{\"components\":", components, ",\"regularized\":");
+  nlohmann::ordered_json json = {{"components", components}, {"regularized", nullptr}, {"general", nullptr}};
   if (answer->has_regularized()) {
-    absl::StrAppend(&json, "{\"rank\":", answer->regularized().rank(),
-                    ",\"alpha_sq\":", JsonNumber(answer->regularized().alpha_sq()),
-                    ",\"solid_components\":", answer->regularized().components(), "}");
-  } else {
-    json += "null";
+    json["regularized"] = {{"rank", answer->regularized().rank()},
+                           {"alpha_sq", answer->regularized().alpha_sq()},
+                           {"solid_components", answer->regularized().components()}};
   }
-  json += ",\"general\":";
   if (answer->has_general()) {
-    absl::StrAppend(&json, "{\"rank\":", answer->general().rank(),
-                    ",\"alpha_sq\":", JsonNumber(answer->general().alpha_sq()),
-                    ",\"components\":", answer->general().components(), "}");
-  } else {
-    json += "null";
+    json["general"] = {{"rank", answer->general().rank()},
+                       {"alpha_sq", answer->general().alpha_sq()},
+                       {"components", answer->general().components()}};
   }
-  json += "}\n";
-  std::fputs(json.c_str(), stdout);
+  std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
 }
 

@@ -1,7 +1,9 @@
 #include "client/text_output.hpp"
 
 #include <charconv>
-#include <cmath>
+
+#include "core/io/json_text.hpp"
+#include "core/io/number_text.hpp"
 
 namespace galpha::alphactl {
 
@@ -28,7 +30,10 @@ void ChunkedWriter::AppendUint(uint64_t value) {
   MaybeFlush();
 }
 
-void ChunkedWriter::AppendDouble(double value) { Append(FormatDouble(value)); }
+void ChunkedWriter::AppendDouble(double value) {
+  AppendShortestDouble(buffer_, value);
+  MaybeFlush();
+}
 
 void ChunkedWriter::MaybeFlush() {
   if (buffer_.size() < kChunkBytes) return;
@@ -45,29 +50,10 @@ bool ChunkedWriter::Finish() {
   return !failed_;
 }
 
-std::string FormatDouble(double value) {
-  char text[32];
-  const int n = std::snprintf(text, sizeof text, "%.17g", value);
-  return std::string(text, static_cast<size_t>(n));
-}
-
-std::string JsonNumber(double value) { return std::isfinite(value) ? FormatDouble(value) : "null"; }
-
-std::string JsonString(absl::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
+std::string JsonLine(const nlohmann::ordered_json& json) {
+  std::string line = JsonText(json);
+  line += '\n';
+  return line;
 }
 
 const char* EndpointName(Endpoint endpoint) {
@@ -82,15 +68,10 @@ const char* EndpointName(Endpoint endpoint) {
   return "UNKNOWN";
 }
 
-std::string ClassCountsJson(const std::array<uint64_t, 4>& counts) {
-  std::string json = "{";
-  for (size_t c = 0; c < counts.size(); ++c) {
-    json += c > 0 ? ",\"" : "\"";
-    json += SimplexClassName(static_cast<SimplexClass>(c));
-    json += "\":";
-    json += std::to_string(counts[c]);
-  }
-  return json + "}";
+nlohmann::ordered_json ClassCountsJson(const std::array<uint64_t, 4>& counts) {
+  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+  for (size_t c = 0; c < counts.size(); ++c) json[SimplexClassName(static_cast<SimplexClass>(c))] = counts[c];
+  return json;
 }
 
 }  // namespace galpha::alphactl

@@ -1,5 +1,6 @@
 // alphactl's output for scripts: a buffered writer for line-per-simplex output (millions of lines),
-// numbers printed exactly (%.17g) and JSON string literals.
+// numbers as their shortest round-trip decimal (core/io/number_text.hpp) and one-line JSON objects
+// built with nlohmann-json (core/io/json_text.hpp).
 #pragma once
 
 #include <array>
@@ -11,6 +12,7 @@
 #include "absl/strings/string_view.h"
 #include "core/family/alpha_family.hpp"
 #include "core/family/alpha_ranks.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha::alphactl {
 
@@ -24,7 +26,7 @@ class ChunkedWriter {
   void Append(absl::string_view text);
   void Append(char c);
   void AppendUint(uint64_t value);
-  /// %.17g: every double reads back exactly.
+  /// The shortest decimal that reads back as exactly `value` (ShortestDouble).
   void AppendDouble(double value);
   /// Writes what is buffered and flushes `out`. False when a write failed (the writer stops
   /// writing after the first failure).
@@ -38,12 +40,9 @@ class ChunkedWriter {
   bool failed_ = false;
 };
 
-/// `value` as printf's %.17g.
-std::string FormatDouble(double value);
-/// A JSON number for `value` (%.17g), or null when it is not finite (JSON has no NaN or infinity).
-std::string JsonNumber(double value);
-/// A JSON string literal for `text` (quotes, backslashes and control characters escaped).
-std::string JsonString(absl::string_view text);
+/// `json` as one compact line of JSON text, newline included (JsonText: doubles as
+/// ShortestDouble, null when not finite).
+std::string JsonLine(const nlohmann::ordered_json& json);
 
 /// Appends KIND and the vertex indices: "v 3", "e 1 4", "t 0 2 5".
 template <size_t N>
@@ -59,6 +58,6 @@ void AppendSimplex(ChunkedWriter& out, char kind, const std::array<uint32_t, N>&
 const char* EndpointName(Endpoint endpoint);
 
 /// {"EXTERIOR":n,"SINGULAR":n,"REGULAR":n,"INTERIOR":n}, indexed by SimplexClass.
-std::string ClassCountsJson(const std::array<uint64_t, 4>& counts);
+nlohmann::ordered_json ClassCountsJson(const std::array<uint64_t, 4>& counts);
 
 }  // namespace galpha::alphactl

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "absl/strings/str_cat.h"
-#include "absl/strings/str_format.h"
+#include "core/io/number_text.hpp"
 
 namespace galpha {
 namespace {
@@ -16,8 +16,10 @@ double SpreadMagnitude(double c) {
   return a == 0.0 ? 0.0 : std::max(a, kSpreadFloor);
 }
 
-/// "(x, y)" with every digit needed to read the doubles back.
-std::string Coordinates(const Point2& p) { return absl::StrFormat("(%.17g, %.17g)", p.x, p.y); }
+/// "(x, y)" with the digits that read the doubles back, and no more.
+std::string Coordinates(const Point2& p) {
+  return absl::StrCat("(", ShortestDouble(p.x), ", ", ShortestDouble(p.y), ")");
+}
 
 }  // namespace
 

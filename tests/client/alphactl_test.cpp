@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -88,10 +89,10 @@ std::vector<std::string> SplitLines(const std::string& text) {
   return lines;
 }
 
+// The shortest decimal that reads back as `value`, as alphactl prints doubles (C++17's to_chars).
 std::string Printed(double value) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
+  return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
 }
 
 /// Runs `args` on `file` and expects success; returns standard output.
@@ -147,6 +148,11 @@ TEST(AlphactlTest, FileNamesAreEscapedInTheJson) {
   EXPECT_EQ(nlohmann::json::parse(run.out)["file"], path);
   EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", path, "--rank 0"))["file"], path);
   std::filesystem::remove(path);
+  // A name that is not UTF-8 (Latin-1 e-acute) still gives valid JSON: the byte becomes U+FFFD.
+  const std::string latin1 = WriteFile("alphactl_caf\xe9.csv", "0 0\n1 0\n0 1\n");
+  const nlohmann::json summary = nlohmann::json::parse(Succeeds("summary", latin1, "--rank 0"));
+  EXPECT_EQ(summary["file"], latin1.substr(0, latin1.size() - 5) + "\xef\xbf\xbd.csv");
+  std::filesystem::remove(latin1);
 }
 
 TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
@@ -174,9 +180,11 @@ TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
 TEST(AlphactlTest, SpectrumsArePrintedExactly) {
   EXPECT_EQ(Succeeds("spectrum", SquareCsv(), ""), "0.25\n0.5\n");
   // (0,0), (4,0), (2,3): sides 16/4 and 13/4 (twice, one value), all unattached; circumradius^2
-  // 169/36.
+  // 169/36, printed as the shortest decimal that reads back as the double nearest it (%.17g said
+  // 4.6944444444444446).
   const std::string triangle = WriteFile("alphactl_triangle.txt", "0 0\n4 0\n2 3\n");
-  EXPECT_EQ(Succeeds("spectrum", triangle, "--backend=cpu"), Lines({"3.25", "4", Printed(169.0 / 36.0)}));
+  EXPECT_EQ(Succeeds("spectrum", triangle, "--backend=cpu"), Lines({"3.25", "4", "4.694444444444445"}));
+  EXPECT_EQ(std::strtod("4.694444444444445", nullptr), 169.0 / 36.0);
   // Obtuse (0,0), (4,0), (2,1): the long edge is attached ((2,1) is inside its diametral circle),
   // so its 4 is not in the spectrum; the short edges 5/4, circumradius^2 (centre (2,-1.5)) 25/4.
   const std::string obtuse = WriteFile("alphactl_obtuse.txt", "0 0\n4 0\n2 1\n");
@@ -247,7 +255,7 @@ TEST(AlphactlTest, ThresholdUnitsAgreeAndCompareExactly) {
   // (0,0), (4,0), (2,6): sides 4 and 10 (twice), circumradius^2 100/9, whose nearest double lies
   // below it: as --alpha-sq that double is compared exactly and the triangle is not yet in.
   const std::string tall = WriteFile("alphactl_tall.txt", "0 0\n4 0\n2 6\n");
-  EXPECT_EQ(Succeeds("spectrum", tall, ""), Lines({"4", "10", Printed(100.0 / 9.0)}));
+  EXPECT_EQ(Succeeds("spectrum", tall, ""), Lines({"4", "10", "11.11111111111111"}));
   const nlohmann::json rank3 = nlohmann::json::parse(Succeeds("summary", tall, "--rank 3"));
   EXPECT_EQ(rank3["level"], 3);
   EXPECT_EQ(rank3["alpha_sq"], 100.0 / 9.0);
@@ -285,6 +293,10 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
                                    {"interior_area", 0.0},
                                    {"backend", "cpu"}};
   EXPECT_EQ(nlohmann::json::parse(run.out), expected);
+  // Compact, doubles as their shortest text (0.25, not 0.25000000000000000; 0, not 0.0).
+  EXPECT_NE(run.out.find("{\"file\":"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(",\"alpha_sq\":0.25,\"mode\":\"general\","), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(",\"interior_area\":0,"), std::string::npos) << run.out;
 
   const nlohmann::json full =
       nlohmann::json::parse(Succeeds("summary", SquareCsv(), "--rank 2 --mode regularized --vertex-rule cgal"));
