@@ -7,6 +7,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/family/canonical_order.hpp"
+#include "core/family/persistence.hpp"
 
 namespace galpha::python {
 namespace {
@@ -34,9 +36,27 @@ void KeepNonExterior(const std::vector<SimplexClass>& classes, const std::vector
   }
 }
 
-std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
-  std::sort(t.begin(), t.end());
-  return t;
+constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
+
+// One pair as server/persistence_answers.cpp's PersistenceSource lists it.
+void AppendPair(const AlphaFamily& family, const PersistencePair& p, double birth, double death,
+                PersistencePairs* out) {
+  out->birth_rank.push_back(p.birth_rank);
+  out->death_rank.push_back(p.essential() ? -1 : static_cast<int64_t>(p.death_rank));
+  out->birth_alpha_sq.push_back(birth);
+  out->death_alpha_sq.push_back(death);
+  if (p.dimension == 0) {
+    out->creator_vertices.push_back(p.creator);
+    const std::array<uint32_t, 2> killer =
+        p.essential() ? std::array<uint32_t, 2>{kNoVertex, kNoVertex} : SortedEdge(family.edges()[p.killer]);
+    out->killer_vertices.insert(out->killer_vertices.end(), killer.begin(), killer.end());
+  } else {
+    const std::array<uint32_t, 2> creator = SortedEdge(family.edges()[p.creator]);
+    out->creator_vertices.insert(out->creator_vertices.end(), creator.begin(), creator.end());
+    const std::array<uint32_t, 3> killer = p.essential() ? std::array<uint32_t, 3>{kNoVertex, kNoVertex, kNoVertex}
+                                                         : SortedTriangle(family.triangles()[p.killer]);
+    out->killer_vertices.insert(out->killer_vertices.end(), killer.begin(), killer.end());
+  }
 }
 
 }  // namespace
@@ -71,6 +91,7 @@ absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Th
   answer.counts = SummarizeClassification(family, classes);
   answer.components = family.Components(level->level);
   answer.solid_components = family.SolidComponents(level->level);
+  answer.holes = family.Holes(level->level, mode);
   answer.summary_only = summary_only;
   if (summary_only) return answer;
 
@@ -177,19 +198,81 @@ absl::StatusOr<ComponentsAnswer> AnswerComponents(const AlphaFamily& family, int
   return answer;
 }
 
-absl::StatusOr<OptimalAnswer> AnswerOptimal(const AlphaFamily& family, int64_t max_components) {
-  if (max_components < 1) return absl::InvalidArgumentError("max_components must be at least 1");
-  if (max_components > std::numeric_limits<uint32_t>::max()) {
+absl::StatusOr<BettiAnswer> AnswerBetti(const AlphaFamily& family, int64_t first_level, int64_t last_level) {
+  const int64_t k = family.max_level();
+  if (first_level < 0 || last_level > k || last_level < first_level) {
     return absl::InvalidArgumentError(
-        absl::StrCat("max_components ", max_components, " exceeds ", std::numeric_limits<uint32_t>::max()));
+        absl::StrCat("rank range ", first_level, "..", last_level, " is not within 0..", k, " (first <= last)"));
+  }
+  BettiAnswer answer;
+  answer.first_level = first_level;
+  const auto n = static_cast<size_t>(last_level - first_level + 1);
+  answer.components.reserve(n);
+  answer.holes.reserve(n);
+  answer.regularized_components.reserve(n);
+  answer.regularized_holes.reserve(n);
+  for (int64_t level = first_level; level <= last_level; ++level) {
+    answer.components.push_back(family.Components(level));
+    answer.holes.push_back(family.Holes(level, ClassifyMode::kGeneral));
+    answer.regularized_components.push_back(family.RegularizedComponents(level));
+    answer.regularized_holes.push_back(family.Holes(level, ClassifyMode::kRegularized));
+  }
+  return answer;
+}
+
+absl::StatusOr<OptimalAnswer> AnswerOptimal(const AlphaFamily& family, int64_t max_components,
+                                            std::optional<int64_t> max_holes) {
+  constexpr int64_t kMaxWire = std::numeric_limits<uint32_t>::max();
+  if (max_components < 1) return absl::InvalidArgumentError("max_components must be at least 1");
+  if (max_components > kMaxWire) {
+    return absl::InvalidArgumentError(absl::StrCat("max_components ", max_components, " exceeds ", kMaxWire));
+  }
+  if (max_holes && (*max_holes < 0 || *max_holes > kMaxWire)) {
+    return absl::InvalidArgumentError(absl::StrCat("max_holes ", *max_holes, " is outside 0..", kMaxWire));
   }
   const auto n = static_cast<uint32_t>(max_components);
+  const std::optional<uint32_t> holes =
+      max_holes ? std::optional<uint32_t>(static_cast<uint32_t>(*max_holes)) : std::nullopt;
   OptimalAnswer answer;
-  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(n)) {
-    answer.regularized = OptimalLevel{*level, PublishedAlphaSq(family, *level), family.SolidComponents(*level)};
+  // Components as the service reports them: solid ones in the regularized sense (CGAL's).
+  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(n, holes)) {
+    answer.regularized = OptimalLevel{*level, PublishedAlphaSq(family, *level), family.SolidComponents(*level),
+                                      family.Holes(*level, ClassifyMode::kRegularized)};
   }
-  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(n)) {
-    answer.general = OptimalLevel{*level, PublishedAlphaSq(family, *level), family.Components(*level)};
+  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(n, holes)) {
+    answer.general = OptimalLevel{*level, PublishedAlphaSq(family, *level), family.Components(*level),
+                                  family.Holes(*level, ClassifyMode::kGeneral)};
+  }
+  return answer;
+}
+
+absl::StatusOr<std::array<PersistencePairs, 2>> AnswerPersistence(const FamilyState& state,
+                                                                  const std::vector<int64_t>& dimensions,
+                                                                  double min_persistence) {
+  std::array<bool, 2> wanted = {dimensions.empty(), dimensions.empty()};
+  for (int64_t d : dimensions) {
+    if (d < 0 || d > 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("dimension ", d, " has no classes: a planar alpha complex has H0 (0) and H1 (1) only"));
+    }
+    wanted[static_cast<size_t>(d)] = true;
+  }
+  if (std::isnan(min_persistence) || min_persistence < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_persistence ", min_persistence, " is not a length: give 0 or more"));
+  }
+  const AlphaFamily& family = state.family();
+  absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(family, state.EdgeOrder(), state.TriangleOrder());
+  if (!diagram.ok()) return diagram.status();
+  std::array<PersistencePairs, 2> answer;
+  for (size_t d = 0; d < 2; ++d) {
+    if (!wanted[d]) continue;
+    for (size_t i = diagram->dimension_begin[d]; i < diagram->dimension_begin[d + 1]; ++i) {
+      const PersistencePair& p = diagram->pairs[i];
+      const double birth = RankValue(family, p.birth_rank), death = RankValue(family, p.death_rank);
+      if (!p.essential() && !(death - birth >= min_persistence)) continue;
+      AppendPair(family, p, birth, death, &answer[d]);
+    }
   }
   return answer;
 }

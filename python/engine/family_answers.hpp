@@ -4,10 +4,12 @@
 // std::vectors that the binding hands to NumPy without copying (numpy_arrays.hpp).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <vector>
+
 #include "absl/strings/string_view.h"
 
 #include "absl/status/statusor.h"
@@ -46,6 +48,8 @@ struct ClassifyAnswer {
   ClassificationSummary counts;
   uint32_t components = 0;
   uint32_t solid_components = 0;
+  /// b1 of the complex in the request's mode.
+  uint32_t holes = 0;
   bool summary_only = false;
   bool filtered = false;
   std::vector<uint32_t> vertices, edges, triangles;  // only when filtered
@@ -83,16 +87,46 @@ struct ComponentsAnswer {
 };
 absl::StatusOr<ComponentsAnswer> AnswerComponents(const AlphaFamily& family, int64_t first_level, int64_t last_level);
 
-/// The smallest rank with at most N components, in the regularized sense and the general one.
+/// The Betti numbers at levels first_level .. last_level (within 0..K), as the service's Betti: b0
+/// and b1 of the general complex and of the regularized one. O(1) a level.
+struct BettiAnswer {
+  int64_t first_level = 0;
+  std::vector<uint32_t> components, holes, regularized_components, regularized_holes;
+};
+absl::StatusOr<BettiAnswer> AnswerBetti(const AlphaFamily& family, int64_t first_level, int64_t last_level);
+
+/// The smallest rank with at most N components (and, when given, at most H holes), in the
+/// regularized sense and the general one.
 struct OptimalLevel {
   int64_t rank = 0;
   double alpha_sq = 0.0;
   uint32_t components = 0;
+  uint32_t holes = 0;
 };
 struct OptimalAnswer {
   std::optional<OptimalLevel> regularized, general;
 };
-/// InvalidArgument unless 1 <= max_components <= 2^32 - 1 (the wire's uint32).
-absl::StatusOr<OptimalAnswer> AnswerOptimal(const AlphaFamily& family, int64_t max_components);
+/// InvalidArgument unless 1 <= max_components <= 2^32 - 1 and 0 <= max_holes <= 2^32 - 1 (the
+/// wire's uint32s).
+absl::StatusOr<OptimalAnswer> AnswerOptimal(const AlphaFamily& family, int64_t max_components,
+                                            std::optional<int64_t> max_holes = std::nullopt);
+
+/// The persistence pairs of one dimension as the service's Persistence stream lists them: ranks
+/// (death -1 when essential), published values (alpha_sq; death +infinity when essential), and the
+/// creator's and killer's vertices, ascending within a simplex (dimension + 1 and dimension + 2 a
+/// pair; 0xFFFFFFFF for an essential class's killer).
+struct PersistencePairs {
+  std::vector<int64_t> birth_rank, death_rank;
+  std::vector<double> birth_alpha_sq, death_alpha_sq;
+  std::vector<uint32_t> creator_vertices, killer_vertices;
+};
+/// The diagram (core/family/persistence.hpp, from the state's canonical orders) filtered like the
+/// service's Persistence: only the dimensions asked for (an empty list: both), only pairs whose
+/// death_alpha_sq - birth_alpha_sq is at least min_persistence (essential classes always). A
+/// dimension not asked for is empty. InvalidArgument for a dimension other than 0 or 1, or a
+/// negative or NaN min_persistence. O(n log n).
+absl::StatusOr<std::array<PersistencePairs, 2>> AnswerPersistence(const FamilyState& state,
+                                                                  const std::vector<int64_t>& dimensions,
+                                                                  double min_persistence);
 
 }  // namespace galpha::python

@@ -1,5 +1,6 @@
 #include "python/engine/family_binding.hpp"
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -88,6 +89,7 @@ py::dict ClassifyDict(ClassifyAnswer answer, const StatePtr& state) {
   out["triangle_counts"] = CountsTuple(answer.counts.triangles);
   out["components"] = answer.components;
   out["solid_components"] = answer.solid_components;
+  out["holes"] = answer.holes;
   out["interior_area"] = answer.counts.interior_area;
   if (answer.summary_only) {
     out["vertices"] = py::array_t<uint32_t>(std::vector<py::ssize_t>{0});
@@ -135,7 +137,19 @@ py::dict ShapeDict(ShapeGeometry shape) {
 
 py::object OptimalTuple(const std::optional<OptimalLevel>& level) {
   if (!level) return py::none();
-  return py::make_tuple(level->rank, level->alpha_sq, level->components);
+  return py::make_tuple(level->rank, level->alpha_sq, level->components, level->holes);
+}
+
+py::dict PairsDict(PersistencePairs pairs, py::ssize_t dimension) {
+  const auto n = static_cast<py::ssize_t>(pairs.birth_rank.size());
+  py::dict out;
+  out["birth_rank"] = ArrayFromVector(std::move(pairs.birth_rank));
+  out["death_rank"] = ArrayFromVector(std::move(pairs.death_rank));
+  out["birth"] = ArrayFromVector(std::move(pairs.birth_alpha_sq));
+  out["death"] = ArrayFromVector(std::move(pairs.death_alpha_sq));
+  out["creator"] = ArrayFromVector(std::move(pairs.creator_vertices), {n, dimension + 1});
+  out["killer"] = ArrayFromVector(std::move(pairs.killer_vertices), {n, dimension + 2});
+  return out;
 }
 
 }  // namespace
@@ -250,22 +264,60 @@ void RegisterFamily(py::module_& module) {
           py::arg("first_level"), py::arg("last_level"),
           "Components and solid components at levels first_level .. last_level (0..K, inclusive).")
       .def(
-          "optimal",
-          [](const FamilyObject& self, int64_t max_components) {
+          "betti",
+          [](const FamilyObject& self, int64_t first_level, int64_t last_level) {
             const StatePtr state = self.state();
-            OptimalAnswer answer;
+            std::optional<absl::StatusOr<BettiAnswer>> answer;
             {
               py::gil_scoped_release release;
-              answer = ValueOrThrow(AnswerOptimal(state->family(), max_components));
+              answer.emplace(AnswerBetti(state->family(), first_level, last_level));
             }
+            BettiAnswer betti = ValueOrThrow(*std::move(answer));
             py::dict out;
-            out["regularized"] = OptimalTuple(answer.regularized);
-            out["general"] = OptimalTuple(answer.general);
+            out["first_level"] = betti.first_level;
+            out["components"] = ArrayFromVector(std::move(betti.components));
+            out["holes"] = ArrayFromVector(std::move(betti.holes));
+            out["regularized_components"] = ArrayFromVector(std::move(betti.regularized_components));
+            out["regularized_holes"] = ArrayFromVector(std::move(betti.regularized_holes));
             return out;
           },
-          py::arg("max_components"),
-          "The smallest rank with at most max_components components: {'regularized', 'general'}, each (rank, "
-          "alpha_sq, components) or None.")
+          py::arg("first_level"), py::arg("last_level"),
+          "b0 and b1 of the general and the regularized complex at levels first_level .. last_level (0..K, "
+          "inclusive): components, holes, regularized_components, regularized_holes.")
+      .def(
+          "optimal",
+          [](const FamilyObject& self, int64_t max_components, std::optional<int64_t> max_holes) {
+            const StatePtr state = self.state();
+            std::optional<absl::StatusOr<OptimalAnswer>> answer;
+            {
+              py::gil_scoped_release release;
+              answer.emplace(AnswerOptimal(state->family(), max_components, max_holes));
+            }
+            const OptimalAnswer optimal = ValueOrThrow(*std::move(answer));
+            py::dict out;
+            out["regularized"] = OptimalTuple(optimal.regularized);
+            out["general"] = OptimalTuple(optimal.general);
+            return out;
+          },
+          py::arg("max_components"), py::arg("max_holes") = py::none(),
+          "The smallest rank with at most max_components components (and at most max_holes holes when given): "
+          "{'regularized', 'general'}, each (rank, alpha_sq, components, holes) or None.")
+      .def(
+          "persistence",
+          [](const FamilyObject& self, const std::vector<int64_t>& dimensions, double min_persistence) {
+            const StatePtr state = self.state();
+            std::optional<absl::StatusOr<std::array<PersistencePairs, 2>>> answer;
+            {
+              py::gil_scoped_release release;
+              answer.emplace(AnswerPersistence(*state, dimensions, min_persistence));
+            }
+            std::array<PersistencePairs, 2> pairs = ValueOrThrow(*std::move(answer));
+            return py::make_tuple(PairsDict(std::move(pairs[0]), 0), PairsDict(std::move(pairs[1]), 1));
+          },
+          py::arg("dimensions"), py::arg("min_persistence") = 0.0,
+          "The persistence diagram as the service's Persistence lists it: a tuple of two dicts (H0, H1) of "
+          "birth_rank, death_rank (-1: essential), birth, death (alpha_sq; inf: essential), creator (n, d + 1) and "
+          "killer (n, d + 2) vertices; dimensions not asked for (empty: both) are empty.")
       .def("release", &FamilyObject::Release, "Drops the family (arrays already returned stay valid); True when held.")
       .def("__repr__", [](const FamilyObject& self) {
         try {

@@ -96,7 +96,12 @@ def test_square_with_center_by_hand() -> None:
     comps = family.components(0, 2)
     np.testing.assert_array_equal(comps["components"], [5, 1, 1])
     np.testing.assert_array_equal(comps["solid_components"], [0, 0, 1])
-    assert family.optimal(1) == {"regularized": (2, 0.25, 1), "general": (1, 0.125, 1)}
+    # (rank, alpha_sq, components, holes): no hole ever (the center edges come before the sides).
+    assert family.optimal(1) == {"regularized": (2, 0.25, 1, 0), "general": (1, 0.125, 1, 0)}
+    assert family.optimal(1, max_holes=0) == family.optimal(1)
+    betti = family.betti(0, 2)
+    np.testing.assert_array_equal(betti["holes"], [0, 0, 0])
+    np.testing.assert_array_equal(betti["regularized_components"], [0, 0, 1])
 
 
 def test_obtuse_triangle_by_hand() -> None:
@@ -226,10 +231,12 @@ def test_random_points_counts_monotone_classes_and_master_list() -> None:
         assert c["solid_components"] == curve["solid_components"][rank]
         previous = c
     # Optimal: the first rank whose component count is within the bound, in each sense.
+    holes = family.betti(0, k)["holes"]
     for bound in (1, 3, 10):
         general = family.optimal(bound)["general"]
         first = int(np.argmax(curve["components"] <= bound))
-        assert general == (first, 0.0 if first == 0 else family.spectrum()[first - 1], curve["components"][first])
+        value = 0.0 if first == 0 else family.spectrum()[first - 1]
+        assert general == (first, value, curve["components"][first], holes[first])
     # Filtering and summaries change the arrays, never the counts.
     rank = k // 3
     c = family.classify("rank", rank, mode="regularized", vertex_rule="cgal")

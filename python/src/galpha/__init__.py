@@ -3,7 +3,7 @@
 Two clients with the same calls: ``galpha.connect("host:port")`` talks to a galpha server over
 gRPC; ``galpha.local()`` runs the engine in this process. ``client.build(points)`` returns a
 :class:`Family`, which answers every query (classify, shape, spectrum, master list, components,
-optimal alpha) for every alpha at once::
+optimal alpha, Betti numbers, persistence) for every alpha at once::
 
     import galpha
     family = galpha.local().build(points)          # (N, 2) array, shapely points, GeoDataFrame
@@ -32,6 +32,7 @@ from ._errors import (  # noqa: E402
 from ._family import Family, radius_from_alphashape  # noqa: E402
 from ._handle import point_set_handle  # noqa: E402
 from ._types import (  # noqa: E402
+    BettiCurves,
     BuildSummary,
     ClassCounts,
     Classification,
@@ -41,6 +42,8 @@ from ._types import (  # noqa: E402
     Mode,
     Optimal,
     OptimalLevel,
+    PersistenceDiagram,
+    PersistencePairs,
     ShapePolygon,
     ShapeRings,
     SimplexClass,
@@ -78,6 +81,7 @@ __all__ = [
     "OutOfRange",
     "FailedPrecondition",
     "Internal",
+    "BettiCurves",
     "BuildSummary",
     "ClassCounts",
     "Classification",
@@ -87,6 +91,8 @@ __all__ = [
     "Mode",
     "Optimal",
     "OptimalLevel",
+    "PersistenceDiagram",
+    "PersistencePairs",
     "ShapePolygon",
     "ShapeRings",
     "SimplexClass",

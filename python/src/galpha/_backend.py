@@ -7,11 +7,23 @@ user-facing conveniences (threshold keywords, shapely geometry, GeoDataFrames) o
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Optional, Protocol, Tuple
 
 import numpy as np
 
-from ._types import BuildSummary, Classification, ComponentCurve, MasterList, Mode, Optimal, ShapeRings, Threshold, VertexRule
+from ._types import (
+    BettiCurves,
+    BuildSummary,
+    Classification,
+    ComponentCurve,
+    MasterList,
+    Mode,
+    Optimal,
+    PersistenceDiagram,
+    ShapeRings,
+    Threshold,
+    VertexRule,
+)
 
 
 class FamilyBackend(Protocol):
@@ -38,7 +50,13 @@ class FamilyBackend(Protocol):
     def components(self, first_level: int, last_level: int) -> ComponentCurve:
         """Levels first_level .. last_level (0 .. K), inclusive."""
 
-    def optimal(self, max_components: int) -> Optimal: ...
+    def betti(self, first_level: int, last_level: int) -> BettiCurves:
+        """Levels first_level .. last_level (0 .. K), inclusive."""
+
+    def optimal(self, max_components: int, max_holes: Optional[int]) -> Optimal: ...
+
+    def persistence(self, dimensions: Tuple[int, ...], min_persistence: float) -> PersistenceDiagram:
+        """The dimensions (a non-empty tuple of 0 and 1, checked by the caller); the others empty."""
 
     def release(self) -> bool:
         """Frees the family (network: drops it from the server's cache); True when it was held."""

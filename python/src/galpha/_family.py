@@ -8,19 +8,22 @@ points' CRS.
 
 from __future__ import annotations
 
-from typing import Any, List, Optional, Union
+import math
+from typing import Any, Iterable, List, Optional, Tuple, Union
 
 import numpy as np
 
 from ._backend import FamilyBackend
 from ._errors import InvalidInput
 from ._types import (
+    BettiCurves,
     BuildSummary,
     Classification,
     ComponentCurve,
     MasterList,
     Mode,
     Optimal,
+    PersistenceDiagram,
     ShapeRings,
     Threshold,
     VertexRule,
@@ -73,6 +76,60 @@ def _rule(rule: Union[str, VertexRule]) -> VertexRule:
         return VertexRule(rule)
     except ValueError:
         raise InvalidInput(f"unknown vertex_rule {rule!r} (expected 'report' or 'cgal')") from None
+
+
+_MAX_UINT32 = (1 << 32) - 1
+
+
+def _integer(name: str, value: Any) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise InvalidInput(f"{name} must be an integer, got {value!r}")
+    return int(value)
+
+
+def level_range(first_rank: Any, last_rank: Any, k: int) -> Tuple[int, int]:
+    """first_rank .. last_rank (last None: K) checked within 0..K."""
+    first = _integer("first_rank", first_rank)
+    last = k if last_rank is None else _integer("last_rank", last_rank)
+    if not 0 <= first <= last <= k:
+        raise InvalidInput(f"ranks {first}..{last} are not within 0..{k}")
+    return first, last
+
+
+def optimal_bounds(components: Any, holes: Any) -> Tuple[int, Optional[int]]:
+    """(max_components in 1..2^32-1, max_holes None or in 0..2^32-1), as the wire's uint32s."""
+    if isinstance(components, bool) or not isinstance(components, (int, np.integer)) or not 1 <= components <= _MAX_UINT32:
+        raise InvalidInput(f"components must be an integer in 1..{_MAX_UINT32}, got {components!r}")
+    if holes is None:
+        return int(components), None
+    if isinstance(holes, bool) or not isinstance(holes, (int, np.integer)) or not 0 <= holes <= _MAX_UINT32:
+        raise InvalidInput(f"holes must be None or an integer in 0..{_MAX_UINT32}, got {holes!r}")
+    return int(components), int(holes)
+
+
+def persistence_arguments(dimensions: Union[int, Iterable[int]], min_persistence: Any) -> Tuple[Tuple[int, ...], float]:
+    """The dimensions asked for (0, 1 or both; sorted, once each) and min_persistence, checked as
+    the service checks them (by the same messages), before any call."""
+    if isinstance(dimensions, (int, np.integer)) and not isinstance(dimensions, bool):
+        dimensions = (int(dimensions),)
+    try:
+        asked = list(dimensions)  # type: ignore[arg-type]
+    except TypeError:
+        raise InvalidInput(f"dimensions must be 0, 1 or a sequence of them, got {dimensions!r}") from None
+    if not asked:
+        raise InvalidInput("dimensions is empty: give 0 (components), 1 (holes) or both")
+    for d in asked:
+        if isinstance(d, bool) or not isinstance(d, (int, np.integer)):
+            raise InvalidInput(f"a dimension must be an integer, got {d!r}")
+        if d not in (0, 1):
+            raise InvalidInput(f"dimension {d} has no classes: a planar alpha complex has H0 (0) and H1 (1) only")
+    try:
+        minimum = float(min_persistence)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"min_persistence must be a number, got {min_persistence!r}") from None
+    if math.isnan(minimum) or minimum < 0:
+        raise InvalidInput(f"min_persistence {minimum} is not a length: give 0 or more")
+    return tuple(sorted({int(d) for d in asked})), minimum
 
 
 def rings_to_shapely(rings: ShapeRings, points: np.ndarray, mode: Mode) -> Any:
@@ -229,19 +286,36 @@ class Family:
 
     def components(self, first_level: int = 0, last_level: Optional[int] = None) -> ComponentCurve:
         """Connected and solid components at every level first_level .. last_level (0..K; all by
-        default): the curve over all ranks."""
+        default): the curve over all ranks. :meth:`betti` adds the holes."""
         k = self.spectrum_size
         last = k if last_level is None else int(last_level)
         if not 0 <= first_level <= last <= k:
             raise InvalidInput(f"levels {first_level}..{last} are not within 0..{k}")
         return self._backend.components(int(first_level), last)
 
-    def optimal(self, components: int = 1) -> Optimal:
-        """The smallest rank with at most ``components`` components (CGAL's regularized sense and
-        the general one)."""
-        if isinstance(components, bool) or int(components) < 1:
-            raise InvalidInput(f"components must be >= 1, got {components!r}")
-        return self._backend.optimal(int(components))
+    def betti(self, first_rank: int = 0, last_rank: Optional[int] = None) -> BettiCurves:
+        """Betti numbers at every rank first_rank .. last_rank (0..K; all by default): b0
+        (components) and b1 (holes) of the general complex and of the regularized one. O(1) a
+        rank."""
+        first, last = level_range(first_rank, last_rank, self.spectrum_size)
+        return self._backend.betti(first, last)
+
+    def persistence(
+        self, dimensions: Union[int, Iterable[int]] = (0, 1), min_persistence: float = 0.0
+    ) -> PersistenceDiagram:
+        """The persistence diagram of the alpha filtration: every component (``dimensions`` 0) and
+        hole (1) class with its birth and death (squared radii, exact by rank; inf for a class that
+        never dies) and the simplices that create and kill it. ``min_persistence`` (alpha_sq
+        units) leaves out pairs with death - birth below it (essential classes always stay). A
+        dimension not asked for is empty. O(n log n)."""
+        dims, minimum = persistence_arguments(dimensions, min_persistence)
+        return self._backend.persistence(dims, minimum)
+
+    def optimal(self, components: int = 1, holes: Optional[int] = None) -> Optimal:
+        """The smallest rank with at most ``components`` components and, when ``holes`` is given,
+        at most that many holes (CGAL's regularized sense, holes of the regularized complex, and
+        the general one); each answer carries the holes at its rank."""
+        return self._backend.optimal(*optimal_bounds(components, holes))
 
     def release(self) -> bool:
         """Frees the family (on a server: drops it from the cache). True when it was held."""

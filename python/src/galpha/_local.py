@@ -13,13 +13,14 @@ triangles of a full classification) are read-only views into the family.
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable, Optional, TypeVar
+from typing import Any, Callable, Optional, Tuple, TypeVar
 
 import numpy as np
 
 from . import _engine
 from ._errors import error_for_code
 from ._types import (
+    BettiCurves,
     BuildSummary,
     ClassCounts,
     Classification,
@@ -28,6 +29,8 @@ from ._types import (
     Mode,
     Optimal,
     OptimalLevel,
+    PersistenceDiagram,
+    PersistencePairs,
     ShapePolygon,
     ShapeRings,
     Threshold,
@@ -67,8 +70,12 @@ def _counts(c: tuple) -> ClassCounts:
 def _optimal_level(level: Optional[tuple]) -> Optional[OptimalLevel]:
     if level is None:
         return None
-    rank, alpha_sq, components = level
-    return OptimalLevel(rank=rank, alpha_sq=alpha_sq, components=components)
+    rank, alpha_sq, components, holes = level
+    return OptimalLevel(rank=rank, alpha_sq=alpha_sq, components=components, holes=holes)
+
+
+def _pairs(dimension: int, p: dict) -> PersistencePairs:
+    return PersistencePairs(dimension=dimension, **p)
 
 
 class LocalFamilyBackend:
@@ -123,6 +130,7 @@ class LocalFamilyBackend:
             edge_classes=c["edge_classes"],
             triangles=c["triangles"],
             triangle_classes=c["triangle_classes"],
+            holes=c["holes"],
         )
 
     @_translated
@@ -148,9 +156,18 @@ class LocalFamilyBackend:
         )
 
     @_translated
-    def optimal(self, max_components: int) -> Optimal:
-        o = self._family.optimal(int(max_components))
+    def betti(self, first_level: int, last_level: int) -> BettiCurves:
+        return BettiCurves(**self._family.betti(int(first_level), int(last_level)))
+
+    @_translated
+    def optimal(self, max_components: int, max_holes: Optional[int] = None) -> Optimal:
+        o = self._family.optimal(int(max_components), None if max_holes is None else int(max_holes))
         return Optimal(regularized=_optimal_level(o["regularized"]), general=_optimal_level(o["general"]))
+
+    @_translated
+    def persistence(self, dimensions: Tuple[int, ...], min_persistence: float) -> PersistenceDiagram:
+        h0, h1 = self._family.persistence([int(d) for d in dimensions], float(min_persistence))
+        return PersistenceDiagram(h0=_pairs(0, h0), h1=_pairs(1, h1))
 
     def release(self) -> bool:
         return self._family.release()

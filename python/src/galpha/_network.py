@@ -1,5 +1,5 @@
 """The network backend: galpha.v1.AlphaShapes over gRPC, with the bulk arrays of the Build upload
-and of Classify, MasterList and Spectrum answers encoded and decoded by hand (``_wire.py``), and
+and of Classify, MasterList, Spectrum and Persistence answers encoded and decoded by hand (``_wire.py``), and
 every failure raised as a :mod:`galpha` exception carrying the server's code and message.
 """
 
@@ -20,6 +20,7 @@ from . import _encoding, _wire
 from ._errors import GalphaError, InvalidInput, error_for_code
 from ._handle import point_set_handle
 from ._types import (
+    BettiCurves,
     BuildSummary,
     ClassCounts,
     Classification,
@@ -28,6 +29,8 @@ from ._types import (
     Mode,
     Optimal,
     OptimalLevel,
+    PersistenceDiagram,
+    PersistencePairs,
     ShapePolygon,
     ShapeRings,
     Threshold,
@@ -46,7 +49,7 @@ HANDLE_HEADER = "x-galpha-handle"
 MAX_RECEIVE_BYTES = 256 << 20
 #: Spectrum values per page (the server's cap).
 SPECTRUM_PAGE = 262144
-#: Levels per Components call (the server's cap).
+#: Levels per Components and Betti call (the server's cap).
 COMPONENTS_PAGE = 262144
 
 _MODES = {Mode.GENERAL: pb.CLASSIFY_MODE_GENERAL, Mode.REGULARIZED: pb.CLASSIFY_MODE_REGULARIZED}
@@ -150,6 +153,7 @@ class ClassifyAssembler:
             edge_classes=edge_classes,
             triangles=triangles,
             triangle_classes=triangle_classes,
+            holes=s.holes,
         )
 
 
@@ -184,9 +188,68 @@ def optimal_from(message: pb.OptimalAlphaResponse) -> Optimal:
         if not message.HasField(field):
             return None
         m = getattr(message, field)
-        return OptimalLevel(rank=m.rank, alpha_sq=m.alpha_sq, components=m.components)
+        return OptimalLevel(rank=m.rank, alpha_sq=m.alpha_sq, components=m.components, holes=m.holes)
 
     return Optimal(regularized=level("regularized"), general=level("general"))
+
+
+def optimal_request(handle: str, max_components: int, max_holes: Optional[int]) -> pb.OptimalAlphaRequest:
+    request = pb.OptimalAlphaRequest(handle=handle, max_components=max_components)
+    if max_holes is not None:
+        request.max_holes = max_holes
+    return request
+
+
+def betti_from(first_level: int, answers: Sequence[pb.BettiResponse]) -> BettiCurves:
+    def joined(field: str) -> np.ndarray:
+        parts = [np.array(getattr(a, field), dtype=np.uint32) for a in answers]
+        return np.concatenate(parts) if parts else np.empty(0, np.uint32)
+
+    return BettiCurves(
+        first_level=first_level,
+        components=joined("components"),
+        holes=joined("holes"),
+        regularized_components=joined("regularized_components"),
+        regularized_holes=joined("regularized_holes"),
+    )
+
+
+def level_pages(first_level: int, last_level: int) -> List[Tuple[int, int]]:
+    """first..last (inclusive) in pieces of at most COMPONENTS_PAGE levels."""
+    return [(b, min(last_level, b + COMPONENTS_PAGE - 1)) for b in range(first_level, last_level + 1, COMPONENTS_PAGE)]
+
+
+def persistence_request(handle: str, dimensions: Tuple[int, ...], min_persistence: float) -> pb.PersistenceRequest:
+    return pb.PersistenceRequest(handle=handle, dimensions=list(dimensions), min_persistence=min_persistence)
+
+
+def persistence_from(chunks: Sequence[bytes]) -> PersistenceDiagram:
+    """The Persistence stream's chunks (each of one dimension, in the diagram's order) as a diagram."""
+    parts: dict = {0: [], 1: []}
+    for raw in chunks:
+        dimension, arrays = _wire.decode_persistence_chunk(raw)
+        if dimension not in parts:
+            raise GalphaError(f"the server sent persistence pairs of dimension {dimension}", code="DATA_LOSS", code_number=15)
+        parts[dimension].append(arrays)
+
+    def pairs(dimension: int) -> PersistencePairs:
+        chunks_of = parts[dimension]
+
+        def joined(key: str, dtype: Any) -> np.ndarray:
+            arrays = [c[key] for c in chunks_of]
+            return np.concatenate(arrays).astype(dtype, copy=False) if arrays else np.empty(0, dtype=dtype)
+
+        return PersistencePairs(
+            dimension=dimension,
+            birth_rank=joined("birth_rank", np.int64),
+            death_rank=joined("death_rank", np.int64),
+            birth=joined("birth_alpha_sq", np.float64),
+            death=joined("death_alpha_sq", np.float64),
+            creator=joined("creator_vertices", np.uint32).reshape(-1, dimension + 1),
+            killer=joined("killer_vertices", np.uint32).reshape(-1, dimension + 2),
+        )
+
+    return PersistenceDiagram(h0=pairs(0), h1=pairs(1))
 
 
 def master_list_from(pages: Sequence[bytes]) -> MasterList:
@@ -310,6 +373,10 @@ class Calls:
         self.release = unary("Release", pb.ReleaseRequest, pb.ReleaseResponse)
         self.components = unary("Components", pb.ComponentsRequest, pb.ComponentsResponse)
         self.optimal = unary("OptimalAlpha", pb.OptimalAlphaRequest, pb.OptimalAlphaResponse)
+        self.betti = unary("Betti", pb.BettiRequest, pb.BettiResponse)
+        self.persistence = channel.unary_stream(
+            SERVICE + "Persistence", request_serializer=pb.PersistenceRequest.SerializeToString, response_deserializer=_identity
+        )
         self.spectrum = channel.unary_unary(
             SERVICE + "Spectrum", request_serializer=pb.SpectrumRequest.SerializeToString, response_deserializer=_identity
         )
@@ -424,10 +491,19 @@ class NetworkFamilyBackend:
             solid_components=np.concatenate(solid) if solid else np.empty(0, np.uint32),
         )
 
-    def optimal(self, max_components: int) -> Optimal:
-        return optimal_from(
-            self._call(self._calls.optimal, pb.OptimalAlphaRequest(handle=self._handle, max_components=max_components))
-        )
+    def betti(self, first_level: int, last_level: int) -> BettiCurves:
+        answers = [
+            self._call(self._calls.betti, pb.BettiRequest(handle=self._handle, ranks=pb.RankRange(first=first, last=last)))
+            for first, last in level_pages(first_level, last_level)
+        ]
+        return betti_from(first_level, answers)
+
+    def optimal(self, max_components: int, max_holes: Optional[int] = None) -> Optimal:
+        return optimal_from(self._call(self._calls.optimal, optimal_request(self._handle, max_components, max_holes)))
+
+    def persistence(self, dimensions: Tuple[int, ...], min_persistence: float) -> PersistenceDiagram:
+        request = persistence_request(self._handle, dimensions, min_persistence)
+        return persistence_from(self._stream(self._calls.persistence, request))
 
     def release(self) -> bool:
         return self._call(self._calls.release, pb.ReleaseRequest(handle=self._handle)).released

@@ -31,6 +31,9 @@ __all__ = [
     "ComponentCurve",
     "OptimalLevel",
     "Optimal",
+    "BettiCurves",
+    "PersistencePairs",
+    "PersistenceDiagram",
 ]
 
 
@@ -138,6 +141,9 @@ class Classification:
     edge_classes: np.ndarray  #: (E,) uint8
     triangles: np.ndarray  #: (T, 3) uint32
     triangle_classes: np.ndarray  #: (T,) uint8
+    #: Holes (b1) of the complex in the classification's mode: of the whole complex (general), of
+    #: its closed interior triangles (regularized).
+    holes: int = 0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -191,13 +197,83 @@ class ComponentCurve:
 class OptimalLevel:
     rank: int
     alpha_sq: float
-    components: int
+    components: int  #: solid components (regularized answer) or connected components (general)
+    holes: int = 0  #: holes at that rank, of the regularized or the general complex as the answer's sense
 
 
 @dataclasses.dataclass(frozen=True)
 class Optimal:
-    """The smallest rank with at most N components: in CGAL's regularized sense (every point on an
-    interior triangle) and in the general sense; ``None`` where no rank qualifies."""
+    """The smallest rank with at most N components (and at most H holes, when asked): in CGAL's
+    regularized sense (every point on an interior triangle) and in the general sense; ``None``
+    where no rank qualifies."""
 
     regularized: Optional[OptimalLevel]
     general: Optional[OptimalLevel]
+
+
+@dataclasses.dataclass(frozen=True)
+class BettiCurves:
+    """Betti numbers at each level ``first_level .. first_level + len - 1``: b0 (components) and b1
+    (holes) of the general complex (every simplex that is in) and of the regularized one (its
+    closed interior triangles; triangles sharing only a vertex are one component, unlike
+    :attr:`ComponentCurve.solid_components`)."""
+
+    first_level: int
+    components: np.ndarray  #: uint32, b0 of the general complex
+    holes: np.ndarray  #: uint32, b1 of the general complex
+    regularized_components: np.ndarray  #: uint32, b0 of the regularized complex
+    regularized_holes: np.ndarray  #: uint32, b1 of the regularized complex
+
+
+@dataclasses.dataclass(frozen=True)
+class PersistencePairs:
+    """The classes of one homology dimension ``d`` (0: components, 1: holes), in the diagram's
+    order (birth rank, death rank with essential classes last, then the creator's canonical
+    position). Values are squared radii (``alpha_sq``), as GUDHI's alpha complex filtration."""
+
+    dimension: int
+    birth_rank: np.ndarray  #: (n,) int64, 0..K
+    death_rank: np.ndarray  #: (n,) int64, birth_rank + 1 .. K, or -1 for an essential class
+    birth: np.ndarray  #: (n,) float64, alpha_sq where the class is born (0 for rank 0)
+    death: np.ndarray  #: (n,) float64, alpha_sq where it dies; inf when essential
+    creator: np.ndarray  #: (n, d + 1) uint32: the vertex (H0) or edge (H1) that creates it, ascending
+    killer: np.ndarray  #: (n, d + 2) uint32: the edge (H0) or triangle (H1) that kills it; 0xFFFFFFFF when essential
+
+    def __len__(self) -> int:
+        return len(self.birth_rank)
+
+    @property
+    def essential(self) -> np.ndarray:
+        """(n,) bool: the classes that never die."""
+        return self.death_rank < 0
+
+    @property
+    def persistence(self) -> np.ndarray:
+        """(n,) float64: death - birth (inf for essential classes)."""
+        return self.death - self.birth
+
+    def intervals(self) -> np.ndarray:
+        """(n, 2) float64 (birth, death) rows, like GUDHI's ``persistence_intervals_in_dimension``."""
+        return np.stack([self.birth, self.death], axis=1) if len(self) else np.empty((0, 2), dtype=np.float64)
+
+
+@dataclasses.dataclass(frozen=True)
+class PersistenceDiagram:
+    """The persistence diagram of the alpha filtration (H0 and H1), exact by ranks: every class
+    whose death rank is above its birth rank (and, with ``min_persistence``, whose death - birth
+    is at least that). A dimension that was not asked for is empty."""
+
+    h0: PersistencePairs
+    h1: PersistencePairs
+
+    def __getitem__(self, dimension: int) -> PersistencePairs:
+        if dimension == 0:
+            return self.h0
+        if dimension == 1:
+            return self.h1
+        raise IndexError(f"dimension {dimension!r}: a planar diagram has 0 and 1 only")
+
+    def intervals(self, dimension: int) -> np.ndarray:
+        """(n, 2) float64 (birth, death) rows of one dimension, like GUDHI's
+        ``persistence_intervals_in_dimension`` (death inf for essential classes)."""
+        return self[dimension].intervals()

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import dataclasses
-from typing import Any, AsyncIterator, Callable, List, Optional, Union
+from typing import Any, AsyncIterator, Callable, Iterable, List, Optional, Union
 
 import grpc
 import numpy as np
@@ -18,10 +18,29 @@ from . import _network, _wire
 from ._client import Progress, progress_callback
 from ._encoding import check_encoding
 from ._errors import InvalidInput
-from ._family import _mode, _rule, rings_to_shapely, threshold_from
+from ._family import (
+    _mode,
+    _rule,
+    level_range,
+    optimal_bounds,
+    persistence_arguments,
+    rings_to_shapely,
+    threshold_from,
+)
 from ._handle import point_set_handle
 from ._points import as_points
-from ._types import BuildSummary, Classification, ComponentCurve, MasterList, Mode, Optimal, ShapeRings, VertexRule
+from ._types import (
+    BettiCurves,
+    BuildSummary,
+    Classification,
+    ComponentCurve,
+    MasterList,
+    Mode,
+    Optimal,
+    PersistenceDiagram,
+    ShapeRings,
+    VertexRule,
+)
 from .v1 import alpha_shapes_pb2 as pb
 
 __all__ = ["connect", "AsyncClient", "AsyncFamily"]
@@ -163,10 +182,24 @@ class AsyncFamily:
             level = end + 1
         return ComponentCurve(first_level, np.concatenate(comps), np.concatenate(solid))
 
-    async def optimal(self, components: int = 1) -> Optimal:
-        if isinstance(components, bool) or int(components) < 1:
-            raise InvalidInput(f"components must be >= 1, got {components!r}")
-        answer = await self._call(self._calls.optimal, pb.OptimalAlphaRequest(handle=self.handle, max_components=int(components)))
+    async def betti(self, first_rank: int = 0, last_rank: Optional[int] = None) -> BettiCurves:
+        first, last = level_range(first_rank, last_rank, self.summary.spectrum_size)
+        answers = [
+            await self._call(self._calls.betti, pb.BettiRequest(handle=self.handle, ranks=pb.RankRange(first=a, last=b)))
+            for a, b in _network.level_pages(first, last)
+        ]
+        return _network.betti_from(first, answers)
+
+    async def persistence(
+        self, dimensions: Union[int, Iterable[int]] = (0, 1), min_persistence: float = 0.0
+    ) -> PersistenceDiagram:
+        dims, minimum = persistence_arguments(dimensions, min_persistence)
+        request = _network.persistence_request(self.handle, dims, minimum)
+        return _network.persistence_from(await self._stream(self._calls.persistence, request))
+
+    async def optimal(self, components: int = 1, holes: Optional[int] = None) -> Optimal:
+        max_components, max_holes = optimal_bounds(components, holes)
+        answer = await self._call(self._calls.optimal, _network.optimal_request(self.handle, max_components, max_holes))
         return _network.optimal_from(answer)
 
     async def release(self) -> bool:
