@@ -30,6 +30,8 @@ constexpr Command kCommands[] = {
     {"shape", galpha::alphactl::RunShape},
     {"masterlist", galpha::alphactl::RunMasterList},
     {"optimal", galpha::alphactl::RunOptimal},
+    {"persistence", galpha::alphactl::RunPersistence},
+    {"holes", galpha::alphactl::RunHoles},
     {"bench", galpha::alphactl::RunBench},
 };
 

@@ -3,6 +3,7 @@
 // progress on standard error, resolving a threshold, one-line error reports.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -14,6 +15,7 @@
 #include "absl/types/span.h"
 #include "client/cli_args.hpp"
 #include "client/point_input.hpp"
+#include "client/topology_output.hpp"
 #include "core/base/point.hpp"
 #include "core/family/alpha_family.hpp"
 #include "core/family/threshold.hpp"
@@ -30,6 +32,8 @@ int RunShape(Args args);
 int RunMasterList(Args args);
 int RunOptimal(Args args);
 int RunBench(Args args);
+int RunPersistence(Args args);
+int RunHoles(Args args);
 
 // ---- shared by the commands (command_support.cpp) ----
 
@@ -69,6 +73,24 @@ struct ClassifyArgs {
 };
 absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line);
 
+/// persistence's options after FILE: --dimension 0|1 (default both), --min-persistence X >= 0
+/// (alpha_sq units), --format text|csv|json|svg (default text).
+struct PersistenceArgs {
+  std::array<bool, 2> dimensions = {true, true};
+  double min_persistence = 0.0;
+  PersistenceFormat format = PersistenceFormat::kText;
+};
+absl::StatusOr<PersistenceArgs> ParsePersistenceArgs(const CommandLine& line);
+
+/// holes' options after FILE: a THRESHOLD, --min-area A >= 0 (squared input units; default 0),
+/// --format text|geojson (default text).
+struct HolesArgs {
+  ThresholdArg threshold;
+  double min_area = 0.0;
+  HolesFormat format = HolesFormat::kText;
+};
+absl::StatusOr<HolesArgs> ParseHolesArgs(const CommandLine& line);
+
 /// ReadInputPoints of the command's FILE (read once: it may be a pipe), with an exception thrown
 /// while reading (out of memory) reported as an error.
 absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common);
@@ -107,5 +129,7 @@ int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold, Classif
 int RemoteMasterList(const CommonArgs& common, int64_t rank);
 int RemoteOptimal(const CommonArgs& common, int64_t components);
 int RemoteBench(const CommonArgs& common, int64_t repeat);
+int RemotePersistence(const CommonArgs& common, const PersistenceArgs& options);
+int RemoteHoles(const CommonArgs& common, const HolesArgs& options);
 
 }  // namespace galpha::alphactl

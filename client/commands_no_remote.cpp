@@ -18,5 +18,7 @@ int RemoteShape(const CommonArgs&, const ThresholdArg&, ClassifyMode, const std:
 int RemoteMasterList(const CommonArgs&, int64_t) { return NoServer(); }
 int RemoteOptimal(const CommonArgs&, int64_t) { return NoServer(); }
 int RemoteBench(const CommonArgs&, int64_t) { return NoServer(); }
+int RemotePersistence(const CommonArgs&, const PersistenceArgs&) { return NoServer(); }
+int RemoteHoles(const CommonArgs&, const HolesArgs&) { return NoServer(); }
 
 }  // namespace galpha::alphactl

@@ -20,6 +20,8 @@
 #include "client/commands.hpp"
 #include "client/galpha_client.hpp"
 #include "client/text_output.hpp"
+#include "core/geometry/shape.hpp"
+#include "core/geometry/shape_holes.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "nlohmann/json.hpp"
 
@@ -36,6 +38,8 @@ struct RemoteFamily {
   std::unique_ptr<client::AlphaClient> client;
   client::BuildResult build;
   size_t input_points = 0;
+  /// FILE's points (read once: it may be a pipe), for answers measured here (holes' areas).
+  std::vector<Point2> points;
 };
 
 absl::StatusOr<std::unique_ptr<client::AlphaClient>> ConnectTo(const CommonArgs& common) {
@@ -95,6 +99,7 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
     std::fprintf(stderr, "alphactl: %s on the server (%.2f s%s)\n",
                  remote.build.cached ? "family found" : "family built", seconds, upload.c_str());
   }
+  remote.points = *std::move(points);
   return remote;
 }
 
@@ -378,6 +383,83 @@ int RemoteBench(const CommonArgs& common, int64_t repeat) {
   rows.emplace_back("spectrum_size", absl::StrCat(summary.spectrum_size()));
   rows.emplace_back("backend", summary.backend());
   return PrintBenchTable(common.file, input_points, summary.distinct_points(), repeat, best.size() + 2, rows);
+}
+
+int RemoteHoles(const CommonArgs& common, const HolesArgs& options) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  auto threshold = ToThreshold(options.threshold, *remote);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+  v1::ShapeRequest request;
+  request.set_handle(remote->build.handle);
+  *request.mutable_threshold() = *threshold;
+  request.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+  request.set_format(v1::SHAPE_FORMAT_RINGS);
+  // The rings arrive by polygon; their areas are measured here, from FILE's points, as locally.
+  ShapeGeometry shape;
+  const absl::Status status = remote->client->Shape(request, [&](const v1::ShapeResponse& m) {
+    for (const v1::ShapePolygon& polygon : m.rings().polygons()) {
+      ShapePolygon& out = shape.polygons.emplace_back();
+      out.outer.assign(polygon.outer().begin(), polygon.outer().end());
+      for (const v1::Ring& hole : polygon.holes()) {
+        for (uint32_t v : hole.vertex_indices()) {
+          if (v >= remote->points.size()) return absl::DataLossError("holes: the server named a vertex beyond FILE's");
+        }
+        out.holes.emplace_back(hole.vertex_indices().begin(), hole.vertex_indices().end());
+      }
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return QueryError(common, status);
+  const std::vector<ShapeHole> holes = ListHoles(shape, remote->points, options.min_area);
+  if (!WriteHoles(holes, remote->points, options.format, stdout)) {
+    return Failure(absl::DataLossError("holes: writing to standard output failed"));
+  }
+  return kExitOk;
+}
+
+int RemotePersistence(const CommonArgs& common, const PersistenceArgs& options) {
+  auto remote = OpenRemote(common);
+  if (!remote.ok()) return Failure(remote.status());
+  v1::PersistenceRequest request;
+  request.set_handle(remote->build.handle);
+  for (uint32_t d = 0; d < 2; ++d) {
+    // Both dimensions: the default (an empty list).
+    if (options.dimensions[d] && !(options.dimensions[0] && options.dimensions[1])) request.add_dimensions(d);
+  }
+  request.set_min_persistence(options.min_persistence);
+  std::vector<PersistenceRow> rows;
+  const absl::Status status = remote->client->Persistence(request, [&](const v1::PersistenceResponse& m) {
+    const uint32_t arity = m.dimension() + 1;
+    const auto n = static_cast<size_t>(m.birth_rank_size());
+    if (m.death_rank_size() != m.birth_rank_size() || m.birth_alpha_sq_size() != m.birth_rank_size() ||
+        m.death_alpha_sq_size() != m.birth_rank_size() ||
+        static_cast<size_t>(m.creator_vertices().size()) != n * arity ||
+        static_cast<size_t>(m.killer_vertices().size()) != n * (arity + 1)) {
+      return absl::DataLossError("persistence: a message's columns disagree in length");
+    }
+    for (size_t i = 0; i < n; ++i) {
+      PersistenceRow row;
+      row.dimension = m.dimension();
+      row.birth_rank = m.birth_rank(static_cast<int>(i));
+      row.death_rank = m.death_rank(static_cast<int>(i));
+      row.birth = m.birth_alpha_sq(static_cast<int>(i));
+      row.death = m.death_alpha_sq(static_cast<int>(i));
+      row.creator.assign(m.creator_vertices().begin() + static_cast<std::ptrdiff_t>(i * arity),
+                         m.creator_vertices().begin() + static_cast<std::ptrdiff_t>((i + 1) * arity));
+      if (row.death_rank >= 0) {
+        row.killer.assign(m.killer_vertices().begin() + static_cast<std::ptrdiff_t>(i * (arity + 1)),
+                          m.killer_vertices().begin() + static_cast<std::ptrdiff_t>((i + 1) * (arity + 1)));
+      }
+      rows.push_back(std::move(row));
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return QueryError(common, status);
+  if (!WritePersistence(rows, options.format, stdout)) {
+    return Failure(absl::DataLossError("persistence: writing to standard output failed"));
+  }
+  return kExitOk;
 }
 
 }  // namespace galpha::alphactl

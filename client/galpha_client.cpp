@@ -192,6 +192,15 @@ absl::StatusOr<v1::OptimalAlphaResponse> AlphaClient::OptimalAlpha(const v1::Opt
   return response;
 }
 
+absl::StatusOr<v1::BettiResponse> AlphaClient::Betti(const v1::BettiRequest& request) {
+  grpc::ClientContext context;
+  PrepareContext(&context, request.handle());
+  v1::BettiResponse response;
+  absl::Status status = FromGrpc(stub_->Betti(&context, request, &response));
+  if (!status.ok()) return status;
+  return response;
+}
+
 absl::StatusOr<v1::ReleaseResponse> AlphaClient::Release(const std::string& handle) {
   grpc::ClientContext context;
   PrepareContext(&context, handle);
@@ -238,6 +247,11 @@ absl::Status AlphaClient::MasterList(const v1::MasterListRequest& request,
 absl::Status AlphaClient::Shape(const v1::ShapeRequest& request,
                                 const std::function<absl::Status(const v1::ShapeResponse&)>& on_message) {
   return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Shape, request, on_message);
+}
+
+absl::Status AlphaClient::Persistence(const v1::PersistenceRequest& request,
+                                      const std::function<absl::Status(const v1::PersistenceResponse&)>& on_message) {
+  return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Persistence, request, on_message);
 }
 
 }  // namespace galpha::client

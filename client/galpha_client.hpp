@@ -90,6 +90,7 @@ class AlphaClient {
   absl::StatusOr<galpha::v1::SpectrumResponse> Spectrum(const galpha::v1::SpectrumRequest& request);
   absl::StatusOr<galpha::v1::ComponentsResponse> Components(const galpha::v1::ComponentsRequest& request);
   absl::StatusOr<galpha::v1::OptimalAlphaResponse> OptimalAlpha(const galpha::v1::OptimalAlphaRequest& request);
+  absl::StatusOr<galpha::v1::BettiResponse> Betti(const galpha::v1::BettiRequest& request);
   absl::StatusOr<galpha::v1::ReleaseResponse> Release(const std::string& handle);
 
   /// Server-streamed answers: `on_message` sees each message; an error it returns cancels the
@@ -100,6 +101,8 @@ class AlphaClient {
                           const std::function<absl::Status(const galpha::v1::MasterListResponse&)>& on_message);
   absl::Status Shape(const galpha::v1::ShapeRequest& request,
                      const std::function<absl::Status(const galpha::v1::ShapeResponse&)>& on_message);
+  absl::Status Persistence(const galpha::v1::PersistenceRequest& request,
+                           const std::function<absl::Status(const galpha::v1::PersistenceResponse&)>& on_message);
 
   /// For callers that need more (tests, benchmarks): a context with the token and deadline set,
   /// and the handle in the routing header (kHandleHeader) when one is given.

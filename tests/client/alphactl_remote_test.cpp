@@ -64,6 +64,12 @@ TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
       "shape --rank 50 --format svg",
       "masterlist --rank 77",
       "optimal --components 3",
+      "persistence",
+      "persistence --dimension 1 --min-persistence 1e-6 --format csv",
+      "persistence --format json --dimension 0",
+      "persistence --format svg",
+      "holes --rank 3500",
+      "holes --rank 3500 --format geojson --min-area 0",
   };
   for (const char* command : commands) {
     SCOPED_TRACE(command);

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/family/persistence.hpp"
 #include "core/geometry/shape.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "tests/server/service_test_calls.hpp"
@@ -162,6 +163,36 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
     EXPECT_EQ(curve->components(static_cast<int>(level)), local.Components(level));
     EXPECT_EQ(curve->solid_components(static_cast<int>(level)), local.SolidComponents(level));
   }
+
+  v1::BettiRequest betti;
+  betti.set_handle(built->handle);
+  betti.mutable_ranks()->set_first(0);
+  betti.mutable_ranks()->set_last(k);
+  auto curves = client.Betti(betti);
+  ASSERT_THAT(curves, IsOk());
+  ASSERT_EQ(curves->holes_size(), k + 1);
+  for (int64_t level = 0; level <= k; ++level) {
+    const int i = static_cast<int>(level);
+    EXPECT_EQ(curves->components(i), local.Components(level));
+    EXPECT_EQ(curves->holes(i), local.Holes(level, ClassifyMode::kGeneral));
+    EXPECT_EQ(curves->regularized_components(i), local.RegularizedComponents(level));
+    EXPECT_EQ(curves->regularized_holes(i), local.Holes(level, ClassifyMode::kRegularized));
+  }
+
+  // The diagram over the wire: as many pairs per dimension as the local one lists.
+  const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(local);
+  ASSERT_THAT(diagram, IsOk());
+  v1::PersistenceRequest persistence;
+  persistence.set_handle(built->handle);
+  size_t pairs[2] = {0, 0};
+  ASSERT_THAT(client.Persistence(persistence,
+                                 [&](const v1::PersistenceResponse& m) {
+                                   pairs[m.dimension()] += static_cast<size_t>(m.birth_rank_size());
+                                   return absl::OkStatus();
+                                 }),
+              IsOk());
+  EXPECT_EQ(pairs[0], diagram->dimension_begin[1]);
+  EXPECT_EQ(pairs[1], diagram->dimension_begin[2] - diagram->dimension_begin[1]);
 
   v1::OptimalAlphaRequest optimal;
   optimal.set_handle(built->handle);

@@ -1,0 +1,127 @@
+// alphactl persistence and holes: the persistence diagram of the alpha filtration
+// (core/family/persistence.hpp) and the holes of the shape at a threshold
+// (core/geometry/shape_holes.hpp), computed by the embedded engine or asked of a server (the remote
+// halves are in commands_remote.cpp), written by client/topology_output.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "client/commands.hpp"
+#include "client/topology_output.hpp"
+#include "core/family/canonical_order.hpp"
+#include "core/family/persistence.hpp"
+#include "core/geometry/shape.hpp"
+#include "core/geometry/shape_holes.hpp"
+
+namespace galpha::alphactl {
+
+absl::StatusOr<PersistenceArgs> ParsePersistenceArgs(const CommandLine& line) {
+  PersistenceArgs out;
+  if (const std::string* text = line.Find("dimension")) {
+    auto dimension = ParseInteger("dimension", *text, 0);
+    if (!dimension.ok()) return dimension.status();
+    if (*dimension > 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--dimension ", *dimension, ": a planar alpha complex has classes in dimensions 0 and 1 only"));
+    }
+    out.dimensions = {*dimension == 0, *dimension == 1};
+  }
+  if (const std::string* text = line.Find("min-persistence")) {
+    auto value = ParseFiniteDouble("min-persistence", *text);
+    if (!value.ok()) return value.status();
+    if (*value < 0) return absl::InvalidArgumentError(absl::StrCat("--min-persistence '", *text, "' is negative"));
+    out.min_persistence = *value;
+  }
+  if (const std::string* text = line.Find("format")) {
+    auto format = ParsePersistenceFormat(*text);
+    if (!format.ok()) return format.status();
+    out.format = *format;
+  }
+  return out;
+}
+
+int RunPersistence(Args args) {
+  auto common = ParseCommon("persistence", args, {"dimension", "min-persistence", "format"});
+  if (!common.ok()) return UsageError(common.status());
+  auto options = ParsePersistenceArgs(common->line);
+  if (!options.ok()) return UsageError(options.status());
+  if (!common->server.empty()) return RemotePersistence(*common, *options);
+  size_t input_points = 0;
+  auto family = LoadFamily(*common, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  auto diagram = ComputePersistence(*family);
+  if (!diagram.ok()) return Failure(diagram.status());
+
+  std::vector<PersistenceRow> rows;
+  for (const PersistencePair& p : diagram->pairs) {
+    if (!options->dimensions[p.dimension] || !PersistsAtLeast(*family, p, options->min_persistence)) continue;
+    PersistenceRow row;
+    row.dimension = p.dimension;
+    row.birth_rank = p.birth_rank;
+    row.death_rank = p.essential() ? -1 : static_cast<int64_t>(p.death_rank);
+    row.birth = RankValue(*family, p.birth_rank);
+    row.death = RankValue(*family, p.death_rank);
+    if (p.dimension == 0) {
+      row.creator = {p.creator};
+      if (!p.essential()) {
+        const auto edge = SortedEdge(family->edges()[p.killer]);
+        row.killer.assign(edge.begin(), edge.end());
+      }
+    } else {
+      const auto edge = SortedEdge(family->edges()[p.creator]);
+      row.creator.assign(edge.begin(), edge.end());
+      if (!p.essential()) {
+        const auto triangle = SortedTriangle(family->triangles()[p.killer]);
+        row.killer.assign(triangle.begin(), triangle.end());
+      }
+    }
+    rows.push_back(std::move(row));
+  }
+  if (!WritePersistence(rows, options->format, stdout)) {
+    return Failure(absl::DataLossError("persistence: writing to standard output failed"));
+  }
+  return kExitOk;
+}
+
+absl::StatusOr<HolesArgs> ParseHolesArgs(const CommandLine& line) {
+  HolesArgs out;
+  auto threshold = ParseThreshold(line);
+  if (!threshold.ok()) return threshold.status();
+  out.threshold = *threshold;
+  if (const std::string* text = line.Find("min-area")) {
+    auto value = ParseFiniteDouble("min-area", *text);
+    if (!value.ok()) return value.status();
+    if (*value < 0) return absl::InvalidArgumentError(absl::StrCat("--min-area '", *text, "' is negative"));
+    out.min_area = *value;
+  }
+  if (const std::string* text = line.Find("format")) {
+    auto format = ParseHolesFormat(*text);
+    if (!format.ok()) return format.status();
+    out.format = *format;
+  }
+  return out;
+}
+
+int RunHoles(Args args) {
+  auto common = ParseCommon("holes", args, {"alpha-sq", "alpha", "rank", "min-area", "format"});
+  if (!common.ok()) return UsageError(common.status());
+  auto options = ParseHolesArgs(common->line);
+  if (!options.ok()) return UsageError(options.status());
+  if (!common->server.empty()) return RemoteHoles(*common, *options);
+  size_t input_points = 0;
+  auto family = LoadFamily(*common, &input_points);
+  if (!family.ok()) return Failure(family.status());
+  auto threshold = ResolveThreshold(*family, options->threshold);
+  if (!threshold.ok()) return ArgumentError(threshold.status());
+  // The polygons are the same in both modes: holes are rings of the regularized shape.
+  auto shape = AssembleShape(family->ComplexAt(threshold->level, ClassifyMode::kRegularized));
+  if (!shape.ok()) return Failure(shape.status());
+  const std::vector<ShapeHole> holes = ListHoles(*shape, family->points(), options->min_area);
+  if (!WriteHoles(holes, family->points(), options->format, stdout)) {
+    return Failure(absl::DataLossError("holes: writing to standard output failed"));
+  }
+  return kExitOk;
+}
+
+}  // namespace galpha::alphactl
