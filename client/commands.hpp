@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -125,9 +126,10 @@ absl::Status CheckMasterListRank(int64_t rank, int64_t k);
 int RemoteSpectrum(const CommonArgs& common);
 int RemoteClassify(const CommonArgs& common, const ClassifyArgs& options);
 int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options);
-int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold, ClassifyMode mode, const std::string& format);
+int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold, ClassifyMode mode, const std::string& format,
+                double min_hole_area);
 int RemoteMasterList(const CommonArgs& common, int64_t rank);
-int RemoteOptimal(const CommonArgs& common, int64_t components);
+int RemoteOptimal(const CommonArgs& common, int64_t components, std::optional<int64_t> holes);
 int RemoteBench(const CommonArgs& common, int64_t repeat);
 int RemotePersistence(const CommonArgs& common, const PersistenceArgs& options);
 int RemoteHoles(const CommonArgs& common, const HolesArgs& options);

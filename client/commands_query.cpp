@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
 #include "core/geometry/shape.hpp"
+#include "core/geometry/shape_holes.hpp"
 #include "nlohmann/json.hpp"
 
 namespace galpha::alphactl {
@@ -98,6 +100,7 @@ int RunSummary(Args args) {
                                        {"triangles", ClassCountsJson(counts.triangles)},
                                        {"components", family->Components(level)},
                                        {"solid_components", family->SolidComponents(level)},
+                                       {"holes", family->Holes(level, options->mode)},
                                        {"interior_area", counts.interior_area},
                                        {"backend", family->report().backend}};
   std::fputs(JsonLine(json).c_str(), stdout);
@@ -105,7 +108,7 @@ int RunSummary(Args args) {
 }
 
 int RunShape(Args args) {
-  auto common = ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "mode", "format"});
+  auto common = ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "mode", "format", "min-hole-area"});
   if (!common.ok()) return UsageError(common.status());
   auto threshold_arg = ParseThreshold(common->line);
   if (!threshold_arg.ok()) return UsageError(threshold_arg.status());
@@ -117,7 +120,15 @@ int RunShape(Args args) {
     return UsageError(
         absl::InvalidArgumentError(absl::StrCat("unknown --format '", *format, "' (expected geojson, wkt or svg)")));
   }
-  if (!common->server.empty()) return RemoteShape(*common, *threshold_arg, *mode, *format);
+  double min_hole_area = 0.0;
+  if (const std::string* text = common->line.Find("min-hole-area")) {
+    auto value = ParseFiniteDouble("min-hole-area", *text);
+    if (!value.ok()) return UsageError(value.status());
+    if (*value < 0)
+      return UsageError(absl::InvalidArgumentError(absl::StrCat("--min-hole-area '", *text, "' is negative")));
+    min_hole_area = *value;
+  }
+  if (!common->server.empty()) return RemoteShape(*common, *threshold_arg, *mode, *format, min_hole_area);
   size_t input_points = 0;
   auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
@@ -127,6 +138,7 @@ int RunShape(Args args) {
   auto shape = AssembleShape(family->ComplexAt(threshold->level, *mode));
   if (!shape.ok()) return Failure(shape.status());
   const absl::Span<const Point2> points = family->points();
+  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, points, min_hole_area);
   std::string text = *format == "geojson" ? ShapeToGeoJson(*shape, points)
                      : *format == "wkt"   ? ShapeToWkt(*shape, points)
                                           : ShapeToSvg(*shape, points);
@@ -175,28 +187,43 @@ int RunMasterList(Args args) {
 }
 
 int RunOptimal(Args args) {
-  auto common = ParseCommon("optimal", args, {"components"});
+  auto common = ParseCommon("optimal", args, {"components", "holes"});
   if (!common.ok()) return UsageError(common.status());
   const std::string* text = common->line.Find("components");
   if (text == nullptr) return UsageError(absl::InvalidArgumentError("optimal: missing --components N"));
   auto components = ParseInteger("components", *text, 1);
   if (!components.ok()) return UsageError(components.status());
-  if (!common->server.empty()) return RemoteOptimal(*common, *components);
+  std::optional<int64_t> holes;
+  if (const std::string* holes_text = common->line.Find("holes")) {
+    auto parsed = ParseInteger("holes", *holes_text, 0);
+    if (!parsed.ok()) return UsageError(parsed.status());
+    holes = *parsed;
+  }
+  if (!common->server.empty()) return RemoteOptimal(*common, *components, holes);
   size_t input_points = 0;
   auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
 
   // Counts are 32-bit: "at most N" for any larger N means the same as for the largest count.
   const uint32_t n = static_cast<uint32_t>(std::min<int64_t>(*components, std::numeric_limits<uint32_t>::max()));
-  nlohmann::ordered_json json = {{"components", *components}, {"regularized", nullptr}, {"general", nullptr}};
-  if (const std::optional<int64_t> level = family->OptimalLevelRegularized(n)) {
+  const std::optional<uint32_t> max_holes = holes ? std::optional<uint32_t>(static_cast<uint32_t>(std::min<int64_t>(
+                                                        *holes, std::numeric_limits<uint32_t>::max())))
+                                                  : std::nullopt;
+  nlohmann::ordered_json json = {{"components", *components}};
+  if (holes) json["holes"] = *holes;
+  json["regularized"] = nullptr;
+  json["general"] = nullptr;
+  if (const std::optional<int64_t> level = family->OptimalLevelRegularized(n, max_holes)) {
     json["regularized"] = {{"rank", *level},
                            {"alpha_sq", PublishedAlphaSq(*family, *level)},
-                           {"solid_components", family->SolidComponents(*level)}};
+                           {"solid_components", family->SolidComponents(*level)},
+                           {"holes", family->Holes(*level, ClassifyMode::kRegularized)}};
   }
-  if (const std::optional<int64_t> level = family->OptimalLevelGeneral(n)) {
-    json["general"] = {
-        {"rank", *level}, {"alpha_sq", PublishedAlphaSq(*family, *level)}, {"components", family->Components(*level)}};
+  if (const std::optional<int64_t> level = family->OptimalLevelGeneral(n, max_holes)) {
+    json["general"] = {{"rank", *level},
+                       {"alpha_sq", PublishedAlphaSq(*family, *level)},
+                       {"components", family->Components(*level)},
+                       {"holes", family->Holes(*level, ClassifyMode::kGeneral)}};
   }
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -240,6 +241,7 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
                                        {"triangles", ClassCountsJson(FromProto(summary.triangles()))},
                                        {"components", summary.components()},
                                        {"solid_components", summary.solid_components()},
+                                       {"holes", summary.holes()},
                                        {"interior_area", summary.interior_area()},
                                        {"backend", build.backend()}};
   std::fputs(JsonLine(json).c_str(), stdout);
@@ -247,7 +249,7 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
 }
 
 int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, ClassifyMode mode,
-                const std::string& format) {
+                const std::string& format, double min_hole_area) {
   auto remote = OpenRemote(common);
   if (!remote.ok()) return Failure(remote.status());
   auto threshold = ToThreshold(threshold_arg, *remote);
@@ -259,6 +261,7 @@ int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, Cla
   request.set_format(format == "geojson" ? v1::SHAPE_FORMAT_GEOJSON
                      : format == "wkt"   ? v1::SHAPE_FORMAT_WKT
                                          : v1::SHAPE_FORMAT_SVG);
+  request.set_min_hole_area(min_hole_area);
   ChunkedWriter out(stdout);
   char last = '\n';
   bool any = false;
@@ -307,25 +310,32 @@ int RemoteMasterList(const CommonArgs& common, int64_t rank) {
   return FinishOutput(out);
 }
 
-int RemoteOptimal(const CommonArgs& common, int64_t components) {
+int RemoteOptimal(const CommonArgs& common, int64_t components, std::optional<int64_t> holes) {
   auto remote = OpenRemote(common);
   if (!remote.ok()) return Failure(remote.status());
   v1::OptimalAlphaRequest request;
   request.set_handle(remote->build.handle);
   request.set_max_components(
       static_cast<uint32_t>(std::min<int64_t>(components, std::numeric_limits<uint32_t>::max())));
+  if (holes)
+    request.set_max_holes(static_cast<uint32_t>(std::min<int64_t>(*holes, std::numeric_limits<uint32_t>::max())));
   auto answer = remote->client->OptimalAlpha(request);
   if (!answer.ok()) return QueryError(common, answer.status());
-  nlohmann::ordered_json json = {{"components", components}, {"regularized", nullptr}, {"general", nullptr}};
+  nlohmann::ordered_json json = {{"components", components}};
+  if (holes) json["holes"] = *holes;
+  json["regularized"] = nullptr;
+  json["general"] = nullptr;
   if (answer->has_regularized()) {
     json["regularized"] = {{"rank", answer->regularized().rank()},
                            {"alpha_sq", answer->regularized().alpha_sq()},
-                           {"solid_components", answer->regularized().components()}};
+                           {"solid_components", answer->regularized().components()},
+                           {"holes", answer->regularized().holes()}};
   }
   if (answer->has_general()) {
     json["general"] = {{"rank", answer->general().rank()},
                        {"alpha_sq", answer->general().alpha_sq()},
-                       {"components", answer->general().components()}};
+                       {"components", answer->general().components()},
+                       {"holes", answer->general().holes()}};
   }
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;

@@ -8,8 +8,7 @@
 // two merging components, the one whose oldest vertex comes later dies). In the plane, H1 is dual
 // to H0 of the complement (Alexander duality): a union-find over the triangles and the outer face
 // in reverse order, joined by the edges that close a loop, pairs each such edge with the triangle
-// that fills the hole it made last (the elder rule again, in reverse). Semantics: docs/design.md,
-// "Holes and persistence".
+// that fills the hole it made last (the elder rule again, in reverse). Semantics: docs/topology.md.
 #pragma once
 
 #include <cstdint>

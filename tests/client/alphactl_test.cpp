@@ -159,14 +159,36 @@ TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
   const CommandResult help = Alphactl("--help");
   EXPECT_EQ(help.exit_code, 0);
   EXPECT_TRUE(help.err.empty());
-  for (const char* word : {"triangulate",    "spectrum",        "classify",
-                           "summary",        "shape",           "masterlist",
-                           "optimal",        "bench",           "--alpha-sq",
-                           "--alpha ",       "--rank",          "--mode",
-                           "--vertex-rule",  "--format",        "--components",
-                           "--repeat",       "--backend",       "--max-points",
-                           "GLOBAL OPTIONS", "geojson|wkt|svg", "general|regularized",
-                           "report|cgal"}) {
+  for (const char* word : {"triangulate",
+                           "spectrum",
+                           "classify",
+                           "summary",
+                           "shape",
+                           "masterlist",
+                           "optimal",
+                           "bench",
+                           "--alpha-sq",
+                           "--alpha ",
+                           "--rank",
+                           "--mode",
+                           "--vertex-rule",
+                           "--format",
+                           "--components",
+                           "--repeat",
+                           "--backend",
+                           "--max-points",
+                           "GLOBAL OPTIONS",
+                           "geojson|wkt|svg",
+                           "general|regularized",
+                           "report|cgal",
+                           "persistence",
+                           "holes",
+                           "--holes",
+                           "--min-persistence",
+                           "--dimension",
+                           "--min-area",
+                           "--min-hole-area",
+                           "text|csv|json|svg"}) {
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   }
   const CommandResult none = Alphactl("");
@@ -275,7 +297,7 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   for (const auto& item : j.items()) keys.push_back(item.key());
   EXPECT_EQ(keys, (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size", "level",
                                             "alpha_sq", "mode", "vertex_rule", "vertices", "edges", "triangles",
-                                            "components", "solid_components", "interior_area", "backend"}));
+                                            "components", "solid_components", "holes", "interior_area", "backend"}));
   const nlohmann::json expected = {{"file", SquareCsv()},
                                    {"points", 4},
                                    {"distinct_points", 4},
@@ -290,6 +312,7 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
                                    {"triangles", {{"EXTERIOR", 2}, {"SINGULAR", 0}, {"REGULAR", 0}, {"INTERIOR", 0}}},
                                    {"components", 1},
                                    {"solid_components", 0},
+                                   {"holes", 1},  // the four sides enclose the square
                                    {"interior_area", 0.0},
                                    {"backend", "cpu"}};
   EXPECT_EQ(nlohmann::json::parse(run.out), expected);
@@ -306,6 +329,7 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   EXPECT_EQ(full["edges"]["INTERIOR"], 1);
   EXPECT_EQ(full["triangles"]["INTERIOR"], 2);
   EXPECT_EQ(full["solid_components"], 1);
+  EXPECT_EQ(full["holes"], 0);
   EXPECT_EQ(full["interior_area"], 1.0);
 }
 
@@ -360,29 +384,98 @@ TEST(AlphactlTest, MasterListOfTheSquare) {
 
 TEST(AlphactlTest, OptimalRanks) {
   EXPECT_EQ(Succeeds("optimal", SquareCsv(), "--components 1"),
-            "{\"components\":1,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1},"
-            "\"general\":{\"rank\":1,\"alpha_sq\":0.25,\"components\":1}}\n");
+            "{\"components\":1,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1,\"holes\":0},"
+            "\"general\":{\"rank\":1,\"alpha_sq\":0.25,\"components\":1,\"holes\":1}}\n");
   EXPECT_EQ(Succeeds("optimal", SquareCsv(), "--components 4"),
-            "{\"components\":4,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1},"
-            "\"general\":{\"rank\":0,\"alpha_sq\":0,\"components\":4}}\n");
+            "{\"components\":4,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1,\"holes\":0},"
+            "\"general\":{\"rank\":0,\"alpha_sq\":0,\"components\":4,\"holes\":0}}\n");
+  // At 1/4 the sides enclose a hole, which the triangles fill at 1/2: with at most 0 holes the
+  // general answer moves there.
+  EXPECT_EQ(Succeeds("optimal", SquareCsv(), "--components 1 --holes 0"),
+            "{\"components\":1,\"holes\":0,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,\"solid_components\":1,"
+            "\"holes\":0},\"general\":{\"rank\":2,\"alpha_sq\":0.5,\"components\":1,\"holes\":0}}\n");
+  ExpectError(Alphactl("optimal " + Quote(SquareCsv()) + " --components 1 --holes -1"), 2, "--holes '-1'");
   // Two unit squares 9 apart: each square is connected at 1/4 and solid at 1/2.
   const std::string two = WriteFile("alphactl_two_squares.txt", "0 0\n1 0\n1 1\n0 1\n10 0\n11 0\n11 1\n10 1\n");
   const nlohmann::json j = nlohmann::json::parse(Succeeds("optimal", two, "--components 2"));
   EXPECT_EQ(j, nlohmann::json::parse("{\"components\":2,\"regularized\":{\"rank\":2,\"alpha_sq\":0.5,"
-                                     "\"solid_components\":2},\"general\":{\"rank\":1,\"alpha_sq\":0.25,"
-                                     "\"components\":2}}"));
+                                     "\"solid_components\":2,\"holes\":0},\"general\":{\"rank\":1,\"alpha_sq\":0.25,"
+                                     "\"components\":2,\"holes\":2}}"));
   const nlohmann::json one = nlohmann::json::parse(Succeeds("optimal", two, "--components 1"));
   EXPECT_GT(one["general"]["rank"].get<int>(), 2);
   EXPECT_EQ(one["general"]["components"], 1);
   // Collinear points never have a triangle: no regularized answer.
   const std::string line = WriteFile("alphactl_line.txt", "0 0\n1 0\n3 0\n");
   EXPECT_EQ(Succeeds("optimal", line, "--components 1"),
-            "{\"components\":1,\"regularized\":null,\"general\":{\"rank\":2,\"alpha_sq\":1,\"components\":1}}\n");
+            "{\"components\":1,\"regularized\":null,\"general\":{\"rank\":2,\"alpha_sq\":1,\"components\":1,"
+            "\"holes\":0}}\n");
   ExpectError(Alphactl("optimal " + Quote(line) + " --components 0"), 2, "--components '0'");
   ExpectError(Alphactl("optimal " + Quote(line) + " --components x"), 2, "--components 'x'");
   ExpectError(Alphactl("optimal " + Quote(line)), 2, "missing --components");
   std::filesystem::remove(two);
   std::filesystem::remove(line);
+}
+
+// The unit square by hand: the four sides are born at 1/4 and join the four points (three H0 pairs
+// by the elder rule: each later vertex dies as the edge in canonical order reaches it), the last
+// side closes the square (an H1 class born at 1/4), and the triangles fill it at 1/2.
+TEST(AlphactlTest, PersistenceOfTheSquareInEveryFormat) {
+  EXPECT_EQ(Succeeds("persistence", SquareCsv(), ""),
+            "H0 0 0.25 0 1 1 0-1\n"
+            "H0 0 0.25 0 1 2 1-2\n"
+            "H0 0 0.25 0 1 3 0-3\n"
+            "H0 0 inf 0 - 0 -\n"
+            "H1 0.25 0.5 1 2 2-3 1-2-3\n");
+  EXPECT_EQ(Succeeds("persistence", SquareCsv(), "--dimension 1 --format csv"),
+            "dimension,birth_alpha_sq,death_alpha_sq,birth_rank,death_rank,creator,killer\n"
+            "1,0.25,0.5,1,2,2-3,1-2-3\n");
+  const std::vector<std::string> json = SplitLines(Succeeds("persistence", SquareCsv(), "--format json"));
+  ASSERT_EQ(json.size(), 5u);
+  EXPECT_EQ(nlohmann::json::parse(json[3]),
+            nlohmann::json::parse("{\"dimension\":0,\"birth_alpha_sq\":0,\"death_alpha_sq\":null,\"birth_rank\":0,"
+                                  "\"death_rank\":null,\"creator\":[0],\"killer\":null}"));
+  EXPECT_EQ(nlohmann::json::parse(json[4])["killer"], nlohmann::json::parse("[1,2,3]"));
+  // The minimum persistence keeps the essential class whatever it is.
+  EXPECT_EQ(Succeeds("persistence", SquareCsv(), "--min-persistence 0.3"), "H0 0 inf 0 - 0 -\n");
+  const std::string svg = Succeeds("persistence", SquareCsv(), "--format svg");
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  // One circle a class, and the legend's two.
+  size_t circles = 0;
+  for (size_t at = svg.find("<circle"); at != std::string::npos; at = svg.find("<circle", at + 1)) ++circles;
+  EXPECT_EQ(circles, 5u + 2u);
+  ExpectError(Alphactl("persistence " + Quote(SquareCsv()) + " --dimension 2"), 2, "dimensions 0 and 1");
+  ExpectError(Alphactl("persistence " + Quote(SquareCsv()) + " --min-persistence -1"), 2, "negative");
+  ExpectError(Alphactl("persistence " + Quote(SquareCsv()) + " --format png"), 2, "'png'");
+}
+
+// A 12 x 12 integer grid without a 3 x 3 block: at alpha_sq 1/2 one octagonal hole of area 14 (a
+// 4 x 4 square less the four corner triangles that are in).
+TEST(AlphactlTest, HolesAreListedAndFilledBelowAnArea) {
+  std::string text;
+  for (int i = 0; i < 12; ++i) {
+    for (int j = 0; j < 12; ++j) {
+      if (i < 4 || i > 6 || j < 4 || j > 6) text += std::to_string(i) + " " + std::to_string(j) + "\n";
+    }
+  }
+  const std::string grid = WriteFile("alphactl_holed_grid.txt", text);
+  EXPECT_EQ(Succeeds("holes", grid, "--alpha-sq 0.5"),
+            "14 0 POLYGON ((4 3, 5 3, 6 3, 7 4, 7 5, 7 6, 6 7, 5 7, 4 7, 3 6, 3 5, 3 4, 4 3))\n");
+  EXPECT_EQ(Succeeds("holes", grid, "--alpha-sq 0.5 --min-area 14.5"), "");
+  const nlohmann::json geojson = nlohmann::json::parse(Succeeds("holes", grid, "--alpha-sq 0.5 --format geojson"));
+  ASSERT_EQ(geojson["features"].size(), 1u);
+  EXPECT_EQ(geojson["features"][0]["properties"]["area"], 14);
+  EXPECT_EQ(geojson["features"][0]["geometry"]["type"], "Polygon");
+  const nlohmann::json summary = nlohmann::json::parse(Succeeds("summary", grid, "--alpha-sq 0.5 --mode regularized"));
+  EXPECT_EQ(summary["holes"], 1);
+  const std::string kept = Succeeds("shape", grid, "--alpha-sq 0.5 --mode regularized --format wkt");
+  const std::string filled =
+      Succeeds("shape", grid, "--alpha-sq 0.5 --mode regularized --format wkt --min-hole-area 20");
+  EXPECT_NE(kept.find("), ("), std::string::npos) << kept;
+  EXPECT_EQ(filled.find("), ("), std::string::npos) << filled;
+  ExpectError(Alphactl("shape " + Quote(grid) + " --rank 1 --format wkt --min-hole-area -2"), 2, "negative");
+  ExpectError(Alphactl("holes " + Quote(grid) + " --rank 1 --format svg"), 2, "'svg'");
+  std::filesystem::remove(grid);
 }
 
 TEST(AlphactlTest, BenchPrintsEveryStageAndTheCounts) {
