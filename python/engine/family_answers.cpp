@@ -269,9 +269,8 @@ absl::StatusOr<std::array<PersistencePairs, 2>> AnswerPersistence(const FamilySt
     if (!wanted[d]) continue;
     for (size_t i = diagram->dimension_begin[d]; i < diagram->dimension_begin[d + 1]; ++i) {
       const PersistencePair& p = diagram->pairs[i];
-      const double birth = RankValue(family, p.birth_rank), death = RankValue(family, p.death_rank);
-      if (!p.essential() && !(death - birth >= min_persistence)) continue;
-      AppendPair(family, p, birth, death, &answer[d]);
+      if (!PersistsAtLeast(family, p, min_persistence)) continue;
+      AppendPair(family, p, RankValue(family, p.birth_rank), RankValue(family, p.death_rank), &answer[d]);
     }
   }
   return answer;
