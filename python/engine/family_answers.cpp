@@ -111,10 +111,32 @@ absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Th
   return answer;
 }
 
-absl::StatusOr<ShapeGeometry> AnswerShape(const AlphaFamily& family, const Threshold& threshold, ClassifyMode mode) {
+absl::StatusOr<ShapeGeometry> AnswerShape(const AlphaFamily& family, const Threshold& threshold, ClassifyMode mode,
+                                          double min_hole_area) {
   auto level = ResolveLevel(family, threshold);
   if (!level.ok()) return level.status();
-  return AssembleShape(family.ComplexAt(level->level, mode));
+  // The service's check and message (server/query_answers.cpp, MakeShapeSource), after the
+  // threshold's as there.
+  if (std::isnan(min_hole_area) || min_hole_area < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_hole_area ", min_hole_area, " is not an area: give 0 (keep every hole) or more"));
+  }
+  auto shape = AssembleShape(family.ComplexAt(level->level, mode));
+  if (!shape.ok()) return shape.status();
+  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family.points(), min_hole_area);
+  return shape;
+}
+
+absl::StatusOr<std::vector<ShapeHole>> AnswerHoles(const AlphaFamily& family, const Threshold& threshold,
+                                                   double min_area) {
+  if (std::isnan(min_area) || min_area < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("min_area ", min_area, " is not an area: give 0 (every hole) or more"));
+  }
+  // The polygons are the same in both modes: holes are rings of the regularized shape.
+  auto shape = AnswerShape(family, threshold, ClassifyMode::kRegularized);
+  if (!shape.ok()) return shape.status();
+  return ListHoles(*shape, family.points(), min_area);
 }
 
 absl::StatusOr<std::pair<size_t, size_t>> AnswerSpectrumRange(const AlphaFamily& family, int64_t first_rank,

@@ -17,6 +17,7 @@
 #include "core/family/classification_summary.hpp"
 #include "core/family/threshold.hpp"
 #include "core/geometry/shape.hpp"
+#include "core/geometry/shape_holes.hpp"
 #include "python/engine/family_state.hpp"
 
 namespace galpha::python {
@@ -58,8 +59,19 @@ struct ClassifyAnswer {
 absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Threshold& threshold, ClassifyMode mode,
                                               VertexRule rule, bool non_exterior_only, bool summary_only);
 
-/// The shape at one threshold (core/geometry/shape.hpp's AssembleShape of the complex there).
-absl::StatusOr<ShapeGeometry> AnswerShape(const AlphaFamily& family, const Threshold& threshold, ClassifyMode mode);
+/// The shape at one threshold (core/geometry/shape.hpp's AssembleShape of the complex there), with
+/// the holes whose area is below min_hole_area filled as the service's Shape fills them
+/// (core/geometry/shape_holes.hpp's FillHolesSmallerThan; 0 keeps every hole). InvalidArgument for
+/// a negative or NaN min_hole_area, by the service's message.
+absl::StatusOr<ShapeGeometry> AnswerShape(const AlphaFamily& family, const Threshold& threshold, ClassifyMode mode,
+                                          double min_hole_area = 0.0);
+
+/// Every hole of the regularized shape at one threshold with an area of at least min_area, largest
+/// first, as `alphactl holes` lists them (core/geometry/shape_holes.hpp's ListHoles: rings
+/// clockwise, as AssembleShape writes them; areas by RingArea). InvalidArgument for a negative or
+/// NaN min_area.
+absl::StatusOr<std::vector<ShapeHole>> AnswerHoles(const AlphaFamily& family, const Threshold& threshold,
+                                                   double min_area);
 
 /// Spectrum ranks first_rank .. first_rank + count - 1, clipped at K, as [begin, end) positions in
 /// family.spectrum(). InvalidArgument for first_rank outside 1..K+1 or a negative count.

@@ -1,5 +1,6 @@
 #include "python/engine/family_binding.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -217,20 +218,44 @@ void RegisterFamily(py::module_& module) {
           "a dict of the counts and the arrays of galpha.Classification.")
       .def(
           "shape_rings",
-          [](const FamilyObject& self, const std::string& kind, const py::object& value, const std::string& mode) {
+          [](const FamilyObject& self, const std::string& kind, const py::object& value, const std::string& mode,
+             double min_hole_area) {
             const StatePtr state = self.state();
             const Threshold threshold = ThresholdOf(kind, value);
             const ClassifyMode parsed_mode = ValueOrThrow(ParseMode(mode));
             std::optional<absl::StatusOr<ShapeGeometry>> shape;
             {
               py::gil_scoped_release release;
-              shape.emplace(AnswerShape(state->family(), threshold, parsed_mode));
+              shape.emplace(AnswerShape(state->family(), threshold, parsed_mode, min_hole_area));
             }
             return ShapeDict(ValueOrThrow(*std::move(shape)));
           },
-          py::arg("kind"), py::arg("value"), py::arg("mode") = "general",
+          py::arg("kind"), py::arg("value"), py::arg("mode") = "general", py::arg("min_hole_area") = 0.0,
           "The alpha shape at one threshold by input indices: polygons as (outer, [holes]), singular_edges (k, 2), "
-          "isolated_points, area.")
+          "isolated_points, area; holes with an area below min_hole_area filled (their area joins the shape's), as "
+          "the service's Shape fills them.")
+      .def(
+          "holes",
+          [](const FamilyObject& self, const std::string& kind, const py::object& value, double min_area) {
+            const StatePtr state = self.state();
+            const Threshold threshold = ThresholdOf(kind, value);
+            std::optional<absl::StatusOr<std::vector<ShapeHole>>> answer;
+            {
+              py::gil_scoped_release release;
+              answer.emplace(AnswerHoles(state->family(), threshold, min_area));
+            }
+            std::vector<ShapeHole> holes = ValueOrThrow(*std::move(answer));
+            py::list out;
+            for (ShapeHole& hole : holes) {
+              // Counter-clockwise, as alphactl holes prints the ring (AssembleShape writes it clockwise).
+              std::reverse(hole.ring.begin(), hole.ring.end());
+              out.append(py::make_tuple(hole.polygon, ArrayFromVector(std::move(hole.ring)), hole.area));
+            }
+            return out;
+          },
+          py::arg("kind"), py::arg("value"), py::arg("min_area") = 0.0,
+          "The holes of the regularized shape at one threshold with an area of at least min_area, largest first, as "
+          "alphactl holes lists them: a list of (polygon index, ring uint32 counter-clockwise and open, area).")
       .def(
           "master_list",
           [](const FamilyObject& self, int64_t first_rank, int64_t last_rank) {

@@ -3,7 +3,7 @@
 Two clients with the same calls: ``galpha.connect("host:port")`` talks to a galpha server over
 gRPC; ``galpha.local()`` runs the engine in this process. ``client.build(points)`` returns a
 :class:`Family`, which answers every query (classify, shape, spectrum, master list, components,
-optimal alpha, Betti numbers, persistence) for every alpha at once::
+optimal alpha, Betti numbers, persistence, holes) for every alpha at once::
 
     import galpha
     family = galpha.local().build(points)          # (N, 2) array, shapely points, GeoDataFrame
@@ -38,6 +38,7 @@ from ._types import (  # noqa: E402
     Classification,
     ComponentCurve,
     Endpoint,
+    Hole,
     MasterList,
     Mode,
     Optimal,
@@ -87,6 +88,7 @@ __all__ = [
     "Classification",
     "ComponentCurve",
     "Endpoint",
+    "Hole",
     "MasterList",
     "Mode",
     "Optimal",

@@ -7,7 +7,7 @@ user-facing conveniences (threshold keywords, shapely geometry, GeoDataFrames) o
 
 from __future__ import annotations
 
-from typing import Optional, Protocol, Tuple
+from typing import List, Optional, Protocol, Tuple
 
 import numpy as np
 
@@ -16,6 +16,7 @@ from ._types import (
     BuildSummary,
     Classification,
     ComponentCurve,
+    Hole,
     MasterList,
     Mode,
     Optimal,
@@ -43,7 +44,12 @@ class FamilyBackend(Protocol):
         self, threshold: Threshold, mode: Mode, vertex_rule: VertexRule, non_exterior_only: bool, summary_only: bool
     ) -> Classification: ...
 
-    def shape_rings(self, threshold: Threshold, mode: Mode) -> ShapeRings: ...
+    def shape_rings(self, threshold: Threshold, mode: Mode, min_hole_area: float = 0.0) -> ShapeRings:
+        """min_hole_area: checked by the caller (0 or more); holes below it are filled."""
+
+    def holes(self, threshold: Threshold, min_area: float, points: np.ndarray) -> List[Hole]:
+        """The regularized shape's holes of area >= min_area (checked by the caller), largest
+        first; ``points`` are the family's (the network backend measures the rings with them)."""
 
     def master_list(self, first_rank: int, last_rank: int) -> MasterList: ...
 

@@ -20,6 +20,7 @@ from ._types import (
     BuildSummary,
     Classification,
     ComponentCurve,
+    Hole,
     MasterList,
     Mode,
     Optimal,
@@ -132,6 +133,68 @@ def persistence_arguments(dimensions: Union[int, Iterable[int]], min_persistence
     return tuple(sorted({int(d) for d in asked})), minimum
 
 
+def c_double_text(value: float) -> str:
+    """A double as absl::StrCat writes it (six significant digits, %g), so that messages the
+    package writes read as the service's."""
+    return "%.6g" % value
+
+
+def area_argument(name: str, value: Any, zero_means: str) -> float:
+    """An area bound (min_hole_area, min_area) as a float, checked as the service checks
+    min_hole_area (by its message) before any call: a number, 0 or more (NaN refused)."""
+    if isinstance(value, bool):
+        raise InvalidInput(f"{name} must be a number, got {value!r}")
+    try:
+        area = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInput(f"{name} must be a number, got {value!r}") from None
+    if math.isnan(area) or area < 0:
+        raise InvalidInput(f"{name} {c_double_text(area)} is not an area: give 0 ({zero_means}) or more")
+    return area
+
+
+def ring_area(ring: np.ndarray, points: np.ndarray) -> float:
+    """The area of a simple ring of input indices, computed as the C++ core's RingArea
+    (core/geometry/shape_holes.cpp) computes it, to the same double: the shoelace terms about the
+    ring's first vertex, summed one after another (np.add.accumulate is sequential; np.sum's
+    pairwise sum would round differently), half the absolute value."""
+    if len(ring) < 3:
+        return 0.0
+    xy = points[ring]
+    a = xy[1:-1] - xy[0]
+    b = xy[2:] - xy[0]
+    terms = a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]
+    return 0.5 * abs(float(np.add.accumulate(terms)[-1]))
+
+
+def holes_from_rings(rings: ShapeRings, points: np.ndarray, min_area: float) -> List[Hole]:
+    """The holes of a (regularized) shape by rings, as core's ListHoles lists them: every hole ring
+    whose area is at least min_area, largest first (a stable sort: equal areas keep polygon, then
+    ring order), each ring reversed to counter-clockwise. Areas are measured on the rings as they
+    arrive (clockwise), as core measures them."""
+    holes: List[Hole] = []
+    for index, polygon in enumerate(rings.polygons):
+        for ring in polygon.holes:
+            area = ring_area(ring, points)
+            if area >= min_area:
+                holes.append(Hole(polygon=index, ring=np.ascontiguousarray(ring[::-1], dtype=np.uint32), area=area))
+    holes.sort(key=lambda h: -h.area)
+    return holes
+
+
+def holes_geodataframe(holes: List[Hole], points: np.ndarray, crs: Any) -> Any:
+    """One row per hole: ``polygon``, ``area`` and the hole as a shapely Polygon, in ``crs``."""
+    import geopandas
+    from shapely.geometry import Polygon
+
+    geometries = [Polygon(points[h.ring]) for h in holes]
+    columns = {
+        "polygon": np.array([h.polygon for h in holes], dtype=np.int64),
+        "area": np.array([h.area for h in holes], dtype=np.float64),
+    }
+    return geopandas.GeoDataFrame(columns, geometry=geometries, crs=crs)
+
+
 def rings_to_shapely(rings: ShapeRings, points: np.ndarray, mode: Mode) -> Any:
     """A MultiPolygon (regularized), or a GeometryCollection of the MultiPolygon, the singular edges
     as a MultiLineString and the isolated points as a MultiPoint, each present when not empty
@@ -233,10 +296,15 @@ class Family:
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
+        min_hole_area: float = 0.0,
     ) -> ShapeRings:
         """The shape by input indices: polygons (outer ring and holes), singular edges, isolated
-        points, area."""
-        return self._backend.shape_rings(threshold_from(alpha, alpha_sq, rank), _mode(mode))
+        points, area. Holes whose area is below ``min_hole_area`` (squared input units) are
+        filled: their rings leave the polygons and their areas join ``area`` (0, the default,
+        keeps every hole; a negative or NaN bound raises InvalidInput)."""
+        threshold = threshold_from(alpha, alpha_sq, rank)
+        m = _mode(mode)
+        return self._backend.shape_rings(threshold, m, area_argument("min_hole_area", min_hole_area, "keep every hole"))
 
     def shape(
         self,
@@ -246,6 +314,7 @@ class Family:
         rank: Optional[int] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
         as_geodataframe: bool = False,
+        min_hole_area: float = 0.0,
     ) -> Any:
         """The alpha shape at one threshold as shapely geometry (valid, holes included).
 
@@ -254,9 +323,11 @@ class Family:
         (MultiLineString) and isolated points (MultiPoint). With ``as_geodataframe=True``: a
         GeoDataFrame with one row per polygon (``kind="polygon"``, ``area``), then one row for the
         singular edges and one for the isolated points where present, in the points' CRS.
+        ``min_hole_area``: holes with a smaller area (squared input units, as :meth:`holes`
+        measures them) are filled; 0 keeps every hole.
         """
         m = _mode(mode)
-        rings = self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m)
+        rings = self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m, min_hole_area=min_hole_area)
         if not as_geodataframe:
             return rings_to_shapely(rings, self._points, m)
         return self._geodataframe(rings)
@@ -279,6 +350,29 @@ class Family:
         frame = geopandas.GeoDataFrame({"kind": kinds}, geometry=geometries, crs=self.crs)
         frame["area"] = [g.area if k == "polygon" else 0.0 for k, g in zip(kinds, geometries)]
         return frame
+
+    def holes(
+        self,
+        *,
+        alpha: Optional[float] = None,
+        alpha_sq: Optional[float] = None,
+        rank: Optional[int] = None,
+        min_area: float = 0.0,
+        as_geodataframe: bool = False,
+    ) -> Any:
+        """The holes of the regularized shape at one threshold with an area of at least
+        ``min_area`` (squared input units), largest first, as ``alphactl holes`` lists them: a list
+        of :class:`Hole` (polygon index, counter-clockwise open ring of input indices, area measured
+        as the C++ core measures it). With ``as_geodataframe=True``: a GeoDataFrame with columns
+        ``polygon``, ``area`` and each hole as a shapely Polygon, in the points' CRS.
+
+        The local engine lists them in C++; the network client asks the server for the shape's
+        rings and measures them here, from the points this family keeps (``family.points``), to
+        the same doubles."""
+        threshold = threshold_from(alpha, alpha_sq, rank)
+        minimum = area_argument("min_area", min_area, "every hole")
+        holes = self._backend.holes(threshold, minimum, self._points)
+        return holes_geodataframe(holes, self._points, self.crs) if as_geodataframe else holes
 
     def master_list(self, rank: int, last_rank: Optional[int] = None) -> MasterList:
         """Master-list entries of ranks rank .. last_rank (1..K; last_rank defaults to rank)."""

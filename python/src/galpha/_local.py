@@ -13,7 +13,7 @@ triangles of a full classification) are read-only views into the family.
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable, Optional, Tuple, TypeVar
+from typing import Any, Callable, List, Optional, Tuple, TypeVar
 
 import numpy as np
 
@@ -25,6 +25,7 @@ from ._types import (
     ClassCounts,
     Classification,
     ComponentCurve,
+    Hole,
     MasterList,
     Mode,
     Optimal,
@@ -134,14 +135,22 @@ class LocalFamilyBackend:
         )
 
     @_translated
-    def shape_rings(self, threshold: Threshold, mode: Mode) -> ShapeRings:
-        s = self._family.shape_rings(threshold.kind, threshold.value, _mode(mode))
+    def shape_rings(self, threshold: Threshold, mode: Mode, min_hole_area: float = 0.0) -> ShapeRings:
+        s = self._family.shape_rings(threshold.kind, threshold.value, _mode(mode), float(min_hole_area))
         return ShapeRings(
             polygons=[ShapePolygon(outer=outer, holes=list(holes)) for outer, holes in s["polygons"]],
             singular_edges=s["singular_edges"],
             isolated_points=s["isolated_points"],
             area=s["area"],
         )
+
+    @_translated
+    def holes(self, threshold: Threshold, min_area: float, points: np.ndarray) -> List[Hole]:
+        # The engine measures with its own copy of the points (the same values).
+        return [
+            Hole(polygon=polygon, ring=ring, area=area)
+            for polygon, ring, area in self._family.holes(threshold.kind, threshold.value, float(min_area))
+        ]
 
     @_translated
     def master_list(self, first_rank: int, last_rank: int) -> MasterList:

@@ -18,6 +18,7 @@ import numpy as np
 
 from . import _encoding, _wire
 from ._errors import GalphaError, InvalidInput, error_for_code
+from ._family import holes_from_rings
 from ._handle import point_set_handle
 from ._types import (
     BettiCurves,
@@ -25,6 +26,7 @@ from ._types import (
     ClassCounts,
     Classification,
     ComponentCurve,
+    Hole,
     MasterList,
     Mode,
     Optimal,
@@ -155,6 +157,17 @@ class ClassifyAssembler:
             triangle_classes=triangle_classes,
             holes=s.holes,
         )
+
+
+def shape_request(handle: str, threshold: Threshold, mode: Mode, min_hole_area: float) -> pb.ShapeRequest:
+    """A Shape request for the rings (min_hole_area checked by the caller)."""
+    return pb.ShapeRequest(
+        handle=handle,
+        threshold=threshold_message(threshold),
+        mode=_MODES[mode],
+        format=pb.SHAPE_FORMAT_RINGS,
+        min_hole_area=min_hole_area,
+    )
 
 
 def shape_rings_from(pieces: Sequence[pb.ShapeResponse]) -> ShapeRings:
@@ -462,11 +475,13 @@ class NetworkFamilyBackend:
             assembler.add(raw)
         return assembler.result()
 
-    def shape_rings(self, threshold: Threshold, mode: Mode) -> ShapeRings:
-        request = pb.ShapeRequest(
-            handle=self._handle, threshold=threshold_message(threshold), mode=_MODES[mode], format=pb.SHAPE_FORMAT_RINGS
-        )
+    def shape_rings(self, threshold: Threshold, mode: Mode, min_hole_area: float = 0.0) -> ShapeRings:
+        request = shape_request(self._handle, threshold, mode, min_hole_area)
         return shape_rings_from(self._stream(self._calls.shape, request))
+
+    def holes(self, threshold: Threshold, min_area: float, points: np.ndarray) -> List[Hole]:
+        # The server sends the rings; their areas are measured here, as alphactl --server does.
+        return holes_from_rings(self.shape_rings(threshold, Mode.REGULARIZED), points, min_area)
 
     def master_list(self, first_rank: int, last_rank: int) -> MasterList:
         request = pb.MasterListRequest(handle=self._handle, first_rank=first_rank, last_rank=last_rank)

@@ -27,6 +27,7 @@ __all__ = [
     "Classification",
     "ShapePolygon",
     "ShapeRings",
+    "Hole",
     "MasterList",
     "ComponentCurve",
     "OptimalLevel",
@@ -162,6 +163,23 @@ class ShapeRings:
     singular_edges: np.ndarray  #: (k, 2) uint32, (smaller, larger)
     isolated_points: np.ndarray  #: (j,) uint32
     area: float
+
+
+@dataclasses.dataclass(frozen=True)
+class Hole:
+    """One hole of the regularized shape at a threshold (:meth:`galpha.Family.holes`), as
+    ``alphactl holes`` lists it.
+
+    ``ring`` runs counter-clockwise (the hole's boundary as a polygon of its own: the reverse of
+    the clockwise hole ring of :class:`ShapePolygon`) and is not closed (its first vertex is not
+    repeated, like every ring of :class:`ShapeRings`; alphactl prints it closed). ``area`` is
+    measured as the C++ core measures it (core/geometry/shape_holes.hpp's RingArea: the shoelace
+    sum of the clockwise ring in doubles about that ring's first vertex), so it is the same double
+    on both clients and in alphactl."""
+
+    polygon: int  #: index of the polygon it belongs to, in ``shape_rings(...).polygons`` (regularized)
+    ring: np.ndarray  #: (n,) uint32 input indices, counter-clockwise, open
+    area: float  #: squared input units
 
 
 @dataclasses.dataclass(frozen=True)

@@ -21,6 +21,9 @@ from ._errors import InvalidInput
 from ._family import (
     _mode,
     _rule,
+    area_argument,
+    holes_from_rings,
+    holes_geodataframe,
     level_range,
     optimal_bounds,
     persistence_arguments,
@@ -137,12 +140,12 @@ class AsyncFamily:
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
+        min_hole_area: float = 0.0,
     ) -> ShapeRings:
-        request = pb.ShapeRequest(
-            handle=self.handle,
-            threshold=_network.threshold_message(threshold_from(alpha, alpha_sq, rank)),
-            mode=_network._MODES[_mode(mode)],
-            format=pb.SHAPE_FORMAT_RINGS,
+        threshold = threshold_from(alpha, alpha_sq, rank)
+        m = _mode(mode)
+        request = _network.shape_request(
+            self.handle, threshold, m, area_argument("min_hole_area", min_hole_area, "keep every hole")
         )
         return _network.shape_rings_from(await self._stream(self._calls.shape, request))
 
@@ -153,10 +156,29 @@ class AsyncFamily:
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
+        min_hole_area: float = 0.0,
     ) -> Any:
         m = _mode(mode)
-        rings = await self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m)
+        rings = await self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m, min_hole_area=min_hole_area)
         return rings_to_shapely(rings, self.points, m)
+
+    async def holes(
+        self,
+        *,
+        alpha: Optional[float] = None,
+        alpha_sq: Optional[float] = None,
+        rank: Optional[int] = None,
+        min_area: float = 0.0,
+        as_geodataframe: bool = False,
+    ) -> Any:
+        """The holes of the regularized shape at one threshold, as :meth:`galpha.Family.holes`
+        (the rings from the server, measured here from ``points``)."""
+        threshold = threshold_from(alpha, alpha_sq, rank)
+        minimum = area_argument("min_area", min_area, "every hole")
+        request = _network.shape_request(self.handle, threshold, Mode.REGULARIZED, 0.0)
+        rings = _network.shape_rings_from(await self._stream(self._calls.shape, request))
+        holes = holes_from_rings(rings, self.points, minimum)
+        return holes_geodataframe(holes, self.points, self.crs) if as_geodataframe else holes
 
     async def master_list(self, rank: int, last_rank: Optional[int] = None) -> MasterList:
         request = pb.MasterListRequest(
