@@ -1,5 +1,7 @@
 #include "core/family/canonical_order.hpp"
 
+#include <parallel/algorithm>
+
 #include <algorithm>
 #include <array>
 #include <utility>
@@ -16,7 +18,9 @@ CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family) {
     const uint32_t a = std::min(edges[e][0], edges[e][1]), b = std::max(edges[e][0], edges[e][1]);
     edge_keys[e] = {(uint64_t{a} << 32) | b, e};
   }
-  std::sort(edge_keys.begin(), edge_keys.end());
+  // Keys are unique, so the parallel sort's order is the one order (libstdc++'s parallel mode,
+  // on the OpenMP threads the family library already uses).
+  __gnu_parallel::sort(edge_keys.begin(), edge_keys.end());
   orders.edge_order.resize(edges.size());
   orders.edge_vertices.resize(2 * edges.size());
   for (size_t i = 0; i < edge_keys.size(); ++i) {
@@ -32,7 +36,7 @@ CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family) {
     std::sort(key.begin(), key.end());
     triangle_keys[t] = {key, t};
   }
-  std::sort(triangle_keys.begin(), triangle_keys.end());
+  __gnu_parallel::sort(triangle_keys.begin(), triangle_keys.end());
   orders.triangle_order.resize(triangles.size());
   orders.triangle_vertices.resize(3 * triangles.size());
   for (size_t i = 0; i < triangle_keys.size(); ++i) {

@@ -10,11 +10,11 @@
 namespace galpha {
 namespace {
 
-/// Union-find with path halving; each root keeps a representative chosen by the caller (the
-/// eldest member under the elder rule).
+/// Union-find with path halving and union by size; each root keeps a representative chosen by
+/// the caller (the eldest member under the elder rule).
 class ElderForest {
  public:
-  explicit ElderForest(size_t n) : parent_(n), eldest_(n) {
+  explicit ElderForest(size_t n) : parent_(n), eldest_(n), size_(n, 1) {
     std::iota(parent_.begin(), parent_.end(), uint32_t{0});
     std::iota(eldest_.begin(), eldest_.end(), uint32_t{0});
   }
@@ -27,14 +27,29 @@ class ElderForest {
   }
   uint32_t eldest(uint32_t root) const { return eldest_[root]; }
   /// Joins two roots; the joined component's eldest is `eldest`.
-  void Join(uint32_t survivor, uint32_t other, uint32_t eldest) {
-    parent_[other] = survivor;
-    eldest_[survivor] = eldest;
+  void Join(uint32_t a, uint32_t b, uint32_t eldest) {
+    if (size_[a] < size_[b]) std::swap(a, b);
+    parent_[b] = a;
+    size_[a] += size_[b];
+    eldest_[a] = eldest;
   }
 
  private:
-  std::vector<uint32_t> parent_, eldest_;
+  std::vector<uint32_t> parent_, eldest_, size_;
 };
+
+/// Sorts each run of consecutive items that `same_run` puts together by `less`: the lists below
+/// come out of the union-finds already ordered but for ties, so sorting the runs is linear.
+template <class SameRun, class Less>
+void SortRuns(std::vector<PersistencePair>::iterator begin, std::vector<PersistencePair>::iterator end,
+              SameRun same_run, Less less) {
+  while (begin != end) {
+    auto run_end = begin + 1;
+    while (run_end != end && same_run(*begin, *run_end)) ++run_end;
+    if (run_end - begin > 1) std::sort(begin, run_end, less);
+    begin = run_end;
+  }
+}
 
 /// Ids in filtration order within ranks: `order` lists ids in canonical order; the result lists
 /// them by rank (kNeverRank last), canonical order within a rank (a stable counting sort).
@@ -103,7 +118,7 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
       const uint32_t young = oldest_a < oldest_b ? b : a, old = young == a ? b : a;
       const uint32_t birth = 0, death = EdgeBirthRank(r, e);
       if (death > birth) pairs.push_back({0, birth, death, forest.eldest(young), e});
-      forest.Join(old, young, forest.eldest(old));
+      forest.Join(a, b, forest.eldest(old));
     }
     for (uint32_t v = 0; v < num_points; ++v) {
       if (family.representative()[v] == v && forest.Find(v) == v) pairs.push_back({0, 0, kNeverRank, v, kNoSimplex});
@@ -139,18 +154,27 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
       const uint32_t killer = forest.eldest(young);
       const uint32_t birth = EdgeBirthRank(r, e), death = r.tri_rank[killer];
       if (death > birth) pairs.push_back({1, birth, death, e, death == kNeverRank ? kNoSimplex : killer});
-      forest.Join(old, young, forest.eldest(old));
+      forest.Join(a, b, forest.eldest(old));
     }
   }
 
-  // Dimension, birth, death (kNeverRank sorts last), creator's canonical position.
+  // The order: dimension, birth, death (kNeverRank sorts last), creator's canonical position. H0
+  // pairs came in Kruskal's order (birth 0, death ascending; the essential classes last, by
+  // vertex); H1 pairs in reverse filtration order of their creators (birth descending): reversed,
+  // only runs of equal birth remain to be ordered.
   auto position = [&](const PersistencePair& p) { return p.dimension == 0 ? p.creator : edge_position[p.creator]; };
   auto by_key = [&](const PersistencePair& x, const PersistencePair& y) {
     return std::make_tuple(x.birth_rank, x.death_rank, position(x)) <
            std::make_tuple(y.birth_rank, y.death_rank, position(y));
   };
-  std::sort(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(num_h0), by_key);
-  std::sort(pairs.begin() + static_cast<std::ptrdiff_t>(num_h0), pairs.end(), by_key);
+  const auto h1_begin = pairs.begin() + static_cast<std::ptrdiff_t>(num_h0);
+  SortRuns(
+      pairs.begin(), h1_begin,
+      [](const PersistencePair& x, const PersistencePair& y) { return x.death_rank == y.death_rank; }, by_key);
+  std::reverse(h1_begin, pairs.end());
+  SortRuns(
+      h1_begin, pairs.end(),
+      [](const PersistencePair& x, const PersistencePair& y) { return x.birth_rank == y.birth_rank; }, by_key);
   diagram.dimension_begin[0] = 0;
   diagram.dimension_begin[1] = num_h0;
   diagram.dimension_begin[2] = pairs.size();
