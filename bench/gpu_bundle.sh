@@ -7,7 +7,9 @@
 #   tar -xJf .carry-pack/carry.tar.xz && bash bench/gpu_run.sh test alpha
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake --preset cuda >/dev/null
+# Without GDAL: alphactl would carry GDAL and the hundred libraries it pulls in (the GPU machine
+# reads .bin files only).
+cmake --preset cuda -DGALPHA_WITH_GDAL=OFF >/dev/null
 cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
@@ -15,7 +17,7 @@ bins=()
 for name in predicates_test predicates_device_test delaunay_test delaunay_cgal_test triangulation_checks_test \
             radius_test alpha_family_cgal_test alpha_family_test alpha_bruteforce_test alpha_backend_identity_test \
             persistence_gudhi_test \
-            shape_test delaunay_bench alpha_bench alphactl service_bench galpha_server service_test; do
+            shape_test delaunay_bench alpha_bench topology_bench alphactl service_bench galpha_server service_test; do
   b=$(find build/cuda -name "$name" -type f -perm -u+x -not -path '*/CMakeFiles/*' | head -n 1)
   if [ -n "$b" ]; then cp "$b" .carry/bin/; bins+=(".carry/bin/$name"); fi
 done
