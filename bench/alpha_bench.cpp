@@ -36,9 +36,7 @@
 #include "bench/bench_options.hpp"
 #include "bench/sort_floor/sort_floor.hpp"
 #include "core/family/alpha_family.hpp"
-#include "core/io/point_formats.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
-#include "tests/support/point_generators.hpp"
 
 namespace galpha {
 namespace {
@@ -289,16 +287,9 @@ int Main(int argc, char** argv) {
     PrintRow(r);
     results.push_back(std::move(r));
   };
-  for (const std::string& name : options->distributions) {
-    for (size_t n : options->sizes) run(name, gen::FindDistribution(name)->generate(n, options->seed));
-  }
-  for (const std::string& file : options->data_files) {
-    absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
-    if (!points.ok()) {
-      std::fprintf(stderr, "%s\n", points.status().ToString().c_str());
-      return 1;
-    }
-    run(file.substr(file.find_last_of('/') + 1), *points);
+  if (const absl::Status read = ForEachBenchInput(*options, run); !read.ok()) {
+    std::fprintf(stderr, "%s\n", read.ToString().c_str());
+    return 1;
   }
   PrintStages(results);
   PrintHardness(results);

@@ -3,6 +3,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/io/point_formats.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {
@@ -63,6 +64,21 @@ absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, const char* c
   }
   if (!options.data_files.empty() && !explicit_generated) options.distributions.clear();
   return options;
+}
+
+absl::Status ForEachBenchInput(
+    const BenchOptions& options,
+    const std::function<void(const std::string& name, const std::vector<Point2>& points)>& run) {
+  for (const std::string& name : options.distributions) {
+    for (size_t n : options.sizes) run(name, gen::FindDistribution(name)->generate(n, options.seed));
+  }
+  for (const std::string& file : options.data_files) {
+    absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
+    if (!points.ok()) return points.status();
+    const size_t slash = file.find_last_of('/');
+    run(slash == std::string::npos ? file : file.substr(slash + 1), *points);
+  }
+  return absl::OkStatus();
 }
 
 }  // namespace galpha

@@ -3,10 +3,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "core/base/point.hpp"
 #include "gpu/triangulation/delaunay.hpp"
 
 namespace galpha {
@@ -28,5 +31,11 @@ struct BenchOptions {
 /// when `competitor_max_flag` names one ("--cgal-max"), that flag. With --data and no
 /// --sizes/--dists, only the files run.
 absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, const char* competitor_max_flag);
+
+/// Calls `run` with every input the options name: each distribution at each size (generated with
+/// the seed), then each data file (named by its file name). An error reading a file stops there.
+absl::Status ForEachBenchInput(
+    const BenchOptions& options,
+    const std::function<void(const std::string& name, const std::vector<Point2>& points)>& run);
 
 }  // namespace galpha

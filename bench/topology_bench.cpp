@@ -22,10 +22,8 @@
 #include "core/family/alpha_family.hpp"
 #include "core/family/canonical_order.hpp"
 #include "core/family/persistence.hpp"
-#include "core/io/point_formats.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "tests/support/gudhi_persistence_oracle.hpp"
-#include "tests/support/point_generators.hpp"
 
 namespace galpha {
 namespace {
@@ -144,16 +142,9 @@ int Main(int argc, char** argv) {
     failed |= !r.error.empty();
     PrintRow(r);
   };
-  for (const std::string& name : options->distributions) {
-    for (size_t n : options->sizes) run(name, gen::FindDistribution(name)->generate(n, options->seed));
-  }
-  for (const std::string& file : options->data_files) {
-    absl::StatusOr<std::vector<Point2>> points = ReadPointsFile(file);
-    if (!points.ok()) {
-      std::fprintf(stderr, "%s\n", points.status().ToString().c_str());
-      return 1;
-    }
-    run(file.substr(file.find_last_of('/') + 1), *points);
+  if (const absl::Status read = ForEachBenchInput(*options, run); !read.ok()) {
+    std::fprintf(stderr, "%s\n", read.ToString().c_str());
+    return 1;
   }
   return failed ? 1 : 0;
 }
