@@ -440,6 +440,9 @@ int RemotePersistence(const CommonArgs& common, const PersistenceArgs& options) 
   request.set_min_persistence(options.min_persistence);
   std::vector<PersistenceRow> rows;
   const absl::Status status = remote->client->Persistence(request, [&](const v1::PersistenceResponse& m) {
+    if (m.dimension() > 1) {
+      return absl::DataLossError(absl::StrCat("persistence: the server sent pairs of dimension ", m.dimension()));
+    }
     const uint32_t arity = m.dimension() + 1;
     const auto n = static_cast<size_t>(m.birth_rank_size());
     if (m.death_rank_size() != m.birth_rank_size() || m.birth_alpha_sq_size() != m.birth_rank_size() ||

@@ -62,20 +62,9 @@ int RunPersistence(Args args) {
     row.death_rank = p.essential() ? -1 : static_cast<int64_t>(p.death_rank);
     row.birth = RankValue(*family, p.birth_rank);
     row.death = RankValue(*family, p.death_rank);
-    if (p.dimension == 0) {
-      row.creator = {p.creator};
-      if (!p.essential()) {
-        const auto edge = SortedEdge(family->edges()[p.killer]);
-        row.killer.assign(edge.begin(), edge.end());
-      }
-    } else {
-      const auto edge = SortedEdge(family->edges()[p.creator]);
-      row.creator.assign(edge.begin(), edge.end());
-      if (!p.essential()) {
-        const auto triangle = SortedTriangle(family->triangles()[p.killer]);
-        row.killer.assign(triangle.begin(), triangle.end());
-      }
-    }
+    const PairVertices vertices = VerticesOf(*family, p);
+    row.creator.assign(vertices.creator.begin(), vertices.creator.begin() + p.dimension + 1);
+    if (!p.essential()) row.killer.assign(vertices.killer.begin(), vertices.killer.begin() + p.dimension + 2);
     rows.push_back(std::move(row));
   }
   if (!WritePersistence(rows, options->format, stdout)) {

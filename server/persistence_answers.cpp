@@ -15,8 +15,6 @@ namespace {
 
 namespace v1 = galpha::v1;
 
-constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
-
 class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
  public:
   PersistenceSource(std::shared_ptr<const CachedFamily> cached, PersistenceDiagram diagram,
@@ -55,17 +53,9 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
     message->add_death_rank(p.essential() ? -1 : static_cast<int64_t>(p.death_rank));
     message->add_birth_alpha_sq(birth);
     message->add_death_alpha_sq(death);
-    if (p.dimension == 0) {
-      message->add_creator_vertices(p.creator);
-      const std::array<uint32_t, 2> killer =
-          p.essential() ? std::array<uint32_t, 2>{kNoVertex, kNoVertex} : SortedEdge(family.edges()[p.killer]);
-      for (uint32_t v : killer) message->add_killer_vertices(v);
-    } else {
-      for (uint32_t v : SortedEdge(family.edges()[p.creator])) message->add_creator_vertices(v);
-      const std::array<uint32_t, 3> killer = p.essential() ? std::array<uint32_t, 3>{kNoVertex, kNoVertex, kNoVertex}
-                                                           : SortedTriangle(family.triangles()[p.killer]);
-      for (uint32_t v : killer) message->add_killer_vertices(v);
-    }
+    const PairVertices vertices = VerticesOf(family, p);
+    for (uint32_t i = 0; i <= p.dimension; ++i) message->add_creator_vertices(vertices.creator[i]);
+    for (uint32_t i = 0; i <= p.dimension + 1; ++i) message->add_killer_vertices(vertices.killer[i]);
   }
 
   std::shared_ptr<const CachedFamily> cached_;

@@ -1,6 +1,9 @@
 #include "core/family/persistence.hpp"
 
+#include <gmpxx.h>
+
 #include <algorithm>
+#include <cmath>
 #include <future>
 #include <limits>
 #include <numeric>
@@ -77,8 +80,33 @@ double RankValue(const AlphaFamily& family, uint32_t rank) {
   return family.spectrum()[rank - 1];
 }
 
+PairVertices VerticesOf(const AlphaFamily& family, const PersistencePair& pair) {
+  PairVertices out;
+  if (pair.dimension == 0) {
+    out.creator[0] = pair.creator;
+    if (!pair.essential()) {
+      const auto edge = SortedEdge(family.edges()[pair.killer]);
+      std::copy(edge.begin(), edge.end(), out.killer.begin());
+    }
+  } else {
+    out.creator = SortedEdge(family.edges()[pair.creator]);
+    if (!pair.essential()) out.killer = SortedTriangle(family.triangles()[pair.killer]);
+  }
+  return out;
+}
+
 bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence) {
-  return pair.essential() || RankValue(family, pair.death_rank) - RankValue(family, pair.birth_rank) >= min_persistence;
+  if (pair.essential()) return true;
+  const double birth = RankValue(family, pair.birth_rank), death = RankValue(family, pair.death_rank);
+  // The rounded difference is within half an ulp of the exact one, so a bound two doubles away or
+  // more is on the same side of both; only a bound at the difference or next to it needs the
+  // exact rationals.
+  const double difference = death - birth;
+  if (min_persistence != difference && min_persistence != std::nextafter(difference, -INFINITY) &&
+      min_persistence != std::nextafter(difference, INFINITY)) {
+    return difference > min_persistence;
+  }
+  return mpq_class(death) - mpq_class(birth) >= mpq_class(min_persistence);
 }
 
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family) {
@@ -108,7 +136,7 @@ std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const std
     const uint32_t oldest_a = forest.eldest(a), oldest_b = forest.eldest(b);
     const uint32_t young = oldest_a < oldest_b ? b : a, old = young == a ? b : a;
     const uint32_t death = EdgeBirthRank(r, e);
-    if (death > 0) pairs.push_back({0, 0, death, forest.eldest(young), e});
+    if (death > 0) pairs.push_back({0, 0, death, forest.eldest(young), death == kNeverRank ? kNoSimplex : e});
     forest.Join(a, b, forest.eldest(old));
   }
   for (uint32_t v = 0; v < num_points; ++v) {

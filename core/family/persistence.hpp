@@ -11,6 +11,7 @@
 // that fills the hole it made last (the elder rule again, in reverse). Semantics: docs/topology.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -56,8 +57,21 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
 /// The same, computing the canonical orders first.
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family);
 
+/// No vertex: the killer's vertices of an essential class, as answers write them.
+constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
+
+/// A pair's simplices as answers name them, by sorted vertices: the creator's dimension + 1 first
+/// entries of `creator` (H0: the vertex; H1: the edge), the killer's dimension + 2 first entries
+/// of `killer` (H0: the edge; H1: the triangle), kNoVertex when the class is essential.
+struct PairVertices {
+  std::array<uint32_t, 2> creator{kNoVertex, kNoVertex};
+  std::array<uint32_t, 3> killer{kNoVertex, kNoVertex, kNoVertex};
+};
+PairVertices VerticesOf(const AlphaFamily& family, const PersistencePair& pair);
+
 /// Whether `pair` is listed under a minimum persistence (alpha_sq units, on the published values:
-/// RankValue(death) - RankValue(birth) >= min_persistence, in double); essential classes always are.
+/// RankValue(death) - RankValue(birth) >= min_persistence, compared exactly); essential classes
+/// always are.
 bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence);
 
 /// The value of a rank as the family reports it: 0 for rank 0, the spectrum's nearest double for

@@ -2,10 +2,10 @@
 // shape with the holes below an area filled (what `alphactl holes` lists and what the Shape answer
 // drops on request: lakes smaller than a pond, pockets smaller than a probe).
 //
-// Areas are measured, not decided: the shoelace sum of the ring in doubles, taken about the ring's
-// first vertex so that large coordinate offsets cancel before the products. The topology (which
-// rings are holes, of which polygon) comes from AssembleShape's exact construction; only the
-// filter compares the measured area with the caller's bound.
+// Areas are exact: the shoelace sum of the ring in GMP rationals (every double is one), so the
+// order of the holes and the comparisons with the caller's bound never depend on rounding; the
+// area reported is the exact area's nearest double. The topology (which rings are holes, of which
+// polygon) comes from AssembleShape's exact construction.
 #pragma once
 
 #include <cstddef>
@@ -18,7 +18,8 @@
 
 namespace galpha {
 
-/// Area of a simple ring (either orientation), in squared input units.
+/// Area of a simple ring (either orientation), in squared input units: the nearest double of the
+/// exact area.
 double RingArea(absl::Span<const uint32_t> ring, absl::Span<const Point2> points);
 
 /// One hole: the polygon it belongs to (an index into ShapeGeometry::polygons), its ring (as
@@ -29,12 +30,12 @@ struct ShapeHole {
   double area = 0.0;
 };
 
-/// Every hole of `shape` with an area of at least `min_area`, largest area first (then by polygon
-/// and ring order).
+/// Every hole of `shape` whose exact area is at least `min_area`, largest exact area first (then
+/// by polygon and ring order).
 std::vector<ShapeHole> ListHoles(const ShapeGeometry& shape, absl::Span<const Point2> points, double min_area);
 
-/// Fills every hole whose area is below `min_area`: the ring leaves its polygon and its area joins
-/// the shape's. Returns how many holes were filled.
+/// Fills every hole whose exact area is below `min_area`: the ring leaves its polygon and its area
+/// (RingArea's double) joins the shape's. Returns how many holes were filled.
 size_t FillHolesSmallerThan(ShapeGeometry* shape, absl::Span<const Point2> points, double min_area);
 
 }  // namespace galpha

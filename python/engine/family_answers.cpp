@@ -36,8 +36,6 @@ void KeepNonExterior(const std::vector<SimplexClass>& classes, const std::vector
   }
 }
 
-constexpr uint32_t kNoVertex = 0xFFFFFFFFu;
-
 // One pair as server/persistence_answers.cpp's PersistenceSource lists it.
 void AppendPair(const AlphaFamily& family, const PersistencePair& p, double birth, double death,
                 PersistencePairs* out) {
@@ -45,18 +43,11 @@ void AppendPair(const AlphaFamily& family, const PersistencePair& p, double birt
   out->death_rank.push_back(p.essential() ? -1 : static_cast<int64_t>(p.death_rank));
   out->birth_alpha_sq.push_back(birth);
   out->death_alpha_sq.push_back(death);
-  if (p.dimension == 0) {
-    out->creator_vertices.push_back(p.creator);
-    const std::array<uint32_t, 2> killer =
-        p.essential() ? std::array<uint32_t, 2>{kNoVertex, kNoVertex} : SortedEdge(family.edges()[p.killer]);
-    out->killer_vertices.insert(out->killer_vertices.end(), killer.begin(), killer.end());
-  } else {
-    const std::array<uint32_t, 2> creator = SortedEdge(family.edges()[p.creator]);
-    out->creator_vertices.insert(out->creator_vertices.end(), creator.begin(), creator.end());
-    const std::array<uint32_t, 3> killer = p.essential() ? std::array<uint32_t, 3>{kNoVertex, kNoVertex, kNoVertex}
-                                                         : SortedTriangle(family.triangles()[p.killer]);
-    out->killer_vertices.insert(out->killer_vertices.end(), killer.begin(), killer.end());
-  }
+  const PairVertices vertices = VerticesOf(family, p);
+  out->creator_vertices.insert(out->creator_vertices.end(), vertices.creator.begin(),
+                               vertices.creator.begin() + p.dimension + 1);
+  out->killer_vertices.insert(out->killer_vertices.end(), vertices.killer.begin(),
+                              vertices.killer.begin() + p.dimension + 2);
 }
 
 }  // namespace

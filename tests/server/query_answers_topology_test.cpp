@@ -2,6 +2,8 @@
 // in-process family and its diagram (core/family/persistence.hpp): every pair once, in order, with
 // its simplices named by sorted vertices, chunked, filtered by dimension and minimum persistence;
 // bad requests refused.
+#include <gmpxx.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -175,17 +177,24 @@ TEST(QueryAnswersTopologyTest, PersistenceFiltersByDimensionAndPersistence) {
   request.set_min_persistence(median);
   auto source = MakePersistenceSource(cached, request);
   ASSERT_THAT(source, IsOk());
+  // The bound is compared with the exact difference of the published values.
+  auto exact_length = [](double birth, double death) -> mpq_class { return mpq_class(death) - mpq_class(birth); };
   size_t listed = 0;
   for (const v1::PersistenceResponse& m : Drain(**source)) {
     ASSERT_EQ(m.dimension(), 1u);
     for (int i = 0; i < m.birth_rank_size(); ++i) {
-      ASSERT_GE(m.death_alpha_sq(i) - m.birth_alpha_sq(i), median);
+      ASSERT_GE(exact_length(m.birth_alpha_sq(i), m.death_alpha_sq(i)), mpq_class(median));
       ++listed;
     }
   }
-  const size_t expected =
-      static_cast<size_t>(std::count_if(lengths.begin(), lengths.end(), [&](double l) { return l >= median; }));
+  size_t expected = 0;
+  for (size_t i = diagram->dimension_begin[1]; i < diagram->dimension_begin[2]; ++i) {
+    const PersistencePair& p = diagram->pairs[i];
+    expected += exact_length(RankValue(family, p.birth_rank), RankValue(family, p.death_rank)) >= mpq_class(median);
+  }
   EXPECT_EQ(listed, expected);
+  EXPECT_GT(expected, 0u);
+  EXPECT_LT(expected, lengths.size());
 
   // Dimension 0 alone: every H0 pair, the essential one included, whatever the bound.
   v1::PersistenceRequest h0;

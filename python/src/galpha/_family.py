@@ -9,6 +9,7 @@ points' CRS.
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 from typing import Any, Iterable, List, Optional, Tuple, Union
 
 import numpy as np
@@ -153,33 +154,37 @@ def area_argument(name: str, value: Any, zero_means: str) -> float:
     return area
 
 
+def exact_ring_area(ring: np.ndarray, points: np.ndarray) -> Fraction:
+    """The exact area of a ring of input indices (every double is a rational): half the absolute
+    value of the shoelace sum, as core/geometry/shape_holes.cpp computes it in GMP rationals."""
+    xy = [(Fraction(float(x)), Fraction(float(y))) for x, y in points[ring]]
+    twice = sum(
+        (a[0] * b[1] - b[0] * a[1] for a, b in zip(xy, xy[1:] + xy[:1])),
+        Fraction(0),
+    )
+    return abs(twice) / 2
+
+
 def ring_area(ring: np.ndarray, points: np.ndarray) -> float:
-    """The area of a simple ring of input indices, computed as the C++ core's RingArea
-    (core/geometry/shape_holes.cpp) computes it, to the same double: the shoelace terms about the
-    ring's first vertex, summed one after another (np.add.accumulate is sequential; np.sum's
-    pairwise sum would round differently), half the absolute value."""
-    if len(ring) < 3:
-        return 0.0
-    xy = points[ring]
-    a = xy[1:-1] - xy[0]
-    b = xy[2:] - xy[0]
-    terms = a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1]
-    return 0.5 * abs(float(np.add.accumulate(terms)[-1]))
+    """The area of a ring as core's RingArea reports it: the exact area's nearest double (Python's
+    float() of a Fraction rounds correctly)."""
+    return float(exact_ring_area(ring, points))
 
 
 def holes_from_rings(rings: ShapeRings, points: np.ndarray, min_area: float) -> List[Hole]:
     """The holes of a (regularized) shape by rings, as core's ListHoles lists them: every hole ring
-    whose area is at least min_area, largest first (a stable sort: equal areas keep polygon, then
-    ring order), each ring reversed to counter-clockwise. Areas are measured on the rings as they
-    arrive (clockwise), as core measures them."""
-    holes: List[Hole] = []
+    whose exact area is at least min_area, largest exact area first (a stable sort: equal areas
+    keep polygon, then ring order), each ring reversed to counter-clockwise."""
+    bound = Fraction(min_area)
+    found = []
     for index, polygon in enumerate(rings.polygons):
         for ring in polygon.holes:
-            area = ring_area(ring, points)
-            if area >= min_area:
-                holes.append(Hole(polygon=index, ring=np.ascontiguousarray(ring[::-1], dtype=np.uint32), area=area))
-    holes.sort(key=lambda h: -h.area)
-    return holes
+            area = exact_ring_area(ring, points)
+            if area >= bound:
+                hole = Hole(polygon=index, ring=np.ascontiguousarray(ring[::-1], dtype=np.uint32), area=float(area))
+                found.append((area, hole))
+    found.sort(key=lambda item: -item[0])
+    return [hole for _, hole in found]
 
 
 def holes_geodataframe(holes: List[Hole], points: np.ndarray, crs: Any) -> Any:
