@@ -119,7 +119,7 @@ namespace {
 /// H0: every distinct point is born at rank 0; an edge joining two components kills the one whose
 /// oldest vertex (lowest index: vertices of one rank are ordered by index) comes later. An edge
 /// inside one component closes a loop (it creates an H1 class): marked in `closes_loop`. Pairs in
-/// Kruskal's order (death ascending), the essential classes last by vertex.
+/// Kruskal's order (death ascending), then the essential classes (ordered by the caller).
 std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const std::vector<uint32_t>& edges_in_order,
                                             std::vector<uint8_t>* closes_loop) {
   const AlphaRanks& r = family.ranks();
@@ -140,7 +140,11 @@ std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const std
     forest.Join(a, b, forest.eldest(old));
   }
   for (uint32_t v = 0; v < num_points; ++v) {
-    if (family.representative()[v] == v && forest.Find(v) == v) pairs.push_back({0, 0, kNeverRank, v, kNoSimplex});
+    // One essential class a component, created by its oldest vertex (not its root: the forest
+    // joins by size).
+    if (family.representative()[v] == v && forest.Find(v) == v) {
+      pairs.push_back({0, 0, kNeverRank, forest.eldest(v), kNoSimplex});
+    }
   }
   return pairs;
 }
@@ -218,9 +222,9 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
   }
 
   // The order: dimension, birth, death (kNeverRank sorts last), creator's canonical position. H0
-  // pairs came in Kruskal's order (birth 0, death ascending; the essential classes last, by
-  // vertex); H1 pairs in reverse filtration order of their creators (birth descending): reversed,
-  // only runs of equal birth remain to be ordered.
+  // pairs came in Kruskal's order (birth 0, death ascending; the essential classes last); H1 pairs
+  // in reverse filtration order of their creators (birth descending): reversed, only runs of equal
+  // ranks remain to be ordered.
   PersistenceDiagram diagram;
   std::vector<PersistencePair>& pairs = diagram.pairs;
   pairs = std::move(components);

@@ -258,6 +258,7 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
         << "level " << level;
   }
   ExpectPersistenceMatchesCurves(f);
+  ExpectPairsMatchMatrixReduction(f);
 
   // Optimal levels, by their definitions in core/family/alpha_family.hpp, over all levels 0..K.
   std::optional<int64_t> solid;
