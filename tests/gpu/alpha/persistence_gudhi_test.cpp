@@ -153,6 +153,7 @@ TEST_P(PersistenceGudhiTest, DegenerateSets) {
   ExpectSameAsGudhi(holed, "grid with every third point removed");
   // Collinear points: a chain, no triangles; no holes.
   std::vector<Point2> line;
+  line.reserve(200);
   for (int i = 0; i < 200; ++i) line.push_back({0.5 * i, 0.25 * i});
   ExpectSameAsGudhi(line, "collinear");
   // A ring of random points in an annulus around an empty disk of radius 10: one hole lives from
