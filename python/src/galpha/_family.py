@@ -365,10 +365,10 @@ class Family:
         min_area: float = 0.0,
         as_geodataframe: bool = False,
     ) -> Any:
-        """The holes of the regularized shape at one threshold with an area of at least
+        """The holes of the regularized shape at one threshold with an exact area of at least
         ``min_area`` (squared input units), largest first, as ``alphactl holes`` lists them: a list
-        of :class:`Hole` (polygon index, counter-clockwise open ring of input indices, area measured
-        as the C++ core measures it). With ``as_geodataframe=True``: a GeoDataFrame with columns
+        of :class:`Hole` (polygon index, counter-clockwise open ring of input indices, the exact
+        area's nearest double). With ``as_geodataframe=True``: a GeoDataFrame with columns
         ``polygon``, ``area`` and each hole as a shapely Polygon, in the points' CRS.
 
         The local engine lists them in C++; the network client asks the server for the shape's

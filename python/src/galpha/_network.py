@@ -480,7 +480,7 @@ class NetworkFamilyBackend:
         return shape_rings_from(self._stream(self._calls.shape, request))
 
     def holes(self, threshold: Threshold, min_area: float, points: np.ndarray) -> List[Hole]:
-        # The server sends the rings; their areas are measured here, as alphactl --server does.
+        # The server sends the rings; their exact areas are computed here, as alphactl --server does.
         return holes_from_rings(self.shape_rings(threshold, Mode.REGULARIZED), points, min_area)
 
     def master_list(self, first_rank: int, last_rank: int) -> MasterList:

@@ -172,10 +172,10 @@ class Hole:
 
     ``ring`` runs counter-clockwise (the hole's boundary as a polygon of its own: the reverse of
     the clockwise hole ring of :class:`ShapePolygon`) and is not closed (its first vertex is not
-    repeated, like every ring of :class:`ShapeRings`; alphactl prints it closed). ``area`` is
-    measured as the C++ core measures it (core/geometry/shape_holes.hpp's RingArea: the shoelace
-    sum of the clockwise ring in doubles about that ring's first vertex), so it is the same double
-    on both clients and in alphactl."""
+    repeated, like every ring of :class:`ShapeRings`; alphactl prints it closed). ``area`` is the
+    double nearest to the exact area (core/geometry/shape_holes.hpp's RingArea: the shoelace sum in
+    rationals), the same on both clients and in alphactl; the holes' order and the ``min_area``
+    comparisons use the exact areas."""
 
     polygon: int  #: index of the polygon it belongs to, in ``shape_rings(...).polygons`` (regularized)
     ring: np.ndarray  #: (n,) uint32 input indices, counter-clockwise, open

@@ -172,7 +172,7 @@ class AsyncFamily:
         as_geodataframe: bool = False,
     ) -> Any:
         """The holes of the regularized shape at one threshold, as :meth:`galpha.Family.holes`
-        (the rings from the server, measured here from ``points``)."""
+        (the rings from the server, their exact areas computed here from ``points``)."""
         threshold = threshold_from(alpha, alpha_sq, rank)
         minimum = area_argument("min_area", min_area, "every hole")
         request = _network.shape_request(self.handle, threshold, Mode.REGULARIZED, 0.0)
