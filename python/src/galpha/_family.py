@@ -130,7 +130,7 @@ def persistence_arguments(dimensions: Union[int, Iterable[int]], min_persistence
     except (TypeError, ValueError):
         raise InvalidInput(f"min_persistence must be a number, got {min_persistence!r}") from None
     if math.isnan(minimum) or minimum < 0:
-        raise InvalidInput(f"min_persistence {minimum} is not a length: give 0 or more")
+        raise InvalidInput(f"min_persistence {c_double_text(minimum)} is not a length: give 0 or more")
     return tuple(sorted({int(d) for d in asked})), minimum
 
 
