@@ -2,22 +2,33 @@
 // clients over TCP): the cost of the transport against the in-process engine, the streaming rate
 // of Classify, build throughput with N concurrent clients, and query latency percentiles under
 // concurrent load. CGAL's Alpha_shape_2 (exact constructions) on the same points, in the same run,
-// is the competitor's reference.
+// is the competitor's reference. With --links naming tc rates (root only), the build and Classify
+// are also measured over a veth pair between two network namespaces shaped to each rate.
 //
 //   service_bench [--backend=auto|cpu|cuda] [--points=N] [--clients=1,2,4,8] [--repeat=R]
 //                 [--query-seconds=S] [--query-clients=Q] [--build-slots=K] [--cgal-max=N]
+//                 [--links=loopback,1gbit,10gbit]
 #include <CGAL/Alpha_shape_2.h>
 #include <CGAL/Alpha_shape_face_base_2.h>
 #include <CGAL/Alpha_shape_vertex_base_2.h>
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <fcntl.h>
 #include <grpcpp/grpcpp.h>
+#include <sched.h>
+#include <spawn.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <memory>
@@ -26,7 +37,9 @@
 #include <thread>
 #include <vector>
 
+#include "absl/status/statusor.h"
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "client/galpha_client.hpp"
 #include "core/io/point_set_handle.hpp"
@@ -49,7 +62,19 @@ struct Options {
   int query_clients = 8;
   int build_slots = 0;
   size_t cgal_max = 1000000;
+  /// "loopback" and tc rates ("1gbit", "10gbit", "100mbit"): the links Build and Classify cross.
+  std::vector<std::string> links = {"loopback"};
 };
+
+/// A tc rate "<digits><kbit|mbit|gbit>" in bits per second; 0 when it is not one.
+double RateBits(const std::string& rate) {
+  const size_t unit = rate.find_first_not_of("0123456789");
+  double value = 0;
+  if (unit == 0 || unit == std::string::npos || !absl::SimpleAtod(rate.substr(0, unit), &value)) return 0;
+  const std::string suffix = rate.substr(unit);
+  const double scale = suffix == "kbit" ? 1e3 : suffix == "mbit" ? 1e6 : suffix == "gbit" ? 1e9 : 0;
+  return value * scale;
+}
 
 double SecondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
@@ -81,6 +106,9 @@ bool ParseOptions(int argc, char** argv, Options* options) {
       ok = absl::SimpleAtoi(value, &options->build_slots);
     } else if (name == "--cgal-max") {
       ok = absl::SimpleAtoi(value, &options->cgal_max);
+    } else if (name == "--links") {
+      options->links = absl::StrSplit(value, ',');
+      for (const std::string& link : options->links) ok = ok && (link == "loopback" || RateBits(link) > 0);
     } else {
       ok = false;
     }
@@ -91,6 +119,175 @@ bool ParseOptions(int argc, char** argv, Options* options) {
   }
   return true;
 }
+
+server::ServerOptions BenchServerOptions(const Options& options, const std::string& listen_address) {
+  server::ServerOptions server_options;
+  server_options.listen_address = listen_address;
+  server_options.metrics_address = "";
+  server_options.service.backend = options.backend;
+  server_options.service.build_slots = options.build_slots;
+  server_options.service.max_queued_builds = 256;
+  server_options.service.cache_bytes = size_t{64} << 30;
+  server_options.service.max_in_flight_bytes = size_t{64} << 30;
+  // The bench's clients are one anonymous tenant: its share must not be what limits them.
+  server_options.service.max_tenant_queued_builds = 256;
+  server_options.service.max_tenant_in_flight_bytes = size_t{64} << 30;
+  server_options.drain_notice = std::chrono::milliseconds(0);
+  return server_options;
+}
+
+/// Runs a command (no shell) and waits; true when it exits 0. posix_spawn rather than fork, so
+/// that gRPC's threads and fork handlers are not involved; `quiet` sends its output to /dev/null.
+bool RunCommand(const std::vector<std::string>& args, bool quiet = false) {
+  std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
+  for (const std::string& arg : args) argv.push_back(const_cast<char*>(arg.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  if (quiet) {
+    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  }
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return false;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+/// Two network namespaces joined by a veth pair, shaped with tc: this process moves to a new
+/// namespace (the client's side, 10.77.0.1) and a forked child serves from another (10.77.0.2).
+/// Both namespaces are anonymous, so they vanish with their last process: no exit path (an error,
+/// a signal, SIGKILL) leaves one behind. Create() must run before the process starts a thread.
+class VethLink {
+ public:
+  static constexpr const char* kClientAddress = "10.77.0.1";
+  static constexpr const char* kServerAddress = "10.77.0.2";
+
+  /// Why shaped links cannot be measured here (not root, `ip`/`tc`/`nsenter` missing), or "".
+  static std::string Unavailable() {
+    if (geteuid() != 0) return "shaped links need root (network namespaces, veth, tc)";
+    for (const char* tool : {"ip", "tc", "nsenter"}) {
+      if (!RunCommand({tool, "-V"}, true) && !RunCommand({tool, "--version"}, true)) {
+        return absl::StrCat("shaped links need `", tool, "`, which is not on PATH");
+      }
+    }
+    return "";
+  }
+
+  static absl::StatusOr<std::unique_ptr<VethLink>> Create(const server::ServerOptions& server_options) {
+    if (unshare(CLONE_NEWNET) != 0) return absl::InternalError(absl::StrCat("unshare: ", std::strerror(errno)));
+    // The in-process loopback server lives in the new namespace too: its loopback must be up.
+    if (!RunCommand({"ip", "link", "set", "lo", "up"})) return absl::InternalError("ip link set lo up failed");
+    std::unique_ptr<VethLink> link(new VethLink);
+    int up[2], down[2];
+    if (pipe(up) != 0 || pipe(down) != 0) return absl::InternalError("pipe failed");
+    std::fflush(stdout);
+    link->child_ = fork();
+    if (link->child_ < 0) return absl::InternalError(absl::StrCat("fork: ", std::strerror(errno)));
+    if (link->child_ == 0) {
+      close(up[0]);
+      close(down[1]);
+      _exit(ServeInChild(server_options, up[1], down[0]));
+    }
+    close(up[1]);
+    close(down[0]);
+    link->to_child_ = down[1];
+    link->from_child_ = up[0];
+    char ready = 0;
+    if (read(link->from_child_, &ready, 1) != 1) return absl::InternalError("the server's child did not start");
+    const std::string pid = std::to_string(link->child_);
+    const bool configured =
+        RunCommand({"ip", "link", "add", "galpha-c", "type", "veth", "peer", "name", "galpha-s", "netns", pid}) &&
+        RunCommand({"ip", "addr", "add", absl::StrCat(kClientAddress, "/24"), "dev", "galpha-c"}) &&
+        RunCommand({"ip", "link", "set", "galpha-c", "up"}) &&
+        RunCommand(link->InChild({"ip", "link", "set", "lo", "up"})) &&
+        RunCommand(link->InChild({"ip", "addr", "add", absl::StrCat(kServerAddress, "/24"), "dev", "galpha-s"})) &&
+        RunCommand(link->InChild({"ip", "link", "set", "galpha-s", "up"}));
+    if (!configured) return absl::InternalError("configuring the veth pair failed (see ip's message above)");
+    // Some kernels (this build machine's) lack sch_netem: then the rate is shaped, the RTT is not.
+    link->netem_ = RunCommand({"tc", "qdisc", "add", "dev", "galpha-c", "root", "netem", "delay", "500us"}, true);
+    if (link->netem_) RunCommand({"tc", "qdisc", "del", "dev", "galpha-c", "root"}, true);
+    if (write(link->to_child_, "g", 1) != 1 ||
+        read(link->from_child_, &link->port_, sizeof link->port_) != static_cast<ssize_t>(sizeof link->port_) ||
+        link->port_ <= 0) {
+      return absl::InternalError("the server in the other namespace did not start");
+    }
+    return link;
+  }
+
+  VethLink(const VethLink&) = delete;
+  VethLink& operator=(const VethLink&) = delete;
+
+  /// Closing the pipe tells the child to drain and exit.
+  ~VethLink() {
+    if (to_child_ >= 0) close(to_child_);
+    if (from_child_ >= 0) close(from_child_);
+    if (child_ > 0) waitpid(child_, nullptr, 0);
+  }
+
+  /// Shapes both directions to `rate` with tbf (a burst of 1 ms at the rate, at least 64 KiB), under
+  /// a netem delay of 0.5 ms each way (1 ms RTT) where the kernel has netem.
+  absl::Status Shape(const std::string& rate) {
+    const auto burst = static_cast<uint64_t>(std::max(65536.0, RateBits(rate) / 8 / 1000));
+    for (const bool server_side : {false, true}) {
+      const std::string dev = server_side ? "galpha-s" : "galpha-c";
+      auto tc = [&](std::vector<std::string> args, bool quiet = false) {
+        args.insert(args.begin(), "tc");
+        return RunCommand(server_side ? InChild(args) : args, quiet);
+      };
+      tc({"qdisc", "del", "dev", dev, "root"}, true);  // the previous link's shaping, if any
+      const std::string burst_bytes = std::to_string(burst);
+      const bool shaped =
+          netem_
+              ? tc({"qdisc", "add", "dev", dev, "root", "handle", "1:", "netem", "delay", "500us", "limit",
+                    "100000"}) &&
+                    tc({"qdisc", "add", "dev", dev, "parent", "1:1", "handle", "10:", "tbf", "rate", rate, "burst",
+                        burst_bytes, "latency", "50ms"})
+              : tc({"qdisc", "add", "dev", dev, "root", "tbf", "rate", rate, "burst", burst_bytes, "latency", "50ms"});
+      if (!shaped) return absl::InternalError(absl::StrCat("tc could not shape ", dev, " to ", rate));
+    }
+    return absl::OkStatus();
+  }
+
+  bool rtt_emulated() const { return netem_; }
+  std::string target() const { return absl::StrCat(kServerAddress, ":", port_); }
+
+ private:
+  VethLink() = default;
+
+  /// The command, run in the child's namespace.
+  std::vector<std::string> InChild(std::vector<std::string> args) const {
+    args.insert(args.begin(), {"nsenter", absl::StrCat("--net=/proc/", child_, "/ns/net")});
+    return args;
+  }
+
+  /// The child: a namespace of its own, then (once the parent has joined it to the veth pair) a
+  /// server on kServerAddress until the parent closes the pipe or dies.
+  static int ServeInChild(server::ServerOptions options, int up, int down) {
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (unshare(CLONE_NEWNET) != 0 || write(up, "r", 1) != 1) return 1;
+    char go = 0;
+    if (read(down, &go, 1) != 1) return 1;
+    options.listen_address = absl::StrCat(kServerAddress, ":0");
+    auto server = server::GalphaServer::Start(options);
+    const int port = server.ok() ? (*server)->port() : -1;
+    if (!server.ok())
+      std::fprintf(stderr, "service_bench (server side): %s\n", std::string(server.status().message()).c_str());
+    if (write(up, &port, sizeof port) != static_cast<ssize_t>(sizeof port) || !server.ok()) return 1;
+    while (read(down, &go, 1) > 0) {}
+    (*server)->Drain();
+    return 0;
+  }
+
+  pid_t child_ = -1;
+  int to_child_ = -1, from_child_ = -1;
+  int port_ = 0;
+  bool netem_ = false;
+};
 
 double CgalSeconds(const std::vector<Point2>& points) {
   using Kernel = CGAL::Exact_predicates_exact_constructions_kernel;
@@ -113,14 +310,16 @@ double Percentile(std::vector<double> values, double q) {
   return values[std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())))];
 }
 
-std::unique_ptr<client::AlphaClient> Client(int port) {
+std::unique_ptr<client::AlphaClient> Client(const std::string& target) {
   client::ClientOptions options;
-  options.target = "127.0.0.1:" + std::to_string(port);
+  options.target = target;
   return *client::AlphaClient::Connect(options);
 }
 
+std::unique_ptr<client::AlphaClient> Client(int port) { return Client("127.0.0.1:" + std::to_string(port)); }
+
 /// Releases, then uploads and builds `points`; the RPC's wall time.
-double TimedBuild(client::AlphaClient& client, const std::vector<Point2>& points, v1::BuildSummary* summary) {
+double TimedBuild(client::AlphaClient& client, const std::vector<Point2>& points, client::BuildResult* result) {
   if (auto released = client.Release(PointSetHandle(points)); !released.ok()) {
     std::fprintf(stderr, "release failed: %s\n", std::string(released.status().message()).c_str());
     std::exit(1);
@@ -134,24 +333,78 @@ double TimedBuild(client::AlphaClient& client, const std::vector<Point2>& points
     std::fprintf(stderr, "build failed: %s\n", std::string(built.status().message()).c_str());
     std::exit(1);
   }
-  if (summary != nullptr) *summary = built->summary;
+  if (result != nullptr) *result = *built;
   return seconds;
 }
 
+/// One build and one Classify of every simplex at rank K/2, over one link (best of `repeat`).
+struct LinkMeasure {
+  double build_seconds = 1e30, server_stage_seconds = 1e30, classify_seconds = 1e30;
+  uint64_t bytes_up = 0, bytes_down = 0, simplices = 0;
+  int64_t spectrum_size = 0;
+};
+
+LinkMeasure MeasureLink(client::AlphaClient& client, const std::vector<Point2>& points, int repeat) {
+  LinkMeasure m;
+  for (int r = 0; r < repeat; ++r) {
+    client::BuildResult built;
+    m.build_seconds = std::min(m.build_seconds, TimedBuild(client, points, &built));
+    m.bytes_up = built.upload_bytes;
+    double stages = 0;
+    for (const auto& s : built.summary.stage_times()) stages += s.seconds();
+    m.server_stage_seconds = std::min(m.server_stage_seconds, stages);
+  }
+  const std::string handle = PointSetHandle(points);
+  v1::SpectrumRequest size_request;
+  size_request.set_handle(handle);
+  size_request.set_page_size(1);
+  m.spectrum_size = client.Spectrum(size_request)->spectrum_size();
+  v1::ClassifyRequest classify;
+  classify.set_handle(handle);
+  classify.mutable_threshold()->set_rank(m.spectrum_size / 2);
+  for (int r = 0; r < repeat; ++r) {
+    m.bytes_down = m.simplices = 0;
+    const auto start = Clock::now();
+    absl::Status status = client.Classify(classify, [&](const v1::ClassifyResponse& message) {
+      m.bytes_down += message.ByteSizeLong();
+      m.simplices += message.chunk().classes().size();
+      return absl::OkStatus();
+    });
+    m.classify_seconds = std::min(m.classify_seconds, SecondsSince(start));
+    if (!status.ok()) {
+      std::fprintf(stderr, "classify failed: %s\n", std::string(status.message()).c_str());
+      std::exit(1);
+    }
+  }
+  return m;
+}
+
+double Megabytes(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
+
 int Run(const Options& options) {
-  server::ServerOptions server_options;
-  server_options.listen_address = "127.0.0.1:0";
-  server_options.metrics_address = "";
-  server_options.service.backend = options.backend;
-  server_options.service.build_slots = options.build_slots;
-  server_options.service.max_queued_builds = 256;
-  server_options.service.cache_bytes = size_t{64} << 30;
-  server_options.service.max_in_flight_bytes = size_t{64} << 30;
-  // The bench's clients are one anonymous tenant: its share must not be what limits them.
-  server_options.service.max_tenant_queued_builds = 256;
-  server_options.service.max_tenant_in_flight_bytes = size_t{64} << 30;
-  server_options.drain_notice = std::chrono::milliseconds(0);
-  auto server = server::GalphaServer::Start(server_options);
+  // Shaped links first: the namespaces must exist before this process starts any thread.
+  std::vector<std::string> links;
+  std::unique_ptr<VethLink> veth;
+  const bool wants_shaped = std::any_of(options.links.begin(), options.links.end(),
+                                        [](const std::string& link) { return link != "loopback"; });
+  if (wants_shaped) {
+    std::string why = VethLink::Unavailable();
+    if (why.empty()) {
+      auto created = VethLink::Create(BenchServerOptions(options, ""));
+      if (created.ok()) {
+        veth = *std::move(created);
+      } else {
+        why = std::string(created.status().message());
+      }
+    }
+    if (!why.empty()) std::fprintf(stderr, "service_bench: %s; measuring loopback only\n", why.c_str());
+  }
+  for (const std::string& link : options.links) {
+    if (link == "loopback" || veth != nullptr) links.push_back(link);
+  }
+  if (std::find(links.begin(), links.end(), "loopback") == links.end()) links.insert(links.begin(), "loopback");
+
+  auto server = server::GalphaServer::Start(BenchServerOptions(options, "127.0.0.1:0"));
   if (!server.ok()) {
     std::fprintf(stderr, "service_bench: %s\n", std::string(server.status().message()).c_str());
     return 1;
@@ -164,8 +417,8 @@ int Run(const Options& options) {
   auto client = Client(port);
   const std::vector<Point2> points = gen::Uniform(options.points, 1);
 
-  // 1. One build: in-process engine, the same through gRPC, CGAL.
-  double engine = 1e30, rpc = 1e30, server_engine = 1e30;
+  // 1. One build: in-process engine, the same through gRPC over each link, CGAL.
+  double engine = 1e30;
   for (int r = 0; r < options.repeat; ++r) {
     BuildOptions build;
     build.backend = options.backend;
@@ -173,45 +426,49 @@ int Run(const Options& options) {
     auto family = BuildAlphaFamily(points, build);
     engine = std::min(engine, SecondsSince(start));
     if (!family.ok()) return 1;
-    v1::BuildSummary summary;
-    rpc = std::min(rpc, TimedBuild(*client, points, &summary));
-    double stages = 0;
-    for (const auto& s : summary.stage_times()) stages += s.seconds();
-    server_engine = std::min(server_engine, stages);
+  }
+  std::map<std::string, LinkMeasure> measured;
+  for (const std::string& link : links) {
+    if (link == "loopback") {
+      measured[link] = MeasureLink(*client, points, options.repeat);
+      continue;
+    }
+    if (absl::Status shaped = veth->Shape(link); !shaped.ok()) {
+      std::fprintf(stderr, "service_bench: %s\n", std::string(shaped.message()).c_str());
+      return 1;
+    }
+    measured[link] = MeasureLink(*Client(veth->target()), points, options.repeat);
   }
   const double cgal = options.points <= options.cgal_max ? CgalSeconds(points) : -1;
-  std::printf("| one build of %zu points | ms | vs in-process |\n|---|---:|---:|\n", options.points);
-  std::printf("| in-process BuildAlphaFamily (wall) | %.1f | 1.00 |\n", engine * 1e3);
-  std::printf("| Build RPC over loopback (upload + build + answer) | %.1f | %.2f |\n", rpc * 1e3, rpc / engine);
-  std::printf("| of which the server's stage times | %.1f | |\n", server_engine * 1e3);
-  if (cgal >= 0) std::printf("| CGAL Alpha_shape_2 EPEC, 1 thread | %.1f | %.2f |\n", cgal * 1e3, cgal / engine);
+  std::printf(
+      "| one build of %zu points; Classify of every simplex at rank K/2 | bytes up | bytes down | build ms | build vs "
+      "in-process | Classify ms |\n|---|---:|---:|---:|---:|---:|\n",
+      options.points);
+  std::printf("| in-process BuildAlphaFamily (wall) | | | %.1f | 1.00 | |\n", engine * 1e3);
+  for (const std::string& link : links) {
+    const LinkMeasure& m = measured[link];
+    const std::string name =
+        link == "loopback" ? "Build RPC over loopback (upload + build + answer)"
+                           : absl::StrCat("Build RPC over a veth pair, tbf ", link, " both ways, ",
+                                          veth->rtt_emulated() ? "netem 1 ms RTT" : "RTT not emulated (no netem)");
+    std::printf("| %s | %.2f MB | %.2f MB | %.1f | %.2f | %.1f |\n", name.c_str(), Megabytes(m.bytes_up),
+                Megabytes(m.bytes_down), m.build_seconds * 1e3, m.build_seconds / engine, m.classify_seconds * 1e3);
+    if (link == "loopback") {
+      std::printf("| of which the server's stage times | | | %.1f | | |\n", m.server_stage_seconds * 1e3);
+    }
+  }
+  if (cgal >= 0) std::printf("| CGAL Alpha_shape_2 EPEC, 1 thread | | | %.1f | %.2f | |\n", cgal * 1e3, cgal / engine);
   std::printf("\n");
 
-  // 2. Classify streaming rate: every simplex at the middle rank.
+  // 2. Classify streaming rate over loopback: every simplex at the middle rank.
+  const LinkMeasure& loopback = measured["loopback"];
   const std::string handle = PointSetHandle(points);
-  v1::SpectrumRequest size_request;
-  size_request.set_handle(handle);
-  size_request.set_page_size(1);
-  const int64_t k = client->Spectrum(size_request)->spectrum_size();
-  v1::ClassifyRequest classify;
-  classify.set_handle(handle);
-  classify.mutable_threshold()->set_rank(k / 2);
-  double classify_seconds = 1e30;
-  size_t bytes = 0, simplices = 0;
-  for (int r = 0; r < options.repeat; ++r) {
-    bytes = simplices = 0;
-    const auto start = Clock::now();
-    absl::Status status = client->Classify(classify, [&](const v1::ClassifyResponse& message) {
-      bytes += message.ByteSizeLong();
-      simplices += message.chunk().classes().size();
-      return absl::OkStatus();
-    });
-    classify_seconds = std::min(classify_seconds, SecondsSince(start));
-    if (!status.ok()) return 1;
-  }
+  const int64_t k = loopback.spectrum_size;
   std::printf("| Classify, all simplices at rank K/2 | value |\n|---|---:|\n");
   std::printf("| simplices | %zu |\n| bytes on the wire (messages) | %zu |\n| ms | %.1f |\n| GB/s | %.2f |\n\n",
-              simplices, bytes, classify_seconds * 1e3, static_cast<double>(bytes) / classify_seconds / 1e9);
+              static_cast<size_t>(loopback.simplices), static_cast<size_t>(loopback.bytes_down),
+              loopback.classify_seconds * 1e3,
+              static_cast<double>(loopback.bytes_down) / loopback.classify_seconds / 1e9);
 
   // 3. Concurrent builds of distinct point sets.
   std::printf(
