@@ -17,9 +17,9 @@ libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthre
 clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
   proto/codec/point_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
   $(pkg-config --libs libzstd)
-clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp \
-  -o "$out/point_formats_fuzzer" "${libs[@]}"
-clang++ "${flags[@]}" tests/fuzz/predicates_fuzzer.cpp core/io/input_validation.cpp \
+clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp core/io/las_reader.cpp \
+  -o "$out/point_formats_fuzzer" "${libs[@]}" $(pkg-config --libs absl_str_format)
+clang++ "${flags[@]}" tests/fuzz/predicates_fuzzer.cpp core/io/input_validation.cpp core/io/number_text.cpp \
   -o "$out/predicates_fuzzer" "${libs[@]}" $(pkg-config --libs absl_str_format) -lgmpxx -lgmp
 
 for target in build_stream_fuzzer point_formats_fuzzer predicates_fuzzer; do
