@@ -7,7 +7,6 @@
 #include "absl/strings/str_cat.h"
 #include "client/text_output.hpp"
 #include "core/io/json_text.hpp"
-#include "core/io/number_text.hpp"
 
 namespace galpha::alphactl {
 namespace {

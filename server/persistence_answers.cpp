@@ -7,7 +7,6 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
-#include "core/family/canonical_order.hpp"
 #include "core/family/persistence.hpp"
 
 namespace galpha::server {

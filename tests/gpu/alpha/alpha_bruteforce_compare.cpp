@@ -279,6 +279,23 @@ void CompareWithBruteForce(const std::vector<Point2>& points, Backend backend) {
     }
     ASSERT_EQ(f.OptimalLevelGeneral(want_n), general) << "n = " << want_n;
     ASSERT_EQ(f.OptimalLevelRegularized(want_n), regularized) << "n = " << want_n;
+    // With a hole bound: the smallest level meeting both bounds, holes by GF(2) ranks.
+    for (uint32_t want_holes = 0; want_holes <= 2; ++want_holes) {
+      std::optional<int64_t> general_h, regularized_h;
+      for (int64_t level = 0; level <= k; ++level) {
+        const mpq_class A = b.Threshold(level);
+        if (!general_h && BruteComponents(b, A) <= want_n && BruteHoles(b, A, ClassifyMode::kGeneral) <= want_holes) {
+          general_h = level;
+        }
+        if (!regularized_h && !b.tris.empty() && EveryPointOnATriangle(b, A) && BruteSolidComponents(b, A) <= want_n &&
+            BruteHoles(b, A, ClassifyMode::kRegularized) <= want_holes) {
+          regularized_h = level;
+        }
+      }
+      ASSERT_EQ(f.OptimalLevelGeneral(want_n, want_holes), general_h) << "n = " << want_n << ", holes " << want_holes;
+      ASSERT_EQ(f.OptimalLevelRegularized(want_n, want_holes), regularized_h)
+          << "n = " << want_n << ", holes " << want_holes;
+    }
   }
 
   CheckLevelResolution(f, b);
