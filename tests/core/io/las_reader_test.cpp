@@ -53,8 +53,7 @@ double TwoRoundings(double offset, double scale, int32_t x) {
 }
 
 std::string WriteLas(const std::string& name, const std::string& bytes) {
-  const std::string path =
-      std::filesystem::temp_directory_path() / absl::StrCat("las_reader_test_", getpid(), "_", name);
+  std::string path = std::filesystem::temp_directory_path() / absl::StrCat("las_reader_test_", getpid(), "_", name);
   std::ofstream(path, std::ios::binary) << bytes;
   return path;
 }
