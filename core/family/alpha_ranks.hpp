@@ -52,6 +52,13 @@ struct ComparisonCounts {
   uint64_t cpu_fallback = 0;
 };
 
+/// The scale of AlphaRanks::area_units: the area of `units` is units * 2^unit_log2, and at every
+/// level the exact area differs from the curve's by at most error_units units (gpu/alpha/area_curve.cuh).
+struct AreaCurveScale {
+  int32_t unit_log2 = 0;
+  uint64_t error_units = 0;
+};
+
 struct AlphaRanks {
   /// The spectrum: the doubles nearest to the distinct exact births of triangles and unattached
   /// edges, strictly increasing in exact value (nearest doubles of neighbours may coincide only
@@ -85,6 +92,10 @@ struct AlphaRanks {
   /// the general complex; components (b0: triangles sharing a vertex connect) and holes of the
   /// regularized one (the closed triangles that are in).
   HostVector<uint32_t> holes, regularized_components, regularized_holes;
+  /// Per level 0..K: the area of the regularized complex (the triangles that are in), in fixed
+  /// point, with a certified error bound (area_scale); the last level's is the convex hull's.
+  HostVector<uint64_t> area_units;
+  AreaCurveScale area_scale;
 
   ComparisonCounts comparisons;
 };

@@ -1,6 +1,7 @@
 #include "core/family/threshold.hpp"
 
 #include "absl/strings/str_cat.h"
+#include "core/family/area_ratio.hpp"
 
 namespace galpha {
 
@@ -28,6 +29,10 @@ absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, co
     case Threshold::Kind::kAlpha:
       level = family.LevelForAlpha(threshold.value);
       resolved.alpha_sq = threshold.value * threshold.value;
+      break;
+    case Threshold::Kind::kRatio:
+      level = LevelForAreaRatio(family, threshold.value);
+      if (level.ok()) resolved.alpha_sq = PublishedAlphaSq(family, *level);
       break;
   }
   if (!level.ok()) return absl::InvalidArgumentError(level.status().message());

@@ -31,6 +31,7 @@
 #include "gpu/alpha/alpha_backend.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
 #include "gpu/alpha/alpha_host_repair.hpp"
+#include "gpu/alpha/area_curve.cuh"
 #include "gpu/alpha/component_curve.cuh"
 #include "gpu/alpha/spectrum_refine.cuh"
 #include "gpu/system/engine_system.cuh"
@@ -170,7 +171,7 @@ struct MasterListCsr {
   uint32_t num_master;
 };
 
-/// The component and hole curves: their values at every level 0..K.
+/// The component, hole and area curves: their values at every level 0..K.
 template <class System>
 struct ComponentCounts {
   Buffer<uint32_t, System> components;
@@ -178,6 +179,8 @@ struct ComponentCounts {
   Buffer<uint32_t, System> holes;
   Buffer<uint32_t, System> regularized_components;
   Buffer<uint32_t, System> regularized_holes;
+  Buffer<unsigned long long, System> area_units;
+  AreaCurveScale area_scale;
 };
 
 // ---- The stages, in order ---------------------------------------------------------------------------------
@@ -575,15 +578,20 @@ MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, con
   return {std::move(master_begin), std::move(master_entries), num_master};
 }
 
-/// Component and hole curves over all levels (Borůvka spanning forests, component_curve.cuh).
+/// Component and hole curves over all levels (Borůvka spanning forests, component_curve.cuh) and
+/// the area curve (area_curve.cuh).
 template <class System>
 ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                                         const Buffer<EdgeTris, System>& edge_tris, const SpectrumRanks<System>& ranks,
                                         const IntervalRanks<System>& iv) {
   const size_t levels = static_cast<size_t>(ranks.num_ranks) + 1;
-  ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels),
-                                 Buffer<uint32_t, System>(sys, levels), Buffer<uint32_t, System>(sys, levels),
-                                 Buffer<uint32_t, System>(sys, levels)};
+  ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<uint32_t, System>(sys, levels),
+                                 Buffer<unsigned long long, System>(sys, levels),
+                                 AreaCurveScale{}};
   TopologyCurves(
       sys,
       TopologyCurvesIn{mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
@@ -591,6 +599,9 @@ ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                        iv.edge_mu_low.data(), iv.edge_mu_high.data(), iv.vertex_tri_low.data()},
       TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
                         counts.regularized_components.data(), counts.regularized_holes.data()});
+  counts.area_scale =
+      AreaCurve(sys, AreaCurveIn{mesh.points, mesh.tri, ranks.tri_rank.data(), mesh.n, mesh.num_tri, ranks.num_ranks},
+                counts.area_units.data());
   return counts;
 }
 
@@ -607,6 +618,8 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
   out->holes.resize(static_cast<size_t>(num_ranks) + 1);
   out->regularized_components.resize(static_cast<size_t>(num_ranks) + 1);
   out->regularized_holes.resize(static_cast<size_t>(num_ranks) + 1);
+  out->area_units.resize(static_cast<size_t>(num_ranks) + 1);
+  out->area_scale = counts.area_scale;
   out->master_begin.resize(static_cast<size_t>(num_ranks) + 2);
   static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
   out->master.resize(master.num_master);
@@ -617,6 +630,7 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
        {out->regularized_components.data(), counts.regularized_components.data(),
         (size_t{num_ranks} + 1) * sizeof(uint32_t)},
        {out->regularized_holes.data(), counts.regularized_holes.data(), (size_t{num_ranks} + 1) * sizeof(uint32_t)},
+       {out->area_units.data(), counts.area_units.data(), (size_t{num_ranks} + 1) * sizeof(uint64_t)},
        {out->master_begin.data(), master.begin.data(), (size_t{num_ranks} + 2) * sizeof(uint32_t)},
        {out->master.data(), master.entries.data(), size_t{master.num_master} * sizeof(uint64_t)}});
   tables_download->Wait();

@@ -104,6 +104,10 @@ void ExpectIdentical(const std::vector<Point2>& points, const std::string& where
       ASSERT_EQ(cpu->Holes(level, mode), cuda->Holes(level, mode)) << where << " level " << level;
     }
   }
+  // The area curve: integer sums, so identical whatever order each backend adds in.
+  ASSERT_EQ(cpu->ranks().area_units, cuda->ranks().area_units) << where;
+  ASSERT_EQ(cpu->ranks().area_scale.unit_log2, cuda->ranks().area_scale.unit_log2) << where;
+  ASSERT_EQ(cpu->ranks().area_scale.error_units, cuda->ranks().area_scale.error_units) << where;
   // The persistence diagram: the same classes with the same creating and killing simplices.
   ASSERT_EQ(PersistenceByVertices(*cpu), PersistenceByVertices(*cuda)) << where;
   EXPECT_EQ(cuda->report().comparisons.cpu_fallback, 0u) << where;

@@ -1,0 +1,184 @@
+#include "core/family/area_ratio.hpp"
+
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/family/alpha_ranks.hpp"
+
+namespace galpha {
+
+namespace {
+
+/// Coordinates as exact integers: every double is an integer multiple of 2^grid_log2 when
+/// grid_log2 is the smallest ulp exponent among them, so a cross product x_a * y_b - x_b * y_a is
+/// an integer times 2^(2 grid_log2), and sums of them are exact in mpz (faster than mpq, whose
+/// every step reduces a fraction).
+class IntegerCoordinates {
+ public:
+  explicit IntegerCoordinates(absl::Span<const Point2> points) {
+    for (const Point2& p : points) {
+      for (double v : {p.x, p.y}) {
+        if (v != 0.0) grid_log2_ = std::min(grid_log2_, UlpExponent(v));
+      }
+    }
+  }
+
+  void Set(double v, mpz_class* out) const {
+    if (v == 0.0) {
+      *out = 0;
+      return;
+    }
+    int exponent = 0;
+    const double fraction = std::frexp(v, &exponent);
+    *out = static_cast<long>(std::ldexp(fraction, 53));  // exact: an integer below 2^53
+    *out <<= static_cast<mp_bitcnt_t>(exponent - 53 - grid_log2_);
+  }
+
+ private:
+  /// v = m * 2^(exponent - 53) with an integer |m| < 2^53.
+  static int UlpExponent(double v) {
+    int exponent = 0;
+    std::frexp(v, &exponent);
+    return exponent - 53;
+  }
+
+  int grid_log2_ = std::numeric_limits<int>::max();
+};
+
+/// Twice the exact area of the regularized complex at `level`, in units of the coordinates' grid
+/// squared: the shoelace sum over its boundary (edges with exactly one incident triangle in),
+/// each edge directed as in that triangle, so that only the boundary's edges cost exact work.
+mpz_class TwiceAreaExact(const AlphaFamily& family, int64_t level, const IntegerCoordinates& grid) {
+  const AlphaRanks& r = family.ranks();
+  auto in = [&](int32_t t) {
+    return t >= 0 && r.tri_rank[static_cast<size_t>(t)] != kNeverRank &&
+           static_cast<int64_t>(r.tri_rank[static_cast<size_t>(t)]) <= level;
+  };
+  mpz_class sum = 0, xa, ya, xb, yb;
+  for (size_t e = 0; e < family.edges().size(); ++e) {
+    const auto [t0, t1] = r.edge_triangles[e];
+    const bool in0 = in(t0), in1 = in(t1);
+    if (in0 == in1) continue;
+    const std::array<uint32_t, 3>& tri = family.triangles()[static_cast<size_t>(in0 ? t0 : t1)];
+    uint32_t a = family.edges()[e][0], b = family.edges()[e][1];
+    const bool forward = (tri[0] == a && tri[1] == b) || (tri[1] == a && tri[2] == b) || (tri[2] == a && tri[0] == b);
+    if (!forward) std::swap(a, b);
+    const Point2 pa = family.points()[a], pb = family.points()[b];
+    grid.Set(pa.x, &xa);
+    grid.Set(pa.y, &ya);
+    grid.Set(pb.x, &xb);
+    grid.Set(pb.y, &yb);
+    sum += xa * yb - xb * ya;
+  }
+  return abs(sum);
+}
+
+/// ratio = mantissa * 2^-shift, an integer mantissa below 2^53 and shift >= 52 (ratio in (0, 1]).
+struct DyadicRatio {
+  uint64_t mantissa = 0;
+  int shift = 0;
+};
+
+DyadicRatio DyadicOf(double ratio) {
+  int exponent = 0;
+  const double fraction = std::frexp(ratio, &exponent);
+  return {static_cast<uint64_t>(std::ldexp(fraction, 53)), 53 - exponent};
+}
+
+/// mantissa * x * 2^-shift rounded up (round_up) or down, in 128 bits (the product is below 2^117).
+__int128 ScaleBy(const DyadicRatio& ratio, uint64_t x, bool round_up) {
+  const unsigned __int128 product = static_cast<unsigned __int128>(ratio.mantissa) * x;
+  if (ratio.shift >= 120) return round_up && product != 0 ? 1 : 0;
+  const unsigned __int128 quotient = product >> ratio.shift;
+  const bool exact = (quotient << ratio.shift) == product;
+  return static_cast<__int128>(quotient) + (round_up && !exact ? 1 : 0);
+}
+
+}  // namespace
+
+double RegularizedAreaApprox(const AlphaFamily& family, int64_t level) {
+  const AlphaRanks& r = family.ranks();
+  if (level < 0 || r.area_units.empty()) return 0.0;
+  const size_t at = std::min(static_cast<size_t>(level), r.area_units.size() - 1);
+  return std::ldexp(static_cast<double>(r.area_units[at]), r.area_scale.unit_log2);
+}
+
+double HullAreaApprox(const AlphaFamily& family) { return RegularizedAreaApprox(family, family.max_level()); }
+
+absl::StatusOr<int64_t> LevelForAreaRatio(const AlphaFamily& family, double ratio) {
+  if (!(ratio >= 0.0 && ratio <= 1.0)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("ratio ", ratio, " is outside 0..1 (the share of the convex hull's area the shape must cover)"));
+  }
+  const int64_t k = family.max_level();
+  if (ratio == 0.0) return 0;  // every area is >= 0
+  const DyadicRatio dyadic = DyadicOf(ratio);
+  const AlphaRanks& r = family.ranks();
+  // The filter: with exact areas X (in units) within E of the curve Q at every level,
+  //   Q_L - E >= ratio (Q_K + E)  proves X_L >= ratio X_K, and
+  //   Q_L + E <  ratio (Q_K - E)  proves X_L <  ratio X_K.
+  // Both are monotone in L (Q never decreases): two binary searches bound the answer to (low, high].
+  int64_t low = -1, high = k;  // level k always qualifies: X_K >= ratio X_K for ratio <= 1
+  if (r.area_units.size() == static_cast<size_t>(k) + 1) {
+    const __int128 error = static_cast<__int128>(r.area_scale.error_units);
+    const uint64_t hull = r.area_units[static_cast<size_t>(k)];
+    const __int128 need_up = ScaleBy(dyadic, hull + r.area_scale.error_units, /*round_up=*/true);
+    const __int128 need_down =
+        hull >= r.area_scale.error_units ? ScaleBy(dyadic, hull - r.area_scale.error_units, false) : 0;
+    auto surely_enough = [&](int64_t level) {
+      return static_cast<__int128>(r.area_units[static_cast<size_t>(level)]) - error >= need_up;
+    };
+    auto surely_short = [&](int64_t level) {
+      return static_cast<__int128>(r.area_units[static_cast<size_t>(level)]) + error < need_down;
+    };
+    int64_t lo = 0, hi = k;  // smallest surely-enough level, or k
+    while (lo < hi) {
+      const int64_t mid = lo + (hi - lo) / 2;
+      if (surely_enough(mid)) {
+        hi = mid;
+      } else {
+        lo = mid + 1;
+      }
+    }
+    high = lo;
+    lo = -1;
+    hi = high - 1;  // largest surely-short level below high, or -1
+    while (lo < hi) {
+      const int64_t mid = hi - (hi - lo) / 2;
+      if (surely_short(mid)) {
+        lo = mid;
+      } else {
+        hi = mid - 1;
+      }
+    }
+    low = lo;
+  }
+  if (high == low + 1) return high;
+  // Undecided levels: exact areas, by binary search in (low, high] (high qualifies).
+  const IntegerCoordinates grid(absl::MakeConstSpan(family.points()));
+  const mpz_class hull_times_mantissa =
+      TwiceAreaExact(family, k, grid) * mpz_class(static_cast<unsigned long>(dyadic.mantissa));
+  auto exactly_enough = [&](int64_t level) {
+    mpz_class twice = TwiceAreaExact(family, level, grid);
+    twice <<= static_cast<mp_bitcnt_t>(dyadic.shift);
+    return twice >= hull_times_mantissa;
+  };
+  int64_t lo = low + 1, hi = high;
+  while (lo < hi) {
+    const int64_t mid = lo + (hi - lo) / 2;
+    if (exactly_enough(mid)) {
+      hi = mid;
+    } else {
+      lo = mid + 1;
+    }
+  }
+  return lo;
+}
+
+}  // namespace galpha

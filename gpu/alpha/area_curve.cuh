@@ -1,0 +1,142 @@
+// The area curve: the area of the regularized complex (the triangles that are in) at every level,
+// in fixed point, one source for both backends.
+//
+// Why fixed point: integer sums do not depend on the order of the additions, so the curve is the
+// same on CUDA and OpenMP bit for bit (a floating-point scan is not: its association order differs
+// between the backends). Each triangle's twice-area is evaluated in doubles on differences scaled
+// by one power of two (the bounding box's larger side to [0.5, 1)), rounded to an integer number of
+// units of 2^-kAreaFractionBits, and its error bound (Shewchuk's ccwerrboundA times the permanent,
+// plus one unit for the rounding to an integer and for any underflow) is summed beside it. The
+// curve is then a certified approximation: |exact twice-area at level L - curve[L]| <= the error
+// sum, in units, at every level. core/family/area_ratio.* decides the area-ratio thresholds with it
+// and falls back to exact arithmetic only where the bound cannot decide.
+#pragma once
+
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/scan.h>
+#include <thrust/transform_reduce.h>
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/exact/expansion.hpp"
+#include "core/family/alpha_ranks.hpp"
+#include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/triangulation/point_order.cuh"
+
+namespace galpha::detail {
+
+/// A scaled twice-area is below 2 (scaled differences are below 1); 2^57 units each keeps the
+/// whole sum (twice the scaled hull area, below 2) under 2^59 and the error sum far below 2^63.
+constexpr int kAreaFractionBits = 57;
+/// Shewchuk's ccwerrboundA, (3 + 16 eps) eps: |computed - exact| of bx*cy - by*cx on differences
+/// of the coordinates is at most this times |bx*cy| + |by*cx| (the predicates' filter, which we
+/// enlarge the same way: by a relative 2^-20).
+constexpr double kTwiceAreaErrBound = (3.0 + 16.0 * exact::kEpsilon) * exact::kEpsilon * (1.0 + 0x1p-20);
+
+GALPHA_HD inline void AtomicAddU64(unsigned long long* p, unsigned long long v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(p, v);
+#else
+  __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
+/// One triangle's twice-area in units and its error bound in units.
+struct TriangleAreaUnits {
+  const Point2* points;
+  const TriIdx* tri;
+  int scale_log2;  ///< the differences are multiplied by 2^scale_log2
+
+  GALPHA_HD void Evaluate(uint32_t t, unsigned long long* units, unsigned long long* error) const {
+    // The rotation that starts at the smallest index: the same rounding whichever rotation of
+    // the triangle a backend stores.
+    const TriIdx& v = tri[t];
+    const int first = v.v[0] < v.v[1] ? (v.v[0] < v.v[2] ? 0 : 2) : (v.v[1] < v.v[2] ? 1 : 2);
+    const Point2 a = points[v.v[first]], b = points[v.v[(first + 1) % 3]], c = points[v.v[(first + 2) % 3]];
+    using exact::Mul;
+    using exact::ScaleByPow2;
+    using exact::Sub;
+    const double bx = ScaleByPow2(Sub(b.x, a.x), scale_log2), by = ScaleByPow2(Sub(b.y, a.y), scale_log2);
+    const double cx = ScaleByPow2(Sub(c.x, a.x), scale_log2), cy = ScaleByPow2(Sub(c.y, a.y), scale_log2);
+    const double left = Mul(bx, cy), right = Mul(by, cx);
+    const double det = exact::Abs(Sub(left, right));
+    const double permanent = exact::Add(exact::Abs(left), exact::Abs(right));
+    const double unit = exact::Pow2(kAreaFractionBits);
+    *units = static_cast<unsigned long long>(llround(Mul(det, unit)));
+    // The bound rounded up, plus one unit: the rounding to an integer (half a unit) and products
+    // or differences that underflowed (below 2^-1000 units each).
+    *error = static_cast<unsigned long long>(ceil(Mul(Mul(kTwiceAreaErrBound, permanent), unit))) + 1ull;
+  }
+};
+
+/// Adds each born triangle's units into its birth rank.
+struct AddTriangleArea {
+  TriangleAreaUnits area;
+  const uint32_t* tri_rank;
+  unsigned long long* units_at_rank;
+  GALPHA_HD void operator()(uint32_t t) const {
+    if (tri_rank[t] == kNeverRank) return;  // collinear: never in, and of area zero
+    unsigned long long units = 0, error = 0;
+    area.Evaluate(t, &units, &error);
+    AtomicAddU64(&units_at_rank[tri_rank[t]], units);
+  }
+};
+
+/// Each born triangle's error bound (summed by a reduction).
+struct TriangleAreaError {
+  TriangleAreaUnits area;
+  const uint32_t* tri_rank;
+  GALPHA_HD unsigned long long operator()(uint32_t t) const {
+    if (tri_rank[t] == kNeverRank) return 0;
+    unsigned long long units = 0, error = 0;
+    area.Evaluate(t, &units, &error);
+    return error;
+  }
+};
+
+/// The area curve's scale: 2^scale_log2 brings the bounding box's larger side to [0.5, 1). Zero
+/// for a box without extent (then there are no triangles).
+template <class System>
+int AreaScaleLog2(System& sys, const Point2* points, uint32_t n) {
+  if (n == 0) return 0;
+  auto policy = sys.policy();
+  const BoundingBox box =
+      thrust::transform_reduce(policy, points, points + n, PointToBox(), PointToBox()(sys.Read(points)), MergeBoxes());
+  const double width = exact::Sub(box.max_x, box.min_x), height = exact::Sub(box.max_y, box.min_y);
+  const double side = width > height ? width : height;
+  if (side == 0.0) return 0;
+  return -(exact::ExponentOf(side) + 1);
+}
+
+struct AreaCurveIn {
+  const Point2* points;
+  const TriIdx* tri;
+  const uint32_t* tri_rank;
+  uint32_t n, num_tri, num_ranks;
+};
+
+/// The area curve over levels 0..num_ranks into `units_out` (twice the area, in units of
+/// 2^-(kAreaFractionBits + 2 * scale)); returns the scale and the error bound in units.
+template <class System>
+AreaCurveScale AreaCurve(System& sys, const AreaCurveIn& in, unsigned long long* units_out) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t levels = in.num_ranks + 1;
+  AreaCurveScale scale;
+  const int scale_log2 = AreaScaleLog2(sys, in.points, in.n);
+  scale.unit_log2 = -(kAreaFractionBits + 2 * scale_log2) - 1;  // units of twice the area: halve
+  thrust::fill_n(policy, units_out, levels, 0ull);
+  if (in.num_tri == 0) return scale;
+  const TriangleAreaUnits area{in.points, in.tri, scale_log2};
+  thrust::for_each_n(policy, zero, in.num_tri, AddTriangleArea{area, in.tri_rank, units_out});
+  thrust::inclusive_scan(policy, units_out, units_out + levels, units_out);
+  scale.error_units = thrust::transform_reduce(policy, zero, zero + in.num_tri, TriangleAreaError{area, in.tri_rank},
+                                               0ull, thrust::plus<unsigned long long>());
+  return scale;
+}
+
+}  // namespace galpha::detail
