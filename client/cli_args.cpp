@@ -49,6 +49,9 @@ const char kUsage[] =
     "  --alpha-sq A                a squared radius (CGAL's and PostGIS's alpha), compared exactly\n"
     "  --alpha R                   a radius R >= 0 (R*R compared exactly)\n"
     "  --rank K                    the K-th spectrum value (0: the points alone)\n"
+    "  --ratio F                   an area ratio 0 <= F <= 1 (PostGIS ST_ConcaveHull's target_percent):\n"
+    "                              the smallest rank whose regularized area is >= F x the convex hull's\n"
+    "                              (compared exactly; 1: the convex hull)\n"
     "\n"
     "GLOBAL OPTIONS, for every command, before or after it:\n"
     "  --backend auto|cpu|cuda     where the engine runs (default auto: CUDA when a GPU is visible)\n"
@@ -200,10 +203,11 @@ absl::StatusOr<int64_t> ParseInteger(absl::string_view option, const std::string
 absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line) {
   std::vector<absl::string_view> given;
   for (const auto& [name, value] : line.options) {
-    if (name == "alpha-sq" || name == "alpha" || name == "rank") given.emplace_back(name);
+    if (name == "alpha-sq" || name == "alpha" || name == "rank" || name == "ratio") given.emplace_back(name);
   }
   if (given.empty()) {
-    return absl::InvalidArgumentError("missing threshold: give one of --alpha-sq A, --alpha R or --rank K");
+    return absl::InvalidArgumentError(
+        "missing threshold: give one of --alpha-sq A, --alpha R, --rank K or --ratio F (an area ratio, 0..1)");
   }
   if (given.size() > 1) {
     return absl::InvalidArgumentError(absl::StrCat("give only one threshold, got --", given[0], " and --", given[1]));
@@ -222,6 +226,12 @@ absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line) {
   threshold.value = *value;
   if (given[0] == "alpha-sq") {
     threshold.kind = ThresholdArg::Kind::kAlphaSq;
+  } else if (given[0] == "ratio") {
+    if (*value < 0 || *value > 1) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--ratio '", text, "' is outside 0..1 (the share of the convex hull's area the shape covers)"));
+    }
+    threshold.kind = ThresholdArg::Kind::kRatio;
   } else {
     if (*value < 0) {
       return absl::InvalidArgumentError(absl::StrCat("--alpha '", text, "' is a radius and must be >= 0"));

@@ -71,13 +71,14 @@ absl::StatusOr<int64_t> ParseInteger(absl::string_view option, const std::string
 
 /// Which threshold the user named, in the unit they used.
 struct ThresholdArg {
-  enum class Kind { kAlphaSq, kAlpha, kRank };
+  enum class Kind { kAlphaSq, kAlpha, kRank, kRatio };
   Kind kind = Kind::kRank;
-  double value = 0.0;  ///< alpha_sq for kAlphaSq, the radius for kAlpha
+  double value = 0.0;  ///< alpha_sq for kAlphaSq, the radius for kAlpha, the area ratio for kRatio
   int64_t rank = 0;    ///< for kRank
 };
 
-/// Exactly one of --alpha-sq, --alpha (a radius, >= 0) or --rank (>= 0).
+/// Exactly one of --alpha-sq, --alpha (a radius, >= 0), --rank (>= 0) or --ratio (an area ratio in
+/// 0..1).
 absl::StatusOr<ThresholdArg> ParseThreshold(const CommandLine& line);
 
 /// --max-points (default kDefaultMaxPoints of point_input.hpp): an integer in 1..kMaxPoints, the

@@ -166,6 +166,10 @@ absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, co
       resolved_from.kind = Threshold::Kind::kAlpha;
       resolved_from.value = threshold.value;
       break;
+    case ThresholdArg::Kind::kRatio:
+      resolved_from.kind = Threshold::Kind::kRatio;
+      resolved_from.value = threshold.value;
+      break;
   }
   return ::galpha::ResolveThreshold(family, resolved_from);
 }

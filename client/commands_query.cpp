@@ -13,6 +13,7 @@
 #include "absl/strings/str_cat.h"
 #include "client/commands.hpp"
 #include "client/text_output.hpp"
+#include "core/family/area_ratio.hpp"
 #include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
 #include "core/geometry/shape.hpp"
@@ -31,7 +32,7 @@ int FinishOutput(ChunkedWriter& out) {
 }  // namespace
 
 int RunClassify(Args args) {
-  auto common = ParseCommon("classify", args, {"alpha-sq", "alpha", "rank", "mode", "vertex-rule"});
+  auto common = ParseCommon("classify", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "vertex-rule"});
   if (!common.ok()) return UsageError(common.status());
   auto options = ParseClassifyArgs(common->line);
   if (!options.ok()) return UsageError(options.status());
@@ -71,7 +72,7 @@ int RunClassify(Args args) {
 }
 
 int RunSummary(Args args) {
-  auto common = ParseCommon("summary", args, {"alpha-sq", "alpha", "rank", "mode", "vertex-rule"});
+  auto common = ParseCommon("summary", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "vertex-rule"});
   if (!common.ok()) return UsageError(common.status());
   auto options = ParseClassifyArgs(common->line);
   if (!options.ok()) return UsageError(options.status());
@@ -102,13 +103,14 @@ int RunSummary(Args args) {
                                        {"solid_components", family->SolidComponents(level)},
                                        {"holes", family->Holes(level, options->mode)},
                                        {"interior_area", counts.interior_area},
+                                       {"hull_area", HullAreaApprox(*family)},
                                        {"backend", family->report().backend}};
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
 }
 
 int RunShape(Args args) {
-  auto common = ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "mode", "format", "min-hole-area"});
+  auto common = ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "format", "min-hole-area"});
   if (!common.ok()) return UsageError(common.status());
   auto threshold_arg = ParseThreshold(common->line);
   if (!threshold_arg.ok()) return UsageError(threshold_arg.status());

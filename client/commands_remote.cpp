@@ -120,6 +120,9 @@ absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, const R
     case ThresholdArg::Kind::kAlpha:
       out.set_alpha(threshold.value);
       break;
+    case ThresholdArg::Kind::kRatio:
+      out.set_ratio(threshold.value);
+      break;
   }
   return out;
 }
@@ -243,6 +246,7 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
                                        {"solid_components", summary.solid_components()},
                                        {"holes", summary.holes()},
                                        {"interior_area", summary.interior_area()},
+                                       {"hull_area", summary.hull_area()},
                                        {"backend", build.backend()}};
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;

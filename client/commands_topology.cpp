@@ -93,7 +93,7 @@ absl::StatusOr<HolesArgs> ParseHolesArgs(const CommandLine& line) {
 }
 
 int RunHoles(Args args) {
-  auto common = ParseCommon("holes", args, {"alpha-sq", "alpha", "rank", "min-area", "format"});
+  auto common = ParseCommon("holes", args, {"alpha-sq", "alpha", "rank", "ratio", "min-area", "format"});
   if (!common.ok()) return UsageError(common.status());
   auto options = ParseHolesArgs(common->line);
   if (!options.ok()) return UsageError(options.status());

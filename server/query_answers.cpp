@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "core/family/area_ratio.hpp"
 #include "core/family/canonical_order.hpp"
 #include "core/family/classification_summary.hpp"
 #include "core/geometry/shape_holes.hpp"
@@ -103,6 +104,7 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
     summary->set_solid_components(family.SolidComponents(level_.level));
     summary->set_interior_area(counts_.interior_area);
     summary->set_holes(family.Holes(level_.level, mode_));
+    summary->set_hull_area(HullAreaApprox(family));
   }
 
   // Fills one chunk of edges or triangles from position_ on: the ordered vertices are copied in a
@@ -294,8 +296,12 @@ absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::
       t.kind = Threshold::Kind::kAlpha;
       t.value = threshold.alpha();
       break;
+    case v1::Threshold::kRatio:
+      t.kind = Threshold::Kind::kRatio;
+      t.value = threshold.ratio();
+      break;
     case v1::Threshold::VALUE_NOT_SET:
-      return absl::InvalidArgumentError("the request has no threshold: set alpha_sq, alpha or rank");
+      return absl::InvalidArgumentError("the request has no threshold: set alpha_sq, alpha, rank or ratio");
   }
   return ResolveThreshold(family, t);
 }

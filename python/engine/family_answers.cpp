@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/family/area_ratio.hpp"
 #include "core/family/canonical_order.hpp"
 #include "core/family/persistence.hpp"
 
@@ -56,7 +57,9 @@ absl::StatusOr<Threshold::Kind> ParseThresholdKind(absl::string_view kind) {
   if (kind == "alpha_sq") return Threshold::Kind::kAlphaSq;
   if (kind == "alpha") return Threshold::Kind::kAlpha;
   if (kind == "rank") return Threshold::Kind::kRank;
-  return absl::InvalidArgumentError(absl::StrCat("unknown threshold kind '", kind, "': give alpha_sq, alpha or rank"));
+  if (kind == "ratio") return Threshold::Kind::kRatio;
+  return absl::InvalidArgumentError(
+      absl::StrCat("unknown threshold kind '", kind, "': give alpha_sq, alpha, rank or ratio"));
 }
 
 absl::StatusOr<ClassifyMode> ParseMode(absl::string_view mode) {
@@ -83,6 +86,7 @@ absl::StatusOr<ClassifyAnswer> AnswerClassify(const FamilyState& state, const Th
   answer.components = family.Components(level->level);
   answer.solid_components = family.SolidComponents(level->level);
   answer.holes = family.Holes(level->level, mode);
+  answer.hull_area = HullAreaApprox(family);
   answer.summary_only = summary_only;
   if (summary_only) return answer;
 

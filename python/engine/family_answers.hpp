@@ -51,6 +51,8 @@ struct ClassifyAnswer {
   uint32_t solid_components = 0;
   /// b1 of the complex in the request's mode.
   uint32_t holes = 0;
+  /// The convex hull's area, from the area curve (core/family/area_ratio.hpp).
+  double hull_area = 0.0;
   bool summary_only = false;
   bool filtered = false;
   std::vector<uint32_t> vertices, edges, triangles;  // only when filtered

@@ -92,6 +92,7 @@ py::dict ClassifyDict(ClassifyAnswer answer, const StatePtr& state) {
   out["solid_components"] = answer.solid_components;
   out["holes"] = answer.holes;
   out["interior_area"] = answer.counts.interior_area;
+  out["hull_area"] = answer.hull_area;
   if (answer.summary_only) {
     out["vertices"] = py::array_t<uint32_t>(std::vector<py::ssize_t>{0});
     out["edges"] = py::array_t<uint32_t>(std::vector<py::ssize_t>{0, 2});

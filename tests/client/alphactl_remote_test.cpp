@@ -59,6 +59,8 @@ TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
       "classify --alpha-sq 2.5e-5 --mode regularized --vertex-rule cgal",
       "summary --alpha 0.004",
       "summary --rank 0",
+      "summary --ratio 0.5 --mode regularized",
+      "shape --ratio 0.8 --format wkt",
       "shape --rank 300 --format geojson",
       "shape --alpha-sq 1e-4 --format wkt --mode regularized",
       "shape --rank 50 --format svg",

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -295,9 +296,10 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(run.out);
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size", "level",
-                                            "alpha_sq", "mode", "vertex_rule", "vertices", "edges", "triangles",
-                                            "components", "solid_components", "holes", "interior_area", "backend"}));
+  EXPECT_EQ(keys,
+            (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size", "level",
+                                      "alpha_sq", "mode", "vertex_rule", "vertices", "edges", "triangles", "components",
+                                      "solid_components", "holes", "interior_area", "hull_area", "backend"}));
   const nlohmann::json expected = {{"file", SquareCsv()},
                                    {"points", 4},
                                    {"distinct_points", 4},
@@ -314,6 +316,7 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
                                    {"solid_components", 0},
                                    {"holes", 1},  // the four sides enclose the square
                                    {"interior_area", 0.0},
+                                   {"hull_area", 1.0},
                                    {"backend", "cpu"}};
   EXPECT_EQ(nlohmann::json::parse(run.out), expected);
   // Compact, doubles as their shortest text (0.25, not 0.25000000000000000; 0, not 0.0).
@@ -331,6 +334,73 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   EXPECT_EQ(full["solid_components"], 1);
   EXPECT_EQ(full["holes"], 0);
   EXPECT_EQ(full["interior_area"], 1.0);
+}
+
+// The convex hull's area by Andrew's monotone chain and the shoelace formula, in long double: an
+// oracle independent of the engine's triangles and of its area curve.
+double ConvexHullArea(std::vector<std::array<double, 2>> p) {
+  std::sort(p.begin(), p.end());
+  p.erase(std::unique(p.begin(), p.end()), p.end());
+  if (p.size() < 3) return 0.0;
+  auto cross = [](const std::array<double, 2>& o, const std::array<double, 2>& a, const std::array<double, 2>& b) {
+    return (static_cast<long double>(a[0]) - o[0]) * (static_cast<long double>(b[1]) - o[1]) -
+           (static_cast<long double>(a[1]) - o[1]) * (static_cast<long double>(b[0]) - o[0]);
+  };
+  std::vector<std::array<double, 2>> hull(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && cross(hull[k - 2], hull[k - 1], p[i]) <= 0) --k;
+    hull[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, lower = k + 1; i > 0; --i) {
+    while (k >= lower && cross(hull[k - 2], hull[k - 1], p[i - 1]) <= 0) --k;
+    hull[k++] = p[i - 1];
+  }
+  long double twice = 0;
+  for (size_t i = 0; i + 1 < k; ++i) {
+    twice +=
+        static_cast<long double>(hull[i][0]) * hull[i + 1][1] - static_cast<long double>(hull[i + 1][0]) * hull[i][1];
+  }
+  return static_cast<double>(twice / 2);
+}
+
+TEST(AlphactlTest, AreaRatiosPickTheSmallestRankThatCoversThem) {
+  // The unit square: both triangles come at rank 2, so every ratio in (0, 1] is rank 2.
+  const std::string& square = SquareCsv();
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", square, "--ratio 0"))["level"], 0);
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", square, "--ratio 1e-300"))["level"], 2);
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", square, "--ratio 1"))["level"], 2);
+  EXPECT_EQ(Succeeds("shape", square, "--ratio 0.5 --format wkt"), Succeeds("shape", square, "--rank 2 --format wkt"));
+
+  // Random points: the level of each ratio covers it, the level before does not (interior areas
+  // summed in doubles: compared with a relative margin far above their rounding), and the hull's
+  // area is the convex hull's.
+  std::mt19937_64 random(2026);
+  std::uniform_real_distribution<double> coordinate(-3.0, 7.0);
+  std::vector<std::array<double, 2>> points(300);
+  for (auto& p : points) p = {coordinate(random), coordinate(random)};
+  const std::string file = WriteBin("alphactl_ratio.bin", points);
+  for (double ratio : {0.1, 0.5, 0.9, 0.999, 1.0}) {
+    SCOPED_TRACE(ratio);
+    const nlohmann::json at =
+        nlohmann::json::parse(Succeeds("summary", file, "--mode regularized --ratio " + Printed(ratio)));
+    const int64_t level = at["level"].get<int64_t>();
+    const double hull = at["hull_area"].get<double>();
+    EXPECT_NEAR(hull, ConvexHullArea(points), 1e-12 * hull);
+    EXPECT_GE(at["interior_area"].get<double>(), ratio * hull * (1 - 1e-12));
+    ASSERT_GT(level, 0);
+    const nlohmann::json before =
+        nlohmann::json::parse(Succeeds("summary", file, "--mode regularized --rank " + std::to_string(level - 1)));
+    EXPECT_LT(before["interior_area"].get<double>(), ratio * hull * (1 + 1e-12));
+    EXPECT_EQ(Succeeds("shape", file, "--ratio " + Printed(ratio) + " --format wkt"),
+              Succeeds("shape", file, "--rank " + std::to_string(level) + " --format wkt"));
+  }
+
+  ExpectError(Alphactl("summary " + Quote(square) + " --ratio 1.5"), 2, "--ratio '1.5' is outside 0..1");
+  ExpectError(Alphactl("summary " + Quote(square) + " --ratio -0.1"), 2, "outside 0..1");
+  ExpectError(Alphactl("summary " + Quote(square) + " --ratio 0.5 --rank 1"), 2, "give only one threshold");
+  ExpectError(Alphactl("shape " + Quote(square) + " --ratio half --format wkt"), 2, "--ratio 'half'");
+  std::filesystem::remove(file);
 }
 
 TEST(AlphactlTest, ShapesInEveryFormat) {

@@ -32,21 +32,31 @@ from ._types import (
 )
 
 
-def threshold_from(alpha: Optional[float], alpha_sq: Optional[float], rank: Optional[int]) -> Threshold:
-    """The one threshold among the keywords; InvalidInput unless exactly one is given."""
-    given = [(k, v) for k, v in (("alpha", alpha), ("alpha_sq", alpha_sq), ("rank", rank)) if v is not None]
+def threshold_from(
+    alpha: Optional[float], alpha_sq: Optional[float], rank: Optional[int], ratio: Optional[float] = None
+) -> Threshold:
+    """The one threshold among the keywords; InvalidInput unless exactly one is given.
+
+    ``ratio`` (0..1, PostGIS ``ST_ConcaveHull``'s target_percent, shapely's ``concave_hull`` ratio)
+    names the smallest rank whose regularized area is at least ``ratio`` times the convex hull's,
+    decided exactly by the engine."""
+    named = (("alpha", alpha), ("alpha_sq", alpha_sq), ("rank", rank), ("ratio", ratio))
+    given = [(k, v) for k, v in named if v is not None]
     if len(given) != 1:
         names = ", ".join(k for k, _ in given) or "none"
-        raise InvalidInput(f"give exactly one of alpha=, alpha_sq= or rank= (got {names})")
+        raise InvalidInput(f"give exactly one of alpha=, alpha_sq=, rank= or ratio= (got {names})")
     kind, value = given[0]
     if kind == "rank":
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
             raise InvalidInput(f"rank must be an integer, got {value!r}")
         return Threshold("rank", int(value))
     try:
-        return Threshold(kind, float(value))
+        number = float(value)
     except (TypeError, ValueError):
         raise InvalidInput(f"{kind} must be a number, got {value!r}") from None
+    if kind == "ratio" and not 0.0 <= number <= 1.0:
+        raise InvalidInput(f"ratio {value!r} is outside 0..1 (the share of the convex hull's area the shape covers)")
+    return Threshold(kind, number)
 
 
 def radius_from_alphashape(alpha: float) -> float:
@@ -284,6 +294,7 @@ class Family:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         mode: Union[str, Mode] = Mode.GENERAL,
         vertex_rule: Union[str, VertexRule] = VertexRule.REPORT,
         non_exterior_only: bool = False,
@@ -291,7 +302,7 @@ class Family:
     ) -> Classification:
         """The class of every simplex at one threshold, as NumPy arrays (see Classification)."""
         return self._backend.classify(
-            threshold_from(alpha, alpha_sq, rank), _mode(mode), _rule(vertex_rule), non_exterior_only, summary_only
+            threshold_from(alpha, alpha_sq, rank, ratio), _mode(mode), _rule(vertex_rule), non_exterior_only, summary_only
         )
 
     def shape_rings(
@@ -300,6 +311,7 @@ class Family:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
         min_hole_area: float = 0.0,
     ) -> ShapeRings:
@@ -307,7 +319,7 @@ class Family:
         points, area. Holes whose area is below ``min_hole_area`` (squared input units) are
         filled: their rings leave the polygons and their areas join ``area`` (0, the default,
         keeps every hole; a negative or NaN bound raises InvalidInput)."""
-        threshold = threshold_from(alpha, alpha_sq, rank)
+        threshold = threshold_from(alpha, alpha_sq, rank, ratio)
         m = _mode(mode)
         return self._backend.shape_rings(threshold, m, area_argument("min_hole_area", min_hole_area, "keep every hole"))
 
@@ -317,6 +329,7 @@ class Family:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
         as_geodataframe: bool = False,
         min_hole_area: float = 0.0,
@@ -332,7 +345,9 @@ class Family:
         measures them) are filled; 0 keeps every hole.
         """
         m = _mode(mode)
-        rings = self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m, min_hole_area=min_hole_area)
+        rings = self.shape_rings(
+            alpha=alpha, alpha_sq=alpha_sq, rank=rank, ratio=ratio, mode=m, min_hole_area=min_hole_area
+        )
         if not as_geodataframe:
             return rings_to_shapely(rings, self._points, m)
         return self._geodataframe(rings)
@@ -362,6 +377,7 @@ class Family:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         min_area: float = 0.0,
         as_geodataframe: bool = False,
     ) -> Any:
@@ -374,7 +390,7 @@ class Family:
         The local engine lists them in C++; the network client asks the server for the shape's
         rings and measures them here, from the points this family keeps (``family.points``), to
         the same doubles."""
-        threshold = threshold_from(alpha, alpha_sq, rank)
+        threshold = threshold_from(alpha, alpha_sq, rank, ratio)
         minimum = area_argument("min_area", min_area, "every hole")
         holes = self._backend.holes(threshold, minimum, self._points)
         return holes_geodataframe(holes, self._points, self.crs) if as_geodataframe else holes

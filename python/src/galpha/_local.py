@@ -132,6 +132,7 @@ class LocalFamilyBackend:
             triangles=c["triangles"],
             triangle_classes=c["triangle_classes"],
             holes=c["holes"],
+            hull_area=c["hull_area"],
         )
 
     @_translated

@@ -79,6 +79,8 @@ def threshold_message(threshold: Threshold) -> pb.Threshold:
         return pb.Threshold(rank=int(threshold.value))
     if threshold.kind == "alpha":
         return pb.Threshold(alpha=float(threshold.value))
+    if threshold.kind == "ratio":
+        return pb.Threshold(ratio=float(threshold.value))
     return pb.Threshold(alpha_sq=float(threshold.value))
 
 
@@ -156,6 +158,7 @@ class ClassifyAssembler:
             triangles=triangles,
             triangle_classes=triangle_classes,
             holes=s.holes,
+            hull_area=s.hull_area,
         )
 
 

@@ -77,13 +77,14 @@ class VertexRule(str, enum.Enum):
 
 @dataclasses.dataclass(frozen=True)
 class Threshold:
-    """Exactly one of a squared radius, a radius, or a rank; built by :func:`threshold_from`."""
+    """Exactly one of a squared radius, a radius, a rank or an area ratio; built by
+    :func:`threshold_from`."""
 
-    kind: str  # "alpha_sq", "alpha" or "rank"
+    kind: str  # "alpha_sq", "alpha", "rank" or "ratio"
     value: float  # an int for "rank"
 
     def __post_init__(self) -> None:
-        if self.kind not in ("alpha_sq", "alpha", "rank"):
+        if self.kind not in ("alpha_sq", "alpha", "rank", "ratio"):
             raise ValueError(f"unknown threshold kind {self.kind!r}")
 
 
@@ -145,6 +146,9 @@ class Classification:
     #: Holes (b1) of the complex in the classification's mode: of the whole complex (general), of
     #: its closed interior triangles (regularized).
     holes: int = 0
+    #: The convex hull's area (squared input units, within about 1e-12 of it, relative):
+    #: ``interior_area / hull_area`` is the level's area ratio, what ``ratio=`` asks for.
+    hull_area: float = 0.0
 
 
 @dataclasses.dataclass(frozen=True)

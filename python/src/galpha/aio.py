@@ -115,6 +115,7 @@ class AsyncFamily:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         mode: Union[str, Mode] = Mode.GENERAL,
         vertex_rule: Union[str, VertexRule] = VertexRule.REPORT,
         non_exterior_only: bool = False,
@@ -122,7 +123,7 @@ class AsyncFamily:
     ) -> Classification:
         request = pb.ClassifyRequest(
             handle=self.handle,
-            threshold=_network.threshold_message(threshold_from(alpha, alpha_sq, rank)),
+            threshold=_network.threshold_message(threshold_from(alpha, alpha_sq, rank, ratio)),
             mode=_network._MODES[_mode(mode)],
             vertex_rule=_network._RULES[_rule(vertex_rule)],
             non_exterior_only=non_exterior_only,
@@ -139,10 +140,11 @@ class AsyncFamily:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
         min_hole_area: float = 0.0,
     ) -> ShapeRings:
-        threshold = threshold_from(alpha, alpha_sq, rank)
+        threshold = threshold_from(alpha, alpha_sq, rank, ratio)
         m = _mode(mode)
         request = _network.shape_request(
             self.handle, threshold, m, area_argument("min_hole_area", min_hole_area, "keep every hole")
@@ -155,11 +157,14 @@ class AsyncFamily:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         mode: Union[str, Mode] = Mode.REGULARIZED,
         min_hole_area: float = 0.0,
     ) -> Any:
         m = _mode(mode)
-        rings = await self.shape_rings(alpha=alpha, alpha_sq=alpha_sq, rank=rank, mode=m, min_hole_area=min_hole_area)
+        rings = await self.shape_rings(
+            alpha=alpha, alpha_sq=alpha_sq, rank=rank, ratio=ratio, mode=m, min_hole_area=min_hole_area
+        )
         return rings_to_shapely(rings, self.points, m)
 
     async def holes(
@@ -168,12 +173,13 @@ class AsyncFamily:
         alpha: Optional[float] = None,
         alpha_sq: Optional[float] = None,
         rank: Optional[int] = None,
+        ratio: Optional[float] = None,
         min_area: float = 0.0,
         as_geodataframe: bool = False,
     ) -> Any:
         """The holes of the regularized shape at one threshold, as :meth:`galpha.Family.holes`
         (the rings from the server, their exact areas computed here from ``points``)."""
-        threshold = threshold_from(alpha, alpha_sq, rank)
+        threshold = threshold_from(alpha, alpha_sq, rank, ratio)
         minimum = area_argument("min_area", min_area, "every hole")
         request = _network.shape_request(self.handle, threshold, Mode.REGULARIZED, 0.0)
         rings = _network.shape_rings_from(await self._stream(self._calls.shape, request))
