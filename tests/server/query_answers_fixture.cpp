@@ -60,6 +60,11 @@ v1::Threshold Alpha(double alpha) {
   t.set_alpha(alpha);
   return t;
 }
+v1::Threshold Ratio(double ratio) {
+  v1::Threshold t;
+  t.set_ratio(ratio);
+  return t;
+}
 
 std::vector<v1::Threshold> Thresholds(const AlphaFamily& family) {
   const int64_t k = family.max_level();
@@ -70,7 +75,10 @@ std::vector<v1::Threshold> Thresholds(const AlphaFamily& family) {
                                     AlphaSq(0.0),
                                     AlphaSq(std::numeric_limits<double>::infinity()),
                                     Alpha(0.0),
-                                    Alpha(std::numeric_limits<double>::infinity())};
+                                    Alpha(std::numeric_limits<double>::infinity()),
+                                    Ratio(0.0),
+                                    Ratio(0.5),
+                                    Ratio(1.0)};
   if (k >= 1) {
     out.push_back(Rank(1));
     out.push_back(Rank(k / 2 + 1));

@@ -35,6 +35,7 @@ std::shared_ptr<const CachedFamily> LargeFamily();
 v1::Threshold Rank(int64_t rank);
 v1::Threshold AlphaSq(double alpha_sq);
 v1::Threshold Alpha(double alpha);
+v1::Threshold Ratio(double ratio);
 
 /// Thresholds of every kind that hit interesting levels of `family`.
 std::vector<v1::Threshold> Thresholds(const AlphaFamily& family);

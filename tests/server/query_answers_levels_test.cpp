@@ -7,6 +7,8 @@
 #include <cstdint>
 
 #include "absl/strings/str_cat.h"
+#include "core/family/area_ratio.hpp"
+#include "core/family/threshold.hpp"
 #include "gtest/gtest.h"
 #include "tests/server/query_answers_fixture.hpp"
 #include "tests/support/status_matchers.hpp"
@@ -20,6 +22,7 @@ using galpha::testing::StatusIs;
 using testing::Alpha;
 using testing::AlphaSq;
 using testing::Families;
+using testing::Ratio;
 using testing::NamedFamily;
 using testing::Rank;
 using testing::Thresholds;
@@ -54,6 +57,10 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
           EXPECT_EQ(resolved->level, *family.LevelForAlpha(threshold.alpha()));
           EXPECT_EQ(resolved->alpha_sq, threshold.alpha() * threshold.alpha());
           break;
+        case v1::Threshold::kRatio:
+          EXPECT_EQ(resolved->level, *LevelForAreaRatio(family, threshold.ratio()));
+          EXPECT_EQ(resolved->alpha_sq, PublishedAlphaSq(family, resolved->level));
+          break;
         case v1::Threshold::VALUE_NOT_SET:
           FAIL();
       }
@@ -78,6 +85,8 @@ TEST(QueryAnswersTest, ResolveLevelRefusesBadThresholds) {
     EXPECT_THAT(none.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     const absl::StatusOr<ResolvedLevel> beyond = ResolveLevel(family, Rank(k + 1));
     EXPECT_THAT(beyond.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(family, Ratio(1.5)).status(),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("outside 0..1")));
     EXPECT_NE(beyond.status().message().find(absl::StrCat(k + 1)), absl::string_view::npos) << beyond.status();
     EXPECT_THAT(ResolveLevel(family, Rank(-1)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
     EXPECT_THAT(ResolveLevel(family, AlphaSq(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
