@@ -64,6 +64,11 @@ const char kUsage[] =
     "  --max-points N              read at most N points (default 100000000, a default server's limit;\n"
     "                              at most 1073741824, the engine's)\n"
     "  --layer NAME                the layer of a .shp, .gpkg or .fgb FILE to read (default: its first)\n"
+    "  --crs CRS|none              the CRS of FILE's coordinates (EPSG:4326, WKT, a PROJ string), over\n"
+    "                              the one FILE states (GeoJSON: WGS84; LAS, GDAL sources: theirs);\n"
+    "                              none: planar coordinates. A geographic CRS (x longitude, y latitude)\n"
+    "                              is computed in metres (alpha, areas) in a local projection; GeoJSON\n"
+    "                              is written in WGS84 longitude/latitude, other formats in FILE's CRS\n"
     "  -h, --help                  this text\n"
     "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
     "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
@@ -88,7 +93,7 @@ const char kUsage[] =
 static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && kDefaultMaxLineBytes == 65536,
               "update kUsage");
 
-const absl::string_view kGlobalOptions[6] = {"backend", "server", "tls-ca", "encoding", "max-points", "layer"};
+const absl::string_view kGlobalOptions[7] = {"backend", "server", "tls-ca", "encoding", "max-points", "layer", "crs"};
 
 namespace {
 

@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
+#include "core/base/status_macros.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 
 namespace galpha::alphactl {
@@ -80,6 +81,10 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
     if (common.server.empty()) return absl::InvalidArgumentError("--tls-ca needs --server");
     common.tls_ca_file = *ca;
   }
+  if (const std::string* crs = line->Find("crs")) {
+    if (crs->empty()) return absl::InvalidArgumentError("--crs needs a CRS (as EPSG:4326), or none");
+    common.crs = *crs;
+  }
   if (const std::string* encoding = line->Find("encoding")) {
     if (common.server.empty()) return absl::InvalidArgumentError("--encoding needs --server");
     if (*encoding != "auto" && *encoding != "raw") {
@@ -127,11 +132,63 @@ absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vec
   return BuildAlphaFamily(points, options);
 }
 
-absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points) {
-  auto points = ReadPoints(common);
-  if (!points.ok()) return points.status();
-  *input_points = points->size();
-  return BuildFamily(common, *points);
+absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common) {
+  FramedPoints frame;
+  std::optional<std::string> stated;
+  try {
+    GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadInputPointsAndCrs(common.file, common.input));
+    frame.input = std::move(read.points);
+    stated = std::move(read.crs);
+  } catch (const std::exception& e) {
+    return absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
+  }
+  const std::optional<std::string> definition =
+      common.crs ? (*common.crs == "none" ? std::nullopt : common.crs) : stated;
+  if (!definition) return frame;
+  absl::StatusOr<CrsInfo> crs = DescribeCrs(*definition);
+  if (!crs.ok()) {
+    return absl::Status(crs.status().code(),
+                        absl::StrCat(common.crs ? "--crs: " : absl::StrCat("the CRS '", common.file, "' states: "),
+                                     crs.status().message(), common.crs ? "" : " (--crs overrides it)"));
+  }
+  frame.crs = *std::move(crs);
+  if (frame.crs->geographic) {
+    absl::StatusOr<LocalMetres> local = ProjectToLocalMetres(*frame.crs, frame.input);
+    if (!local.ok()) {
+      return absl::Status(local.status().code(),
+                          absl::StrCat("points file '", common.file, "': ", local.status().message()));
+    }
+    frame.projected = std::move(local->points);
+    frame.projection = std::move(local->projection);
+  }
+  return frame;
+}
+
+absl::StatusOr<std::vector<Point2>> OutputPoints(const FramedPoints& frame, bool geojson) {
+  if (!geojson || !frame.crs) return frame.input;
+  return ToWgs84LonLat(*frame.crs, frame.input);
+}
+
+nlohmann::ordered_json CrsJson(const FramedPoints& frame) {
+  if (!frame.crs) return nullptr;
+  return {{"name", frame.crs->name},
+          {"id", frame.crs->id.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(frame.crs->id)},
+          {"geographic", frame.crs->geographic},
+          {"computed_in", frame.crs->geographic ? nlohmann::ordered_json(frame.projection) : nullptr}};
+}
+
+std::string CrsLabel(const FramedPoints& frame) {
+  if (!frame.crs) return "";
+  return absl::StrCat("coordinates in CRS ", frame.crs->name, frame.crs->id.empty() ? "" : " (", frame.crs->id,
+                      frame.crs->id.empty() ? "" : ")");
+}
+
+absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points, FramedPoints* frame) {
+  GALPHA_ASSIGN_OR_RETURN(FramedPoints read, ReadFramedPoints(common));
+  *input_points = read.input.size();
+  absl::StatusOr<AlphaFamily> family = BuildFamily(common, read.Computed());
+  if (frame != nullptr) *frame = std::move(read);
+  return family;
 }
 
 absl::Status CheckThresholdRank(int64_t rank, int64_t k) {

@@ -20,6 +20,8 @@
 #include "core/base/point.hpp"
 #include "core/family/alpha_family.hpp"
 #include "core/family/threshold.hpp"
+#include "core/io/coordinate_system.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha::alphactl {
 
@@ -60,6 +62,9 @@ struct CommonArgs {
   bool raw_upload = false;
   /// How FILE is read: --max-points, --layer.
   InputOptions input;
+  /// --crs: the CRS of FILE's coordinates, overriding the one the file states ("none": planar
+  /// coordinates, no CRS, whatever the file states).
+  std::optional<std::string> crs;
 };
 /// ParseCommandLine with `allowed` and kGlobalOptions, then exactly one positional FILE and valid
 /// global options. --backend with --server, or --tls-ca without it, is a usage error.
@@ -96,12 +101,41 @@ absl::StatusOr<HolesArgs> ParseHolesArgs(const CommandLine& line);
 /// while reading (out of memory) reported as an error.
 absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common);
 
+/// FILE's points and the frame the family is computed in (docs/design.md, "Coordinate reference
+/// systems"): with a geographic CRS, the local projection of the points, in metres; otherwise
+/// the points as read.
+struct FramedPoints {
+  /// As read: the coordinates of the output geometry (WKT, SVG, text rings).
+  std::vector<Point2> input;
+  /// The local projection of `input` (geographic CRS only; empty otherwise).
+  std::vector<Point2> projected;
+  /// The CRS in effect: --crs, else the one FILE states; nullopt for planar coordinates.
+  std::optional<CrsInfo> crs;
+  /// The local projection as a PROJ string (geographic CRS only).
+  std::string projection;
+
+  /// What the family is built from, and what areas are measured in.
+  const std::vector<Point2>& Computed() const { return crs && crs->geographic ? projected : input; }
+};
+/// Reads FILE and resolves its CRS. Errors: ReadPoints's, an unknown CRS (naming --crs or the
+/// file), points that are not longitudes and latitudes of a geographic CRS.
+absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common);
+/// The coordinates a format is written in: for GeoJSON, WGS84 longitude/latitude where a CRS is
+/// known (RFC 7946); otherwise, and for every other format, the input's.
+absl::StatusOr<std::vector<Point2>> OutputPoints(const FramedPoints& frame, bool geojson);
+/// The CRS in effect as a summary reports it: null, or name, id (null if none), geographic, and
+/// the local projection the family was computed in (null for a planar CRS).
+nlohmann::ordered_json CrsJson(const FramedPoints& frame);
+/// "coordinates in CRS NAME (ID)", what an SVG's <desc> says; empty without a CRS.
+std::string CrsLabel(const FramedPoints& frame);
+
 /// Builds the family of `points` on the command's backend; for 100000 points or more, reports
 /// each build phase on stderr.
 absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points);
 
-/// ReadPoints, then BuildFamily. `input_points` receives the number of points read.
-absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points);
+/// ReadFramedPoints, then BuildFamily of the computed points. `input_points` receives the number of
+/// points read, `frame` (when given) the points and their CRS.
+absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points, FramedPoints* frame = nullptr);
 
 /// A threshold resolved against a family (core/family/threshold.hpp).
 using ResolvedThreshold = ::galpha::ResolvedThreshold;

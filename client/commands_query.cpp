@@ -38,7 +38,8 @@ int RunClassify(Args args) {
   if (!options.ok()) return UsageError(options.status());
   if (!common->server.empty()) return RemoteClassify(*common, *options);
   size_t input_points = 0;
-  auto family = LoadFamily(*common, &input_points);
+  FramedPoints frame;
+  auto family = LoadFamily(*common, &input_points, &frame);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, options->threshold);
   if (!threshold.ok()) return ArgumentError(threshold.status());
@@ -78,7 +79,8 @@ int RunSummary(Args args) {
   if (!options.ok()) return UsageError(options.status());
   if (!common->server.empty()) return RemoteSummary(*common, *options);
   size_t input_points = 0;
-  auto family = LoadFamily(*common, &input_points);
+  FramedPoints frame;
+  auto family = LoadFamily(*common, &input_points, &frame);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, options->threshold);
   if (!threshold.ok()) return ArgumentError(threshold.status());
@@ -104,6 +106,7 @@ int RunSummary(Args args) {
                                        {"holes", family->Holes(level, options->mode)},
                                        {"interior_area", counts.interior_area},
                                        {"hull_area", HullAreaApprox(*family)},
+                                       {"crs", CrsJson(frame)},
                                        {"backend", family->report().backend}};
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
@@ -132,18 +135,21 @@ int RunShape(Args args) {
   }
   if (!common->server.empty()) return RemoteShape(*common, *threshold_arg, *mode, *format, min_hole_area);
   size_t input_points = 0;
-  auto family = LoadFamily(*common, &input_points);
+  FramedPoints frame;
+  auto family = LoadFamily(*common, &input_points, &frame);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, *threshold_arg);
   if (!threshold.ok()) return ArgumentError(threshold.status());
 
   auto shape = AssembleShape(family->ComplexAt(threshold->level, *mode));
   if (!shape.ok()) return Failure(shape.status());
-  const absl::Span<const Point2> points = family->points();
-  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, points, min_hole_area);
-  std::string text = *format == "geojson" ? ShapeToGeoJson(*shape, points)
-                     : *format == "wkt"   ? ShapeToWkt(*shape, points)
-                                          : ShapeToSvg(*shape, points);
+  // Areas in the computation's units (metres for a geographic CRS); coordinates in the format's.
+  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family->points(), min_hole_area);
+  auto points = OutputPoints(frame, *format == "geojson");
+  if (!points.ok()) return Failure(points.status());
+  std::string text = *format == "geojson" ? ShapeToGeoJson(*shape, *points)
+                     : *format == "wkt"   ? ShapeToWkt(*shape, *points)
+                                          : ShapeToSvg(*shape, *points, CrsLabel(frame));
   if (text.empty() || text.back() != '\n') text += '\n';
   ChunkedWriter out(stdout);
   out.Append(text);

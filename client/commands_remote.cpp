@@ -21,6 +21,7 @@
 #include "client/commands.hpp"
 #include "client/galpha_client.hpp"
 #include "client/text_output.hpp"
+#include "core/base/status_macros.hpp"
 #include "core/geometry/shape.hpp"
 #include "core/geometry/shape_holes.hpp"
 #include "core/io/point_set_handle.hpp"
@@ -39,8 +40,9 @@ struct RemoteFamily {
   std::unique_ptr<client::AlphaClient> client;
   client::BuildResult build;
   size_t input_points = 0;
-  /// FILE's points (read once: it may be a pipe), for answers measured here (holes' areas).
-  std::vector<Point2> points;
+  /// FILE's points (read once: it may be a pipe) and their CRS: the server holds the computed
+  /// ones; answers written here (holes, shapes in a CRS) take their coordinates from the input.
+  FramedPoints frame;
 };
 
 absl::StatusOr<std::unique_ptr<client::AlphaClient>> ConnectTo(const CommonArgs& common) {
@@ -63,8 +65,10 @@ absl::Status ServerError(const CommonArgs& common, const absl::Status& status) {
 
 /// Reads FILE, then finds or builds its family on the server (progress on stderr for large files).
 absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_upload_if_cached = true) {
-  auto points = ReadPoints(common);
-  if (!points.ok()) return points.status();
+  auto frame = ReadFramedPoints(common);
+  if (!frame.ok()) return frame.status();
+  // With a geographic CRS the server gets the local projection: the family is in metres.
+  const std::vector<Point2>* points = &frame->Computed();
   RemoteFamily remote;
   remote.input_points = points->size();
   auto connected = ConnectTo(common);
@@ -100,7 +104,7 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
     std::fprintf(stderr, "alphactl: %s on the server (%.2f s%s)\n",
                  remote.build.cached ? "family found" : "family built", seconds, upload.c_str());
   }
-  remote.points = *std::move(points);
+  remote.frame = *std::move(frame);
   return remote;
 }
 
@@ -247,9 +251,45 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
                                        {"holes", summary.holes()},
                                        {"interior_area", summary.interior_area()},
                                        {"hull_area", summary.hull_area()},
+                                       {"crs", CrsJson(remote->frame)},
                                        {"backend", build.backend()}};
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
+}
+
+/// The shape a rings-format ShapeRequest answers, every index checked against FILE's points.
+absl::StatusOr<ShapeGeometry> RingsOfShape(RemoteFamily& remote, const v1::ShapeRequest& request) {
+  ShapeGeometry shape;
+  const size_t n = remote.frame.input.size();
+  auto checked = [n](const auto& indices) -> absl::Status {
+    for (uint32_t v : indices) {
+      if (v >= n) return absl::DataLossError("shape: the server named a vertex beyond FILE's");
+    }
+    return absl::OkStatus();
+  };
+  GALPHA_RETURN_IF_ERROR(remote.client->Shape(request, [&](const v1::ShapeResponse& m) -> absl::Status {
+    const v1::ShapeRings& rings = m.rings();
+    for (const v1::ShapePolygon& polygon : rings.polygons()) {
+      GALPHA_RETURN_IF_ERROR(checked(polygon.outer()));
+      ShapePolygon& out = shape.polygons.emplace_back();
+      out.outer.assign(polygon.outer().begin(), polygon.outer().end());
+      for (const v1::Ring& hole : polygon.holes()) {
+        GALPHA_RETURN_IF_ERROR(checked(hole.vertex_indices()));
+        out.holes.emplace_back(hole.vertex_indices().begin(), hole.vertex_indices().end());
+      }
+    }
+    GALPHA_RETURN_IF_ERROR(checked(rings.singular_edges()));
+    GALPHA_RETURN_IF_ERROR(checked(rings.isolated_points()));
+    if (rings.singular_edges_size() % 2 != 0) return absl::DataLossError("shape: an odd number of edge indices");
+    for (int i = 0; i + 1 < rings.singular_edges_size(); i += 2) {
+      shape.singular_edges.push_back({rings.singular_edges(i), rings.singular_edges(i + 1)});
+    }
+    shape.isolated_points.insert(shape.isolated_points.end(), rings.isolated_points().begin(),
+                                 rings.isolated_points().end());
+    shape.area += rings.area();
+    return absl::OkStatus();
+  }));
+  return shape;
 }
 
 int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, ClassifyMode mode,
@@ -266,6 +306,22 @@ int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, Cla
                      : format == "wkt"   ? v1::SHAPE_FORMAT_WKT
                                          : v1::SHAPE_FORMAT_SVG);
   request.set_min_hole_area(min_hole_area);
+  if (remote->frame.crs) {
+    // The server holds the computed (projected) points: the geometry is written here, in the
+    // coordinates of the format (docs/design.md, "Coordinate reference systems").
+    request.set_format(v1::SHAPE_FORMAT_RINGS);
+    auto shape = RingsOfShape(*remote, request);
+    if (!shape.ok()) return QueryError(common, shape.status());
+    auto points = OutputPoints(remote->frame, format == "geojson");
+    if (!points.ok()) return Failure(points.status());
+    std::string text = format == "geojson" ? ShapeToGeoJson(*shape, *points)
+                       : format == "wkt"   ? ShapeToWkt(*shape, *points)
+                                           : ShapeToSvg(*shape, *points, CrsLabel(remote->frame));
+    if (text.empty() || text.back() != '\n') text += '\n';
+    ChunkedWriter out(stdout);
+    out.Append(text);
+    return FinishOutput(out);
+  }
   ChunkedWriter out(stdout);
   char last = '\n';
   bool any = false;
@@ -417,7 +473,9 @@ int RemoteHoles(const CommonArgs& common, const HolesArgs& options) {
       out.outer.assign(polygon.outer().begin(), polygon.outer().end());
       for (const v1::Ring& hole : polygon.holes()) {
         for (uint32_t v : hole.vertex_indices()) {
-          if (v >= remote->points.size()) return absl::DataLossError("holes: the server named a vertex beyond FILE's");
+          if (v >= remote->frame.input.size()) {
+            return absl::DataLossError("holes: the server named a vertex beyond FILE's");
+          }
         }
         out.holes.emplace_back(hole.vertex_indices().begin(), hole.vertex_indices().end());
       }
@@ -425,8 +483,10 @@ int RemoteHoles(const CommonArgs& common, const HolesArgs& options) {
     return absl::OkStatus();
   });
   if (!status.ok()) return QueryError(common, status);
-  const std::vector<ShapeHole> holes = ListHoles(shape, remote->points, options.min_area);
-  if (!WriteHoles(holes, remote->points, options.format, stdout)) {
+  const std::vector<ShapeHole> holes = ListHoles(shape, remote->frame.Computed(), options.min_area);
+  auto points = OutputPoints(remote->frame, options.format == HolesFormat::kGeoJson);
+  if (!points.ok()) return Failure(points.status());
+  if (!WriteHoles(holes, *points, options.format, stdout)) {
     return Failure(absl::DataLossError("holes: writing to standard output failed"));
   }
   return kExitOk;

@@ -99,15 +99,19 @@ int RunHoles(Args args) {
   if (!options.ok()) return UsageError(options.status());
   if (!common->server.empty()) return RemoteHoles(*common, *options);
   size_t input_points = 0;
-  auto family = LoadFamily(*common, &input_points);
+  FramedPoints frame;
+  auto family = LoadFamily(*common, &input_points, &frame);
   if (!family.ok()) return Failure(family.status());
   auto threshold = ResolveThreshold(*family, options->threshold);
   if (!threshold.ok()) return ArgumentError(threshold.status());
   // The polygons are the same in both modes: holes are rings of the regularized shape.
   auto shape = AssembleShape(family->ComplexAt(threshold->level, ClassifyMode::kRegularized));
   if (!shape.ok()) return Failure(shape.status());
+  // Areas in the computation's units (metres for a geographic CRS); rings in the format's.
   const std::vector<ShapeHole> holes = ListHoles(*shape, family->points(), options->min_area);
-  if (!WriteHoles(holes, family->points(), options->format, stdout)) {
+  auto points = OutputPoints(frame, options->format == HolesFormat::kGeoJson);
+  if (!points.ok()) return Failure(points.status());
+  if (!WriteHoles(holes, *points, options->format, stdout)) {
     return Failure(absl::DataLossError("holes: writing to standard output failed"));
   }
   return kExitOk;

@@ -254,7 +254,8 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
         named, " has ", info.st_size, " bytes, room for ", (static_cast<uint64_t>(info.st_size) - 8) / sizeof(Point2),
         " points: more than ", options.max_points, ", the limit (--max-points raises it)"));
   }
-  GALPHA_ASSIGN_OR_RETURN(read.points, CheckCount(ReadPointsFile(file), named, options.max_points));
+  GALPHA_ASSIGN_OR_RETURN(read, ReadGeoreferencedPointsFile(file));
+  GALPHA_ASSIGN_OR_RETURN(read.points, CheckCount(std::move(read.points), named, options.max_points));
   return read;
 }
 

@@ -26,9 +26,13 @@ for b in "$dest"/bin/*; do
 done | sort -u | grep -vE '/(libc|libm|libpthread|libdl|librt|libstdc\+\+|libgcc_s|libcuda)\.so|ld-linux' |
   while read -r lib; do cp -L "$lib" "$dest/lib/"; done
 strip --strip-unneeded "$dest"/bin/* "$dest"/lib/*
+# PROJ's database (alphactl --crs; the image sets PROJ_DATA to it).
+mkdir -p "$dest/share/proj" && cp /usr/share/proj/proj.db "$dest/share/proj/"
 
-# Smoke test of the staged tree: libraries found, server up, health SERVING, SIGTERM exits 0.
-export LD_LIBRARY_PATH="$dest/lib"
+# Smoke test of the staged tree: libraries found, server up, health SERVING, SIGTERM exits 0;
+# alphactl projects with the staged PROJ database.
+export LD_LIBRARY_PATH="$dest/lib" PROJ_DATA="$dest/share/proj"
+printf -- '-123.0 44.0\n-122.99 44.0\n-123.0 44.01\n' | "$dest/bin/alphactl" summary - --crs EPSG:4326 --rank 1 --backend=cpu >/dev/null
 log=$(mktemp)
 "$dest/bin/galpha_server" --listen=127.0.0.1:0 --metrics_listen= --backend=cpu --drain_notice_ms=0 >"$log" 2>&1 &
 pid=$!

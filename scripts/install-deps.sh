@@ -15,6 +15,7 @@ server_packages=(
   libzstd-dev            # zstd-compressed point chunks on the wire (proto/codec)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler  # the gRPC service
   prometheus-cpp-dev libcivetweb-dev  # the metrics exporter
+  libproj-dev proj-data  # coordinate reference systems: geographic input in metres, GeoJSON in WGS84 (GALPHA_WITH_PROJ)
 )
 # Everything else the tests, benchmarks and CI need (the default profile, "all").
 test_packages=(

@@ -400,7 +400,7 @@ std::string ShapeToGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> 
   return JsonText({{"type", "FeatureCollection"}, {"features", std::move(features)}});
 }
 
-std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points) {
+std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points, absl::string_view description) {
   double min_x = 0.0, max_x = 0.0, min_y = 0.0, max_y = 0.0;
   for (size_t i = 0; i < points.size(); ++i) {
     const Point2& p = points[i];
@@ -431,9 +431,19 @@ std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> poin
   std::string out = absl::StrCat("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"", number(-margin), " ",
                                  number(-margin), " ", width, " ", height, "\" width=\"800\" height=\"",
                                  number(800.0 * (max_y - min_y + 2 * margin) / (max_x - min_x + 2 * margin)),
-                                 "\" preserveAspectRatio=\"xMidYMid meet\">\n",
-                                 "<g fill=\"#4a90d9\" fill-opacity=\"0.6\" stroke=\"#1f4e79\" stroke-width=\"", stroke,
-                                 "\" stroke-linejoin=\"round\" fill-rule=\"evenodd\">\n");
+                                 "\" preserveAspectRatio=\"xMidYMid meet\">\n");
+  if (!description.empty()) {
+    out += "<desc>";
+    for (char c : description) {
+      out += c == '&'   ? std::string("&amp;")
+             : c == '<' ? std::string("&lt;")
+             : c == '>' ? std::string("&gt;")
+                        : std::string(1, c);
+    }
+    out += "</desc>\n";
+  }
+  absl::StrAppend(&out, "<g fill=\"#4a90d9\" fill-opacity=\"0.6\" stroke=\"#1f4e79\" stroke-width=\"", stroke,
+                  "\" stroke-linejoin=\"round\" fill-rule=\"evenodd\">\n");
   auto append_ring = [&](const std::vector<uint32_t>& ring) {
     for (size_t i = 0; i < ring.size(); ++i) absl::StrAppend(&out, i == 0 ? "M" : " L", local(points[ring[i]]));
     out += " Z";

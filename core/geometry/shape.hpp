@@ -98,7 +98,9 @@ std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> poin
 /// so that shapes of one point set at different alphas line up), y points up (north up), each
 /// polygon is one path with fill-rule evenodd, singular edges are lines, isolated points small
 /// circles. Coordinates are written relative to the points' bounding box, so that large offsets
-/// keep their detail in a browser's single-precision renderer.
-std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points);
+/// keep their detail in a browser's single-precision renderer. A non-empty `description` (the
+/// coordinates' CRS, for one) becomes the document's <desc>, XML-escaped.
+std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points,
+                       absl::string_view description = {});
 
 }  // namespace galpha

@@ -136,7 +136,31 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
 
 }  // namespace
 
-absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source) {
+namespace {
+
+/// The CRS a GeoJSON document states: RFC 7946's WGS84 longitude/latitude, unless a 2008-style
+/// "crs" member names another (GDAL still writes one for other CRSs).
+absl::StatusOr<std::string> GeoJsonCrs(const nlohmann::json& document, const std::string& source) {
+  if (!document.is_object() || !document.contains("crs") || document["crs"].is_null()) return std::string("OGC:CRS84");
+  const nlohmann::json& crs = document["crs"];
+  const nlohmann::json* properties =
+      crs.is_object() && crs.contains("properties") && crs["properties"].is_object() ? &crs["properties"] : nullptr;
+  if (properties != nullptr && crs.value("type", "") == "name" && properties->contains("name") &&
+      (*properties)["name"].is_string()) {
+    return (*properties)["name"].get<std::string>();
+  }
+  if (properties != nullptr && crs.value("type", "") == "EPSG" && properties->contains("code") &&
+      (*properties)["code"].is_number_integer()) {
+    return absl::StrCat("EPSG:", (*properties)["code"].get<int64_t>());
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(source, ": the crs member is neither {\"type\": \"name\", \"properties\": {\"name\": ...}} nor "
+                           "{\"type\": \"EPSG\", \"properties\": {\"code\": ...}}"));
+}
+
+}  // namespace
+
+absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source) {
   nlohmann::json document;
   try {
     document = nlohmann::json::parse(text.begin(), text.end());
@@ -147,10 +171,19 @@ absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, c
     // out_of_range; found by the point-format fuzzer.
     return absl::InvalidArgumentError(absl::StrCat(source, ": JSON the parser cannot represent (", e.what(), ")"));
   }
-  std::vector<Point2> points;
-  const absl::Status status = AppendGeoJsonPoints(document, "", source, &points);
+  GeoreferencedPoints out;
+  const absl::Status status = AppendGeoJsonPoints(document, "", source, &out.points);
   if (!status.ok()) return status;
-  return points;
+  absl::StatusOr<std::string> crs = GeoJsonCrs(document, source);
+  if (!crs.ok()) return crs.status();
+  out.crs = *std::move(crs);
+  return out;
+}
+
+absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source) {
+  absl::StatusOr<GeoreferencedPoints> read = ParseGeoreferencedGeoJson(text, source);
+  if (!read.ok()) return read.status();
+  return std::move(read->points);
 }
 
 absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source) {
@@ -245,6 +278,12 @@ absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, cons
 }
 
 absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
+  absl::StatusOr<GeoreferencedPoints> read = ReadGeoreferencedPointsFile(path);
+  if (!read.ok()) return read.status();
+  return std::move(read->points);
+}
+
+absl::StatusOr<GeoreferencedPoints> ReadGeoreferencedPointsFile(const std::string& path) {
   const std::string extension = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
   std::error_code error;
   if (!std::filesystem::exists(path, error)) {
@@ -254,12 +293,15 @@ absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
   if (std::filesystem::is_directory(path, error)) {
     return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' is a directory"));
   }
-  if (extension == ".bin") return ReadPointsBin(path);
-  if (extension == ".las") {
-    absl::StatusOr<GeoreferencedPoints> las = ReadLasPoints(path);
-    if (!las.ok()) return las.status();
-    return std::move(las->points);
-  }
+  // Formats without a CRS.
+  auto plain = [](absl::StatusOr<std::vector<Point2>> points) -> absl::StatusOr<GeoreferencedPoints> {
+    if (!points.ok()) return points.status();
+    GeoreferencedPoints out;
+    out.points = *std::move(points);
+    return out;
+  };
+  if (extension == ".bin") return plain(ReadPointsBin(path));
+  if (extension == ".las") return ReadLasPoints(path);
   if (extension == ".laz") {
     return absl::InvalidArgumentError(
         absl::StrCat("points file '", path, "' is compressed LAS (LAZ), which is not read: decompress it to .las"));
@@ -273,9 +315,9 @@ absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
   if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open points file '", path, "'"));
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) return absl::DataLossError(absl::StrCat("cannot read points file '", path, "'"));
-  if (extension == ".npy") return ParsePointsNpy(bytes, path);
-  if (extension == ".geojson" || extension == ".json") return ParsePointsGeoJson(bytes, path);
-  return ParsePointsText(bytes, path);
+  if (extension == ".npy") return plain(ParsePointsNpy(bytes, path));
+  if (extension == ".geojson" || extension == ".json") return ParseGeoreferencedGeoJson(bytes, path);
+  return plain(ParsePointsText(bytes, path));
 }
 
 }  // namespace galpha

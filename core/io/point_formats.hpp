@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
 #include "core/base/point.hpp"
+#include "core/io/georeferenced_points.hpp"
 
 namespace galpha {
 
@@ -40,12 +41,22 @@ absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, cons
 /// silently), a position that is not an array of two or three numbers.
 absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, const std::string& source);
 
+/// ParsePointsGeoJson with the document's CRS: "OGC:CRS84" (RFC 7946: WGS84 longitude and
+/// latitude, always), or the name of a 2008-style "crs" member ({"type": "name", "properties":
+/// {"name": "urn:ogc:def:crs:EPSG::3857"}}, or {"type": "EPSG", "properties": {"code": 3857}}),
+/// which GDAL still writes for other CRSs. InvalidArgument for a "crs" member of another form.
+absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source);
+
 /// Reads a point file, choosing the format by extension: `.bin` (raw, point_io.hpp), `.npy`,
-/// `.geojson` or `.json`, `.las` (las_reader.hpp, without its CRS), anything else as delimited text
+/// `.geojson` or `.json`, `.las` (las_reader.hpp), anything else as delimited text
 /// except the formats refused by name: `.laz` (compressed LAS) and the GDAL vector sources of
 /// vector_points.hpp (`.shp`, `.gpkg`, `.fgb`: InvalidArgument; ReadVectorPoints reads them). Errors
 /// name the file: NotFound when it does not exist, the errno-derived code when it cannot be read, and
 /// the parsers' errors above.
 absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path);
+
+/// ReadPointsFile with the CRS the file states: a LAS file's (las_reader.hpp), a GeoJSON
+/// document's (ParseGeoreferencedGeoJson); nullopt for the formats that state none.
+absl::StatusOr<GeoreferencedPoints> ReadGeoreferencedPointsFile(const std::string& path);
 
 }  // namespace galpha

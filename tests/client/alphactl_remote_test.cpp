@@ -89,6 +89,35 @@ TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
   EXPECT_NE(bench.out.find("backend"), std::string::npos);
 }
 
+#ifdef GALPHA_WITH_PROJ
+// The GPS tracks are WGS84 longitudes and latitudes: with --crs the server holds their local
+// projection (metres) and alphactl writes the geometry in the input's coordinates, as locally.
+TEST(AlphactlRemoteTest, GeographicInputAnswersAsLocally) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  const std::string file = galpha::testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
+  const char* commands[] = {
+      "spectrum",
+      "summary --ratio 0.5 --mode regularized",
+      "shape --ratio 0.8 --format geojson",
+      "shape --alpha 2000 --format wkt --mode general",
+      "shape --rank 300 --format svg --min-hole-area 1e6",
+      "holes --rank 3500 --format geojson",
+      "holes --rank 3500",
+  };
+  for (const char* command : commands) {
+    SCOPED_TRACE(command);
+    const std::string args = std::string(command) + " " + file + " --crs EPSG:4326";
+    const CommandResult local = Alphactl(args);
+    const CommandResult remote = Alphactl(args + " --server " + server.address());
+    EXPECT_EQ(local.exit_code, 0) << local.err;
+    EXPECT_EQ(remote.exit_code, 0) << remote.err;
+    EXPECT_FALSE(local.out.empty());
+    EXPECT_EQ(remote.out, local.out);
+  }
+}
+#endif
+
 // --server, like every global option, may come before the command (as in git and kubectl), and
 // a pipe is read once and uploaded like a file.
 TEST(AlphactlRemoteTest, ServerMayComeBeforeTheCommand) {

@@ -3,6 +3,10 @@
 // real data set, checking the exact output formats, the JSON, the exit codes and one-line errors.
 #include <gtest/gtest.h>
 
+#ifdef GALPHA_WITH_PROJ
+#include <geodesic.h>
+#endif
+
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +14,7 @@
 #include <array>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -299,7 +304,7 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   EXPECT_EQ(keys,
             (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size", "level",
                                       "alpha_sq", "mode", "vertex_rule", "vertices", "edges", "triangles", "components",
-                                      "solid_components", "holes", "interior_area", "hull_area", "backend"}));
+                                      "solid_components", "holes", "interior_area", "hull_area", "crs", "backend"}));
   const nlohmann::json expected = {{"file", SquareCsv()},
                                    {"points", 4},
                                    {"distinct_points", 4},
@@ -317,6 +322,7 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
                                    {"holes", 1},  // the four sides enclose the square
                                    {"interior_area", 0.0},
                                    {"hull_area", 1.0},
+                                   {"crs", nullptr},
                                    {"backend", "cpu"}};
   EXPECT_EQ(nlohmann::json::parse(run.out), expected);
   // Compact, doubles as their shortest text (0.25, not 0.25000000000000000; 0, not 0.0).
@@ -402,6 +408,137 @@ TEST(AlphactlTest, AreaRatiosPickTheSmallestRankThatCoversThem) {
   ExpectError(Alphactl("shape " + Quote(square) + " --ratio half --format wkt"), 2, "--ratio 'half'");
   std::filesystem::remove(file);
 }
+
+#ifdef GALPHA_WITH_PROJ
+
+// Longitude/latitude points around Eugene, Oregon (x longitude, y latitude), a ring of 40 and
+// 60 random ones inside: a geographic set that alphactl computes in metres.
+std::vector<std::array<double, 2>> LonLatPoints() {
+  std::mt19937_64 random(44);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<std::array<double, 2>> points;
+  for (int i = 0; i < 40; ++i) {
+    const double angle = 2 * 3.14159265358979 * i / 40;
+    points.push_back({-123.1 + 0.05 * std::cos(angle), 44.05 + 0.04 * std::sin(angle)});
+  }
+  for (int i = 0; i < 60; ++i) {
+    const double r = 0.9 * std::sqrt(unit(random)), angle = 2 * 3.14159265358979 * unit(random);
+    points.push_back({-123.1 + 0.05 * r * std::cos(angle), 44.05 + 0.04 * r * std::sin(angle)});
+  }
+  return points;
+}
+
+std::string PointsCsv(const std::vector<std::array<double, 2>>& points) {
+  std::string text = "lon,lat\n";
+  for (const auto& p : points) text += Printed(p[0]) + "," + Printed(p[1]) + "\n";
+  return text;
+}
+
+/// The geodesic area (m^2, WGS84) of the ring of input points `ring` (GeographicLib's algorithm).
+double GeodesicArea(const std::vector<std::array<double, 2>>& ring) {
+  geod_geodesic g{};
+  geod_init(&g, 6378137.0, 1 / 298.257223563);
+  std::vector<double> lats, lons;
+  for (const auto& p : ring) lats.push_back(p[1]), lons.push_back(p[0]);
+  double area = 0, perimeter = 0;
+  geod_polygonarea(&g, lats.data(), lons.data(), static_cast<int>(ring.size()), &area, &perimeter);
+  return std::abs(area);
+}
+
+TEST(AlphactlTest, GeographicInputIsComputedInMetresAndWrittenInItsCrs) {
+  const std::vector<std::array<double, 2>> points = LonLatPoints();
+  const std::string csv = WriteFile("alphactl_lonlat.csv", PointsCsv(points));
+  const nlohmann::json summary = nlohmann::json::parse(Succeeds("summary", csv, "--crs EPSG:4326 --ratio 1"));
+  EXPECT_EQ(summary["crs"]["name"], "WGS 84");
+  EXPECT_EQ(summary["crs"]["id"], "EPSG:4326");
+  EXPECT_EQ(summary["crs"]["geographic"], true);
+  EXPECT_NE(summary["crs"]["computed_in"].get<std::string>().find("+proj=aeqd"), std::string::npos);
+  // The hull's area in square metres: the geodesic area of the ring of 40 (the convex hull),
+  // within the local projection's distortion (aeqd is not equal-area: about 1e-7 here).
+  std::vector<std::array<double, 2>> ring(points.begin(), points.begin() + 40);
+  EXPECT_NEAR(summary["hull_area"].get<double>(), GeodesicArea(ring), 1e-6 * GeodesicArea(ring));
+  EXPECT_NEAR(summary["interior_area"].get<double>(), summary["hull_area"].get<double>(), 1e-9 * GeodesicArea(ring));
+
+  // Alpha is in metres: the spectrum's values are squared metres (neighbours are hundreds of
+  // metres apart, so about 1e4 to 1e7), and --alpha takes metres.
+  const std::vector<std::string> spectrum = SplitLines(Succeeds("spectrum", csv, "--crs EPSG:4326"));
+  ASSERT_FALSE(spectrum.empty());
+  EXPECT_GT(std::stod(spectrum.front()), 1e3);
+  EXPECT_LT(std::stod(spectrum.back()), 1e8);
+  const nlohmann::json by_metres = nlohmann::json::parse(Succeeds("summary", csv, "--crs EPSG:4326 --alpha 1000"));
+  EXPECT_EQ(by_metres["alpha_sq"], 1e6);
+
+  // GeoJSON (RFC 7946) and WKT carry the input's coordinates, bit for bit (WGS84 already).
+  const nlohmann::json geojson =
+      nlohmann::json::parse(Succeeds("shape", csv, "--crs EPSG:4326 --ratio 1 --format geojson"));
+  const auto& outer = geojson["features"][0]["geometry"]["coordinates"][0][0];
+  EXPECT_EQ(outer.size(), 41u);
+  for (const auto& position : outer) {
+    const std::array<double, 2> p = {position[0].get<double>(), position[1].get<double>()};
+    EXPECT_NE(std::find(points.begin(), points.end(), p), points.end()) << position;
+  }
+  EXPECT_NE(Succeeds("shape", csv, "--crs EPSG:4326 --ratio 1 --format wkt")
+                .find(Printed(points[0][0]) + " " + Printed(points[0][1])),
+            std::string::npos);
+
+  // SVG names the CRS of its coordinates.
+  EXPECT_NE(Succeeds("shape", csv, "--crs EPSG:4326 --ratio 1 --format svg")
+                .find("<desc>coordinates in CRS WGS 84 (EPSG:4326)</desc>"),
+            std::string::npos);
+
+  // A GeoJSON point file is WGS84 longitude/latitude (RFC 7946): the same family without --crs.
+  std::string features = R"({"type":"FeatureCollection","features":[)";
+  for (size_t i = 0; i < points.size(); ++i) {
+    features += (i ? "," : "") +
+                std::string(R"({"type":"Feature","properties":{},"geometry":{"type":"Point","coordinates":[)") +
+                Printed(points[i][0]) + "," + Printed(points[i][1]) + "]}}";
+  }
+  const std::string geojson_file = WriteFile("alphactl_lonlat.geojson", features + "]}");
+  EXPECT_EQ(Succeeds("spectrum", geojson_file, ""), Succeeds("spectrum", csv, "--crs EPSG:4326"));
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", geojson_file, "--rank 5"))["crs"]["id"], "OGC:CRS84");
+  // --crs none: planar coordinates (squared degrees), as before CRSs.
+  EXPECT_EQ(Succeeds("spectrum", geojson_file, "--crs none"), Succeeds("spectrum", csv, ""));
+  EXPECT_TRUE(nlohmann::json::parse(Succeeds("summary", csv, "--rank 5"))["crs"].is_null());
+  std::filesystem::remove(geojson_file);
+  std::filesystem::remove(csv);
+}
+
+TEST(AlphactlTest, ProjectedInputStaysAndGeoJsonIsWgs84) {
+  // UTM zone 10N (metres): computed as given; GeoJSON in longitude/latitude (pyproj's values for
+  // (500000, 5000000): -123.00000000000001, 45.153477183356024).
+  const std::string csv =
+      WriteFile("alphactl_utm.csv", "x,y\n500000,5000000\n500100,5000000\n500100,5000100\n500000,5000100\n");
+  EXPECT_EQ(Succeeds("spectrum", csv, "--crs EPSG:32610"), Succeeds("spectrum", csv, ""));
+  const nlohmann::json summary = nlohmann::json::parse(Succeeds("summary", csv, "--crs EPSG:32610 --ratio 1"));
+  EXPECT_EQ(summary["crs"]["geographic"], false);
+  EXPECT_TRUE(summary["crs"]["computed_in"].is_null());
+  EXPECT_EQ(summary["hull_area"], 10000.0);
+  const nlohmann::json geojson =
+      nlohmann::json::parse(Succeeds("shape", csv, "--crs EPSG:32610 --ratio 1 --format geojson"));
+  EXPECT_EQ(geojson["features"][0]["properties"]["area"], 10000.0);
+  const auto& first = geojson["features"][0]["geometry"]["coordinates"][0][0][0];
+  EXPECT_NEAR(first[0].get<double>(), -123.00000000000001, 1e-9);
+  EXPECT_NEAR(first[1].get<double>(), 45.153477183356024, 1e-9);
+  // WKT stays in the input's CRS.
+  EXPECT_NE(Succeeds("shape", csv, "--crs EPSG:32610 --ratio 1 --format wkt").find("5e+05 5e+06"), std::string::npos);
+  // A GeoJSON file with a 2008-style crs member is in that CRS.
+  const std::string named =
+      WriteFile("alphactl_utm.geojson",
+                R"({"type":"MultiPoint","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::32610"}},)"
+                R"("coordinates":[[500000,5000000],[500100,5000000],[500100,5000100],[500000,5000100]]})");
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", named, "--rank 1"))["crs"]["name"], "WGS 84 / UTM zone 10N");
+  EXPECT_EQ(Succeeds("spectrum", named, ""), Succeeds("spectrum", csv, ""));
+
+  ExpectError(Alphactl("summary " + Quote(csv) + " --rank 1 --crs EPSG:4326"), 1,
+              "point 0 (5e+05, 5e+06) is not a longitude and latitude");
+  ExpectError(Alphactl("summary " + Quote(csv) + " --rank 1 --crs nonsense"), 1,
+              "--crs: CRS 'nonsense' is not understood");
+  ExpectError(Alphactl("summary " + Quote(csv) + " --rank 1 --crs EPSG:4978"), 1, "geocentric");
+  std::filesystem::remove(named);
+  std::filesystem::remove(csv);
+}
+
+#endif  // GALPHA_WITH_PROJ
 
 TEST(AlphactlTest, ShapesInEveryFormat) {
   const std::string& square = SquareCsv();

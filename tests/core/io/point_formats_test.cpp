@@ -154,6 +154,27 @@ TEST(ParsePointsGeoJsonTest, NumbersBeyondADoubleAreAnErrorNotACrash) {
   EXPECT_NE(overflow.status().message().find("big.json"), std::string::npos) << overflow.status();
 }
 
+TEST(ParsePointsGeoJsonTest, CrsIsWgs84UnlessACrsMemberNamesAnother) {
+  const absl::StatusOr<GeoreferencedPoints> plain =
+      ParseGeoreferencedGeoJson(R"({"type":"Point","coordinates":[1.5,2.5]})", "p");
+  ASSERT_THAT(plain, IsOk());
+  EXPECT_EQ(plain->crs, "OGC:CRS84");  // RFC 7946
+  ASSERT_EQ(plain->points.size(), 1u);
+  EXPECT_EQ(plain->points[0].x, 1.5);
+  const absl::StatusOr<GeoreferencedPoints> named = ParseGeoreferencedGeoJson(
+      R"({"type":"MultiPoint","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::3857"}},)"
+      R"("coordinates":[[1,2]]})",
+      "n");
+  ASSERT_THAT(named, IsOk());
+  EXPECT_EQ(named->crs, "urn:ogc:def:crs:EPSG::3857");
+  const absl::StatusOr<GeoreferencedPoints> coded = ParseGeoreferencedGeoJson(
+      R"({"type":"Point","crs":{"type":"EPSG","properties":{"code":32610}},"coordinates":[1,2]})", "c");
+  ASSERT_THAT(coded, IsOk());
+  EXPECT_EQ(coded->crs, "EPSG:32610");
+  EXPECT_THAT(ParseGeoreferencedGeoJson(R"({"type":"Point","crs":{"type":"link"},"coordinates":[1,2]})", "bad"),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("bad: the crs member")));
+}
+
 TEST(ParsePointsGeoJsonTest, ErrorsNameThePlace) {
   const auto line = ParsePointsGeoJson(R"({"type": "FeatureCollection", "features": [
       {"type": "Feature", "geometry": {"type": "Point", "coordinates": [1, 2]}},
