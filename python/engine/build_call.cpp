@@ -9,9 +9,11 @@
 #include "absl/strings/str_cat.h"
 #include "absl/types/span.h"
 #include "core/base/point.hpp"
+#include "core/io/coordinate_system.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "python/engine/engine_error.hpp"
+#include "python/engine/numpy_arrays.hpp"
 
 namespace py = pybind11;
 
@@ -107,6 +109,37 @@ std::string HandleOf(const py::object& points) {
   const absl::Span<const Point2> span = PointsOf(array);
   py::gil_scoped_release release;
   return PointSetHandle(span);
+}
+
+py::dict FrameOf(const std::string& crs, const py::object& points) {
+  const PointArray array = AsPointArray(points);
+  const absl::Span<const Point2> span = PointsOf(array);
+  py::dict out;
+  const CrsInfo info = ValueOrThrow(DescribeCrs(crs));
+  out["name"] = info.name;
+  out["id"] = info.id.empty() ? py::object(py::none()) : py::object(py::str(info.id));
+  out["geographic"] = info.geographic;
+  out["points"] = py::none();
+  out["projection"] = py::none();
+  if (!info.geographic) return out;
+  LocalMetres local;
+  {
+    py::gil_scoped_release release;
+    absl::StatusOr<LocalMetres> projected = ProjectToLocalMetres(info, span);
+    if (!projected.ok()) {
+      py::gil_scoped_acquire acquire;
+      throw StatusError(projected.status());
+    }
+    local = *std::move(projected);
+  }
+  std::vector<double> flat(2 * local.points.size());
+  for (size_t i = 0; i < local.points.size(); ++i) {
+    flat[2 * i] = local.points[i].x;
+    flat[2 * i + 1] = local.points[i].y;
+  }
+  out["points"] = ArrayFromVector(std::move(flat), {static_cast<py::ssize_t>(local.points.size()), 2});
+  out["projection"] = local.projection;
+  return out;
 }
 
 }  // namespace galpha::python

@@ -23,4 +23,10 @@ std::shared_ptr<const FamilyState> BuildFamily(const pybind11::object& points, c
 /// The content handle of `points` (core/io/point_set_handle.hpp), hashed with the GIL released.
 std::string HandleOf(const pybind11::object& points);
 
+/// The frame `points` are computed in under CRS `crs` (core/io/coordinate_system.hpp): a dict of
+/// name, id (None if PROJ knows none), geographic, and for a geographic CRS points (their local
+/// projection, an (N, 2) float64 array in metres) and projection (its PROJ string), else None for
+/// both. EngineError for an unknown CRS or points that are not longitudes and latitudes.
+pybind11::dict FrameOf(const std::string& crs, const pybind11::object& points);
+
 }  // namespace galpha::python

@@ -26,6 +26,9 @@ PYBIND11_MODULE(_engine, module) {
       "phase; Ctrl-C or an exception in progress stops the build between phases and is raised.");
   module.def("handle", &galpha::python::HandleOf, py::arg("points"),
              "The content handle of an (N, 2) float64 array, as the server and the C++ client compute it.");
+  module.def("frame", &galpha::python::FrameOf, py::arg("crs"), py::arg("points"),
+             "The CRS `crs` (EPSG:4326, WKT, a PROJ string) as PROJ reads it, and for a geographic CRS the local "
+             "projection (metres) of the (N, 2) longitude/latitude array that galpha computes in.");
   module.def("cuda_available", &galpha::CudaBackendAvailable,
              "Whether this build has the CUDA backend and a GPU is visible now.");
 }

@@ -8,6 +8,7 @@ from typing import Any, Callable, Optional, Protocol, Union
 
 
 from ._encoding import check_encoding
+from ._crs import frame_of
 from ._errors import InvalidInput
 from ._family import Family
 from ._points import as_points
@@ -21,7 +22,9 @@ PROGRESS_BAR_MIN_POINTS = 100_000
 
 
 class Client(Protocol):
-    def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> Family: ...
+    def build(
+        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+    ) -> Family: ...
 
     def close(self) -> None: ...
 
@@ -82,8 +85,15 @@ class NetworkClient:
     def __repr__(self) -> str:
         return f"<galpha.NetworkClient {self.target}>"
 
-    def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> Family:
+    def build(
+        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+    ) -> Family:
         """Uploads the points (unless the server already holds them) and returns their family.
+
+        ``crs``: the CRS of the coordinates ("EPSG:4326", an EPSG code, a pyproj CRS; "none" for
+        planar ones), by default a GeoSeries' or GeoDataFrame's own. A geographic CRS is computed
+        in metres (alpha, areas) in a local projection, which is what the server receives; the
+        shapes keep the input's coordinates (see :attr:`Family.projection`).
 
         ``encoding``: ``"auto"`` sends each 65,536-point chunk in its smallest lossless form (exact
         scaled integers or float64, a transform, zstd; raw doubles when nothing is smaller);
@@ -92,32 +102,35 @@ class NetworkClient:
         points"). Either way the server builds the same family under the same handle.
         """
         encoding = check_encoding(encoding)
-        array, crs = as_points(points)
+        array, data_crs = as_points(points)
+        frame = frame_of(array, crs, data_crs)
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         try:
             sent = None if callback is None else (lambda n: callback("upload", n / total))
             # The server's build reports no progress: the bar shows the wait as stage "build".
             building = None if callback is None else (lambda done: callback("build", 1.0 if done else 0.0))
-            backend = self._network.build_on_server(self._calls, array, name, sent, encoding, building)
+            backend = self._network.build_on_server(self._calls, frame.computed, name, sent, encoding, building)
         finally:
             if close is not None:
                 close()
-        return Family(backend, array, crs)
+        return Family(backend, array, frame)
 
-    def family(self, handle: str, points: Any) -> Family:
+    def family(self, handle: str, points: Any, *, crs: Any = None) -> Family:
         """The family the server holds under ``handle`` for these points (NotFound if it holds
-        none); the points give the answers' coordinates and must be the ones the handle names."""
+        none); the points give the answers' coordinates and must be the ones the handle names
+        (with ``crs`` as :meth:`build` took it: the handle names the computed points)."""
         from ._errors import NotFound
         from ._handle import point_set_handle
 
-        array, crs = as_points(points)
-        if point_set_handle(array) != handle:
+        array, data_crs = as_points(points)
+        frame = frame_of(array, crs, data_crs)
+        if point_set_handle(frame.computed) != handle:
             raise InvalidInput(f"these points have another handle than {handle}")
         summary = self._network.find_cached(self._calls, handle)
         if summary is None:
             raise NotFound(f"the server holds no family under {handle}")
-        return Family(self._network.NetworkFamilyBackend(self._calls, handle, summary), array, crs)
+        return Family(self._network.NetworkFamilyBackend(self._calls, handle, summary), array, frame)
 
     def close(self) -> None:
         self._channel.close()
@@ -143,19 +156,22 @@ class LocalClient:
     def __repr__(self) -> str:
         return f"<galpha.LocalClient backend={self.backend}>"
 
-    def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> Family:
+    def build(
+        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+    ) -> Family:
         """Builds the family in this process (the GIL is released while the engine runs).
         ``encoding`` ("auto" or "raw") is checked and ignored: nothing is uploaded, and code can
-        switch between the clients unchanged."""
+        switch between the clients unchanged. ``crs`` as :meth:`NetworkClient.build` takes it."""
         check_encoding(encoding)
-        array, crs = as_points(points)
+        array, data_crs = as_points(points)
+        frame = frame_of(array, crs, data_crs)
         callback, close = progress_callback(progress, len(array))
         try:
-            backend = self._local.build_local(array, self.backend, callback, name=name)
+            backend = self._local.build_local(frame.computed, self.backend, callback, name=name)
         finally:
             if close is not None:
                 close()
-        return Family(backend, array, crs)
+        return Family(backend, array, frame)
 
     def close(self) -> None:
         pass

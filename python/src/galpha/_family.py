@@ -15,6 +15,7 @@ from typing import Any, Iterable, List, Optional, Tuple, Union
 import numpy as np
 
 from ._backend import FamilyBackend
+from ._crs import Frame
 from ._errors import InvalidInput
 from ._types import (
     BettiCurves,
@@ -237,10 +238,19 @@ class Family:
     this process). Use it as a context manager to release it when done.
     """
 
-    def __init__(self, backend: FamilyBackend, points: np.ndarray, crs: Any = None) -> None:
+    def __init__(self, backend: FamilyBackend, points: np.ndarray, frame: Optional[Frame] = None) -> None:
         self._backend = backend
         self._points = points
-        self.crs = crs  #: the CRS of the GeoSeries/GeoDataFrame it was built from, or None
+        self._frame = frame if frame is not None else Frame(None, points)
+        #: The CRS of the coordinates: the ``crs=`` of the build, else the GeoSeries' or
+        #: GeoDataFrame's it was built from; None for planar coordinates.
+        self.crs = self._frame.crs
+
+    @property
+    def projection(self) -> Optional[str]:
+        """For a geographic CRS, the local projection (a PROJ string) the family is computed in:
+        alpha in metres, areas in square metres; None otherwise (computed in the input's units)."""
+        return self._frame.projection
 
     def __repr__(self) -> str:
         s = self.summary
@@ -368,7 +378,13 @@ class Family:
             kinds.append("isolated_points")
             geometries.append(MultiPoint(self._points[rings.isolated_points]))
         frame = geopandas.GeoDataFrame({"kind": kinds}, geometry=geometries, crs=self.crs)
-        frame["area"] = [g.area if k == "polygon" else 0.0 for k, g in zip(kinds, geometries)]
+        if self.projection is None:
+            frame["area"] = [g.area if k == "polygon" else 0.0 for k, g in zip(kinds, geometries)]
+        else:
+            # Square metres, as the engine measures them, not the square degrees of the geometry.
+            computed = self._frame.computed
+            areas = [ring_area(p.outer, computed) - sum(ring_area(h, computed) for h in p.holes) for p in rings.polygons]
+            frame["area"] = areas + [0.0] * (len(kinds) - len(areas))
         return frame
 
     def holes(
@@ -392,7 +408,7 @@ class Family:
         the same doubles."""
         threshold = threshold_from(alpha, alpha_sq, rank, ratio)
         minimum = area_argument("min_area", min_area, "every hole")
-        holes = self._backend.holes(threshold, minimum, self._points)
+        holes = self._backend.holes(threshold, minimum, self._frame.computed)
         return holes_geodataframe(holes, self._points, self.crs) if as_geodataframe else holes
 
     def master_list(self, rank: int, last_rank: Optional[int] = None) -> MasterList:

@@ -16,6 +16,7 @@ import numpy as np
 
 from . import _network, _wire
 from ._client import Progress, progress_callback
+from ._crs import Frame, frame_of
 from ._encoding import check_encoding
 from ._errors import InvalidInput
 from ._family import (
@@ -61,12 +62,14 @@ def _aio_channel(target: str, tls_ca: Optional[str]) -> grpc.aio.Channel:
 class AsyncFamily:
     """A family on a galpha server, queried with coroutines (see :class:`galpha.Family`)."""
 
-    def __init__(self, calls: _network.Calls, handle: str, summary: BuildSummary, points: np.ndarray, crs: Any) -> None:
+    def __init__(self, calls: _network.Calls, handle: str, summary: BuildSummary, points: np.ndarray, frame: Frame) -> None:
         self._calls = calls
         self.handle = handle
         self.summary = summary
         self.points = points
-        self.crs = crs
+        self._frame = frame
+        self.crs = frame.crs  #: as :attr:`galpha.Family.crs`
+        self.projection = frame.projection  #: as :attr:`galpha.Family.projection`
 
     async def __aenter__(self) -> "AsyncFamily":
         return self
@@ -183,7 +186,7 @@ class AsyncFamily:
         minimum = area_argument("min_area", min_area, "every hole")
         request = _network.shape_request(self.handle, threshold, Mode.REGULARIZED, 0.0)
         rings = _network.shape_rings_from(await self._stream(self._calls.shape, request))
-        holes = holes_from_rings(rings, self.points, minimum)
+        holes = holes_from_rings(rings, self._frame.computed, minimum)
         return holes_geodataframe(holes, self.points, self.crs) if as_geodataframe else holes
 
     async def master_list(self, rank: int, last_rank: Optional[int] = None) -> MasterList:
@@ -282,32 +285,36 @@ class AsyncClient:
     async def close(self) -> None:
         await self._channel.close()
 
-    async def build(self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto") -> AsyncFamily:
+    async def build(
+        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+    ) -> AsyncFamily:
         """Uploads the points (unless the server holds them) and awaits the build. Cancelling the
         task cancels the upload; the server then drops what it had received. ``encoding``: "auto"
-        or "raw", as :meth:`galpha.NetworkClient.build` takes it (chunks are encoded off the event
-        loop, in its default executor)."""
+        or "raw", and ``crs``, as :meth:`galpha.NetworkClient.build` takes them (chunks are encoded
+        off the event loop, in its default executor)."""
         encoding = check_encoding(encoding)
-        array, crs = as_points(points)
+        array, data_crs = as_points(points)
+        frame = frame_of(array, crs, data_crs)
+        computed = frame.computed
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         sent: Optional[Callable[[int], None]] = None if callback is None else (lambda n: callback("upload", n / total))
         try:
             # Hashing 1M points takes ~10 ms; off the event loop for larger sets.
-            handle = await asyncio.get_running_loop().run_in_executor(None, point_set_handle, array)
+            handle = await asyncio.get_running_loop().run_in_executor(None, point_set_handle, computed)
             metadata = self._calls.metadata(handle)
             try:
                 answer = await self._calls.describe(
                     pb.DescribeRequest(handle=handle), timeout=self._calls.timeout, metadata=metadata
                 )
-                return AsyncFamily(self._calls, handle, _network.summary_from(answer.summary, True), array, crs)
+                return AsyncFamily(self._calls, handle, _network.summary_from(answer.summary, True), array, frame)
             except grpc.RpcError as e:
                 if e.code() != grpc.StatusCode.NOT_FOUND:
                     raise _network.raise_from_rpc(e) from None
             counter = _network.UploadCounter()
             try:
                 answer = await self._calls.build(
-                    _upload_messages(name, array, sent, encoding, counter), timeout=self._calls.timeout, metadata=metadata
+                    _upload_messages(name, computed, sent, encoding, counter), timeout=self._calls.timeout, metadata=metadata
                 )
             except grpc.RpcError as e:
                 raise _network.raise_from_rpc(e) from None
@@ -315,7 +322,7 @@ class AsyncClient:
             if close is not None:
                 close()
         summary = dataclasses.replace(_network.summary_from(answer.summary, answer.cached), upload_bytes=counter.bytes)
-        return AsyncFamily(self._calls, answer.handle, summary, array, crs)
+        return AsyncFamily(self._calls, answer.handle, summary, array, frame)
 
 
 def connect(
