@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # Without GDAL and PROJ: alphactl would carry GDAL and the hundred libraries it pulls in, and PROJ
 # its database (the GPU machine reads .bin files only, without a CRS).
-cmake --preset cuda -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_PROJ=OFF >/dev/null
+cmake --preset cuda -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_PROJ=OFF -DGALPHA_WITH_GEMMI=OFF >/dev/null
 cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()

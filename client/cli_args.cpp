@@ -64,6 +64,9 @@ const char kUsage[] =
     "  --max-points N              read at most N points (default 100000000, a default server's limit;\n"
     "                              at most 1073741824, the engine's)\n"
     "  --layer NAME                the layer of a .shp, .gpkg or .fgb FILE to read (default: its first)\n"
+    "  --plane xy|yz|zx            the plane a .pdb/.cif FILE's atoms are put in (default xy)\n"
+    "  --slab MIN:MAX              a section: only atoms whose third coordinate (z for xy) is in\n"
+    "                              [MIN, MAX] (angstrom); default: all atoms, projected\n"
     "  --crs CRS|none              the CRS of FILE's coordinates (EPSG:4326, WKT, a PROJ string), over\n"
     "                              the one FILE states (GeoJSON: WGS84; LAS, GDAL sources: theirs);\n"
     "                              none: planar coordinates. A geographic CRS (x longitude, y latitude)\n"
@@ -78,11 +81,12 @@ const char kUsage[] =
     "\n"
     "FILE: .bin (little-endian uint64 N, then N pairs of float64 x, y), .npy (float64, N x 2),\n"
     "      .geojson/.json (Point, MultiPoint), .las (LAS 1.0-1.4 point clouds, uncompressed: x and\n"
-    "      y of every point; .laz is refused), .shp, .gpkg, .fgb (Shapefile, GeoPackage, FlatGeobuf\n"
-    "      point layers, read with GDAL; --layer), or delimited text (CSV, TSV, whitespace: x and y\n"
-    "      first, optional header line, at most 65536 bytes a line). A regular file, or delimited\n"
-    "      text from a named pipe (mkfifo, /dev/stdin) or from '-', standard input; devices,\n"
-    "      directories and sockets are refused.\n"
+    "      y of every point; .laz is refused), .pdb, .ent, .cif, .mmcif (also .gz: the atoms of the\n"
+    "      first model, read with gemmi; --plane, --slab), .shp, .gpkg, .fgb (Shapefile,\n"
+    "      GeoPackage, FlatGeobuf point layers, read with GDAL; --layer), or delimited text (CSV,\n"
+    "      TSV, whitespace: x and y first, optional header line, at most 65536 bytes a line). A\n"
+    "      regular file, or delimited text from a named pipe (mkfifo, /dev/stdin) or from '-',\n"
+    "      standard input; devices, directories and sockets are refused.\n"
     "\n"
     "exit status: 0 success, 1 failure (unreadable file, bad input, more than --max-points), 2 usage\n"
     "error (including a rank outside the spectrum). Progress goes to standard error for 100000\n"
@@ -93,7 +97,8 @@ const char kUsage[] =
 static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && kDefaultMaxLineBytes == 65536,
               "update kUsage");
 
-const absl::string_view kGlobalOptions[7] = {"backend", "server", "tls-ca", "encoding", "max-points", "layer", "crs"};
+const absl::string_view kGlobalOptions[9] = {"backend", "server", "tls-ca", "encoding", "max-points",
+                                             "layer",   "crs",    "plane",  "slab"};
 
 namespace {
 

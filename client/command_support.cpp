@@ -81,6 +81,12 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
     if (common.server.empty()) return absl::InvalidArgumentError("--tls-ca needs --server");
     common.tls_ca_file = *ca;
   }
+  if (line->Find("plane") != nullptr || line->Find("slab") != nullptr) {
+    auto section = ParseMoleculeSection(line->Find("plane"), line->Find("slab"));
+    if (!section.ok()) return section.status();
+    common.input.section = *std::move(section);
+    common.input.molecule_options = true;
+  }
   if (const std::string* crs = line->Find("crs")) {
     if (crs->empty()) return absl::InvalidArgumentError("--crs needs a CRS (as EPSG:4326), or none");
     common.crs = *crs;

@@ -188,6 +188,16 @@ absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, con
 
 absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& file, const InputOptions& options) {
   const std::string extension = absl::AsciiStrToLower(std::filesystem::path(file).extension().string());
+  // A structure may be gzip-compressed: its format is the extension before ".gz".
+  const bool molecule =
+      IsMoleculeExtension(extension) ||
+      (extension == ".gz" &&
+       IsMoleculeExtension(absl::AsciiStrToLower(std::filesystem::path(file).stem().extension().string())));
+  if (options.molecule_options && (file == "-" || !molecule)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--plane and --slab apply to PDB and mmCIF structures (.pdb, .ent, .cif, .mmcif), not to ",
+                     file == "-" ? "standard input" : absl::StrCat("'", file, "'")));
+  }
   if (!options.layer.empty() && (file == "-" || !IsVectorPointsExtension(extension))) {
     return absl::InvalidArgumentError(
         absl::StrCat("--layer applies to Shapefiles, GeoPackages and FlatGeobuf files (.shp, .gpkg, .fgb), not to ",
@@ -220,12 +230,13 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
   }
   const bool las = extension == ".las" || extension == ".laz";
   const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json" &&
-                    !las && !IsVectorPointsExtension(extension);
+                    !las && !IsVectorPointsExtension(extension) && !molecule;
   if (S_ISFIFO(info.st_mode) && !text) {
     // Their readers need the whole input at once, or seek: only a file's size bounds it in advance.
-    return absl::InvalidArgumentError(absl::StrCat(named,
-                                                   " is a named pipe: only delimited text is read from pipes (.bin, "
-                                                   ".npy, GeoJSON, LAS and GDAL sources need a regular file)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(named,
+                     " is a named pipe: only delimited text is read from pipes (.bin, "
+                     ".npy, GeoJSON, LAS, GDAL sources and structures need a regular file)"));
   }
   if (extension == ".laz") {
     return absl::InvalidArgumentError(
@@ -234,6 +245,7 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
                      "translate)"));
   }
   if (las) return WithMaxPointsHint(ReadLasPoints(file, options.max_points));
+  if (molecule) return WithMaxPointsHint(ReadMoleculePoints(file, options.section, options.max_points));
   if (IsVectorPointsExtension(extension)) {
     return WithMaxPointsHint(ReadVectorPoints(file, options.layer, options.max_points));
   }

@@ -22,6 +22,7 @@
 #include "absl/status/statusor.h"
 #include "core/base/point.hpp"
 #include "core/io/georeferenced_points.hpp"
+#include "core/io/molecule_points.hpp"
 
 namespace galpha::alphactl {
 
@@ -44,6 +45,10 @@ struct InputOptions {
   /// The layer of a GDAL vector source to read (--layer); empty: its first. Given with any other
   /// input, it is an error.
   std::string layer;
+  /// The plane and slab of a PDB or mmCIF structure's atoms (--plane, --slab); `molecule_options`
+  /// records that one was given (with any other input, it is an error).
+  MoleculeSection section;
+  bool molecule_options = false;
 };
 
 /// Reads the points of `file`, or of standard input when `file` is "-", as the header comment

@@ -2,7 +2,7 @@
 # The container image's build steps, in one script so that CI runs exactly what the image runs
 # (no Docker engine in CI): installs the server's build dependencies with the same script as the
 # README and CI (--profile=server), builds galpha_server and alphactl without tests, benchmarks,
-# CGAL or GDAL (alphactl in the image reads no Shapefiles or GeoPackages) (CUDA for CMAKE_CUDA_ARCHITECTURES, default 90, when nvcc is present), and stages them with
+# CGAL, GDAL or gemmi (alphactl in the image reads no Shapefiles, GeoPackages or structures) (CUDA for CMAKE_CUDA_ARCHITECTURES, default 90, when nvcc is present), and stages them with
 # the shared libraries a CUDA runtime image lacks:
 #   deploy/build-server.sh DEST       ->  DEST/bin/{galpha_server,alphactl}, DEST/lib/*.so*
 # Then checks that the staged server starts from DEST alone and answers its health check.
@@ -15,7 +15,7 @@ dest=${1:?usage: deploy/build-server.sh DEST}
 build=${GALPHA_IMAGE_BUILD_DIR:-build/image}
 scripts/install-deps.sh --profile=server
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DGALPHA_BUILD_TESTS=OFF -DGALPHA_BUILD_BENCH=OFF \
-  -DGALPHA_WITH_CGAL=OFF -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_CUDA="${GALPHA_IMAGE_WITH_CUDA:-AUTO}" -DCMAKE_CUDA_ARCHITECTURES="${CUDA_ARCHITECTURES:-90}" >/dev/null
+  -DGALPHA_WITH_CGAL=OFF -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_GEMMI=OFF -DGALPHA_WITH_CUDA="${GALPHA_IMAGE_WITH_CUDA:-AUTO}" -DCMAKE_CUDA_ARCHITECTURES="${CUDA_ARCHITECTURES:-90}" >/dev/null
 cmake --build "$build" --target galpha_server alphactl -j"$(nproc)"
 
 rm -rf "$dest" && mkdir -p "$dest/bin" "$dest/lib"

@@ -25,6 +25,8 @@ test_packages=(
   libgudhi-dev libeigen3-dev  # GUDHI's exact alpha-complex persistence: the persistence oracle and competitor
   python3-gudhi          # the same oracle for the Python package's persistence tests
   libgeos-dev            # GEOS C API: validity oracle of the shape tests (geometry validity, union)
+  gemmi-dev tao-pegtl-dev  # alphactl reads PDB and mmCIF structures (GALPHA_WITH_GEMMI; gemmi's headers need PEGTL,
+                         # which Debian's gemmi-dev does not pull in); the server image builds without it
   libgdal-dev            # alphactl reads Shapefile, GeoPackage and FlatGeobuf point layers (GALPHA_WITH_GDAL);
                          # the server image builds without it (deploy/build-server.sh: -DGALPHA_WITH_GDAL=OFF)
   openssl                # the TLS tests make a self-signed certificate

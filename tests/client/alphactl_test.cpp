@@ -409,6 +409,30 @@ TEST(AlphactlTest, AreaRatiosPickTheSmallestRankThatCoversThem) {
   std::filesystem::remove(file);
 }
 
+#ifdef GALPHA_WITH_GEMMI
+TEST(AlphactlTest, StructuresGiveTheirAtomsInThePlaneAndSlabChosen) {
+  // Four atoms of one model (the B conformation of C dropped): a section and projections.
+  const std::string pdb = WriteFile("alphactl_atoms.pdb",
+                                    "ATOM      1  N   ALA A   1       0.000   0.000   0.000  1.00  0.00           N\n"
+                                    "ATOM      2  CA  ALA A   1       4.000   0.000   1.000  1.00  0.00           C\n"
+                                    "ATOM      3  C  AALA A   1       4.000   3.000   2.000  0.50  0.00           C\n"
+                                    "ATOM      4  C  BALA A   1       9.000   9.000   9.000  0.50  0.00           C\n"
+                                    "ATOM      5  O   ALA A   1       0.000   3.000   3.000  1.00  0.00           O\n"
+                                    "END\n");
+  // xy: the 4 x 3 rectangle, area 12; the same as the same points as text.
+  const std::string csv = WriteFile("alphactl_atoms.csv", "0 0\n4 0\n4 3\n0 3\n");
+  EXPECT_EQ(Succeeds("spectrum", pdb, ""), Succeeds("spectrum", csv, ""));
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", pdb, "--ratio 1"))["hull_area"], 12.0);
+  // zx (z, x): (0,0), (1,4), (2,4), (3,0); a slab of y in [0, 1] keeps the first two atoms.
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", pdb, "--plane zx --ratio 1"))["hull_area"], 8.0);
+  EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", pdb, "--slab 0:1 --rank 0"))["points"], 2);
+  ExpectError(Alphactl("summary " + Quote(csv) + " --rank 0 --plane yz"), 1, "--plane and --slab apply to PDB");
+  ExpectError(Alphactl("summary " + Quote(pdb) + " --rank 0 --slab 2:1"), 2, "--slab '2:1'");
+  std::filesystem::remove(pdb);
+  std::filesystem::remove(csv);
+}
+#endif  // GALPHA_WITH_GEMMI
+
 #ifdef GALPHA_WITH_PROJ
 
 // Longitude/latitude points around Eugene, Oregon (x longitude, y latitude), a ring of 40 and

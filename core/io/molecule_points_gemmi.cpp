@@ -1,0 +1,50 @@
+#include <gemmi/gz.hpp>
+#include <gemmi/mmread.hpp>
+#include <gemmi/modify.hpp>
+
+#include <exception>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "core/io/molecule_points.hpp"
+#include "core/io/molecule_section.hpp"
+
+namespace galpha {
+
+absl::StatusOr<GeoreferencedPoints> ReadMoleculePoints(const std::string& path, const MoleculeSection& section,
+                                                       uint64_t max_points) {
+  const std::string named = absl::StrCat("structure file '", path, "'");
+  gemmi::Structure structure;
+  try {
+    // gemmi reports bad input by exceptions; none may cross into galpha.
+    structure = gemmi::read_structure(gemmi::MaybeGzipped(path));
+  } catch (const std::exception& e) {
+    return absl::InvalidArgumentError(absl::StrCat(named, " cannot be read by gemmi: ", e.what()));
+  }
+  if (structure.models.empty()) return absl::InvalidArgumentError(absl::StrCat(named, " has no model"));
+  gemmi::remove_alternative_conformations(structure);
+  size_t atoms = 0;
+  for (const gemmi::Chain& chain : structure.models.front().chains) {
+    for (const gemmi::Residue& residue : chain.residues) atoms += residue.atoms.size();
+  }
+  // gemmi reads text that is no structure as an empty one: no atom at all is not a structure.
+  if (atoms == 0) return absl::InvalidArgumentError(absl::StrCat(named, " has no atoms in its first model"));
+  const SectionAxes axes = AxesOf(section);
+  GeoreferencedPoints out;
+  for (const gemmi::Chain& chain : structure.models.front().chains) {
+    for (const gemmi::Residue& residue : chain.residues) {
+      for (const gemmi::Atom& atom : residue.atoms) {
+        const double xyz[3] = {atom.pos.x, atom.pos.y, atom.pos.z};
+        if (!InSection(section, axes, xyz)) continue;
+        if (out.points.size() == max_points) {
+          return absl::ResourceExhaustedError(
+              absl::StrCat(named, " has more than ", max_points, " atoms in the section: more than the limit"));
+        }
+        out.points.push_back({xyz[axes.u], xyz[axes.v]});
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace galpha
