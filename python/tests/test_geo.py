@@ -1,7 +1,8 @@
 """GeoPandas and shapely in, GeoPandas and shapely out, on both clients: the CRS of a GeoDataFrame
 of points stays on the family and on every geometry answer, in a projected CRS (the Autzen ground
-points, Oregon GIC Lambert in feet) and a geographic one (the same points in degrees); the
-polygons' vertices are exactly the input points; GeoJSON written and read back is the same."""
+points, Oregon GIC Lambert in feet) and a geographic one (the same points in degrees, computed in
+metres); the polygons' vertices are exactly the input points; GeoJSON written and read back is the
+same."""
 
 from __future__ import annotations
 
@@ -27,8 +28,17 @@ def test_geodataframe_round_trip(any_client, file: str, crs: str) -> None:
     family = any_client.build(frame)
     assert family.crs == frame.crs
     np.testing.assert_array_equal(family.points, points)
-    # The same family as from the bare array: the handle covers the coordinates only.
-    assert family.handle == galpha.point_set_handle(points)
+    if crs == "EPSG:4326":
+        # Longitude/latitude is computed in metres: the family (and its handle) is the local
+        # projection's, the same as from the bare array with crs= (docs/design.md, "Coordinate
+        # reference systems").
+        assert family.projection is not None
+        assert family.handle != galpha.point_set_handle(points)
+        assert family.handle == any_client.build(points, crs=crs).handle
+    else:
+        # A projected CRS is computed as given: the same family as from the bare array.
+        assert family.projection is None
+        assert family.handle == galpha.point_set_handle(points)
     optimal = family.optimal(components=1).regularized
     assert optimal is not None
     shape = family.shape(rank=optimal.rank, as_geodataframe=True)
