@@ -1,16 +1,21 @@
 #include "python/engine/build_call.hpp"
 
+#include <filesystem>
 #include <optional>
 #include <string_view>
 #include <utility>
 
 #include <pybind11/numpy.h>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/types/span.h"
 #include "core/base/point.hpp"
 #include "core/io/coordinate_system.hpp"
+#include "core/io/molecule_points.hpp"
+#include "core/io/point_formats.hpp"
 #include "core/io/point_set_handle.hpp"
+#include "core/io/vector_points.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "python/engine/engine_error.hpp"
 #include "python/engine/numpy_arrays.hpp"
@@ -139,6 +144,52 @@ py::dict FrameOf(const std::string& crs, const py::object& points) {
   }
   out["points"] = ArrayFromVector(std::move(flat), {static_cast<py::ssize_t>(local.points.size()), 2});
   out["projection"] = local.projection;
+  return out;
+}
+
+py::dict ReadPointFile(const std::string& path, const std::string& layer, const py::object& plane,
+                       const py::object& slab, uint64_t max_points) {
+  std::string extension = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  // A structure may be gzip-compressed: its format is the extension before ".gz".
+  if (extension == ".gz") extension = absl::AsciiStrToLower(std::filesystem::path(path).stem().extension().string());
+  const bool molecule = IsMoleculeExtension(extension), vector = IsVectorPointsExtension(extension);
+  std::optional<std::string> plane_text, slab_text;
+  if (!plane.is_none()) plane_text = py::cast<std::string>(plane);
+  if (!slab.is_none()) slab_text = py::cast<std::string>(slab);
+  if ((plane_text || slab_text) && !molecule) {
+    throw StatusError(absl::InvalidArgumentError(absl::StrCat(
+        "plane and slab apply to PDB and mmCIF structures (.pdb, .ent, .cif, .mmcif), not to '", path, "'")));
+  }
+  if (!layer.empty() && !vector) {
+    throw StatusError(absl::InvalidArgumentError(absl::StrCat(
+        "layer applies to Shapefiles, GeoPackages and FlatGeobuf files (.shp, .gpkg, .fgb), not to '", path, "'")));
+  }
+  const MoleculeSection section =
+      ValueOrThrow(ParseMoleculeSection(plane_text ? &*plane_text : nullptr, slab_text ? &*slab_text : nullptr));
+  GeoreferencedPoints read;
+  {
+    py::gil_scoped_release release;
+    absl::StatusOr<GeoreferencedPoints> result = molecule ? ReadMoleculePoints(path, section, max_points)
+                                                 : vector ? ReadVectorPoints(path, layer, max_points)
+                                                          : ReadGeoreferencedPointsFile(path);
+    if (result.ok() && result->points.size() > max_points) {
+      result = absl::ResourceExhaustedError(absl::StrCat("points file '", path, "' has ", result->points.size(),
+                                                         " points: more than max_points, ", max_points));
+    }
+    if (!result.ok()) {
+      py::gil_scoped_acquire acquire;
+      throw StatusError(result.status());
+    }
+    read = *std::move(result);
+  }
+  std::vector<double> flat(2 * read.points.size());
+  for (size_t i = 0; i < read.points.size(); ++i) {
+    flat[2 * i] = read.points[i].x;
+    flat[2 * i + 1] = read.points[i].y;
+  }
+  py::dict out;
+  out["points"] = ArrayFromVector(std::move(flat), {static_cast<py::ssize_t>(read.points.size()), 2});
+  out["crs"] = read.crs ? py::object(py::str(*read.crs)) : py::object(py::none());
   return out;
 }
 

@@ -29,4 +29,12 @@ std::string HandleOf(const pybind11::object& points);
 /// both. EngineError for an unknown CRS or points that are not longitudes and latitudes.
 pybind11::dict FrameOf(const std::string& crs, const pybind11::object& points);
 
+/// The points of a file in alphactl's formats, by extension (.bin, .npy, GeoJSON, .las,
+/// .shp/.gpkg/.fgb with `layer`, .pdb/.cif (also .gz) with `plane` and `slab` (None: the
+/// defaults), delimited text), read with the GIL released by core/io's readers: a dict of points
+/// (an (N, 2) float64 array) and crs (the CRS the file states, or None). EngineError as the
+/// readers' errors; ResourceExhausted over `max_points`.
+pybind11::dict ReadPointFile(const std::string& path, const std::string& layer, const pybind11::object& plane,
+                             const pybind11::object& slab, uint64_t max_points);
+
 }  // namespace galpha::python

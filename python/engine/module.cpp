@@ -29,6 +29,9 @@ PYBIND11_MODULE(_engine, module) {
   module.def("frame", &galpha::python::FrameOf, py::arg("crs"), py::arg("points"),
              "The CRS `crs` (EPSG:4326, WKT, a PROJ string) as PROJ reads it, and for a geographic CRS the local "
              "projection (metres) of the (N, 2) longitude/latitude array that galpha computes in.");
+  module.def("read_points", &galpha::python::ReadPointFile, py::arg("path"), py::arg("layer") = "",
+             py::arg("plane") = py::none(), py::arg("slab") = py::none(), py::arg("max_points") = 100000000,
+             "The points of a point file (alphactl's formats) and the CRS it states: {'points', 'crs'}.");
   module.def("cuda_available", &galpha::CudaBackendAvailable,
              "Whether this build has the CUDA backend and a GPU is visible now.");
 }

@@ -30,6 +30,7 @@ from ._errors import (  # noqa: E402
     Unavailable,
 )
 from ._family import Family, radius_from_alphashape  # noqa: E402
+from ._files import PointFile, read_points  # noqa: E402
 from ._handle import point_set_handle  # noqa: E402
 from ._types import (  # noqa: E402
     BettiCurves,
@@ -69,6 +70,8 @@ __all__ = [
     "LocalClient",
     "Family",
     "radius_from_alphashape",
+    "read_points",
+    "PointFile",
     "point_set_handle",
     "GalphaError",
     "InvalidInput",

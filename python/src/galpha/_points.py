@@ -1,7 +1,8 @@
 """Turning what users hold into the (N, 2) float64 array the engine and the wire take.
 
 Accepted: NumPy arrays and array-likes of shape (N, 2); a shapely MultiPoint or a sequence of
-shapely Points; a GeoSeries or GeoDataFrame of points (whose CRS the family keeps). Anything else,
+shapely Points; a GeoSeries or GeoDataFrame of points (whose CRS the family keeps); a
+:class:`galpha.PointFile` from :func:`galpha.read_points` (with the CRS its file states). Anything else,
 or a geometry that is not a point, is an :class:`~galpha.InvalidInput` naming what was found.
 """
 
@@ -53,6 +54,8 @@ def as_points(obj: Any) -> Tuple[np.ndarray, Any]:
     geo = _geopandas_points(obj)
     if geo is not None:
         return geo
+    if type(obj).__name__ == "PointFile" and type(obj).__module__ == "galpha._files":
+        return obj.points, obj.crs
     shapely_coords = _shapely_points(obj)
     if shapely_coords is not None:
         return shapely_coords, None
