@@ -61,9 +61,10 @@ struct InputOptions {
 /// parsers' errors (point_formats.hpp).
 absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, const InputOptions& options);
 
-/// ReadInputPoints, with the CRS of the files that state one (LAS, GDAL vector sources); nullopt
-/// for the others. Errors as ReadInputPoints's, and InvalidArgument for options.layer with an input
-/// that is not a GDAL vector source or for a compressed LAS (.laz) file.
+/// ReadInputPoints, with the CRS of the files that state one (LAS, GDAL vector sources, GeoJSON);
+/// nullopt for the others. Errors as ReadInputPoints's, and InvalidArgument for options.layer with
+/// an input that is not a GDAL vector source, for --plane/--slab with one that is no structure, or
+/// for a compressed LAS (.laz) file.
 absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& file, const InputOptions& options);
 
 /// Parses the delimited text (ParsePointsText's format) read from descriptor `fd` until its end, in
