@@ -42,6 +42,11 @@ int ArgumentError(const absl::Status& status) {
   return kExitUsage;
 }
 
+int FinishOutput(ChunkedWriter& out) {
+  if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
+  return kExitOk;
+}
+
 int Failure(const absl::Status& status) {
   std::fprintf(stderr, "alphactl: %s\n", OneLine(status.message()).c_str());
   return kExitFailure;
@@ -138,16 +143,10 @@ absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vec
   return BuildAlphaFamily(points, options);
 }
 
-absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common) {
+absl::StatusOr<FramedPoints> FramePoints(const CommonArgs& common, std::vector<Point2> input,
+                                         const std::optional<std::string>& stated) {
   FramedPoints frame;
-  std::optional<std::string> stated;
-  try {
-    GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadInputPointsAndCrs(common.file, common.input));
-    frame.input = std::move(read.points);
-    stated = std::move(read.crs);
-  } catch (const std::exception& e) {
-    return absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
-  }
+  frame.input = std::move(input);
   const std::optional<std::string> definition =
       common.crs ? (*common.crs == "none" ? std::nullopt : common.crs) : stated;
   if (!definition) return frame;
@@ -168,6 +167,16 @@ absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common) {
     frame.projection = std::move(local->projection);
   }
   return frame;
+}
+
+absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common) {
+  GeoreferencedPoints read;
+  try {
+    GALPHA_ASSIGN_OR_RETURN(read, ReadInputPointsAndCrs(common.file, common.input));
+  } catch (const std::exception& e) {
+    return absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
+  }
+  return FramePoints(common, std::move(read.points), read.crs);
 }
 
 absl::StatusOr<std::vector<Point2>> OutputPoints(const FramedPoints& frame, bool geojson) {

@@ -16,6 +16,7 @@
 #include "absl/types/span.h"
 #include "client/cli_args.hpp"
 #include "client/point_input.hpp"
+#include "client/text_output.hpp"
 #include "client/topology_output.hpp"
 #include "core/base/point.hpp"
 #include "core/family/alpha_family.hpp"
@@ -45,6 +46,8 @@ int UsageError(const absl::Status& status);
 /// A usage error that the help text would not fix (a rank outside this file's spectrum): prints
 /// "alphactl: MESSAGE" on one line to stderr; returns kExitUsage.
 int ArgumentError(const absl::Status& status);
+/// Flushes `out`: kExitOk, or a Failure when standard output could not be written.
+int FinishOutput(ChunkedWriter& out);
 /// Prints "alphactl: MESSAGE" on one line to stderr; returns kExitFailure.
 int Failure(const absl::Status& status);
 
@@ -120,6 +123,10 @@ struct FramedPoints {
 /// Reads FILE and resolves its CRS. Errors: ReadPoints's, an unknown CRS (naming --crs or the
 /// file), points that are not longitudes and latitudes of a geographic CRS.
 absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common);
+/// The frame of `input` under --crs, else the CRS `stated` by FILE (ReadFramedPoints after the
+/// read; --group-by frames each group on its own, with a projection centred on it).
+absl::StatusOr<FramedPoints> FramePoints(const CommonArgs& common, std::vector<Point2> input,
+                                         const std::optional<std::string>& stated);
 /// The coordinates a format is written in: for GeoJSON, WGS84 longitude/latitude where a CRS is
 /// known (RFC 7946); otherwise, and for every other format, the input's.
 absl::StatusOr<std::vector<Point2>> OutputPoints(const FramedPoints& frame, bool geojson);
@@ -154,6 +161,13 @@ int PrintBenchTable(const std::string& file, size_t input_points, uint64_t disti
 /// rank in 1..K. OK, or InvalidArgument (for ArgumentError).
 absl::Status CheckThresholdRank(int64_t rank, int64_t k);
 absl::Status CheckMasterListRank(int64_t rank, int64_t k);
+
+/// shape --group-by COLUMN: one regularized shape per group of FILE's points (their values of a
+/// GeoJSON property or a GDAL layer's field), each built on its own, in the order the groups first
+/// appear: a GeoJSON FeatureCollection (one MultiPolygon feature per group, properties group,
+/// points, level, alpha_sq, area) or, for wkt, one line per group: the value, a tab, the WKT.
+int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, const std::string& format,
+                    double min_hole_area);
 
 // ---- the same commands against a server (commands_remote.cpp), same output formats ----
 

@@ -22,15 +22,6 @@
 
 namespace galpha::alphactl {
 
-namespace {
-
-int FinishOutput(ChunkedWriter& out) {
-  if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
-  return kExitOk;
-}
-
-}  // namespace
-
 int RunClassify(Args args) {
   auto common = ParseCommon("classify", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "vertex-rule"});
   if (!common.ok()) return UsageError(common.status());
@@ -113,7 +104,8 @@ int RunSummary(Args args) {
 }
 
 int RunShape(Args args) {
-  auto common = ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "format", "min-hole-area"});
+  auto common =
+      ParseCommon("shape", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "format", "min-hole-area", "group-by"});
   if (!common.ok()) return UsageError(common.status());
   auto threshold_arg = ParseThreshold(common->line);
   if (!threshold_arg.ok()) return UsageError(threshold_arg.status());
@@ -132,6 +124,16 @@ int RunShape(Args args) {
     if (*value < 0)
       return UsageError(absl::InvalidArgumentError(absl::StrCat("--min-hole-area '", *text, "' is negative")));
     min_hole_area = *value;
+  }
+  if (const std::string* column = common->line.Find("group-by")) {
+    if (column->empty()) return UsageError(absl::InvalidArgumentError("--group-by needs a column's name"));
+    if (*mode == ClassifyMode::kGeneral && common->line.Find("mode") != nullptr) {
+      return UsageError(
+          absl::InvalidArgumentError("--group-by writes each group's regularized shape (its polygons): "
+                                     "leave out --mode general"));
+    }
+    common->input.group_by = *column;
+    return RunGroupedShape(*common, *threshold_arg, *format, min_hole_area);
   }
   if (!common->server.empty()) return RemoteShape(*common, *threshold_arg, *mode, *format, min_hole_area);
   size_t input_points = 0;

@@ -157,11 +157,6 @@ int QueryError(const CommonArgs& common, const absl::Status& status) {
   return Failure(ServerError(common, status));
 }
 
-int FinishOutput(ChunkedWriter& out) {
-  if (!out.Finish()) return Failure(absl::UnavailableError("cannot write to standard output"));
-  return kExitOk;
-}
-
 std::array<uint64_t, 4> FromProto(const v1::ClassCounts& counts) {
   return {counts.exterior(), counts.singular(), counts.regular(), counts.interior()};
 }

@@ -6,6 +6,8 @@
 
 #include <cerrno>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -193,6 +195,12 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
       IsMoleculeExtension(extension) ||
       (extension == ".gz" &&
        IsMoleculeExtension(absl::AsciiStrToLower(std::filesystem::path(file).stem().extension().string())));
+  const bool geojson = extension == ".geojson" || extension == ".json";
+  if (!options.group_by.empty() && (file == "-" || !(geojson || IsVectorPointsExtension(extension)))) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--group-by reads the properties of GeoJSON features and the fields of .shp, .gpkg and .fgb layers, not ",
+        file == "-" ? "standard input" : absl::StrCat("'", file, "'")));
+  }
   if (options.molecule_options && (file == "-" || !molecule)) {
     return absl::InvalidArgumentError(
         absl::StrCat("--plane and --slab apply to PDB and mmCIF structures (.pdb, .ent, .cif, .mmcif), not to ",
@@ -247,7 +255,19 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
   if (las) return WithMaxPointsHint(ReadLasPoints(file, options.max_points));
   if (molecule) return WithMaxPointsHint(ReadMoleculePoints(file, options.section, options.max_points));
   if (IsVectorPointsExtension(extension)) {
-    return WithMaxPointsHint(ReadVectorPoints(file, options.layer, options.max_points));
+    return WithMaxPointsHint(ReadVectorPoints(file, options.layer, options.max_points, options.group_by));
+  }
+  if (geojson && !options.group_by.empty()) {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open ", named));
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) return absl::DataLossError(absl::StrCat("cannot read ", named));
+    GALPHA_ASSIGN_OR_RETURN(read, ParseGeoreferencedGeoJson(bytes, file, options.group_by));
+    if (read.points.size() > options.max_points) {
+      return absl::ResourceExhaustedError(absl::StrCat(named, " has ", read.points.size(), " points: more than ",
+                                                       options.max_points, ", the limit (--max-points raises it)"));
+    }
+    return read;
   }
   if (text) {
     OwnedFd fd(open(file.c_str(), O_RDONLY | O_CLOEXEC));

@@ -49,6 +49,9 @@ struct InputOptions {
   /// records that one was given (with any other input, it is an error).
   MoleculeSection section;
   bool molecule_options = false;
+  /// A column whose values group the points (--group-by): a GeoJSON feature property or a field of
+  /// a GDAL layer; the result's `groups` then holds each point's value. Empty: none.
+  std::string group_by;
 };
 
 /// Reads the points of `file`, or of standard input when `file` is "-", as the header comment

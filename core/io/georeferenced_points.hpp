@@ -17,6 +17,9 @@ struct GeoreferencedPoints {
   /// The CRS as the file states it: OGC WKT, or "AUTHORITY:CODE" (as "EPSG:32610") where the
   /// reader knows the code; nullopt when the file states none. Carried, not interpreted.
   std::optional<std::string> crs;
+  /// When a group column was asked for (alphactl --group-by): each point's value of it as text,
+  /// point for point (nullopt where its feature has none or null); empty otherwise.
+  std::vector<std::optional<std::string>> groups;
 };
 
 }  // namespace galpha

@@ -1,11 +1,13 @@
 #include "core/io/point_formats.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <system_error>
 #include <utility>
 #include <vector>
@@ -84,9 +86,27 @@ double DoubleAt(absl::string_view bytes, size_t offset, bool little_endian) {
   return v;
 }
 
+/// A group column of GeoJSON features: its property name, each point's value (output), and the
+/// value of the feature being read.
+struct GeoJsonGroups {
+  std::string property;
+  std::vector<std::optional<std::string>>* values = nullptr;
+  std::optional<std::string> current;
+};
+
+/// A property's value as group text: strings as they are, other values as their JSON; nullopt for
+/// null or a missing property.
+std::optional<std::string> GroupText(const nlohmann::json& feature, const std::string& property) {
+  if (!feature.contains("properties") || !feature["properties"].is_object()) return std::nullopt;
+  const nlohmann::json& properties = feature["properties"];
+  if (!properties.contains(property) || properties[property].is_null()) return std::nullopt;
+  const nlohmann::json& value = properties[property];
+  return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
 // Appends the points of one GeoJSON object (geometry, feature or collection) at `where`.
 absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string& where, const std::string& source,
-                                 std::vector<Point2>* points) {
+                                 std::vector<Point2>* points, GeoJsonGroups* groups = nullptr) {
   auto error = [&](const std::string& what) {
     return absl::InvalidArgumentError(absl::StrCat(source, ": ", where.empty() ? "the document" : where, ": ", what));
   };
@@ -96,6 +116,7 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
           absl::StrCat(source, ": ", at, ": a position must be an array of two or three numbers"));
     }
     points->push_back({p[0].get<double>(), p[1].get<double>()});
+    if (groups != nullptr) groups->values->push_back(groups->current);
     return absl::OkStatus();
   };
   if (!object.is_object() || !object.contains("type") || !object["type"].is_string()) {
@@ -110,7 +131,8 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
     }
     const nlohmann::json& items = object[member];
     for (size_t i = 0; i < items.size(); ++i) {
-      absl::Status status = AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points);
+      absl::Status status =
+          AppendGeoJsonPoints(items[i], absl::StrCat(prefix, member, "[", i, "]"), source, points, groups);
       if (!status.ok()) return status;
     }
     return absl::OkStatus();
@@ -118,7 +140,11 @@ absl::Status AppendGeoJsonPoints(const nlohmann::json& object, const std::string
   if (type == "Feature") {
     if (!object.contains("geometry")) return error("Feature without a \"geometry\"");
     if (object["geometry"].is_null()) return absl::OkStatus();  // an unlocated feature: no point
-    return AppendGeoJsonPoints(object["geometry"], absl::StrCat(prefix, "geometry"), source, points);
+    if (groups != nullptr) groups->current = GroupText(object, groups->property);
+    absl::Status status =
+        AppendGeoJsonPoints(object["geometry"], absl::StrCat(prefix, "geometry"), source, points, groups);
+    if (groups != nullptr) groups->current.reset();
+    return status;
   }
   if (type == "Point" || type == "MultiPoint") {
     if (!object.contains("coordinates")) return error(absl::StrCat(type, " without \"coordinates\""));
@@ -154,13 +180,15 @@ absl::StatusOr<std::string> GeoJsonCrs(const nlohmann::json& document, const std
     return absl::StrCat("EPSG:", (*properties)["code"].get<int64_t>());
   }
   return absl::InvalidArgumentError(
-      absl::StrCat(source, ": the crs member is neither {\"type\": \"name\", \"properties\": {\"name\": ...}} nor "
-                           "{\"type\": \"EPSG\", \"properties\": {\"code\": ...}}"));
+      absl::StrCat(source,
+                   ": the crs member is neither {\"type\": \"name\", \"properties\": {\"name\": ...}} nor "
+                   "{\"type\": \"EPSG\", \"properties\": {\"code\": ...}}"));
 }
 
 }  // namespace
 
-absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source) {
+absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source,
+                                                              const std::string& group_property) {
   nlohmann::json document;
   try {
     document = nlohmann::json::parse(text.begin(), text.end());
@@ -172,8 +200,15 @@ absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view 
     return absl::InvalidArgumentError(absl::StrCat(source, ": JSON the parser cannot represent (", e.what(), ")"));
   }
   GeoreferencedPoints out;
-  const absl::Status status = AppendGeoJsonPoints(document, "", source, &out.points);
+  GeoJsonGroups groups{group_property, &out.groups, std::nullopt};
+  const absl::Status status =
+      AppendGeoJsonPoints(document, "", source, &out.points, group_property.empty() ? nullptr : &groups);
   if (!status.ok()) return status;
+  if (!group_property.empty() && !out.points.empty() &&
+      std::none_of(out.groups.begin(), out.groups.end(), [](const auto& g) { return g.has_value(); })) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(source, ": no feature has a property '", group_property, "' (to group the points by)"));
+  }
   absl::StatusOr<std::string> crs = GeoJsonCrs(document, source);
   if (!crs.ok()) return crs.status();
   out.crs = *std::move(crs);

@@ -45,7 +45,11 @@ absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, c
 /// latitude, always), or the name of a 2008-style "crs" member ({"type": "name", "properties":
 /// {"name": "urn:ogc:def:crs:EPSG::3857"}}, or {"type": "EPSG", "properties": {"code": 3857}}),
 /// which GDAL still writes for other CRSs. InvalidArgument for a "crs" member of another form.
-absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source);
+/// With a `group_property`, each point's group is its feature's property of that name (strings as
+/// they are, other values as their JSON text; nullopt for null, a missing property or a bare
+/// geometry); InvalidArgument when no feature has the property at all (a misspelt name).
+absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source,
+                                                              const std::string& group_property = "");
 
 /// Reads a point file, choosing the format by extension: `.bin` (raw, point_io.hpp), `.npy`,
 /// `.geojson` or `.json`, `.las` (las_reader.hpp), anything else as delimited text

@@ -33,8 +33,11 @@ inline bool IsVectorPointsExtension(absl::string_view extension) {
 /// file as its extension's format (GDAL's message attached), when the source has no layers or no
 /// layer `layer` (the layers are listed), or for a feature of another geometry type (its FID and
 /// type named: other geometries are refused rather than skipped, so that no data is lost
-/// silently); ResourceExhausted as soon as more than `max_points` points have been read.
+/// silently); ResourceExhausted as soon as more than `max_points` points have been read. With a
+/// `group_field`, each point's group is its feature's value of that field as text (nullopt where
+/// it is null or unset); InvalidArgument, listing the fields, when the layer has no such field.
 absl::StatusOr<GeoreferencedPoints> ReadVectorPoints(const std::string& path, const std::string& layer = "",
-                                                     uint64_t max_points = std::numeric_limits<uint64_t>::max());
+                                                     uint64_t max_points = std::numeric_limits<uint64_t>::max(),
+                                                     const std::string& group_field = "");
 
 }  // namespace galpha

@@ -79,7 +79,7 @@ std::string LayerNames(GDALDataset& dataset) {
 bool VectorPointsAvailable() { return true; }
 
 absl::StatusOr<GeoreferencedPoints> ReadVectorPoints(const std::string& path, const std::string& layer_name,
-                                                     uint64_t max_points) {
+                                                     uint64_t max_points, const std::string& group_field) {
   static std::once_flag registered;
   std::call_once(registered, [] { GDALAllRegister(); });
   const std::string named = absl::StrCat("points file '", path, "'");
@@ -111,14 +111,29 @@ absl::StatusOr<GeoreferencedPoints> ReadVectorPoints(const std::string& path, co
   }
   const std::string source = absl::StrCat(named, ", layer '", layer->GetName(), "'");
 
+  int group_index = -1;
+  if (!group_field.empty()) {
+    const OGRFeatureDefn* definition = layer->GetLayerDefn();
+    group_index = definition->GetFieldIndex(group_field.c_str());
+    if (group_index < 0) {
+      std::string fields;
+      for (int i = 0; i < definition->GetFieldCount(); ++i) {
+        absl::StrAppend(&fields, i ? ", " : "", definition->GetFieldDefn(i)->GetNameRef());
+      }
+      return absl::InvalidArgumentError(absl::StrCat(source, " has no field '", group_field,
+                                                     "' (its fields: ", fields.empty() ? "none" : fields, ")"));
+    }
+  }
   GeoreferencedPoints out;
   out.crs = CrsOf(*layer);
+  std::optional<std::string> group;  // the current feature's
   const auto take = [&](const OGRPoint& point) -> absl::Status {
     if (point.IsEmpty()) return absl::OkStatus();
     if (out.points.size() == max_points) {
       return absl::ResourceExhaustedError(absl::StrCat(source, ": more than ", max_points, " points, the limit"));
     }
     out.points.push_back({point.getX(), point.getY()});
+    if (group_index >= 0) out.groups.push_back(group);
     return absl::OkStatus();
   };
   layer->ResetReading();
@@ -127,6 +142,11 @@ absl::StatusOr<GeoreferencedPoints> ReadVectorPoints(const std::string& path, co
        feature.reset(layer->GetNextFeature())) {
     const OGRGeometry* geometry = feature->GetGeometryRef();
     if (geometry == nullptr) continue;  // unlocated
+    if (group_index >= 0) {
+      group = feature->IsFieldSetAndNotNull(group_index)
+                  ? std::optional<std::string>(feature->GetFieldAsString(group_index))
+                  : std::nullopt;
+    }
     const OGRwkbGeometryType type = wkbFlatten(geometry->getGeometryType());
     if (type == wkbPoint) {
       if (absl::Status s = take(*geometry->toPoint()); !s.ok()) return s;

@@ -8,7 +8,7 @@ namespace galpha {
 bool VectorPointsAvailable() { return false; }
 
 absl::StatusOr<GeoreferencedPoints> ReadVectorPoints(const std::string& path, const std::string& /*layer*/,
-                                                     uint64_t /*max_points*/) {
+                                                     uint64_t /*max_points*/, const std::string& /*group_field*/) {
   return absl::InvalidArgumentError(
       absl::StrCat("points file '", path,
                    "': this build has no GDAL, which Shapefiles, GeoPackages and FlatGeobuf files are read with "

@@ -77,3 +77,34 @@ def test_structures_and_text(tmp_path: pathlib.Path) -> None:
         galpha.read_points(tmp_path / "missing.csv")
     with pytest.raises(galpha.ResourceExhausted):
         galpha.read_points(pdb, max_points=3)
+
+
+def test_alphactl_group_by_a_geopackage_field(tmp_path: pathlib.Path, alphactl: str) -> None:
+    """One hull per region of a lon/lat GeoPackage (GDAL-written), each as the Python package
+    builds that region's points alone (its own local projection): the GIS user's whole path."""
+    rng = np.random.default_rng(5)
+    centres = {"north": (14.5, 46.5), "south": (15.5, 45.5), "east": (16.5, 46.0)}
+    frames = []
+    for name, centre in centres.items():
+        xy = rng.normal(centre, 0.05, (150, 2))
+        frames.append(geopandas.GeoDataFrame({"region": [name] * len(xy)}, geometry=geopandas.points_from_xy(xy[:, 0], xy[:, 1]), crs="EPSG:4326"))
+    table = geopandas.GeoDataFrame(np.concatenate([f.values for f in frames]), columns=frames[0].columns, crs="EPSG:4326")
+    path = tmp_path / "regions.gpkg"
+    table.to_file(path, layer="points")
+    text = subprocess.run(
+        [alphactl, "shape", str(path), "--group-by", "region", "--ratio", "0.8", "--format", "geojson", "--backend=cpu"],
+        check=True, capture_output=True, text=True,
+    ).stdout
+    hulls = geopandas.GeoDataFrame.from_features(json.loads(text)["features"], crs="EPSG:4326")
+    assert list(hulls["group"]) == list(centres)
+    with galpha.local("cpu") as client:
+        for frame, (_, row) in zip(frames, hulls.iterrows()):
+            family = client.build(frame)
+            expected = family.shape(ratio=0.8)
+            assert row.geometry.is_valid
+            assert row.geometry.equals(expected)
+            assert row["area"] == pytest.approx(family.shape_rings(ratio=0.8).area, rel=1e-12)
+    missing = subprocess.run(
+        [alphactl, "shape", str(path), "--group-by", "nope", "--ratio", "0.8", "--format", "wkt"], capture_output=True, text=True
+    )
+    assert missing.returncode == 1 and "has no field 'nope'" in missing.stderr

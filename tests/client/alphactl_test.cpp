@@ -564,6 +564,63 @@ TEST(AlphactlTest, ProjectedInputStaysAndGeoJsonIsWgs84) {
 
 #endif  // GALPHA_WITH_PROJ
 
+// --group-by: each group's shape is the shape of that group's points alone (built as a file of
+// their own: the oracle), in the order the groups first appear; a feature without the property is
+// the group without a value.
+TEST(AlphactlTest, GroupByGivesEachGroupsOwnShape) {
+  std::mt19937_64 random(7);
+  std::normal_distribution<double> spread(0.0, 1.0);
+  std::map<std::string, std::vector<std::array<double, 2>>> by_group;
+  std::string features;
+  const std::vector<std::pair<std::string, std::array<double, 2>>> centres = {
+      {"b", {0, 0}}, {"a", {20, 5}}, {"", {-10, 15}}};
+  for (int i = 0; i < 240; ++i) {
+    const auto& [group, centre] = centres[static_cast<size_t>(i % 3)];
+    const std::array<double, 2> p = {centre[0] + spread(random), centre[1] + spread(random)};
+    by_group[group].push_back(p);
+    const std::string properties = group.empty() ? R"({"other":1})" : R"({"kind":")" + group + R"("})";
+    features += (i ? "," : "") + std::string(R"({"type":"Feature","properties":)") + properties +
+                R"(,"geometry":{"type":"Point","coordinates":[)" + Printed(p[0]) + "," + Printed(p[1]) + "]}}";
+  }
+  const std::string file =
+      WriteFile("alphactl_groups.geojson", R"({"type":"FeatureCollection","features":[)" + features + "]}");
+  const std::string options = "--crs none --ratio 0.7";
+  const nlohmann::json grouped =
+      nlohmann::json::parse(Succeeds("shape", file, options + " --group-by kind --format geojson"));
+  ASSERT_EQ(grouped["features"].size(), 3u);
+  const std::vector<std::string> wkt = SplitLines(Succeeds("shape", file, options + " --group-by kind --format wkt"));
+  ASSERT_EQ(wkt.size(), 3u);
+  const std::vector<std::string> order = {"b", "a", ""};
+  for (size_t g = 0; g < 3; ++g) {
+    SCOPED_TRACE(order[g]);
+    std::string csv;
+    for (const auto& p : by_group[order[g]]) csv += Printed(p[0]) + "," + Printed(p[1]) + "\n";
+    const std::string alone = WriteFile("alphactl_group_alone.csv", csv);
+    const nlohmann::json expected =
+        nlohmann::json::parse(Succeeds("shape", alone, options + " --mode regularized --format geojson"));
+    const nlohmann::json& feature = grouped["features"][g];
+    if (order[g].empty()) {
+      EXPECT_TRUE(feature["properties"]["group"].is_null());
+    } else {
+      EXPECT_EQ(feature["properties"]["group"], order[g]);
+    }
+    EXPECT_EQ(feature["properties"]["points"], 80);
+    EXPECT_EQ(feature["geometry"], expected["features"][0]["geometry"]);
+    EXPECT_EQ(feature["properties"]["area"], expected["features"][0]["properties"]["area"]);
+    EXPECT_EQ(wkt[g],
+              order[g] + "\t" + SplitLines(Succeeds("shape", alone, options + " --mode regularized --format wkt"))[0]);
+    std::filesystem::remove(alone);
+  }
+  ExpectError(Alphactl("shape " + Quote(file) + " --ratio 0.5 --group-by nope --format wkt --crs none"), 1,
+              "no feature has a property 'nope'");
+  ExpectError(Alphactl("shape " + Quote(file) + " --ratio 0.5 --group-by kind --format svg"), 2, "not svg");
+  ExpectError(Alphactl("shape " + Quote(file) + " --ratio 0.5 --group-by kind --format wkt --mode general"), 2,
+              "leave out --mode general");
+  ExpectError(Alphactl("shape " + Quote(SquareCsv()) + " --ratio 0.5 --group-by kind --format wkt"), 1,
+              "--group-by reads the properties of GeoJSON features");
+  std::filesystem::remove(file);
+}
+
 TEST(AlphactlTest, ShapesInEveryFormat) {
   const std::string& square = SquareCsv();
   // WKT is the simplest type that holds the shape: one polygon is a POLYGON, in either mode;

@@ -1,0 +1,105 @@
+// alphactl shape --group-by: one shape per group of points (issue "Speak GIS": a hull per feature
+// class, cluster or region). Each group is framed (its own local projection for a geographic
+// CRS), built and shaped on its own.
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "client/commands.hpp"
+#include "client/text_output.hpp"
+#include "core/base/status_macros.hpp"
+#include "core/geometry/shape.hpp"
+#include "core/geometry/shape_holes.hpp"
+#include "core/io/json_text.hpp"
+
+namespace galpha::alphactl {
+
+namespace {
+
+/// The points of each group, by input index, in the order the groups first appear.
+std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> GroupsOf(
+    const std::vector<std::optional<std::string>>& values) {
+  std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> groups;
+  std::map<std::optional<std::string>, size_t> position;
+  for (uint32_t i = 0; i < values.size(); ++i) {
+    auto [it, added] = position.emplace(values[i], groups.size());
+    if (added) groups.emplace_back(values[i], std::vector<uint32_t>());
+    groups[it->second].second.push_back(i);
+  }
+  return groups;
+}
+
+/// The MultiPolygon geometry of a shape's polygons, as ShapeToGeoJson writes it.
+nlohmann::ordered_json PolygonsGeometry(const ShapeGeometry& shape, absl::Span<const Point2> points) {
+  const nlohmann::ordered_json collection = nlohmann::ordered_json::parse(ShapeToGeoJson(shape, points));
+  for (const auto& feature : collection["features"]) {
+    if (feature["properties"]["kind"] == "polygons") return feature["geometry"];
+  }
+  return {{"type", "MultiPolygon"}, {"coordinates", nlohmann::ordered_json::array()}};
+}
+
+}  // namespace
+
+int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, const std::string& format,
+                    double min_hole_area) {
+  if (!common.server.empty()) {
+    return UsageError(
+        absl::InvalidArgumentError("--group-by builds each group here; it does not combine with --server"));
+  }
+  if (format != "geojson" && format != "wkt") {
+    return UsageError(absl::InvalidArgumentError("--group-by writes geojson or wkt (one shape per group), not svg"));
+  }
+  GeoreferencedPoints read;
+  try {
+    auto result = ReadInputPointsAndCrs(common.file, common.input);
+    if (!result.ok()) return Failure(result.status());
+    read = *std::move(result);
+  } catch (const std::exception& e) {
+    return Failure(absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what())));
+  }
+  ChunkedWriter out(stdout);
+  nlohmann::ordered_json features = nlohmann::ordered_json::array();
+  for (const auto& [group, indices] : GroupsOf(read.groups)) {
+    const std::string name = group ? absl::StrCat("group '", *group, "'") : std::string("the group without a value");
+    std::vector<Point2> subset;
+    subset.reserve(indices.size());
+    for (uint32_t i : indices) subset.push_back(read.points[i]);
+    auto frame = FramePoints(common, std::move(subset), read.crs);
+    if (!frame.ok())
+      return Failure(absl::Status(frame.status().code(), absl::StrCat(name, ": ", frame.status().message())));
+    auto family = BuildFamily(common, frame->Computed());
+    if (!family.ok())
+      return Failure(absl::Status(family.status().code(), absl::StrCat(name, ": ", family.status().message())));
+    auto level = ResolveThreshold(*family, threshold);
+    if (!level.ok())
+      return ArgumentError(absl::Status(level.status().code(), absl::StrCat(name, ": ", level.status().message())));
+    auto shape = AssembleShape(family->ComplexAt(level->level, ClassifyMode::kRegularized));
+    if (!shape.ok()) return Failure(shape.status());
+    // Areas in the computation's units (square metres for a geographic CRS).
+    if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family->points(), min_hole_area);
+    auto points = OutputPoints(*frame, format == "geojson");
+    if (!points.ok()) return Failure(points.status());
+    if (format == "wkt") {
+      out.Append(absl::StrCat(group.value_or(""), "\t", ShapeToWkt(*shape, *points), "\n"));
+      continue;
+    }
+    nlohmann::ordered_json properties = {{"group", group ? nlohmann::ordered_json(*group) : nlohmann::ordered_json()},
+                                         {"points", indices.size()},
+                                         {"level", level->level},
+                                         {"alpha_sq", level->alpha_sq},
+                                         {"area", shape->area}};
+    features.push_back(
+        {{"type", "Feature"}, {"properties", std::move(properties)}, {"geometry", PolygonsGeometry(*shape, *points)}});
+  }
+  if (format == "geojson") {
+    out.Append(JsonText({{"type", "FeatureCollection"}, {"features", std::move(features)}}));
+    out.Append('\n');
+  }
+  return FinishOutput(out);
+}
+
+}  // namespace galpha::alphactl
