@@ -104,6 +104,17 @@ def test_alphactl_group_by_a_geopackage_field(tmp_path: pathlib.Path, alphactl: 
             assert row.geometry.is_valid
             assert row.geometry.equals(expected)
             assert row["area"] == pytest.approx(family.shape_rings(ratio=0.8).area, rel=1e-12)
+    # The Python path to the same hulls: one call on the GeoDataFrame.
+    with galpha.local("cpu") as client:
+        by_region = galpha.shapes_by_group(client, table, "region", ratio=0.8)
+    assert by_region.crs == table.crs
+    assert list(by_region["group"]) == list(centres) and list(by_region["points"]) == [150, 150, 150]
+    assert all(a.equals(b) for a, b in zip(by_region.geometry, hulls.geometry))
+    assert list(by_region["area"]) == pytest.approx(list(hulls["area"]), rel=1e-12)
+    # RFC 7946 GeoJSON from it is GeoPandas' own (already WGS84 here).
+    assert json.loads(by_region.to_json())["features"][0]["geometry"]["type"] == "MultiPolygon"
+    with pytest.raises(InvalidInput, match="names no column"):
+        galpha.shapes_by_group(client, table, "nope", ratio=0.8)
     missing = subprocess.run(
         [alphactl, "shape", str(path), "--group-by", "nope", "--ratio", "0.8", "--format", "wkt"], capture_output=True, text=True
     )

@@ -31,6 +31,7 @@ from ._errors import (  # noqa: E402
 )
 from ._family import Family, radius_from_alphashape  # noqa: E402
 from ._files import PointFile, read_points  # noqa: E402
+from ._groups import shapes_by_group  # noqa: E402
 from ._handle import point_set_handle  # noqa: E402
 from ._types import (  # noqa: E402
     BettiCurves,
@@ -71,6 +72,7 @@ __all__ = [
     "Family",
     "radius_from_alphashape",
     "read_points",
+    "shapes_by_group",
     "PointFile",
     "point_set_handle",
     "GalphaError",
