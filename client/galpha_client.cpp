@@ -87,7 +87,8 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   // The handle before the upload: to skip it when the server holds the family, and to route the
   // stream to the replica that would hold it.
   const std::string handle = PointSetHandle(points);
-  if (options.skip_upload_if_cached) {
+  // With a CRS the server hashes the projected points: the handle is not known here.
+  if (options.skip_upload_if_cached && options.crs.empty()) {
     auto described = Describe(handle);
     if (described.ok()) {
       result.handle = handle;
@@ -107,6 +108,7 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   v1::BuildRequest message;
   message.mutable_header()->set_name(options.name);
   message.mutable_header()->set_expected_points(points.size());
+  message.mutable_header()->set_crs(options.crs);
   bool open = writer->Write(message);
   // Chunks are encoded in batches, one thread a chunk (each with its own encoder), then written in
   // order: encoding costs 4-16 ms a 1 MiB chunk on one core, as much as sending it over 1 Gb/s.

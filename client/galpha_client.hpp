@@ -75,6 +75,9 @@ struct BuildCallOptions {
   PointEncoding encoding = PointEncoding::kAuto;
   /// zstd's level for compressed encodings (1..19; higher: smaller and slower to encode).
   int zstd_level = 3;
+  /// BuildHeader.crs: the points' CRS, projected by the server when geographic (empty: planar).
+  /// The Describe pre-check is skipped then (the handle is the projected points').
+  std::string crs;
 };
 
 /// gRPC status to absl::Status (the codes are the same numbers).

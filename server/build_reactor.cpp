@@ -120,6 +120,7 @@ void BuildReactor::EndOfStream() {
   }
   build_ = *decoded;
   if (auto cached = service_->cache_->Find(tenant_, build_->handle)) {
+    if (build_->frame != nullptr) cached->AttachFrameIfNone(build_->frame);
     Succeed(*cached, /*was_cached=*/true);
     return;
   }
@@ -169,10 +170,11 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   service_->metrics_->RecordBuild(family->report(), seconds);
   // The last owner of a family (the cache, or a query still streaming from it after a release
   // or an eviction) frees hundreds of megabytes: give them back to the system right then.
-  std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family)), [](const CachedFamily* f) {
-    delete f;
-    ReturnFreedMemory();
-  });
+  std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family), build_->frame),
+                                             [](const CachedFamily* f) {
+                                               delete f;
+                                               ReturnFreedMemory();
+                                             });
   auto inserted = service_->cache_->Insert(tenant_, build_->handle, std::move(cached));
   ReturnFreedMemory();  // the engine's working memory and the points
   if (!inserted.ok()) {

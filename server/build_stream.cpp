@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/io/coordinate_system.hpp"
 #include "server/build_refusal.hpp"
 
 namespace galpha::server {
@@ -220,10 +221,31 @@ absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
     return absl::InvalidArgumentError(
         absl::StrCat("the stream ended after ", decoded_.points.size(), " points; its header announced ", expected));
   }
+  if (!decoded_.header.crs().empty()) {
+    absl::Status framed = FrameByCrs(&decoded_);
+    if (!framed.ok()) return framed;
+  }
   // Hashed once the points are all here: in parallel (point_set_handle.hpp), ~1 ms at 1M points
   // on 16 cores.
   decoded_.handle = PointSetHandle(decoded_.points);
   return &decoded_;
+}
+
+absl::Status FrameByCrs(DecodedBuild* build) {
+  absl::StatusOr<CrsInfo> crs = DescribeCrs(build->header.crs());
+  if (!crs.ok()) return absl::InvalidArgumentError(absl::StrCat("the header's crs: ", crs.status().message()));
+  auto frame = std::make_shared<CachedFamily::InputFrame>();
+  frame->crs = *std::move(crs);
+  if (frame->crs.geographic) {
+    const absl::Span<const Point2> sent(build->points.data(), build->points.size());
+    absl::StatusOr<LocalMetres> local = ProjectToLocalMetres(frame->crs, sent);
+    if (!local.ok()) return absl::InvalidArgumentError(absl::StrCat("the header's crs: ", local.status().message()));
+    frame->input.assign(sent.begin(), sent.end());
+    std::copy(local->points.begin(), local->points.end(), build->points.data());
+    frame->projection = std::move(local->projection);
+  }
+  build->frame = std::move(frame);
+  return absl::OkStatus();
 }
 
 }  // namespace galpha::server

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "core/io/point_set_handle.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "proto/codec/point_chunk_codec.hpp"
+#include "server/cached_family.hpp"
 
 namespace galpha::server {
 
@@ -64,7 +66,15 @@ struct DecodedBuild {
   galpha::v1::BuildHeader header;
   HostVector<Point2> points;  // not zeroed as it grows: every byte is then copied in
   std::string handle;
+  /// With a header CRS: the CRS and, for a geographic one, the points as sent (`points` then
+  /// holds their local projection, which the handle hashes).
+  std::shared_ptr<const CachedFamily::InputFrame> frame;
 };
+
+/// Applies `build`'s header CRS (header.crs non-empty): describes it and, for a geographic CRS,
+/// replaces the points by their local projection, keeping the points as sent in `frame`.
+/// InvalidArgument ("the header's crs: ...") for a CRS PROJ does not read or points it cannot take.
+absl::Status FrameByCrs(DecodedBuild* build);
 
 class BuildStreamDecoder {
  public:

@@ -6,9 +6,21 @@
 
 namespace galpha::server {
 
-CachedFamily::CachedFamily(AlphaFamily family) : family_(std::move(family)) {
+CachedFamily::CachedFamily(AlphaFamily family, std::shared_ptr<const InputFrame> frame)
+    : family_(std::move(family)), frame_(std::move(frame)) {
   bytes_ = sizeof(*this) + family_.HostBytes() + family_.edges().size() * 3 * sizeof(uint32_t) +
            family_.triangles().size() * 4 * sizeof(uint32_t);
+  if (frame_ != nullptr) bytes_ += frame_->input.capacity() * sizeof(Point2);
+}
+
+std::shared_ptr<const CachedFamily::InputFrame> CachedFamily::Frame() const {
+  absl::MutexLock lock(&frame_mutex_);
+  return frame_;
+}
+
+void CachedFamily::AttachFrameIfNone(std::shared_ptr<const InputFrame> frame) const {
+  absl::MutexLock lock(&frame_mutex_);
+  if (frame_ == nullptr) frame_ = std::move(frame);
 }
 
 const std::vector<uint32_t>& CachedFamily::EdgeOrder() const {

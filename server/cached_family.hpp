@@ -10,15 +10,35 @@
 #include <string>
 #include <vector>
 
+#include "absl/base/thread_annotations.h"
+#include "absl/synchronization/mutex.h"
 #include "core/family/alpha_family.hpp"
+#include "core/io/coordinate_system.hpp"
 
 namespace galpha::server {
 
 class CachedFamily {
  public:
-  explicit CachedFamily(AlphaFamily family);
+  struct InputFrame;
+  /// `frame`: where the points came from when the Build header named a CRS (may be null); its
+  /// input points are charged to the family's bytes.
+  explicit CachedFamily(AlphaFamily family, std::shared_ptr<const InputFrame> frame = nullptr);
 
   const AlphaFamily& family() const { return family_; }
+
+  /// Where the family's points came from when a Build header named a CRS: the CRS, the points as
+  /// sent (for a geographic CRS; empty when the family's points are the points as sent), and the
+  /// local projection. Text geometry is written in these coordinates.
+  struct InputFrame {
+    CrsInfo crs;
+    std::vector<Point2> input;
+    std::string projection;
+  };
+  /// The frame attached to the family, if any (set once: by its first build with a CRS, which
+  /// may be a cache hit on a family built from the same projected points without one; such a
+  /// late frame is not charged to the cache).
+  std::shared_ptr<const InputFrame> Frame() const;
+  void AttachFrameIfNone(std::shared_ptr<const InputFrame> frame) const;
   /// Bytes charged to the cache: the family, plus the index orders and ordered vertices once
   /// computed (charged up front so that the charge never changes while cached).
   size_t bytes() const { return bytes_; }
@@ -36,6 +56,8 @@ class CachedFamily {
 
   AlphaFamily family_;
   size_t bytes_ = 0;
+  mutable absl::Mutex frame_mutex_;
+  mutable std::shared_ptr<const InputFrame> frame_ ABSL_GUARDED_BY(frame_mutex_);
   mutable std::once_flag orders_once_;
   mutable std::vector<uint32_t> edge_order_, triangle_order_;
   mutable std::vector<uint32_t> edge_vertices_, triangle_vertices_;

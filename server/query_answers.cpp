@@ -352,6 +352,7 @@ void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
   summary->mutable_comparisons()->set_cpu_fallback(report.comparisons.cpu_fallback);
   summary->set_peak_memory_bytes(report.peak_memory_bytes);
   summary->set_family_bytes(cached.bytes());
+  if (const auto frame = cached.Frame()) summary->set_projection(frame->projection);
 }
 
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifySource(
@@ -408,15 +409,30 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
   }
   auto shape = AssembleShape(family.ComplexAt(level->level, *mode));
   if (!shape.ok()) return shape.status();
-  const absl::Span<const Point2> points = family.points();
-  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, points, min_hole_area);
+  // Areas in the family's units (metres for a projected geographic set).
+  if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family.points(), min_hole_area);
+  // Text geometry in the points as sent, GeoJSON in WGS84 longitude/latitude (the header's CRS).
+  const auto frame = cached->Frame();
+  absl::Span<const Point2> points = family.points();
+  if (frame != nullptr && !frame->input.empty()) points = frame->input;
+  std::vector<Point2> lonlat;
+  if (frame != nullptr && request.format() == v1::SHAPE_FORMAT_GEOJSON) {
+    absl::StatusOr<std::vector<Point2>> converted = ToWgs84LonLat(frame->crs, points);
+    if (!converted.ok()) return converted.status();
+    lonlat = *std::move(converted);
+    points = lonlat;
+  }
+  const std::string crs_label =
+      frame == nullptr ? std::string()
+                       : absl::StrCat("coordinates in CRS ", frame->crs.name, frame->crs.id.empty() ? "" : " (",
+                                      frame->crs.id, frame->crs.id.empty() ? "" : ")");
   switch (request.format()) {
     case v1::SHAPE_FORMAT_GEOJSON:
       return std::make_unique<ShapeTextSource>(ShapeToGeoJson(*shape, points));
     case v1::SHAPE_FORMAT_WKT:
       return std::make_unique<ShapeTextSource>(ShapeToWkt(*shape, points));
     case v1::SHAPE_FORMAT_SVG:
-      return std::make_unique<ShapeTextSource>(ShapeToSvg(*shape, points));
+      return std::make_unique<ShapeTextSource>(ShapeToSvg(*shape, points, crs_label));
     case v1::SHAPE_FORMAT_RINGS:
       return std::make_unique<ShapeRingsSource>(*std::move(shape));
     default:

@@ -9,12 +9,15 @@
 #include <array>
 #include <cstdint>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "core/family/persistence.hpp"
 #include "core/geometry/shape.hpp"
+#include "core/io/coordinate_system.hpp"
 #include "core/io/point_set_handle.hpp"
+#include "nlohmann/json.hpp"
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/data_files.hpp"
@@ -294,3 +297,102 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
 
 }  // namespace
 }  // namespace galpha::server
+
+#ifdef GALPHA_WITH_PROJ
+namespace galpha::server {
+namespace {
+
+/// The GPS tracks (WGS84 longitude/latitude) as users send them.
+std::vector<Point2> GpsTracks() {
+  const std::string file = testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
+  std::ifstream in(file, std::ios::binary);
+  uint64_t n = 0;
+  in.read(reinterpret_cast<char*>(&n), sizeof n);
+  std::vector<Point2> points(n);
+  in.read(reinterpret_cast<char*>(points.data()), static_cast<std::streamsize>(n * sizeof(Point2)));
+  EXPECT_TRUE(in.good()) << file;
+  return points;
+}
+
+/// Shape text of `handle` at `rank` in `format`.
+std::string ShapeText(client::AlphaClient& client, const std::string& handle, int64_t rank, v1::ShapeFormat format) {
+  v1::ShapeRequest request;
+  request.set_handle(handle);
+  request.mutable_threshold()->set_rank(rank);
+  request.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+  request.set_format(format);
+  std::string text;
+  EXPECT_THAT(client.Shape(request,
+                           [&](const v1::ShapeResponse& m) {
+                             text += m.text();
+                             return absl::OkStatus();
+                           }),
+              IsOk());
+  return text;
+}
+
+// BuildHeader.crs: the server builds the local projection of longitude/latitude (the oracle: the
+// same projection in-process, then the local engine), under the handle of the projected points,
+// and writes text geometry in the points as sent.
+TEST(ServiceTest, HeaderCrsBuildsTheLocalProjection) {
+  auto server = StartServer(TestServerOptions());
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  const std::vector<Point2> gps = GpsTracks();
+  absl::StatusOr<CrsInfo> wgs84 = DescribeCrs("EPSG:4326");
+  ASSERT_THAT(wgs84, IsOk());
+  absl::StatusOr<LocalMetres> local = ProjectToLocalMetres(*wgs84, gps);
+  ASSERT_THAT(local, IsOk());
+
+  client::BuildCallOptions options;
+  options.crs = "EPSG:4326";
+  absl::StatusOr<client::BuildResult> built = client->Build(gps, options);
+  ASSERT_THAT(built, IsOk());
+  EXPECT_EQ(built->handle, PointSetHandle(local->points));
+  EXPECT_EQ(built->summary.projection(), local->projection);
+  const AlphaFamily expected = LocalFamily(local->points);
+  EXPECT_EQ(SpectrumRemote(*client, built->handle, 1000),
+            std::vector<double>(expected.spectrum().begin(), expected.spectrum().end()));
+  // GeoJSON and WKT name input points only, bit for bit (WGS84 already: GeoJSON copies them).
+  const int64_t rank = expected.max_level() / 2;
+  const nlohmann::json geojson =
+      nlohmann::json::parse(ShapeText(*client, built->handle, rank, v1::SHAPE_FORMAT_GEOJSON));
+  ASSERT_FALSE(geojson["features"].empty());
+  std::set<std::pair<double, double>> sent;
+  for (const Point2& p : gps) sent.emplace(p.x, p.y);
+  size_t positions = 0;
+  for (const auto& polygon : geojson["features"][0]["geometry"]["coordinates"]) {
+    for (const auto& ring : polygon) {
+      for (const auto& position : ring) {
+        EXPECT_TRUE(sent.count({position[0].get<double>(), position[1].get<double>()})) << position;
+        ++positions;
+      }
+    }
+  }
+  EXPECT_GT(positions, 3u);
+  const std::string svg = ShapeText(*client, built->handle, rank, v1::SHAPE_FORMAT_SVG);
+  EXPECT_NE(svg.find("<desc>coordinates in CRS WGS 84 (EPSG:4326)</desc>"), std::string::npos);
+  // The area stays in square metres (the local engine's, on the projected points).
+  EXPECT_EQ(geojson["features"][0]["properties"]["area"].get<double>(),
+            AssembleShape(expected.ComplexAt(rank, ClassifyMode::kRegularized))->area);
+
+  // The projected points sent without a CRS (what alphactl --crs uploads) are the same family.
+  client::BuildCallOptions plain;
+  plain.skip_upload_if_cached = false;
+  absl::StatusOr<client::BuildResult> again = client->Build(local->points, plain);
+  ASSERT_THAT(again, IsOk());
+  EXPECT_EQ(again->handle, built->handle);
+  EXPECT_TRUE(again->cached);
+
+  // What PROJ cannot take is the caller's error.
+  options.crs = "no such crs";
+  EXPECT_THAT(client->Build(gps, options),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the header's crs")));
+  options.crs = "EPSG:4326";
+  EXPECT_THAT(client->Build(std::vector<Point2>{{500000, 4000000}, {500100, 4000000}, {500000, 4000100}}, options),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("is not a longitude and latitude")));
+}
+
+}  // namespace
+}  // namespace galpha::server
+#endif  // GALPHA_WITH_PROJ
