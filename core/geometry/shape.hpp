@@ -100,7 +100,6 @@ std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> poin
 /// circles. Coordinates are written relative to the points' bounding box, so that large offsets
 /// keep their detail in a browser's single-precision renderer. A non-empty `description` (the
 /// coordinates' CRS, for one) becomes the document's <desc>, XML-escaped.
-std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points,
-                       absl::string_view description = {});
+std::string ShapeToSvg(const ShapeGeometry& shape, absl::Span<const Point2> points, absl::string_view description = {});
 
 }  // namespace galpha

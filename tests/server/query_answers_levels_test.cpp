@@ -22,9 +22,9 @@ using galpha::testing::StatusIs;
 using testing::Alpha;
 using testing::AlphaSq;
 using testing::Families;
-using testing::Ratio;
 using testing::NamedFamily;
 using testing::Rank;
+using testing::Ratio;
 using testing::Thresholds;
 
 // ---- ResolveLevel ---------------------------------------------------------------------------------
