@@ -192,11 +192,7 @@ nlohmann::ordered_json CrsJson(const FramedPoints& frame) {
           {"computed_in", frame.crs->geographic ? nlohmann::ordered_json(frame.projection) : nullptr}};
 }
 
-std::string CrsLabel(const FramedPoints& frame) {
-  if (!frame.crs) return "";
-  return absl::StrCat("coordinates in CRS ", frame.crs->name, frame.crs->id.empty() ? "" : " (", frame.crs->id,
-                      frame.crs->id.empty() ? "" : ")");
-}
+std::string CrsLabel(const FramedPoints& frame) { return frame.crs ? CoordinatesLabel(*frame.crs) : std::string(); }
 
 absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points, FramedPoints* frame) {
   GALPHA_ASSIGN_OR_RETURN(FramedPoints read, ReadFramedPoints(common));

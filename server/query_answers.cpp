@@ -422,10 +422,7 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
     lonlat = *std::move(converted);
     points = lonlat;
   }
-  const std::string crs_label =
-      frame == nullptr ? std::string()
-                       : absl::StrCat("coordinates in CRS ", frame->crs.name, frame->crs.id.empty() ? "" : " (",
-                                      frame->crs.id, frame->crs.id.empty() ? "" : ")");
+  const std::string crs_label = frame == nullptr ? std::string() : CoordinatesLabel(frame->crs);
   switch (request.format()) {
     case v1::SHAPE_FORMAT_GEOJSON:
       return std::make_unique<ShapeTextSource>(ShapeToGeoJson(*shape, points));

@@ -32,6 +32,11 @@ struct CrsInfo {
   bool geographic = false;
 };
 
+/// "coordinates in CRS NAME (ID)", as an SVG's <desc> names the CRS of its coordinates.
+inline std::string CoordinatesLabel(const CrsInfo& crs) {
+  return crs.id.empty() ? "coordinates in CRS " + crs.name : "coordinates in CRS " + crs.name + " (" + crs.id + ")";
+}
+
 /// The horizontal CRS of `definition` (a compound CRS's first part, a bound CRS's source).
 /// InvalidArgument when PROJ does not read it as a CRS, or when it has no horizontal part that is
 /// geographic or planar (geocentric, vertical, temporal).

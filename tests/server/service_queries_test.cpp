@@ -226,6 +226,18 @@ void ExpectServiceMatchesLocal(client::AlphaClient& client, const std::vector<Po
   EXPECT_EQ(text, ShapeToGeoJson(*local_shape, local.points()));
 }
 
+/// The GPS tracks (WGS84 longitude/latitude) as users send them.
+std::vector<Point2> GpsTracks() {
+  const std::string file = testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
+  std::ifstream in(file, std::ios::binary);
+  uint64_t n = 0;
+  in.read(reinterpret_cast<char*>(&n), sizeof n);
+  std::vector<Point2> points(n);
+  in.read(reinterpret_cast<char*>(points.data()), static_cast<std::streamsize>(n * sizeof(Point2)));
+  EXPECT_TRUE(in.good()) << file;
+  return points;
+}
+
 TEST(ServiceTest, EveryQueryMatchesTheLocalEngine) {
   auto server = StartServer(TestServerOptions());
   ASSERT_NE(server, nullptr);
@@ -237,14 +249,7 @@ TEST(ServiceTest, EveryQueryMatchesTheLocalEngine) {
   ExpectServiceMatchesLocal(*client, {{0.5, 0.25}}, "one point");
   ExpectServiceMatchesLocal(*client, {}, "no points");
   // A real data set, as users send them.
-  const std::string file = testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
-  std::ifstream in(file, std::ios::binary);
-  uint64_t n = 0;
-  in.read(reinterpret_cast<char*>(&n), sizeof n);
-  std::vector<Point2> gps(n);
-  in.read(reinterpret_cast<char*>(gps.data()), static_cast<std::streamsize>(n * sizeof(Point2)));
-  ASSERT_TRUE(in.good()) << file;
-  ExpectServiceMatchesLocal(*client, gps, "gps tracks");
+  ExpectServiceMatchesLocal(*client, GpsTracks(), "gps tracks");
 }
 
 TEST(ServiceTest, DescribeReleaseAndTheCache) {
@@ -301,18 +306,6 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
 #ifdef GALPHA_WITH_PROJ
 namespace galpha::server {
 namespace {
-
-/// The GPS tracks (WGS84 longitude/latitude) as users send them.
-std::vector<Point2> GpsTracks() {
-  const std::string file = testdata::DataDir() + "/gps_tracks_slovenia_croatia.bin";
-  std::ifstream in(file, std::ios::binary);
-  uint64_t n = 0;
-  in.read(reinterpret_cast<char*>(&n), sizeof n);
-  std::vector<Point2> points(n);
-  in.read(reinterpret_cast<char*>(points.data()), static_cast<std::streamsize>(n * sizeof(Point2)));
-  EXPECT_TRUE(in.good()) << file;
-  return points;
-}
 
 /// Shape text of `handle` at `rank` in `format`.
 std::string ShapeText(client::AlphaClient& client, const std::string& handle, int64_t rank, v1::ShapeFormat format) {
