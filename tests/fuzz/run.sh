@@ -14,8 +14,10 @@ protoc --proto_path=proto --cpp_out="$out/gen" galpha/v1/alpha_shapes.proto
 flags=(-std=c++17 -O1 -g -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -I. -I"$out/gen")
 libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthread)
 
+# The decoder with the CRS functions that refuse (coordinate_system_no_proj.cpp): a header's crs is
+# then an error, decided without PROJ's database; the fuzzer aims at the decoder.
 clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
-  proto/codec/point_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
+  core/io/coordinate_system_no_proj.cpp proto/codec/point_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
   $(pkg-config --libs libzstd)
 clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp core/io/las_reader.cpp \
   -o "$out/point_formats_fuzzer" "${libs[@]}" $(pkg-config --libs absl_str_format)
