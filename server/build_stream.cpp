@@ -149,6 +149,11 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
                                            limits_.max_points, " points (--max_points_per_build)")),
                           BuildRefusal::kPointsPerBuild);
       }
+      // A CRS PROJ does not read is refused before the upload (Finish applies it to the points).
+      if (!decoded_.header.crs().empty()) {
+        absl::StatusOr<CrsInfo> crs = DescribeCrs(decoded_.header.crs());
+        if (!crs.ok()) return absl::InvalidArgumentError(absl::StrCat("the header's crs: ", crs.status().message()));
+      }
       // Nothing is reserved for an announced size (a stream that only announces would hold the
       // budget for nothing): only a size that no limit could ever hold is refused now.
       if (in_flight_ == nullptr) return absl::OkStatus();

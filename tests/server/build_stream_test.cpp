@@ -176,6 +176,15 @@ TEST(BuildStreamDecoderTest, MessageWithNeitherHeaderNorPointsIsRefused) {
   }
 }
 
+TEST(BuildStreamDecoderTest, AnUnreadableCrsIsRefusedAtTheHeader) {
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  v1::BuildRequest header = Header(0);
+  header.mutable_header()->set_crs("no such crs");
+  // With PROJ: not understood; without: this build reads no CRS. Either way before any point.
+  EXPECT_THAT(decoder.Add(header),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the header's crs")));
+}
+
 TEST(BuildStreamDecoderTest, AnnouncedCountOverTheLimitIsRefusedAtTheHeader) {
   BuildStreamLimits limits;
   limits.max_points = 100;
