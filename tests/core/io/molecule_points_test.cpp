@@ -70,6 +70,8 @@ std::string Write(const std::string& name, const std::string& text) {
   return path;
 }
 
+#ifdef GALPHA_WITH_GEMMI
+
 std::string WriteGz(const std::string& name, const std::string& text) {
   std::string path = std::filesystem::temp_directory_path() / absl::StrCat("molecule_test_", getpid(), "_", name);
   gzFile out = gzopen(path.c_str(), "wb");
@@ -77,8 +79,6 @@ std::string WriteGz(const std::string& name, const std::string& text) {
   gzclose(out);
   return path;
 }
-
-#ifdef GALPHA_WITH_GEMMI
 
 void ExpectAtoms(const absl::StatusOr<GeoreferencedPoints>& read, int u, int v) {
   ASSERT_THAT(read, IsOk());
