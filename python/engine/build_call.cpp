@@ -68,6 +68,29 @@ struct PythonCallbacks {
   std::optional<py::error_already_set> error;
 };
 
+/// `call()` (returning an absl::StatusOr<T>) with the GIL released; its error raised as
+/// EngineError once the GIL is held again.
+template <class T, class Call>
+T WithoutGil(Call&& call) {
+  absl::StatusOr<T> result = absl::UnknownError("not run");
+  {
+    py::gil_scoped_release release;
+    result = call();
+  }
+  if (!result.ok()) throw StatusError(result.status());
+  return *std::move(result);
+}
+
+/// An (N, 2) float64 array holding `points`.
+py::array_t<double> PointsArray(const std::vector<Point2>& points) {
+  std::vector<double> flat(2 * points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    flat[2 * i] = points[i].x;
+    flat[2 * i + 1] = points[i].y;
+  }
+  return ArrayFromVector(std::move(flat), {static_cast<py::ssize_t>(points.size()), 2});
+}
+
 }  // namespace
 
 std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const std::string& backend,
@@ -127,22 +150,8 @@ py::dict FrameOf(const std::string& crs, const py::object& points) {
   out["points"] = py::none();
   out["projection"] = py::none();
   if (!info.geographic) return out;
-  LocalMetres local;
-  {
-    py::gil_scoped_release release;
-    absl::StatusOr<LocalMetres> projected = ProjectToLocalMetres(info, span);
-    if (!projected.ok()) {
-      py::gil_scoped_acquire acquire;
-      throw StatusError(projected.status());
-    }
-    local = *std::move(projected);
-  }
-  std::vector<double> flat(2 * local.points.size());
-  for (size_t i = 0; i < local.points.size(); ++i) {
-    flat[2 * i] = local.points[i].x;
-    flat[2 * i + 1] = local.points[i].y;
-  }
-  out["points"] = ArrayFromVector(std::move(flat), {static_cast<py::ssize_t>(local.points.size()), 2});
+  LocalMetres local = WithoutGil<LocalMetres>([&] { return ProjectToLocalMetres(info, span); });
+  out["points"] = PointsArray(local.points);
   out["projection"] = local.projection;
   return out;
 }
@@ -166,29 +175,18 @@ py::dict ReadPointFile(const std::string& path, const std::string& layer, const 
   }
   const MoleculeSection section =
       ValueOrThrow(ParseMoleculeSection(plane_text ? &*plane_text : nullptr, slab_text ? &*slab_text : nullptr));
-  GeoreferencedPoints read;
-  {
-    py::gil_scoped_release release;
+  GeoreferencedPoints read = WithoutGil<GeoreferencedPoints>([&]() -> absl::StatusOr<GeoreferencedPoints> {
     absl::StatusOr<GeoreferencedPoints> result = molecule ? ReadMoleculePoints(path, section, max_points)
                                                  : vector ? ReadVectorPoints(path, layer, max_points)
                                                           : ReadGeoreferencedPointsFile(path);
     if (result.ok() && result->points.size() > max_points) {
-      result = absl::ResourceExhaustedError(absl::StrCat("points file '", path, "' has ", result->points.size(),
-                                                         " points: more than max_points, ", max_points));
+      return absl::ResourceExhaustedError(absl::StrCat("points file '", path, "' has ", result->points.size(),
+                                                       " points: more than max_points, ", max_points));
     }
-    if (!result.ok()) {
-      py::gil_scoped_acquire acquire;
-      throw StatusError(result.status());
-    }
-    read = *std::move(result);
-  }
-  std::vector<double> flat(2 * read.points.size());
-  for (size_t i = 0; i < read.points.size(); ++i) {
-    flat[2 * i] = read.points[i].x;
-    flat[2 * i + 1] = read.points[i].y;
-  }
+    return result;
+  });
   py::dict out;
-  out["points"] = ArrayFromVector(std::move(flat), {static_cast<py::ssize_t>(read.points.size()), 2});
+  out["points"] = PointsArray(read.points);
   out["crs"] = read.crs ? py::object(py::str(*read.crs)) : py::object(py::none());
   return out;
 }

@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "absl/types/span.h"
 #include "tests/support/data_files.hpp"
 #include "tests/support/server_process.hpp"
 
@@ -49,6 +50,21 @@ CommandResult Alphactl(const std::string& args, const std::string& environment =
 using galpha::testing::ServerProcess;
 constexpr char kServerFlags[] = "--drain_notice_ms 200";
 
+/// Each of `commands` on `file` (then `options`) prints the same locally and against `server`.
+void ExpectRemotePrintsAsLocal(const ServerProcess& server, const std::string& file,
+                               absl::Span<const char* const> commands, const std::string& options = "") {
+  for (const char* command : commands) {
+    SCOPED_TRACE(command);
+    const std::string args = std::string(command) + " " + file + options;
+    const CommandResult local = Alphactl(args);
+    const CommandResult remote = Alphactl(args + " --server " + server.address());
+    EXPECT_EQ(local.exit_code, 0) << local.err;
+    EXPECT_EQ(remote.exit_code, 0) << remote.err;
+    EXPECT_FALSE(local.out.empty());
+    EXPECT_EQ(remote.out, local.out);
+  }
+}
+
 TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
   ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();
@@ -73,15 +89,7 @@ TEST(AlphactlRemoteTest, EveryQueryCommandPrintsWhatTheLocalOnePrints) {
       "holes --rank 3500",
       "holes --rank 3500 --format geojson --min-area 0",
   };
-  for (const char* command : commands) {
-    SCOPED_TRACE(command);
-    const CommandResult local = Alphactl(std::string(command) + " " + file);
-    const CommandResult remote = Alphactl(std::string(command) + " " + file + " --server " + server.address());
-    EXPECT_EQ(local.exit_code, 0) << local.err;
-    EXPECT_EQ(remote.exit_code, 0) << remote.err;
-    EXPECT_FALSE(local.out.empty());
-    EXPECT_EQ(remote.out, local.out);
-  }
+  ExpectRemotePrintsAsLocal(server, file, commands);
   // bench runs on the server: its table names the server's backend and the RPC's time.
   const CommandResult bench = Alphactl("bench " + file + " --server " + server.address());
   EXPECT_EQ(bench.exit_code, 0) << bench.err;
@@ -105,16 +113,7 @@ TEST(AlphactlRemoteTest, GeographicInputAnswersAsLocally) {
       "holes --rank 3500 --format geojson",
       "holes --rank 3500",
   };
-  for (const char* command : commands) {
-    SCOPED_TRACE(command);
-    const std::string args = std::string(command) + " " + file + " --crs EPSG:4326";
-    const CommandResult local = Alphactl(args);
-    const CommandResult remote = Alphactl(args + " --server " + server.address());
-    EXPECT_EQ(local.exit_code, 0) << local.err;
-    EXPECT_EQ(remote.exit_code, 0) << remote.err;
-    EXPECT_FALSE(local.out.empty());
-    EXPECT_EQ(remote.out, local.out);
-  }
+  ExpectRemotePrintsAsLocal(server, file, commands, " --crs EPSG:4326");
 }
 #endif
 
