@@ -18,6 +18,7 @@
 #include <string>
 #include <thread>
 
+#include "absl/strings/str_cat.h"
 #include "absl/types/span.h"
 #include "tests/support/data_files.hpp"
 #include "tests/support/server_process.hpp"
@@ -55,7 +56,7 @@ void ExpectRemotePrintsAsLocal(const ServerProcess& server, const std::string& f
                                absl::Span<const char* const> commands, const std::string& options = "") {
   for (const char* command : commands) {
     SCOPED_TRACE(command);
-    const std::string args = std::string(command) + " " + file + options;
+    const std::string args = absl::StrCat(command, " ", file, options);
     const CommandResult local = Alphactl(args);
     const CommandResult remote = Alphactl(args + " --server " + server.address());
     EXPECT_EQ(local.exit_code, 0) << local.err;
