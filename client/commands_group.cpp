@@ -33,15 +33,6 @@ std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> Groups
   return groups;
 }
 
-/// The MultiPolygon geometry of a shape's polygons, as ShapeToGeoJson writes it.
-nlohmann::ordered_json PolygonsGeometry(const ShapeGeometry& shape, absl::Span<const Point2> points) {
-  const nlohmann::ordered_json collection = nlohmann::ordered_json::parse(ShapeToGeoJson(shape, points));
-  for (const auto& feature : collection["features"]) {
-    if (feature["properties"]["kind"] == "polygons") return feature["geometry"];
-  }
-  return {{"type", "MultiPolygon"}, {"coordinates", nlohmann::ordered_json::array()}};
-}
-
 }  // namespace
 
 int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, const std::string& format,
@@ -92,8 +83,9 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
                                          {"level", level->level},
                                          {"alpha_sq", level->alpha_sq},
                                          {"area", shape->area}};
-    features.push_back(
-        {{"type", "Feature"}, {"properties", std::move(properties)}, {"geometry", PolygonsGeometry(*shape, *points)}});
+    features.push_back({{"type", "Feature"},
+                        {"properties", std::move(properties)},
+                        {"geometry", ShapePolygonsGeoJson(*shape, *points)}});
   }
   if (format == "geojson") {
     out.Append(JsonText({{"type", "FeatureCollection"}, {"features", std::move(features)}}));

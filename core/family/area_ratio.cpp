@@ -79,6 +79,21 @@ mpz_class TwiceAreaExact(const AlphaFamily& family, int64_t level, const Integer
   return abs(sum);
 }
 
+/// The first level L in [first, last) for which `holds(L)` is true, or `last` when none is;
+/// `holds` must be false and then true as L grows (a binary search: O(log) calls).
+template <class Predicate>
+int64_t FirstLevelWhere(int64_t first, int64_t last, const Predicate& holds) {
+  while (first < last) {
+    const int64_t mid = first + (last - first) / 2;
+    if (holds(mid)) {
+      last = mid;
+    } else {
+      first = mid + 1;
+    }
+  }
+  return first;
+}
+
 /// ratio = mantissa * 2^-shift, an integer mantissa below 2^53 and shift >= 52 (ratio in (0, 1]).
 struct DyadicRatio {
   uint64_t mantissa = 0;
@@ -137,27 +152,9 @@ absl::StatusOr<int64_t> LevelForAreaRatio(const AlphaFamily& family, double rati
     auto surely_short = [&](int64_t level) {
       return static_cast<__int128>(r.area_units[static_cast<size_t>(level)]) + error < need_down;
     };
-    int64_t lo = 0, hi = k;  // smallest surely-enough level, or k
-    while (lo < hi) {
-      const int64_t mid = lo + (hi - lo) / 2;
-      if (surely_enough(mid)) {
-        hi = mid;
-      } else {
-        lo = mid + 1;
-      }
-    }
-    high = lo;
-    lo = -1;
-    hi = high - 1;  // largest surely-short level below high, or -1
-    while (lo < hi) {
-      const int64_t mid = hi - (hi - lo) / 2;
-      if (surely_short(mid)) {
-        lo = mid;
-      } else {
-        hi = mid - 1;
-      }
-    }
-    low = lo;
+    high = FirstLevelWhere(0, k, surely_enough);  // or k, which qualifies anyway
+    // The largest surely-short level below it (surely_short holds, then fails, as L grows).
+    low = FirstLevelWhere(0, high, [&](int64_t level) { return !surely_short(level); }) - 1;
   }
   if (high == low + 1) return high;
   // Undecided levels: exact areas, by binary search in (low, high] (high qualifies).
@@ -169,16 +166,7 @@ absl::StatusOr<int64_t> LevelForAreaRatio(const AlphaFamily& family, double rati
     twice <<= static_cast<mp_bitcnt_t>(dyadic.shift);
     return twice >= hull_times_mantissa;
   };
-  int64_t lo = low + 1, hi = high;
-  while (lo < hi) {
-    const int64_t mid = lo + (hi - lo) / 2;
-    if (exactly_enough(mid)) {
-      hi = mid;
-    } else {
-      lo = mid + 1;
-    }
-  }
-  return lo;
+  return FirstLevelWhere(low + 1, high, exactly_enough);
 }
 
 }  // namespace galpha

@@ -374,16 +374,22 @@ std::string ShapeToWkt(const ShapeGeometry& shape, absl::Span<const Point2> poin
   return out;
 }
 
+nlohmann::ordered_json ShapePolygonsGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points) {
+  nlohmann::ordered_json polygons = nlohmann::ordered_json::array();
+  for (const ShapePolygon& polygon : shape.polygons) {
+    nlohmann::ordered_json rings = nlohmann::ordered_json::array({JsonRing(polygon.outer, points)});
+    for (const auto& hole : polygon.holes) rings.push_back(JsonRing(hole, points));
+    polygons.push_back(std::move(rings));
+  }
+  return {{"type", "MultiPolygon"}, {"coordinates", std::move(polygons)}};
+}
+
 std::string ShapeToGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points) {
   nlohmann::ordered_json features = nlohmann::ordered_json::array();
   if (!shape.polygons.empty()) {
-    nlohmann::ordered_json polygons = nlohmann::ordered_json::array();
-    for (const ShapePolygon& polygon : shape.polygons) {
-      nlohmann::ordered_json rings = nlohmann::ordered_json::array({JsonRing(polygon.outer, points)});
-      for (const auto& hole : polygon.holes) rings.push_back(JsonRing(hole, points));
-      polygons.push_back(std::move(rings));
-    }
-    features.push_back(JsonFeature({{"kind", "polygons"}, {"area", shape.area}}, "MultiPolygon", std::move(polygons)));
+    features.push_back({{"type", "Feature"},
+                        {"properties", {{"kind", "polygons"}, {"area", shape.area}}},
+                        {"geometry", ShapePolygonsGeoJson(shape, points)}});
   }
   if (!shape.singular_edges.empty()) {
     nlohmann::ordered_json lines = nlohmann::ordered_json::array();

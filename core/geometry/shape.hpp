@@ -25,6 +25,7 @@
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/base/point.hpp"
+#include "nlohmann/json.hpp"
 
 namespace galpha {
 
@@ -81,6 +82,10 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex);
 /// FeatureCollection. Compact JSON written from an nlohmann-json document (core/io/json_text.hpp);
 /// keys in the order named here ("type", "properties", "geometry"; "type", "coordinates").
 std::string ShapeToGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points);
+
+/// The shape's polygons as one GeoJSON MultiPolygon geometry (as ShapeToGeoJson writes it; empty
+/// coordinates for a shape without polygons), for callers that put it in features of their own.
+nlohmann::ordered_json ShapePolygonsGeoJson(const ShapeGeometry& shape, absl::Span<const Point2> points);
 
 /// OGC WKT, the simplest type that holds the shape, so that a reader (GEOS, shapely, PostGIS) gets
 /// a polygon where the shape is one:
