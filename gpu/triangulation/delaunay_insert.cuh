@@ -79,9 +79,26 @@ struct VoteForInsertion {
       const double px = ldexp(p.x - a.x, -e), py = ldexp(p.y - a.y, -e);
       const double d = bx * cy - by * cx;
       const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-      const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
-      score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
-                                                                    : (power < 0 ? -3.0e38f : 3.0e38f);
+      if (d != 0.0) {
+        const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
+        score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
+                                                                      : (power < 0 ? -3.0e38f : 3.0e38f);
+      } else {
+        // A triangle flat in doubles (collinear vertices, kept by the symbolic perturbation): it
+        // has no circumcentre, and every point would tie. Its points lie on its long edge's line;
+        // the one nearest that edge's midpoint splits the edge's points in halves, as on the hull.
+        const double a2 = (bx - cx) * (bx - cx) + (by - cy) * (by - cy);
+        double mx = 0.5 * (bx + cx), my = 0.5 * (by + cy);  // the long edge b-c, unless...
+        if (b2 >= a2 && b2 >= c2) {
+          mx = 0.5 * bx;  // a-b
+          my = 0.5 * by;
+        } else if (c2 >= a2 && c2 >= b2) {
+          mx = 0.5 * cx;  // a-c
+          my = 0.5 * cy;
+        }
+        const double dx = px - mx, dy = py - my;
+        score = static_cast<float>(dx * dx + dy * dy);
+      }
     }
     const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
     cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(tri_vote[t]);

@@ -57,13 +57,28 @@ struct MeshView {
     return Orient2dSoS(pts[a], sos[a], pts[b], sos[b], pts[c], sos[c]);
   }
 
+  /// Whether finite vertex s is in conflict with the hull edge u->w (outside on its left): strictly
+  /// beyond its line, or on the line strictly between u and w. Exact, without the symbolic
+  /// perturbation: a point on a hull segment becomes a hull vertex, as in reality. Under the
+  /// perturbation, points on a hull line would instead sink in or stick out by rank, and those that
+  /// sink would hang from the few that stick out in long fans of flat triangles: every later point on
+  /// that line would then start a flip cascade along the fan (two parallel lines of points took
+  /// hundreds of sequential flip iterations a round).
+  GALPHA_HD bool HullEdgeConflict(int32_t u, int32_t w, int32_t s) const {
+    const int o = Orient2dSign(pts[u], pts[w], pts[s]);
+    if (o != 0) return o > 0;
+    const Point2 a = pts[u], b = pts[w], m = pts[s];
+    return (LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a));
+  }
+
   /// Whether vertex s lies inside the (symbolically perturbed) circumcircle of triangle t. For an
-  /// infinite triangle the "circle" is the open half-plane beyond its hull edge.
+  /// infinite triangle the "circle" is the half-plane beyond its hull edge, closed on the edge's
+  /// open segment (HullEdgeConflict).
   GALPHA_HD bool InConflict(int32_t t, int32_t s) const {
     if (s == inf) return false;
     const Tri& x = tri[t];
     for (int k = 0; k < 3; ++k) {
-      if (x.v[k] == inf) return Orient(x.v[Next(k)], x.v[Prev(k)], s) > 0;
+      if (x.v[k] == inf) return HullEdgeConflict(x.v[Next(k)], x.v[Prev(k)], s);
     }
     const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
     return InCircleSoS(pts[a], sos[a], pts[b], sos[b], pts[c], sos[c], pts[s], sos[s]) > 0;
@@ -121,17 +136,20 @@ struct MeshView {
   }
 
   /// Whether the edge of t opposite position k must be flipped to restore the (SoS) Delaunay
-  /// property. Edges on the hull between a finite and an infinite triangle never flip; an edge
-  /// between two infinite triangles flips when its finite vertex is not convex (only while the hull
-  /// is still being built: `hull_may_change`).
+  /// property. While the hull is still being built (`hull_may_change`): an edge between two infinite
+  /// triangles flips when its finite vertex is not convex, and a hull edge flips when the finite
+  /// triangle on it is flat with its apex on the edge (the apex joins the hull). Otherwise hull edges
+  /// never flip.
   GALPHA_HD bool ShouldFlip(int32_t t, int k, bool hull_may_change) const {
     const Tri& x = tri[t];
     const int32_t r = x.v[k], p = x.v[Next(k)], q = x.v[Prev(k)];
-    if (r == inf) return false;
     const int32_t nb = nbr[t].n[k];
     const int j = EdgePos(nb, q, p);
     const int32_t s = tri[nb].v[j];
-    if (s == inf) return false;
+    if (r == inf || s == inf) {
+      if (!hull_may_change || (r == inf && s == inf)) return false;
+      return r == inf ? HullEdgeConflict(p, q, s) : HullEdgeConflict(q, p, r);
+    }
     if ((p == inf || q == inf) && !hull_may_change) return false;
     return InConflict(t, s);
   }

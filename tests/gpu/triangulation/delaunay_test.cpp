@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iterator>
 #include <limits>
+#include <random>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -255,6 +256,37 @@ TEST_P(DelaunayTest, CollinearRunPlusOnePointOffTheLine) {
   // A fan from the apex over the 999 segments of the line.
   EXPECT_EQ(t.triangles.size(), 999u);
   EXPECT_EQ(t.edges.size(), 999u + 1000u);
+}
+
+// Hull sides that hold many points, in every arrangement the insertion meets: each collinear
+// point must end as a hull vertex (CheckTriangulation: the boundary is the exact convex hull, every
+// point a vertex, every edge locally Delaunay). Small lattices make points on a hull side also
+// co-circular with interior ones; the shuffled orders put them in every insertion order.
+TEST_P(DelaunayTest, ManyPointsOnHullSidesInAnyOrder) {
+  std::mt19937_64 rng(7);
+  for (int side : {3, 4, 7, 16, 40}) {
+    for (int interior_percent : {0, 10, 60}) {
+      for (int shape = 0; shape < 3; ++shape) {
+        std::vector<Point2> points;
+        std::bernoulli_distribution inside(interior_percent / 100.0);
+        for (int i = 0; i <= side; ++i) {
+          for (int j = 0; j <= side; ++j) {
+            // 0: a square's lattice; 1: a right triangle's; 2: a parallelogram of slope 1/2 (two
+            // parallel hull sides, as in parallel_lines).
+            if (shape == 1 && i + j > side) continue;
+            const bool on_hull = i == 0 || j == 0 || i == side || j == side || (shape == 1 && i + j == side);
+            if (!on_hull && !inside(rng)) continue;
+            const double x = shape == 2 ? 2.0 * j + i : j;
+            points.push_back({x, static_cast<double>(shape == 2 ? j + 3 * i : i)});
+          }
+        }
+        std::shuffle(points.begin(), points.end(), rng);
+        SCOPED_TRACE(absl::StrCat("side=", side, " interior=", interior_percent, "% shape=", shape));
+        Triangulation t;
+        ASSERT_NO_FATAL_FAILURE(RunAndCheck(points, &t));
+      }
+    }
+  }
 }
 
 TEST_P(DelaunayTest, CoCircularSquare) {
