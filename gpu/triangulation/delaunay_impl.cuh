@@ -162,7 +162,8 @@ void WriteCollinearChain(System& sys, DistinctPoints<System>* distinct, SystemTr
 }
 
 /// Hilbert order of the distinct points: neighbours in the order are neighbours in the plane.
-/// Returns the points in that order (the mesh's vertices); `unique` is put in the same order.
+/// Returns the points in that order, scaled by an exact power of two (ExactScaleExponent), as the
+/// mesh's vertices; `unique` is put in the same order. The output keeps the input's coordinates.
 template <class System>
 Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, DistinctPoints<System>* distinct) {
   auto pol = sys.policy();
@@ -173,10 +174,15 @@ Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, 
   {
     const BoundingBox box = thrust::transform_reduce(pol, input.begin(), input.end(), PointToBox(),
                                                      PointToBox()(sys.Read(input.data())), MergeBoxes());
+    const int scale_exponent = ExactScaleExponent(box, [&] {
+      return thrust::transform_reduce(pol, input.begin(), input.end(), SmallestNonzeroMagnitude(),
+                                      static_cast<double>(INFINITY), Minimum());
+    });
     Buffer<uint64_t, System> keys(sys, m);
     thrust::transform(pol, first, first + m, keys.begin(), HilbertKey{input.data(), unique.data(), box});
     thrust::sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
-    thrust::for_each(pol, first, first + m, GatherVertex{input.data(), unique.data(), vertex_points.data()});
+    thrust::for_each(pol, first, first + m,
+                     GatherVertex{input.data(), unique.data(), vertex_points.data(), scale_exponent});
   }
   return vertex_points;
 }

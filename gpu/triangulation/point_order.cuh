@@ -2,6 +2,8 @@
 // wins) and the Hilbert curve key that gives the insertion rounds their locality.
 #pragma once
 
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
@@ -110,12 +112,49 @@ struct HilbertKey {
   }
 };
 
-/// Gathers the distinct points into Hilbert order with their input indices (the SoS ranks).
+/// The smallest nonzero magnitude among a point's coordinates (+inf when both are zero).
+struct SmallestNonzeroMagnitude {
+  GALPHA_HD double operator()(const Point2& p) const {
+    const double ax = fabs(p.x), ay = fabs(p.y);
+    const double sx = ax > 0.0 ? ax : INFINITY, sy = ay > 0.0 ? ay : INFINITY;
+    return sx < sy ? sx : sy;
+  }
+};
+
+struct Minimum {
+  GALPHA_HD double operator()(double a, double b) const { return a < b ? a : b; }
+};
+
+/// The power of two the triangulation scales its points by: the one that brings the largest
+/// magnitude into [1, 2), limited so that the scaling stays exact. Scaling by a power of two
+/// multiplies every orientation determinant by a positive constant (and every in-circle one by its
+/// square), so every predicate keeps its sign and the triangulation is the same; but the floating
+/// filters, which give up where products underflow (coordinates near 1e-300, subnormals) or
+/// overflow, then succeed as on well-scaled input instead of sending every test to exact
+/// arithmetic. Scaling up is exact while nothing overflows; scaling down while the smallest
+/// nonzero coordinate stays a normal number (`smallest_nonzero` is asked for only then).
+template <class SmallestNonzero>
+inline int ExactScaleExponent(const BoundingBox& box, SmallestNonzero smallest_nonzero) {
+  const double largest = fmax(fmax(fabs(box.min_x), fabs(box.max_x)), fmax(fabs(box.min_y), fabs(box.max_y)));
+  if (!(largest > 0.0)) return 0;
+  const int up = -ilogb(largest);
+  if (up >= 0) return up;
+  const double smallest = smallest_nonzero();
+  const int down_allowed = ilogb(smallest) - DBL_MIN_EXP + 1;  // stays >= 2^-1022
+  return down_allowed <= 0 ? 0 : -(down_allowed < -up ? down_allowed : -up);
+}
+
+/// Gathers the distinct points into Hilbert order with their input indices (the SoS ranks),
+/// scaled by 2^scale_exponent (exact: ExactScaleExponent).
 struct GatherVertex {
   const Point2* input_points;
   const uint32_t* input_index;
   Point2* vertex_points;
-  GALPHA_HD void operator()(uint32_t v) const { vertex_points[v] = input_points[input_index[v]]; }
+  int scale_exponent;
+  GALPHA_HD void operator()(uint32_t v) const {
+    const Point2 p = input_points[input_index[v]];
+    vertex_points[v] = Point2{ldexp(p.x, scale_exponent), ldexp(p.y, scale_exponent)};
+  }
 };
 
 }  // namespace galpha::detail

@@ -2,6 +2,7 @@
 // real data sets and the degenerate inputs; each result must pass the exact CheckTriangulation.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <iterator>
@@ -9,6 +10,7 @@
 #include <random>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -319,6 +321,43 @@ TEST_P(DelaunayTest, KiteTakesTheShortDiagonal) {
   Triangulation t;
   ASSERT_NO_FATAL_FAILURE(RunAndCheck({{0, 0}, {4, 0}, {2, 1}, {2, -1}}, &t));
   EXPECT_EQ(CanonicalTriangles(t), std::vector<Tri>({{0, 3, 2}, {1, 2, 3}}));
+}
+
+// The triangulation scales its points by a power of two before the predicates see them (so that
+// the filters work on tiny and huge coordinates); the scaling must be exact, so every scaled copy
+// of a set has the same triangles as the set itself. The sets: lattice points (co-circular cells,
+// collinear rows), and the same moved by single ulps, whose triangles their last bits decide (an
+// inexact scaling loses them); copies from the subnormal range to the input domain's edge (2^500).
+TEST_P(DelaunayTest, ScaledCopiesHaveTheSameTriangles) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> coordinate(0, 63);
+  std::bernoulli_distribution up(0.5);
+  std::vector<Point2> lattice;
+  std::vector<Point2> nudged;  // the lattice moved to [64, 128) and each coordinate by one ulp
+  for (int i = 0; i < 600; ++i) {
+    const Point2 p{1.0 * coordinate(rng), 1.0 * coordinate(rng)};
+    lattice.push_back(p);
+    nudged.push_back({std::nextafter(p.x + 64.0, up(rng) ? 128.0 : 0.0),
+                      std::nextafter(p.y + 64.0, up(rng) ? 128.0 : 0.0)});
+  }
+  // Exponents that keep every coordinate of the set exact (the lattice's small integers fit the
+  // subnormal range; the nudged set's last bits, 2^-46, must stay above 2^-1074).
+  const std::vector<std::pair<const std::vector<Point2>*, std::vector<int>>> cases = {
+      {&lattice, {-1070, -1000, 300, 493}}, {&nudged, {-1020, -600, 300, 490}}};
+  for (const auto& [points, exponents] : cases) {
+    Triangulation reference;
+    ASSERT_NO_FATAL_FAILURE(RunAndCheck(*points, &reference));
+    for (int exponent : exponents) {
+      SCOPED_TRACE(absl::StrCat(points->size(), " points scaled by 2^", exponent));
+      std::vector<Point2> scaled;
+      for (const Point2& p : *points) scaled.push_back({std::ldexp(p.x, exponent), std::ldexp(p.y, exponent)});
+      Triangulation t;
+      ASSERT_NO_FATAL_FAILURE(RunAndCheck(scaled, &t));
+      EXPECT_EQ(t.num_unique, reference.num_unique);
+      EXPECT_EQ(CanonicalTriangles(t), CanonicalTriangles(reference));
+      EXPECT_EQ(SortedEdges(t), SortedEdges(reference));
+    }
+  }
 }
 
 TEST_P(DelaunayTest, NaNIsRejectedWithItsIndex) {
