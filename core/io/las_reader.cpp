@@ -35,6 +35,12 @@ constexpr size_t kUserIdAt = 2, kUserIdBytes = 16, kRecordIdAt = 18, kRecordLeng
 // The OGC coordinate system WKT record (table 21); LASzip's record marks compressed data.
 constexpr absl::string_view kProjectionUser = "LASF_Projection", kLasZipUser = "laszip encoded";
 constexpr uint16_t kWktRecordId = 2112, kLasZipRecordId = 22204;
+// The GeoTIFF GeoKeyDirectoryTag record (table 18) and the keys read from it (GeoTIFF 1.0, 2.7):
+// the model type (1 projected, 2 geographic) and the EPSG codes of the projected and geographic
+// CRS; 32767 is "user-defined", which names no code.
+constexpr uint16_t kGeoKeysRecordId = 34735;
+constexpr uint16_t kModelTypeKey = 1024, kGeographicTypeKey = 2048, kProjectedTypeKey = 3072;
+constexpr uint16_t kModelProjected = 1, kModelGeographic = 2, kUserDefinedCode = 32767;
 // Bytes of point data record formats 0 to 10 (tables 7-17); X and Y are the first two int32 of all.
 constexpr uint16_t kFormatBytes[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
 constexpr int kLastFormat = 10, kFirstFormatOf14 = 6;
@@ -223,12 +229,42 @@ absl::StatusOr<LasHeader> ReadHeader(const LasFile& file) {
 struct RecordSeen {
   bool wkt = false;
   bool laszip = false;
+  bool geokeys = false;
 };
 
 RecordSeen Classify(const unsigned char* header) {
   const absl::string_view user = PaddedText(header + kUserIdAt, kUserIdBytes);
   const uint16_t id = U16(header + kRecordIdAt);
-  return {user == kProjectionUser && id == kWktRecordId, user == kLasZipUser && id == kLasZipRecordId};
+  return {user == kProjectionUser && id == kWktRecordId, user == kLasZipUser && id == kLasZipRecordId,
+          user == kProjectionUser && id == kGeoKeysRecordId};
+}
+
+// The CRS a GeoKeyDirectoryTag body names by EPSG code ("EPSG:26910"): the projected CRS, or the
+// geographic one when the model is geographic (or not given, with no projected code). nullopt when the
+// directory is malformed (its version, or entries past its end) or names no code (user-defined
+// CRSs are described by further keys that are not interpreted: such files need --crs).
+std::optional<std::string> EpsgFromGeoKeys(const std::vector<unsigned char>& body) {
+  const size_t shorts = body.size() / 2;
+  const auto at = [&](size_t i) { return U16(body.data() + 2 * i); };
+  // Header: KeyDirectoryVersion (1), KeyRevision, MinorRevision, NumberOfKeys; then 4 shorts a key.
+  if (shorts < 4 || at(0) != 1 || 4 + 4 * size_t{at(3)} > shorts) return std::nullopt;
+  uint16_t model = 0, geographic = 0, projected = 0;
+  for (size_t k = 0; k < at(3); ++k) {
+    const size_t entry = 4 + 4 * k;
+    // TIFFTagLocation 0: the value is the entry's own last short (one SHORT).
+    if (at(entry + 1) != 0 || at(entry + 2) != 1) continue;
+    const uint16_t value = at(entry + 3);
+    if (at(entry) == kModelTypeKey) model = value;
+    if (at(entry) == kGeographicTypeKey) geographic = value;
+    if (at(entry) == kProjectedTypeKey) projected = value;
+  }
+  const auto code = [](uint16_t c) { return c != 0 && c != kUserDefinedCode; };
+  // A projected model whose projection is user-defined must not fall back to its geographic base:
+  // its coordinates are not degrees.
+  if (model == kModelGeographic) return code(geographic) ? std::optional(absl::StrCat("EPSG:", geographic)) : std::nullopt;
+  if (code(projected)) return absl::StrCat("EPSG:", projected);
+  if (model == kModelProjected || !code(geographic)) return std::nullopt;
+  return absl::StrCat("EPSG:", geographic);
 }
 
 // The WKT of a record body: up to its first NUL (writers terminate and pad it); nullopt when empty.
@@ -244,10 +280,12 @@ absl::StatusOr<std::optional<std::string>> ReadWkt(const LasFile& file, uint64_t
   return std::string(wkt);
 }
 
-// Walks the VLRs between the header and the point data and, in LAS 1.4, the EVLRs: the CRS, and
+// Walks the VLRs between the header and the point data and, in LAS 1.4, the EVLRs: the CRS (the
+// first WKT record's, else the EPSG code of the first GeoTIFF key directory among the VLRs), and
 // a refusal for LASzip's record (a compressed file whose format byte was cleared).
 absl::StatusOr<std::optional<std::string>> ReadCrs(const LasFile& file, const LasHeader& h) {
   std::optional<std::string> crs;
+  std::optional<std::vector<unsigned char>> geokeys;
   uint64_t at = h.header_bytes;
   for (uint32_t i = 0; i < h.vlr_count; ++i) {
     unsigned char header[kVlrHeaderBytes];
@@ -266,6 +304,10 @@ absl::StatusOr<std::optional<std::string>> ReadCrs(const LasFile& file, const La
     if (seen.laszip) return file.Invalid("compressed (LAZ: it has a LASzip record); decompress it to .las first");
     if (seen.wkt && !crs) {
       GALPHA_ASSIGN_OR_RETURN(crs, ReadWkt(file, at + kVlrHeaderBytes, body_bytes));
+    }
+    if (seen.geokeys && !geokeys) {
+      geokeys.emplace(body_bytes);
+      GALPHA_RETURN_IF_ERROR(file.ReadAt(at + kVlrHeaderBytes, geokeys->size(), geokeys->data()));
     }
     at += kVlrHeaderBytes + body_bytes;
   }
@@ -287,6 +329,9 @@ absl::StatusOr<std::optional<std::string>> ReadCrs(const LasFile& file, const La
     }
     at += kEvlrHeaderBytes + body_bytes;
   }
+  // The WKT wins where a file has both (LAS 1.4 requires it for formats 6-10; the keys may be
+  // left over from an older writer).
+  if (!crs && geokeys) crs = EpsgFromGeoKeys(*geokeys);
   return crs;
 }
 

@@ -1,5 +1,5 @@
 // Uncompressed LAS point clouds, versions 1.0 to 1.4 (ASPRS LAS Specification 1.4 R15): x and y of
-// every point record, and the CRS of the OGC WKT record if the file has one. Compressed LAZ files
+// every point record, and the CRS of the OGC WKT record or the GeoTIFF keys if the file has one. Compressed LAZ files
 // are refused (no LASzip decoder here), as are files whose header does not add up.
 #pragma once
 
@@ -16,7 +16,10 @@ namespace galpha {
 /// and y likewise from the record's int32 X and Y, rounded as ScaledCoordinate
 /// (core/base/scaled_coordinate.hpp) says; Z and every other attribute are ignored. `crs` is the
 /// OGC WKT of the first "LASF_Projection" record 2112, a VLR or (LAS 1.4) an EVLR, without its
-/// trailing NULs; nullopt when there is none (GeoTIFF keys, record 34735, are not interpreted).
+/// trailing NULs. Without one, the GeoTIFF key directory (record 34735, a VLR) gives "EPSG:CODE":
+/// ProjectedCSTypeGeoKey's code, or GeographicTypeGeoKey's where the model is geographic (or not
+/// given, with no projected code). nullopt when neither names a CRS (a user-defined GeoTIFF CRS,
+/// whose further keys are not interpreted, or a malformed directory).
 /// Records are read in chunks of about 1 MiB, so memory is the points and one chunk. O(N).
 ///
 /// Errors name the file: NotFound when it does not exist, errno-derived codes when it cannot be

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <optional>
@@ -48,6 +49,20 @@ inline int LasFormatBytes(int format) {
 
 /// The OGC WKT coordinate system record (LASF_Projection 2112), NUL-terminated as writers do.
 inline LasRecord LasWktRecord(const std::string& wkt) { return {"LASF_Projection", 2112, wkt + std::string(3, '\0')}; }
+
+/// A GeoTIFF GeoKeyDirectoryTag record (LASF_Projection 34735): the header shorts (version 1,
+/// revision 1.0, the key count) then each key's four shorts {KeyID, TIFFTagLocation, Count,
+/// Value_Offset}, little-endian.
+inline LasRecord LasGeoKeysRecord(const std::vector<std::array<uint16_t, 4>>& keys, uint16_t version = 1) {
+  std::vector<uint16_t> shorts = {version, 1, 0, static_cast<uint16_t>(keys.size())};
+  for (const auto& key : keys) shorts.insert(shorts.end(), key.begin(), key.end());
+  std::string body(2 * shorts.size(), '\0');
+  for (size_t i = 0; i < shorts.size(); ++i) {
+    body[2 * i] = static_cast<char>(shorts[i] & 0xff);
+    body[2 * i + 1] = static_cast<char>(shorts[i] >> 8);
+  }
+  return {"LASF_Projection", 34735, body};
+}
 
 inline std::string LasFileBytes(const LasSpec& spec) {
   const auto put = [](std::string* out, size_t at, const void* value, size_t bytes) {

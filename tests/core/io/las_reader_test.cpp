@@ -30,6 +30,7 @@ using galpha::testing::IsOk;
 using galpha::testing::LasFileBytes;
 using galpha::testing::LasRecord;
 using galpha::testing::LasSpec;
+using galpha::testing::LasGeoKeysRecord;
 using galpha::testing::LasWktRecord;
 using galpha::testing::StatusIs;
 using ::testing::HasSubstr;
@@ -132,6 +133,41 @@ TEST(LasReaderTest, Format3Las12WithAWktVlrAfterAnotherVlr) {
   ExpectExact(read, spec);
   ASSERT_TRUE(read->crs.has_value());
   EXPECT_EQ(*read->crs, wkt);
+}
+
+// GeoTIFF keys (record 34735) name the CRS by EPSG code where no WKT record does; the codes and
+// model types are GeoTIFF 1.0's (1024 model: 1 projected, 2 geographic; 2048 geographic; 3072
+// projected; 32767 user-defined).
+TEST(LasReaderTest, GeoTiffKeysGiveAnEpsgCode) {
+  LasSpec spec;
+  spec.xy = kEdgeIntegers;
+  const auto crs_of = [&](const std::vector<LasRecord>& vlrs, const std::string& name) {
+    spec.vlrs = vlrs;
+    const auto read = Read(name, spec);
+    EXPECT_TRUE(read.ok()) << read.status();
+    return read.ok() ? read->crs.value_or("(none)") : "(error)";
+  };
+  // NAD83 / UTM 10N on NAD83, as LAStools writes it (with a key stored elsewhere, skipped).
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 1}, {1025, 0, 1, 1}, {2048, 0, 1, 4269}, {3072, 0, 1, 26910},
+                                      {3076, 0, 1, 9001}, {4099, 34736, 1, 0}})},
+                   "projected.las"),
+            "EPSG:26910");
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 2}, {2048, 0, 1, 4326}})}, "geographic.las"), "EPSG:4326");
+  // No model type: the projected code if there is one, else the geographic one.
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{2048, 0, 1, 4326}})}, "bare.las"), "EPSG:4326");
+  // A user-defined projection is not its geographic base (the coordinates are not degrees).
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 1}, {2048, 0, 1, 4269}, {3072, 0, 1, 32767}})}, "user.las"),
+            "(none)");
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 2}, {2048, 0, 1, 32767}})}, "user_geo.las"), "(none)");
+  // Malformed directories name nothing: another version, keys past the record's end.
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{3072, 0, 1, 26910}}, /*version=*/2)}, "version.las"), "(none)");
+  LasRecord cut = LasGeoKeysRecord({{3072, 0, 1, 26910}});
+  cut.body.resize(cut.body.size() - 2);
+  EXPECT_EQ(crs_of({cut}, "cut.las"), "(none)");
+  // A WKT record wins, before or after the keys.
+  const std::string wkt = "PROJCS[\"NAD83 / UTM zone 11N\"]";
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{3072, 0, 1, 26910}}), LasWktRecord(wkt)}, "both.las"), wkt);
+  EXPECT_EQ(crs_of({LasWktRecord(wkt), LasGeoKeysRecord({{3072, 0, 1, 26910}})}, "both2.las"), wkt);
 }
 
 TEST(LasReaderTest, Format6Las14With64BitCountsAndAWktEvlr) {
