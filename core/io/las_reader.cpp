@@ -261,7 +261,8 @@ std::optional<std::string> EpsgFromGeoKeys(const std::vector<unsigned char>& bod
   const auto code = [](uint16_t c) { return c != 0 && c != kUserDefinedCode; };
   // A projected model whose projection is user-defined must not fall back to its geographic base:
   // its coordinates are not degrees.
-  if (model == kModelGeographic) return code(geographic) ? std::optional(absl::StrCat("EPSG:", geographic)) : std::nullopt;
+  if (model == kModelGeographic)
+    return code(geographic) ? std::optional(absl::StrCat("EPSG:", geographic)) : std::nullopt;
   if (code(projected)) return absl::StrCat("EPSG:", projected);
   if (model == kModelProjected || !code(geographic)) return std::nullopt;
   return absl::StrCat("EPSG:", geographic);

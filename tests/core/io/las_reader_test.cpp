@@ -28,9 +28,9 @@ namespace {
 
 using galpha::testing::IsOk;
 using galpha::testing::LasFileBytes;
+using galpha::testing::LasGeoKeysRecord;
 using galpha::testing::LasRecord;
 using galpha::testing::LasSpec;
-using galpha::testing::LasGeoKeysRecord;
 using galpha::testing::LasWktRecord;
 using galpha::testing::StatusIs;
 using ::testing::HasSubstr;
@@ -148,8 +148,12 @@ TEST(LasReaderTest, GeoTiffKeysGiveAnEpsgCode) {
     return read.ok() ? read->crs.value_or("(none)") : "(error)";
   };
   // NAD83 / UTM 10N on NAD83, as LAStools writes it (with a key stored elsewhere, skipped).
-  EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 1}, {1025, 0, 1, 1}, {2048, 0, 1, 4269}, {3072, 0, 1, 26910},
-                                      {3076, 0, 1, 9001}, {4099, 34736, 1, 0}})},
+  EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 1},
+                                      {1025, 0, 1, 1},
+                                      {2048, 0, 1, 4269},
+                                      {3072, 0, 1, 26910},
+                                      {3076, 0, 1, 9001},
+                                      {4099, 34736, 1, 0}})},
                    "projected.las"),
             "EPSG:26910");
   EXPECT_EQ(crs_of({LasGeoKeysRecord({{1024, 0, 1, 2}, {2048, 0, 1, 4326}})}, "geographic.las"), "EPSG:4326");

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <iterator>
 #include <limits>
-#include <random>
 #include <ostream>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -337,8 +337,8 @@ TEST_P(DelaunayTest, ScaledCopiesHaveTheSameTriangles) {
   for (int i = 0; i < 600; ++i) {
     const Point2 p{1.0 * coordinate(rng), 1.0 * coordinate(rng)};
     lattice.push_back(p);
-    nudged.push_back({std::nextafter(p.x + 64.0, up(rng) ? 128.0 : 0.0),
-                      std::nextafter(p.y + 64.0, up(rng) ? 128.0 : 0.0)});
+    nudged.push_back(
+        {std::nextafter(p.x + 64.0, up(rng) ? 128.0 : 0.0), std::nextafter(p.y + 64.0, up(rng) ? 128.0 : 0.0)});
   }
   // Exponents that keep every coordinate of the set exact (the lattice's small integers fit the
   // subnormal range; the nudged set's last bits, 2^-46, must stay above 2^-1074).
