@@ -255,9 +255,9 @@ struct CollectFlatRepairs {
 };
 
 /// The repair of what the parallel rounds leave when flat triangles wait on each other in long
-/// chains (on two parallel lines of points every point is on the hull, and the chains are O(n)
-/// long, so parallel rounds would take O(n) rounds): one thread, depth-first with an explicit
-/// stack, so that each flat triangle is visited O(1) times.
+/// chains (along a hull line whose points the symbolic perturbation sank, chains can be O(n) long,
+/// so parallel rounds would take O(n) rounds): one thread, depth-first with an explicit stack, so
+/// that each flat triangle is visited O(1) times.
 struct RepairFlatChainsSerially {
   MeshView mesh;
   const int32_t* flat;  // the flat triangles left
