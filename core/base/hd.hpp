@@ -5,7 +5,9 @@
 #if defined(__CUDACC__)
 #define GALPHA_HD __host__ __device__
 #define GALPHA_FORCEINLINE __forceinline__
+#define GALPHA_NOINLINE __noinline__
 #else
 #define GALPHA_HD
 #define GALPHA_FORCEINLINE inline __attribute__((always_inline))
+#define GALPHA_NOINLINE __attribute__((noinline))
 #endif

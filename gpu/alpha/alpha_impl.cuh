@@ -336,11 +336,12 @@ void RepairRunsOnHostOnce(System& sys, HostMesh<System>& host_mesh, const TiedRu
 
 /// Runs of entries whose keys may tie: sorted exactly; short runs in parallel on the system,
 /// long or undecided runs on the host. Returns the number of links (neighbours whose keys alone
-/// did not order them).
+/// did not order them). Ends the stages "spectrum_refine" (long runs by refined keys) and
+/// "spectrum_repair" (the runs left, on the system); the host's part follows in the caller's.
 template <class System>
 uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>& host_mesh,
                         const Buffer<uint64_t, System>& sorted_keys, ExactSpectrum<System>* spectrum,
-                        ComparisonCounts* counts) {
+                        StageTimer<System>& timer, ComparisonCounts* counts) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   TiedRuns<System> runs = FindTiedRuns(sys, sorted_keys, spectrum->num_entries);
@@ -350,6 +351,7 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
                      spectrum->new_value.data(), spectrum->num_entries, counts) > 0) {
     runs.num_runs = ListRunStarts(sys, runs.link, spectrum->num_entries, &runs.run_begin);
   }
+  timer.EndStage("spectrum_refine");
   const uint32_t num_runs = runs.num_runs;
   const uint32_t* run_end = runs.run_begin.data() + 1;
   Buffer<uint8_t, System> needs_host(sys, num_runs);
@@ -363,6 +365,7 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
       static_cast<uint32_t>(thrust::count(policy, needs_host.data(), needs_host.data() + num_runs, uint8_t{1}));
   if (host_runs > 0) host_runs = SettleRunsOfOneDouble(sys, mesh, runs, spectrum, &needs_host, counts);
   runs.link.Reset();
+  timer.EndStage("spectrum_repair");
   if (host_runs > 0) RepairRunsOnHostOnce(sys, host_mesh, runs, needs_host, spectrum, counts);
   return runs.num_links;
 }
@@ -385,19 +388,27 @@ void MergeUncertified(System& sys, HostMesh<System>& host_mesh, const Buffer<uin
 }
 
 /// The exact spectrum from the key order: the runs of entries whose keys may tie are sorted
-/// exactly, then the uncertified entries are merged in.
+/// exactly, then the uncertified entries are merged in. Ends the stages "spectrum_refine",
+/// "spectrum_repair" and "spectrum_host_repair" (every build lists all three, zero where idle).
 template <class System>
 ExactSpectrum<System> RepairSpectrum(System& sys, const PipelineMesh& mesh, HostMesh<System>& host_mesh,
-                                     SortedSpectrum<System>* sorted, ComparisonCounts* counts) {
+                                     SortedSpectrum<System>* sorted, StageTimer<System>& timer,
+                                     ComparisonCounts* counts) {
   const uint32_t num_entries = sorted->num_entries;
   ExactSpectrum<System> spectrum{std::move(sorted->ids), Buffer<uint8_t, System>(sys, num_entries), num_entries};
   thrust::fill_n(sys.policy(), spectrum.new_value.data(), num_entries, uint8_t{1});
   uint64_t num_links = 0;
-  if (num_entries > 1) num_links = RepairTiedRuns(sys, mesh, host_mesh, sorted->sorted_keys, &spectrum, counts);
+  if (num_entries > 1) {
+    num_links = RepairTiedRuns(sys, mesh, host_mesh, sorted->sorted_keys, &spectrum, timer, counts);
+  } else {
+    timer.EndStage("spectrum_refine");
+    timer.EndStage("spectrum_repair");
+  }
   counts->filter += num_entries > 0 ? (num_entries - 1) - num_links : 0;
   sorted->sorted_keys.Reset();
   if (sorted->num_odd > 0) MergeUncertified(sys, host_mesh, sorted->odd_ids, sorted->num_odd, &spectrum, counts);
   sorted->odd_ids.Reset();
+  timer.EndStage("spectrum_host_repair");
   return spectrum;
 }
 
@@ -656,8 +667,7 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   timer.EndStage("radii_attachment");
   SortedSpectrum<System> sorted = SortSpectrum(sys, mesh, &keys);
   timer.EndStage("spectrum_sort");
-  ExactSpectrum<System> exact = RepairSpectrum(sys, mesh, host_mesh, &sorted, &out->comparisons);
-  timer.EndStage("spectrum_repair");
+  ExactSpectrum<System> exact = RepairSpectrum(sys, mesh, host_mesh, &sorted, timer, &out->comparisons);
   SpectrumRanks<System> ranks = RankSpectrum(sys, mesh, &exact);
   timer.EndStage("ranks");
   SpectrumValues<System> values = RoundSpectrumValues(sys, mesh, ranks);

@@ -12,9 +12,13 @@
 //    it: a separated pair is a certified boundary.
 //  - Between boundaries lie clusters of entries whose keys may tie. A cluster whose adjacent pairs
 //    all compare Less or Equal exactly is in exact order (order is transitive); its links are cut
-//    and the equal pairs marked as one value. A cluster with a pair out of order or undecided
-//    keeps its links and becomes a run of its own for the existing exact repair (insertion sort on
-//    the device, or the host), which may reorder it freely since its boundaries are certified.
+//    and the equal pairs marked as one value.
+//  - A cluster with a pair out of order or undecided ("bad": values closer than the keys' error,
+//    as a lattice nudged by single ulps has by the thousand) is sorted again, alone, on the
+//    system, by (exact value, id) with the bounded exact comparison (ExactClusterEntryLess), and
+//    judged again; its boundaries are certified, so it may be reordered freely. A cluster where
+//    some bounded comparison is undecided keeps its first order and its links, and becomes a run
+//    of its own for the existing exact repair (the host's), which may reorder it freely too.
 //  - A run with an entry whose key cannot be refined (exact terms beyond the bounded buffers) is
 //    left whole to the existing repair.
 //  - A long run whose values are all exactly one double (ExactDoubleRadiusSq: a grid) is settled
@@ -27,6 +31,7 @@
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/permutation_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/reduce.h>
 #include <thrust/scan.h>
@@ -44,6 +49,7 @@
 #include "core/exact/radius_refined.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/system/atomic_increment.cuh"
 #include "gpu/system/engine_system.cuh"
 
 namespace galpha::detail {
@@ -190,6 +196,95 @@ struct ClusterStartAsU32 {
   GALPHA_HD uint32_t operator()(uint32_t k) const { return verdict[k] == kPairSeparated ? 1u : 0u; }
 };
 
+/// Sign of value(a) - value(b) for two entries of one bad cluster: their keys where they are
+/// separated, else a congruence proof or the bounded exact comparison. Where that is undecided the
+/// cluster is marked (it goes to the host in its first order) and the keys answer, so that the sort
+/// still sees an order. Not inlined: the merge sort instantiates its comparator in many places, and
+/// one out-of-line copy of the exact arithmetic keeps the device code small.
+GALPHA_HD GALPHA_NOINLINE inline int ExactClusterEntrySign(const SimplexPoints& simplex, const RefinedEntry& a,
+                                                           const RefinedEntry& b, uint8_t* cluster_undecided,
+                                                           uint32_t* comparisons) {
+  if (RefinedKeysSeparated(a.key, b.key)) return -1;
+  if (RefinedKeysSeparated(b.key, a.key)) return 1;
+  Point2 pa[3], pb[3];
+  const int na = simplex(a.id, pa), nb = simplex(b.id, pb);
+  if (RadiusCongruent(pa, na, pb, nb)) return 0;
+  AtomicIncrement(comparisons);
+  const Order order = CompareRadiusSqBounded(pa, na, pb, nb);
+  if (order != Order::kUndecided) return SignOf(order);
+  cluster_undecided[a.run] = 1;  // concurrent writes only ever write 1
+  return -CompareRefinedValues(a.key, b.key);
+}
+
+/// Sort order of the entries of bad clusters, whose `run` field holds their cluster here: by
+/// cluster, then exact value, then simplex id. Where every comparison is decided this is a strict
+/// total order, so both backends produce the same permutation.
+struct ExactClusterEntryLess {
+  SimplexPoints simplex;
+  uint8_t* cluster_undecided;
+  uint32_t* comparisons;  // one counter
+  GALPHA_HD bool operator()(const RefinedEntry& a, const RefinedEntry& b) const {
+    if (a.run != b.run) return a.run < b.run;
+    const int sign = ExactClusterEntrySign(simplex, a, b, cluster_undecided, comparisons);
+    if (sign != 0) return sign < 0;
+    return a.id < b.id;
+  }
+};
+
+/// 1 for sorted entries in a bad cluster.
+struct InBadCluster {
+  const uint32_t* cluster_of;  // 1-based
+  const uint8_t* cluster_bad;
+  GALPHA_HD bool operator()(uint32_t k) const { return cluster_bad[cluster_of[k] - 1] != 0; }
+};
+
+/// The entry at sorted position bad_k[j], with its cluster in place of its run.
+struct BadClusterEntry {
+  const RefinedEntry* entries;
+  const uint32_t* bad_k;
+  const uint32_t* cluster_of;
+  GALPHA_HD RefinedEntry operator()(uint32_t j) const {
+    RefinedEntry entry = entries[bad_k[j]];
+    entry.run = cluster_of[bad_k[j]] - 1;
+    return entry;
+  }
+};
+
+/// Puts a re-sorted bad cluster back over its own sorted positions (the clusters' positions
+/// ascend, and sorting by cluster first keeps each cluster's entries over its own), run restored,
+/// and its ids into the spectrum. An undecided cluster keeps its first order.
+struct ScatterSortedCluster {
+  const RefinedEntry* sorted;  // `run` holds the cluster
+  const uint32_t* bad_k;
+  const uint32_t* positions;
+  const uint8_t* cluster_undecided;
+  RefinedEntry* entries;
+  uint32_t* ids;
+  GALPHA_HD void operator()(uint32_t j) const {
+    if (cluster_undecided[sorted[j].run]) return;
+    const uint32_t k = bad_k[j];
+    RefinedEntry entry = sorted[j];
+    entry.run = entries[k].run;  // the cluster lies inside one run
+    entries[k] = entry;
+    ids[positions[k]] = entry.id;
+  }
+};
+
+/// Judges again the pairs inside a re-sorted bad cluster (its first entry stays a certified
+/// boundary); an undecided cluster keeps its verdicts.
+struct JudgeSortedClusterPair {
+  JudgeRefinedPair judge;
+  const uint32_t* bad_k;
+  const uint32_t* cluster_of;
+  const uint8_t* cluster_undecided;
+  GALPHA_HD void operator()(uint32_t j) const {
+    const uint32_t k = bad_k[j];
+    judge.comparisons[k] = 0;
+    if (judge.verdict[k] == kPairSeparated || cluster_undecided[cluster_of[k] - 1]) return;
+    judge(k);
+  }
+};
+
 /// Marks the clusters that hold a bad pair; concurrent writes only ever write 1.
 struct MarkBadCluster {
   const uint8_t* verdict;
@@ -225,6 +320,45 @@ struct ApplyRefinedVerdicts {
     new_value[i] = verdict[k] == kPairEqual ? 0 : 1;
   }
 };
+
+/// Sorts the entries of bad clusters again by exact comparisons (ExactClusterEntryLess) and judges
+/// them again, clearing `cluster_bad` for the clusters that come out in exact order.
+template <class System>
+void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* positions, RefinedEntry* entries,
+                     const uint8_t* run_unrefinable, const uint32_t* cluster_of, uint32_t num_clusters,
+                     uint32_t num_refined, uint32_t* ids, Buffer<uint8_t, System>* verdict,
+                     Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  if (thrust::count(policy, cluster_bad->data(), cluster_bad->data() + num_clusters, uint8_t{1}) == 0) return;
+  Buffer<uint32_t, System> bad_k(sys, num_refined);
+  const auto num_bad = static_cast<uint32_t>(
+      thrust::copy_if(policy, zero, zero + num_refined, bad_k.data(), InBadCluster{cluster_of, cluster_bad->data()}) -
+      bad_k.data());
+  Buffer<RefinedEntry, System> sorted(sys, num_bad);
+  thrust::transform(policy, zero, zero + num_bad, sorted.data(), BadClusterEntry{entries, bad_k.data(), cluster_of});
+  Buffer<uint8_t, System> cluster_undecided(sys, num_clusters);
+  thrust::fill_n(policy, cluster_undecided.data(), num_clusters, uint8_t{0});
+  Buffer<uint32_t, System> sort_comparisons(sys, 1);
+  thrust::fill_n(policy, sort_comparisons.data(), 1, uint32_t{0});
+  thrust::sort(policy, sorted.data(), sorted.data() + num_bad,
+               ExactClusterEntryLess{simplex, cluster_undecided.data(), sort_comparisons.data()});
+  counts->bounded_exact += sys.Read(sort_comparisons.data());
+  thrust::for_each_n(
+      policy, zero, num_bad,
+      ScatterSortedCluster{sorted.data(), bad_k.data(), positions, cluster_undecided.data(), entries, ids});
+  sorted.Reset();
+  Buffer<uint32_t, System> comparisons(sys, num_refined);
+  thrust::for_each_n(policy, zero, num_bad,
+                     JudgeSortedClusterPair{{simplex, entries, run_unrefinable, verdict->data(), comparisons.data()},
+                                            bad_k.data(),
+                                            cluster_of,
+                                            cluster_undecided.data()});
+  const auto judged = thrust::make_permutation_iterator(comparisons.data(), bad_k.data());
+  counts->bounded_exact += thrust::reduce(policy, judged, judged + num_bad, uint64_t{0});
+  thrust::fill_n(policy, cluster_bad->data(), num_clusters, uint8_t{0});
+  thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict->data(), cluster_of, cluster_bad->data()});
+}
 
 /// Orders the entries of runs longer than kMaxDeviceRun by refined keys (see the file comment),
 /// cutting `link` where the order is settled; returns nonzero when it cut links (the caller then
@@ -286,6 +420,8 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   Buffer<uint8_t, System> cluster_bad(sys, num_clusters);
   thrust::fill_n(policy, cluster_bad.data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict.data(), cluster_of.data(), cluster_bad.data()});
+  SortBadClusters(sys, simplex, positions.data(), entries.data(), run_unrefinable.data(), cluster_of.data(),
+                  num_clusters, num_refined, ids, &verdict, &cluster_bad, counts);
   thrust::for_each_n(policy, zero, num_refined,
                      ApplyRefinedVerdicts{positions.data(), entries.data(), run_unrefinable.data(), verdict.data(),
                                           cluster_of.data(), cluster_bad.data(), link, new_value});
