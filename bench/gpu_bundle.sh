@@ -5,7 +5,12 @@
 # prometheus-cpp and what they pull in), and the data sets.
 # Then call the device tool with carry=[".carry-pack"] and the command
 #   tar -xJf .carry-pack/carry.tar.xz && bash bench/gpu_run.sh test alpha
+# The argument picks the binaries (the device takes at most 64 MiB of carry, and all of them
+# compress to about 90 MB): `engine` (default) for the phases test, hard, alpha, bench,
+# topology, identity and profile; `service` for smoke, sanitize and service (the server, its test
+# and benchmark, alphactl, and alpha_bench).
 set -euo pipefail
+set_name=${1:-engine}
 cd "$(dirname "$0")/.."
 # Without GDAL and PROJ: alphactl would carry GDAL and the hundred libraries it pulls in, and PROJ
 # its database (the GPU machine reads .bin files only, without a CRS).
@@ -14,10 +19,14 @@ cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
 # By name, wherever the build tree puts them (it mirrors the source folders).
-for name in predicates_test predicates_device_test delaunay_test delaunay_cgal_test triangulation_checks_test \
-            radius_test alpha_family_cgal_test alpha_family_test alpha_bruteforce_test alpha_backend_identity_test \
-            persistence_gudhi_test \
-            shape_test delaunay_bench alpha_bench topology_bench alphactl service_bench galpha_server service_test; do
+case "$set_name" in
+  engine) names="predicates_test predicates_device_test delaunay_test delaunay_cgal_test triangulation_checks_test
+                 radius_test alpha_family_cgal_test alpha_family_test alpha_bruteforce_test alpha_backend_identity_test
+                 persistence_gudhi_test shape_test delaunay_bench alpha_bench topology_bench" ;;
+  service) names="alphactl service_bench galpha_server service_test alpha_bench" ;;
+  *) echo "usage: $0 [engine|service]" >&2; exit 2 ;;
+esac
+for name in $names; do
   b=$(find build/cuda -name "$name" -type f -perm -u+x -not -path '*/CMakeFiles/*' | head -n 1)
   if [ -n "$b" ]; then cp "$b" .carry/bin/; bins+=(".carry/bin/$name"); fi
 done

@@ -12,6 +12,7 @@
 #include "core/exact/radius_compare.hpp"
 #include "core/exact/radius_key.hpp"
 #include "core/exact/radius_nearest.hpp"
+#include "core/exact/radius_refined.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/system/atomic_increment.cuh"
 
@@ -150,6 +151,17 @@ struct IsRunStart {
 /// Largest run sorted in place by one thread; longer runs go to the host's three-way quicksort.
 constexpr uint32_t kMaxDeviceRun = 16;
 
+/// Exact order of two simplices' squared radii (sign of a - b) for the short runs: congruent
+/// simplices (RadiusCongruent: a translated, turned or mirrored copy, which quantized data such as
+/// centimetre LiDAR has by the million) are equal without arithmetic; others take the bounded
+/// exact comparison, counted. Not inlined: RepairRun calls it from two loops.
+GALPHA_HD GALPHA_NOINLINE inline Order CompareRunEntries(const Point2* pa, int na, const Point2* pb, int nb,
+                                                         uint32_t* count) {
+  if (RadiusCongruent(pa, na, pb, nb)) return Order::kEqual;
+  ++*count;
+  return CompareRadiusSqBounded(pa, na, pb, nb);
+}
+
 /// Sorts one short run of linked entries exactly (insertion sort with the bounded comparison) and
 /// marks where a new exact value starts. A run that the bounded arithmetic cannot decide, or that
 /// is too long, is left for the host (`needs_host`).
@@ -181,8 +193,7 @@ struct RepairRun {
       uint32_t j = i;
       while (j > 0) {
         const int ny = simplex(local[j - 1], pb);
-        const Order c = CompareRadiusSqBounded(pb, ny, pa, nx);
-        ++count;
+        const Order c = CompareRunEntries(pb, ny, pa, nx, &count);
         if (c == Order::kUndecided) {
           needs_host[r] = 1;
           comparisons[r] = count;
@@ -198,8 +209,7 @@ struct RepairRun {
     for (uint32_t i = 1; i < n; ++i) {
       const int na = simplex(local[i - 1], pa);
       const int nb = simplex(local[i], pb);
-      const Order c = CompareRadiusSqBounded(pa, na, pb, nb);
-      ++count;
+      const Order c = CompareRunEntries(pa, na, pb, nb, &count);
       if (c == Order::kUndecided) {
         needs_host[r] = 1;
         comparisons[r] = count;

@@ -30,16 +30,19 @@
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
+#include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/permutation_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/reduce.h>
 #include <thrust/scan.h>
+#include <thrust/sequence.h>
 #include <thrust/sort.h>
 #include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
 #include <cstdint>
+#include <utility>
 
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
@@ -47,6 +50,7 @@
 #include "core/exact/order.hpp"
 #include "core/exact/radius_compare.hpp"
 #include "core/exact/radius_refined.hpp"
+#include "core/exact/refined_sort_words.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
 #include "gpu/system/atomic_increment.cuh"
@@ -84,14 +88,14 @@ GALPHA_HD inline int CompareRefinedValues(const RefinedRadiusSq& a, const Refine
   return ExpansionSign(en, e);
 }
 
-/// Sort order of refined entries: by run, then exact key value, then simplex id (a strict total
-/// order, so both backends produce the same permutation).
-struct RefinedEntryLess {
-  GALPHA_HD bool operator()(const RefinedEntry& a, const RefinedEntry& b) const {
-    if (a.run != b.run) return a.run < b.run;
-    const int c = CompareRefinedValues(a.key, b.key);
-    if (c != 0) return c > 0;
-    return a.id < b.id;
+/// Word `w` of entry perm[k]'s sort words (one pass of the least-significant-word-first sort).
+struct SortWordOf {
+  const RefinedEntry* entries;
+  const uint32_t* perm;
+  int w;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const RefinedEntry& entry = entries[perm[k]];
+    return RefinedSortWordsOf(entry.run, entry.id, entry.key).word[w];
   }
 };
 
@@ -321,6 +325,25 @@ struct ApplyRefinedVerdicts {
   }
 };
 
+/// Sorts refined entries by their sort words (RefinedSortWords): least significant word first, each
+/// pass a stable radix sort of one 64-bit word carrying a permutation, then one gather.
+template <class System>
+void SortRefinedEntries(System& sys, Buffer<RefinedEntry, System>* entries, uint32_t num_refined) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<uint32_t, System> perm(sys, num_refined);
+  thrust::sequence(policy, perm.data(), perm.data() + num_refined);
+  Buffer<uint64_t, System> word(sys, num_refined);
+  for (int w = 3; w >= 0; --w) {
+    thrust::transform(policy, zero, zero + num_refined, word.data(), SortWordOf{entries->data(), perm.data(), w});
+    thrust::stable_sort_by_key(policy, word.data(), word.data() + num_refined, perm.data());
+  }
+  word.Reset();
+  Buffer<RefinedEntry, System> sorted(sys, num_refined);
+  thrust::gather(policy, perm.data(), perm.data() + num_refined, entries->data(), sorted.data());
+  *entries = std::move(sorted);
+}
+
 /// Sorts the entries of bad clusters again by exact comparisons (ExactClusterEntryLess) and judges
 /// them again, clearing `cluster_bad` for the clusters that come out in exact order.
 template <class System>
@@ -401,7 +424,7 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
       policy, zero, num_refined,
       ComputeRefinedEntry{simplex, positions.data(), run_of.data(), ids, entries.data(), run_unrefinable.data()});
   run_of.Reset();
-  thrust::sort(policy, entries.data(), entries.data() + num_refined, RefinedEntryLess{});
+  SortRefinedEntries(sys, &entries, num_refined);
   thrust::for_each_n(policy, zero, num_refined, ScatterRefinedIds{positions.data(), entries.data(), ids});
 
   Buffer<uint8_t, System> verdict(sys, num_refined);
