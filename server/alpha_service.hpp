@@ -15,6 +15,7 @@
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
 #include "server/build_time_limit.hpp"
+#include "server/exact_comparison_limit.hpp"
 #include "server/family_cache.hpp"
 #include "server/metrics.hpp"
 #include "server/tenant_tokens.hpp"
@@ -52,6 +53,9 @@ struct ServiceOptions {
   /// How long one build may run (server/build_time_limit.hpp); past it the build stops at its
   /// next phase boundary and answers DEADLINE_EXCEEDED.
   BuildTimeLimitOptions build_time;
+  /// How many exact radius comparisons one build may make (server/exact_comparison_limit.hpp);
+  /// past it the build stops and answers RESOURCE_EXHAUSTED.
+  ExactComparisonLimitOptions exact_comparisons;
   /// Byte budget of the family cache.
   size_t cache_bytes = size_t{8} << 30;
   TenantTokens tokens;

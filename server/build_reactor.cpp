@@ -12,6 +12,7 @@
 #include "server/alpha_service.hpp"
 #include "server/build_refusal.hpp"
 #include "server/build_time_limit.hpp"
+#include "server/exact_comparison_limit.hpp"
 #include "server/grpc_status.hpp"
 #include "server/query_answers.hpp"
 
@@ -153,6 +154,7 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   const bool limited = limit.count() > 0;
   const auto deadline = start + std::chrono::duration_cast<Clock::duration>(limit);
   options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
+  options.max_exact_comparisons = ExactComparisonLimit(points, service_->options_.exact_comparisons);
   absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(build_->points, options);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   decoder_.ReleasePoints();
@@ -162,6 +164,12 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
       Respond(TagRefusal(
           absl::DeadlineExceededError(BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time)),
           BuildRefusal::kBuildTime));
+      return;
+    }
+    if (IsExactComparisonLimit(family.status())) {
+      Respond(TagRefusal(
+          absl::ResourceExhaustedError(ExactComparisonLimitMessage(points, service_->options_.exact_comparisons)),
+          BuildRefusal::kExactComparisons));
       return;
     }
     Respond(family.status());

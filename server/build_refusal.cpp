@@ -34,6 +34,8 @@ std::string_view RefusalLabel(BuildRefusal reason) {
       return "draining";
     case BuildRefusal::kBuildTime:
       return "build_time";
+    case BuildRefusal::kExactComparisons:
+      return "exact_comparisons";
   }
   return "unknown";
 }

@@ -23,14 +23,15 @@ enum class BuildRefusal {
   kCacheBytes,           // --cache_bytes
   kDraining,             // SIGTERM
   kBuildTime,            // --build_time_multiple, --build_time_floor_ms
+  kExactComparisons,     // --max_exact_comparisons_per_point, --exact_comparisons_floor
 };
 
 /// Every reason, so that the metrics export each series from the start (at 0).
-inline constexpr std::array<BuildRefusal, 10> kAllBuildRefusals = {
-    BuildRefusal::kPointsPerBuild, BuildRefusal::kInFlightBytes, BuildRefusal::kTenantInFlightBytes,
-    BuildRefusal::kIdleTimeout,    BuildRefusal::kQueueFull,     BuildRefusal::kTenantQueuedBuilds,
-    BuildRefusal::kBuildMemory,    BuildRefusal::kCacheBytes,    BuildRefusal::kDraining,
-    BuildRefusal::kBuildTime};
+inline constexpr std::array<BuildRefusal, 11> kAllBuildRefusals = {
+    BuildRefusal::kPointsPerBuild, BuildRefusal::kInFlightBytes,   BuildRefusal::kTenantInFlightBytes,
+    BuildRefusal::kIdleTimeout,    BuildRefusal::kQueueFull,       BuildRefusal::kTenantQueuedBuilds,
+    BuildRefusal::kBuildMemory,    BuildRefusal::kCacheBytes,      BuildRefusal::kDraining,
+    BuildRefusal::kBuildTime,      BuildRefusal::kExactComparisons};
 
 /// The metric label of `reason` ("points_per_build", "in_flight_bytes", ...).
 std::string_view RefusalLabel(BuildRefusal reason);

@@ -39,6 +39,10 @@ ABSL_FLAG(double, build_time_multiple, 50,
           "a build may run this many times its expected time (60 ns a point on CUDA, 14 us a point over the "
           "host's cores on the CPU), then stops with DEADLINE_EXCEEDED; 0: no limit");
 ABSL_FLAG(int, build_time_floor_ms, 10000, "the build time limit is never below this");
+ABSL_FLAG(double, max_exact_comparisons_per_point, 64,
+          "a build may make this many exact radius comparisons per point (honest inputs need a few), then stops "
+          "with RESOURCE_EXHAUSTED; 0: no limit");
+ABSL_FLAG(uint64_t, exact_comparisons_floor, 1000000, "the exact comparison limit is never below this");
 ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30, "byte budget of the family cache (LRU eviction)");
 ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
 ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
@@ -111,6 +115,11 @@ int main(int argc, char** argv) {
   if (absl::GetFlag(FLAGS_build_time_floor_ms) < 0) return Fail("--build_time_floor_ms must be >= 0");
   options.service.build_time.multiple = absl::GetFlag(FLAGS_build_time_multiple);
   options.service.build_time.floor = std::chrono::milliseconds(absl::GetFlag(FLAGS_build_time_floor_ms));
+  if (!(absl::GetFlag(FLAGS_max_exact_comparisons_per_point) >= 0)) {
+    return Fail("--max_exact_comparisons_per_point must be >= 0");
+  }
+  options.service.exact_comparisons.per_point = absl::GetFlag(FLAGS_max_exact_comparisons_per_point);
+  options.service.exact_comparisons.floor = absl::GetFlag(FLAGS_exact_comparisons_floor);
   options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
   if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
     auto tokens = galpha::server::TenantTokens::ReadFile(path);

@@ -35,9 +35,11 @@ struct FamilyOutput {
 };
 
 /// Called between the build's phases: after the triangulation, `after_triangulation` runs (it
-/// reports progress and may throw EngineError kCancelled to stop the build).
+/// reports progress and may throw EngineError kCancelled to stop the build). A build whose exact
+/// radius comparisons pass `max_exact_comparisons` (0: no limit) throws EngineError kWorkLimit.
 struct BuildHooks {
   std::function<void()> after_triangulation;
+  uint64_t max_exact_comparisons = 0;
 };
 
 /// Builds the family of `n` finite points on the OpenMP backend. Throws EngineError (or a

@@ -42,6 +42,7 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   // alpha pipeline reads it there; only the finished family comes back to the host.
   detail::FamilyOutput built;
   detail::BuildHooks hooks;
+  hooks.max_exact_comparisons = options.max_exact_comparisons;
   hooks.after_triangulation = [&] {
     report("triangulation", 0.5);
     if (stop_requested()) {
@@ -79,6 +80,10 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   AlphaFamily family(std::move(parts));
   report("components", 1.0);
   return family;
+}
+
+bool IsExactComparisonLimit(const absl::Status& status) {
+  return absl::IsResourceExhausted(status) && status.GetPayload(detail::kExactComparisonLimitPayload).has_value();
 }
 
 }  // namespace galpha

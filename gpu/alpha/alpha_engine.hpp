@@ -2,9 +2,11 @@
 // the triangulation and the alpha pipeline on one backend (CUDA on one stream, or OpenMP).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string_view>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/base/point.hpp"
@@ -22,7 +24,16 @@ struct BuildOptions {
   /// Polled between phases; when it answers true the build stops, frees what it holds and returns
   /// Cancelled (a server passes its client's cancellation and deadline here).
   std::function<bool()> cancelled;
+  /// The most exact radius comparisons (bounded expansions and CPU fallbacks together, as the
+  /// report counts them) the build may make; 0: no limit. A build that passes it stops and returns
+  /// ResourceExhausted (IsExactComparisonLimit). The device's passes are checked as they end; the
+  /// host's sequential repair, the only part whose work has no bound in the input's size, stops
+  /// within a few hundred comparisons of the limit.
+  uint64_t max_exact_comparisons = 0;
 };
+
+/// Whether `status` is a build stopped by BuildOptions::max_exact_comparisons.
+bool IsExactComparisonLimit(const absl::Status& status);
 
 /// Builds the family. Errors as Triangulate's (gpu/triangulation/delaunay.hpp), and Cancelled.
 absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options = {});

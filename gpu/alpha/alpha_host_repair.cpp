@@ -1,6 +1,7 @@
 #include "gpu/alpha/alpha_host_repair.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <utility>
 
@@ -11,12 +12,42 @@
 namespace galpha::detail {
 namespace {
 
-/// Exact comparison of two spectrum entries by simplex id, counting the path it took.
+/// A limit of exact comparisons shared by the threads of one host repair. Each thread reports its
+/// comparisons in batches (one atomic add per kBatch), so the limit is passed by at most kBatch
+/// comparisons a thread before every thread sees it.
+class SharedComparisonBudget {
+ public:
+  static constexpr uint64_t kBatch = 256;
+  explicit SharedComparisonBudget(uint64_t max_comparisons) : max_(max_comparisons) {}
+  /// Adds `n` comparisons; false once the total passed the limit.
+  bool Spend(uint64_t n) {
+    if (max_ == kNoComparisonLimit) return true;
+    const uint64_t total = spent_.fetch_add(n, std::memory_order_relaxed) + n;
+    if (total > max_) exhausted_.store(true, std::memory_order_relaxed);
+    return !exhausted();
+  }
+  bool exhausted() const { return exhausted_.load(std::memory_order_relaxed); }
+
+ private:
+  const uint64_t max_;
+  std::atomic<uint64_t> spent_{0};
+  std::atomic<bool> exhausted_{false};
+};
+
+/// Exact comparison of two spectrum entries by simplex id, counting the path it took. Once the
+/// shared budget is spent it answers "equal" without comparing, so that the sorts and searches
+/// using it finish in a linear pass; their result is then not used (the caller throws).
 class ExactComparator {
  public:
-  explicit ExactComparator(const AlphaInput& in) : in_(in) {}
+  ExactComparator(const AlphaInput& in, SharedComparisonBudget* budget) : in_(in), budget_(budget) {}
+  ~ExactComparator() { budget_->Spend(unreported_); }
 
   int operator()(uint32_t a, uint32_t b) {
+    if (++unreported_ == SharedComparisonBudget::kBatch) {
+      budget_->Spend(unreported_);
+      unreported_ = 0;
+    }
+    if (budget_->exhausted()) return 0;
     Point2 pa[3], pb[3];
     const int na = Points(a, pa), nb = Points(b, pb);
     const Order c = CompareRadiusSqBounded(pa, na, pb, nb);
@@ -43,6 +74,8 @@ class ExactComparator {
 
  private:
   const AlphaInput& in_;
+  SharedComparisonBudget* budget_;
+  uint64_t unreported_ = 0;
   ComparisonCounts counts_;
 };
 
@@ -117,12 +150,13 @@ bool RepairRunOfExactDoubles(ExactComparator& cmp, uint32_t* ids, uint32_t n, ui
 
 }  // namespace
 
-void RepairRunsOnHost(const AlphaInput& in, const std::vector<std::array<uint32_t, 2>>& runs, uint32_t* ids,
-                      uint8_t* new_value, ComparisonCounts* counts) {
+bool RepairRunsOnHost(const AlphaInput& in, const std::vector<std::array<uint32_t, 2>>& runs, uint64_t max_comparisons,
+                      uint32_t* ids, uint8_t* new_value, ComparisonCounts* counts) {
   const long num_runs = static_cast<long>(runs.size());
+  SharedComparisonBudget budget(max_comparisons);
 #pragma omp parallel
   {
-    ExactComparator cmp(in);
+    ExactComparator cmp(in, &budget);
     ComparisonCounts shortcut;
 #pragma omp for schedule(dynamic, 1)
     for (long r = 0; r < num_runs; ++r) {
@@ -136,11 +170,13 @@ void RepairRunsOnHost(const AlphaInput& in, const std::vector<std::array<uint32_
 #pragma omp critical
     Add(counts, cmp.counts());
   }
+  return !budget.exhausted();
 }
 
-void MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, std::vector<uint32_t>* ids,
-                            std::vector<uint8_t>* new_value, ComparisonCounts* counts) {
-  ExactComparator cmp(in);
+bool MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, uint64_t max_comparisons,
+                            std::vector<uint32_t>* ids, std::vector<uint8_t>* new_value, ComparisonCounts* counts) {
+  SharedComparisonBudget budget(max_comparisons);
+  ExactComparator cmp(in, &budget);
   std::vector<uint8_t> odd_new(odd.size());
   SortThreeWay(odd.data(), odd.size(), odd_new.data(), cmp);
   // Value groups of the main order: starts of exact values.
@@ -188,10 +224,12 @@ void MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, std
   *ids = std::move(merged_ids);
   *new_value = std::move(merged_new);
   Add(counts, cmp.counts());
+  return !budget.exhausted();
 }
 
 void NearestValuesOnHost(const AlphaInput& in, const std::vector<uint8_t>& needs, AlphaRanks* out) {
-  ExactComparator points(in);
+  SharedComparisonBudget unlimited(kNoComparisonLimit);  // it reads points; it compares nothing
+  ExactComparator points(in, &unlimited);
   for (size_t r = 0; r < needs.size(); ++r) {
     if (!needs[r]) continue;
     Point2 p[3];

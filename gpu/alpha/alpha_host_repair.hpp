@@ -13,14 +13,22 @@
 
 namespace galpha::detail {
 
-/// Sorts ids[b..e) exactly for every run {b, e} and sets new_value[i] to 1 where an exact value
-/// starts, 0 inside a tie.
-void RepairRunsOnHost(const AlphaInput& in, const std::vector<std::array<uint32_t, 2>>& runs, uint32_t* ids,
-                      uint8_t* new_value, ComparisonCounts* counts);
+/// `max_comparisons` for no limit on the host's exact comparisons.
+inline constexpr uint64_t kNoComparisonLimit = ~uint64_t{0};
 
-/// Inserts the simplices `odd` (keys not certified) into the exact order ids/new_value.
-void MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, std::vector<uint32_t>* ids,
-                            std::vector<uint8_t>* new_value, ComparisonCounts* counts);
+/// Sorts ids[b..e) exactly for every run {b, e} and sets new_value[i] to 1 where an exact value
+/// starts, 0 inside a tie. Past `max_comparisons` exact comparisons (over it by at most a few
+/// hundred per thread) it stops comparing and returns false: the order is unfinished then, and
+/// the caller must not use it.
+[[nodiscard]] bool RepairRunsOnHost(const AlphaInput& in, const std::vector<std::array<uint32_t, 2>>& runs,
+                                    uint64_t max_comparisons, uint32_t* ids, uint8_t* new_value,
+                                    ComparisonCounts* counts);
+
+/// Inserts the simplices `odd` (keys not certified) into the exact order ids/new_value; stops and
+/// returns false as RepairRunsOnHost past `max_comparisons`.
+[[nodiscard]] bool MergeUncertifiedOnHost(const AlphaInput& in, std::vector<uint32_t> odd, uint64_t max_comparisons,
+                                          std::vector<uint32_t>* ids, std::vector<uint8_t>* new_value,
+                                          ComparisonCounts* counts);
 
 /// out->spectrum[r] for every rank with needs[r], by GMP.
 void NearestValuesOnHost(const AlphaInput& in, const std::vector<uint8_t>& needs, AlphaRanks* out);

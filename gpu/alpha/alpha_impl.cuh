@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -34,6 +35,7 @@
 #include "gpu/alpha/area_curve.cuh"
 #include "gpu/alpha/component_curve.cuh"
 #include "gpu/alpha/spectrum_refine.cuh"
+#include "gpu/system/backend.hpp"
 #include "gpu/system/engine_system.cuh"
 #include "gpu/triangulation/delaunay_impl.cuh"
 
@@ -313,12 +315,32 @@ uint32_t SettleRunsOfOneDouble(System& sys, const PipelineMesh& mesh, const Tied
   return static_cast<uint32_t>(thrust::count(policy, needs_host->data(), needs_host->data() + num_runs, uint8_t{1}));
 }
 
+/// Stops the build: its exact comparisons passed `limit`.
+[[noreturn]] inline void ThrowExactComparisonLimit(const ComparisonCounts& counts, uint64_t limit) {
+  const uint64_t used = counts.bounded_exact + counts.cpu_fallback;
+  throw EngineError(EngineError::Kind::kWorkLimit,
+                    "the spectrum needed more than its limit of " + std::to_string(limit) +
+                        " exact radius comparisons (stopped after " + std::to_string(used) + ")");
+}
+
+/// Throws EngineError kWorkLimit once the build's exact comparisons passed `limit` (0: none).
+inline void CheckExactComparisons(const ComparisonCounts& counts, uint64_t limit) {
+  if (limit != 0 && counts.bounded_exact + counts.cpu_fallback > limit) ThrowExactComparisonLimit(counts, limit);
+}
+
+/// What is left of a limit of exact comparisons for the host's repairs (which stop there).
+inline uint64_t ExactComparisonsLeft(const ComparisonCounts& counts, uint64_t limit) {
+  if (limit == 0) return kNoComparisonLimit;
+  const uint64_t used = counts.bounded_exact + counts.cpu_fallback;
+  return used < limit ? limit - used : 0;
+}
+
 /// Brings the whole order to the host once (rare: long runs of near or exact ties, such as a
 /// grid's congruent triangles) and repairs there the runs marked in `needs_host`.
 template <class System>
 void RepairRunsOnHostOnce(System& sys, HostMesh<System>& host_mesh, const TiedRuns<System>& runs,
                           const Buffer<uint8_t, System>& needs_host, ExactSpectrum<System>* spectrum,
-                          ComparisonCounts* counts) {
+                          uint64_t max_exact_comparisons, ComparisonCounts* counts) {
   const uint32_t num_entries = spectrum->num_entries;
   const uint32_t num_runs = runs.num_runs;
   std::vector<uint32_t> host_ids = spectrum->ids.ToHostVector(num_entries);
@@ -329,7 +351,10 @@ void RepairRunsOnHostOnce(System& sys, HostMesh<System>& host_mesh, const TiedRu
   for (uint32_t r = 0; r < num_runs; ++r) {
     if (host_needs[r]) host_runs.push_back({host_begin[r], host_begin[r + 1]});
   }
-  RepairRunsOnHost(host_mesh.Get(), host_runs, host_ids.data(), host_new.data(), counts);
+  if (!RepairRunsOnHost(host_mesh.Get(), host_runs, ExactComparisonsLeft(*counts, max_exact_comparisons),
+                        host_ids.data(), host_new.data(), counts)) {
+    ThrowExactComparisonLimit(*counts, max_exact_comparisons);
+  }
   sys.FromHost(spectrum->ids.data(), host_ids.data(), num_entries);
   sys.FromHost(spectrum->new_value.data(), host_new.data(), num_entries);
 }
@@ -341,7 +366,7 @@ void RepairRunsOnHostOnce(System& sys, HostMesh<System>& host_mesh, const TiedRu
 template <class System>
 uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>& host_mesh,
                         const Buffer<uint64_t, System>& sorted_keys, ExactSpectrum<System>* spectrum,
-                        StageTimer<System>& timer, ComparisonCounts* counts) {
+                        StageTimer<System>& timer, uint64_t max_exact_comparisons, ComparisonCounts* counts) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   TiedRuns<System> runs = FindTiedRuns(sys, sorted_keys, spectrum->num_entries);
@@ -352,6 +377,7 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
     runs.num_runs = ListRunStarts(sys, runs.link, spectrum->num_entries, &runs.run_begin);
   }
   timer.EndStage("spectrum_refine");
+  CheckExactComparisons(*counts, max_exact_comparisons);
   const uint32_t num_runs = runs.num_runs;
   const uint32_t* run_end = runs.run_begin.data() + 1;
   Buffer<uint8_t, System> needs_host(sys, num_runs);
@@ -366,7 +392,8 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
   if (host_runs > 0) host_runs = SettleRunsOfOneDouble(sys, mesh, runs, spectrum, &needs_host, counts);
   runs.link.Reset();
   timer.EndStage("spectrum_repair");
-  if (host_runs > 0) RepairRunsOnHostOnce(sys, host_mesh, runs, needs_host, spectrum, counts);
+  CheckExactComparisons(*counts, max_exact_comparisons);
+  if (host_runs > 0) RepairRunsOnHostOnce(sys, host_mesh, runs, needs_host, spectrum, max_exact_comparisons, counts);
   return runs.num_links;
 }
 
@@ -374,11 +401,15 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
 /// the exact order on the host.
 template <class System>
 void MergeUncertified(System& sys, HostMesh<System>& host_mesh, const Buffer<uint32_t, System>& odd_ids,
-                      uint32_t num_odd, ExactSpectrum<System>* spectrum, ComparisonCounts* counts) {
+                      uint32_t num_odd, ExactSpectrum<System>* spectrum, uint64_t max_exact_comparisons,
+                      ComparisonCounts* counts) {
   std::vector<uint32_t> host_ids = spectrum->ids.ToHostVector(spectrum->num_entries);
   std::vector<uint8_t> host_new = spectrum->new_value.ToHostVector(spectrum->num_entries);
   std::vector<uint32_t> odd = odd_ids.ToHostVector(num_odd);
-  MergeUncertifiedOnHost(host_mesh.Get(), odd, &host_ids, &host_new, counts);
+  if (!MergeUncertifiedOnHost(host_mesh.Get(), odd, ExactComparisonsLeft(*counts, max_exact_comparisons), &host_ids,
+                              &host_new, counts)) {
+    ThrowExactComparisonLimit(*counts, max_exact_comparisons);
+  }
   const uint32_t total_entries = static_cast<uint32_t>(host_ids.size());
   spectrum->ids = Buffer<uint32_t, System>(sys, total_entries);
   spectrum->new_value = Buffer<uint8_t, System>(sys, total_entries);
@@ -393,20 +424,23 @@ void MergeUncertified(System& sys, HostMesh<System>& host_mesh, const Buffer<uin
 template <class System>
 ExactSpectrum<System> RepairSpectrum(System& sys, const PipelineMesh& mesh, HostMesh<System>& host_mesh,
                                      SortedSpectrum<System>* sorted, StageTimer<System>& timer,
-                                     ComparisonCounts* counts) {
+                                     uint64_t max_exact_comparisons, ComparisonCounts* counts) {
   const uint32_t num_entries = sorted->num_entries;
   ExactSpectrum<System> spectrum{std::move(sorted->ids), Buffer<uint8_t, System>(sys, num_entries), num_entries};
   thrust::fill_n(sys.policy(), spectrum.new_value.data(), num_entries, uint8_t{1});
   uint64_t num_links = 0;
   if (num_entries > 1) {
-    num_links = RepairTiedRuns(sys, mesh, host_mesh, sorted->sorted_keys, &spectrum, timer, counts);
+    num_links =
+        RepairTiedRuns(sys, mesh, host_mesh, sorted->sorted_keys, &spectrum, timer, max_exact_comparisons, counts);
   } else {
     timer.EndStage("spectrum_refine");
     timer.EndStage("spectrum_repair");
   }
   counts->filter += num_entries > 0 ? (num_entries - 1) - num_links : 0;
   sorted->sorted_keys.Reset();
-  if (sorted->num_odd > 0) MergeUncertified(sys, host_mesh, sorted->odd_ids, sorted->num_odd, &spectrum, counts);
+  if (sorted->num_odd > 0) {
+    MergeUncertified(sys, host_mesh, sorted->odd_ids, sorted->num_odd, &spectrum, max_exact_comparisons, counts);
+  }
   sorted->odd_ids.Reset();
   timer.EndStage("spectrum_host_repair");
   return spectrum;
@@ -657,7 +691,7 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
 /// buffers a stage no longer needs are freed by the stage that reads them last.
 template <class System>
 void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points, StageTimer<System>& timer,
-                      FamilyOutput* family) {
+                      uint64_t max_exact_comparisons, FamilyOutput* family) {
   AlphaRanks* out = &family->ranks;
   const PipelineMesh mesh = PipelineMeshOf(t);
   HostMesh<System> host_mesh = StartMeshDownload(sys, t, mesh, host_points, family);
@@ -667,7 +701,8 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   timer.EndStage("radii_attachment");
   SortedSpectrum<System> sorted = SortSpectrum(sys, mesh, &keys);
   timer.EndStage("spectrum_sort");
-  ExactSpectrum<System> exact = RepairSpectrum(sys, mesh, host_mesh, &sorted, timer, &out->comparisons);
+  ExactSpectrum<System> exact =
+      RepairSpectrum(sys, mesh, host_mesh, &sorted, timer, max_exact_comparisons, &out->comparisons);
   SpectrumRanks<System> ranks = RankSpectrum(sys, mesh, &exact);
   timer.EndStage("ranks");
   SpectrumValues<System> values = RoundSpectrumValues(sys, mesh, ranks);
@@ -691,7 +726,7 @@ void RunFamilyBuild(System& sys, const Point2* host_points, uint32_t n, const Bu
   StageTimer<System> timer(sys, &out->stage_times);
   SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, n, /*keep_points=*/true, timer);
   if (hooks.after_triangulation) hooks.after_triangulation();
-  RunAlphaPipeline(sys, t, host_points, timer, out);
+  RunAlphaPipeline(sys, t, host_points, timer, hooks.max_exact_comparisons, out);
   timer.Finish();
   out->peak_memory_bytes = sys.peak_bytes();
 }

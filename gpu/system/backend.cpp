@@ -5,6 +5,7 @@
 #include <exception>
 #include <new>
 
+#include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "gpu/system/backend.hpp"
 
@@ -51,6 +52,11 @@ absl::Status RunEngine(const std::string& what, const std::function<void()>& bod
         return absl::UnavailableError(e.what());
       case EngineError::Kind::kCancelled:
         return absl::CancelledError(e.what());
+      case EngineError::Kind::kWorkLimit: {
+        absl::Status status = absl::ResourceExhaustedError(absl::StrCat(what, ": ", e.what()));
+        status.SetPayload(kExactComparisonLimitPayload, absl::Cord("1"));
+        return status;
+      }
       case EngineError::Kind::kInternal:
         break;
     }

@@ -27,7 +27,9 @@ namespace detail {
 /// turned into an absl::Status once, at the engine boundary (RunEngine, engine_status.hpp).
 class EngineError : public std::runtime_error {
  public:
-  enum class Kind { kInternal, kResourceExhausted, kUnavailable, kCancelled };
+  /// kWorkLimit: the build passed its limit of exact comparisons (BuildOptions); ResourceExhausted
+  /// at the boundary, tagged so that callers can tell it from a lack of memory.
+  enum class Kind { kInternal, kResourceExhausted, kUnavailable, kCancelled, kWorkLimit };
   EngineError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }
 

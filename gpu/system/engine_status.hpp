@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <string>
+#include <string_view>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -14,6 +15,10 @@ namespace galpha::detail {
 /// The backend that runs a request for `requested`: Unavailable when CUDA is asked for and there
 /// is none.
 absl::StatusOr<Backend> ResolveBackend(Backend requested);
+
+/// The payload that tags the ResourceExhausted status of a build stopped by its limit of exact
+/// comparisons (EngineError kWorkLimit).
+inline constexpr std::string_view kExactComparisonLimitPayload = "galpha.dev/exact-comparison-limit";
 
 /// Runs `body`, turning what the engine throws into a status: EngineError by its kind, bad_alloc
 /// as ResourceExhausted, any other exception (Thrust reports CUDA failures as system_error) as

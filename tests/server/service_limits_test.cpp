@@ -13,6 +13,7 @@
 
 #include "core/io/point_set_handle.hpp"
 #include "server/build_time_limit.hpp"
+#include "server/exact_comparison_limit.hpp"
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
@@ -181,6 +182,46 @@ TEST(ServiceLimitsTest, ABuildPastItsTimeLimitStops) {
   EXPECT_EQ(ScrapeMetric(*server, Rejected("build_time")), 1.0);
   EXPECT_THAT(client->Describe(PointSetHandle(points)).status(), StatusIs(absl::StatusCode::kNotFound));
   EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 5));
+}
+
+TEST(ServiceLimitsTest, ExactComparisonLimitIsAMultipleOfThePointsWithAFloor) {
+  ExactComparisonLimitOptions options;  // the defaults: 64 a point, at least 1,000,000
+  EXPECT_EQ(ExactComparisonLimit(1000, options), 1'000'000u);
+  EXPECT_EQ(ExactComparisonLimit(1'000'000, options), 64'000'000u);
+  options.per_point = 0.5;
+  options.floor = 0;
+  EXPECT_EQ(ExactComparisonLimit(3, options), 2u);  // rounded up
+  options.per_point = 1e300;
+  EXPECT_EQ(ExactComparisonLimit(3, options), uint64_t{1} << 63);  // saturates
+  options.per_point = 0;
+  EXPECT_EQ(ExactComparisonLimit(1'000'000, options), 0u);  // off
+}
+
+// A build whose spectrum needs more exact comparisons than its limit stops and answers
+// RESOURCE_EXHAUSTED naming the limit and its flags; nothing is cached, and the refusal is
+// counted once under its reason. The same input builds under the default limit.
+TEST(ServiceLimitsTest, ABuildPastItsExactComparisonLimitStops) {
+  ServerOptions options = TestServerOptions();
+  options.service.exact_comparisons.per_point = 0.1;  // a lattice nudged by ulps needs about 2
+  options.service.exact_comparisons.floor = 0;
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  EXPECT_EQ(ScrapeMetric(*server, Rejected("exact_comparisons")), 0.0) << "every reason is exported from the start";
+  auto client = ClientOf(*server);
+  const std::vector<Point2> points = gen::UlpLattice(2500, 13);
+  client::BuildCallOptions call;
+  call.skip_upload_if_cached = false;
+  const auto built = client->Build(points, call);
+  EXPECT_THAT(built.status(),
+              StatusIs(absl::StatusCode::kResourceExhausted, HasSubstr("--max_exact_comparisons_per_point")));
+  EXPECT_THAT(built.status().message(), HasSubstr("limit of 250 exact radius comparisons"));
+  EXPECT_EQ(ScrapeMetric(*server, Rejected("exact_comparisons")), 1.0);
+  EXPECT_THAT(client->Describe(PointSetHandle(points)).status(), StatusIs(absl::StatusCode::kNotFound));
+  EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 5));
+
+  auto lenient = StartServer(TestServerOptions());
+  ASSERT_NE(lenient, nullptr);
+  EXPECT_THAT(ClientOf(*lenient)->Build(points, call), IsOk());
 }
 
 ServerOptions TwoTenants() {

@@ -1,6 +1,6 @@
 // The alpha family of bad and degenerate input: NaN and infinity name their index; 0, 1, 2 points
 // and collinear sets give families with edges only (a chain, the spectrum of its squared half
-// lengths).
+// lengths). A build past its limit of exact comparisons stops with a tagged ResourceExhausted.
 #include <gmpxx.h>
 
 #include <algorithm>
@@ -19,6 +19,7 @@
 #include "gtest/gtest.h"
 #include "tests/gpu/alpha/alpha_family_fixture.hpp"
 #include "tests/support/backend_fixture.hpp"
+#include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha {
@@ -29,6 +30,7 @@ using testing::ExactThreshold;
 using testing::IsOk;
 using ::testing::Not;
 using testing::StatusIs;
+using ::testing::HasSubstr;
 
 using InputTest = testing::AlphaFamilyTest;
 
@@ -156,6 +158,34 @@ TEST_P(InputTest, FewPointsAndCollinearSetsAreValid) {
   ASSERT_THAT(built, IsOk());
   CheckChainFamily(*built, line);
   EXPECT_EQ(built->max_level(), 1);
+}
+
+TEST_P(InputTest, ExactComparisonLimitStopsTheBuild) {
+  // A lattice nudged by single ulps: its certified keys tie by the thousand, so its spectrum needs
+  // exact comparisons (on the device, in refined-key clusters and short runs).
+  const std::vector<Point2> points = gen::UlpLattice(2500, 13);
+  BuildOptions options;
+  options.backend = GetParam();
+  const absl::StatusOr<AlphaFamily> unlimited = BuildAlphaFamily(points, options);
+  ASSERT_THAT(unlimited, IsOk());
+  const ComparisonCounts& counts = unlimited->report().comparisons;
+  const uint64_t used = counts.bounded_exact + counts.cpu_fallback;
+  ASSERT_GT(used, 1000u);
+
+  options.max_exact_comparisons = used;  // exactly enough: the same family
+  const absl::StatusOr<AlphaFamily> enough = BuildAlphaFamily(points, options);
+  ASSERT_THAT(enough, IsOk());
+  EXPECT_EQ(enough->spectrum(), unlimited->spectrum());
+  EXPECT_EQ(enough->ranks().spectrum_simplex, unlimited->ranks().spectrum_simplex);
+
+  options.max_exact_comparisons = used - 1;
+  const absl::StatusOr<AlphaFamily> stopped = BuildAlphaFamily(points, options);
+  EXPECT_THAT(stopped, StatusIs(absl::StatusCode::kResourceExhausted,
+                                HasSubstr("limit of " + std::to_string(used - 1) + " exact radius comparisons")));
+  EXPECT_TRUE(IsExactComparisonLimit(stopped.status()));
+  // Only the limit is tagged: other refusals of the same code are not.
+  EXPECT_FALSE(IsExactComparisonLimit(absl::ResourceExhaustedError("out of memory")));
+  EXPECT_FALSE(IsExactComparisonLimit(absl::OkStatus()));
 }
 
 GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(InputTest);
