@@ -355,6 +355,7 @@ void RepairRunsOnHostOnce(System& sys, HostMesh<System>& host_mesh, const TiedRu
                         host_ids.data(), host_new.data(), counts)) {
     ThrowExactComparisonLimit(*counts, max_exact_comparisons);
   }
+  CheckExactComparisons(*counts, max_exact_comparisons);  // runs of exact doubles count after the fact
   sys.FromHost(spectrum->ids.data(), host_ids.data(), num_entries);
   sys.FromHost(spectrum->new_value.data(), host_new.data(), num_entries);
 }
