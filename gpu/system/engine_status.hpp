@@ -4,7 +4,6 @@
 
 #include <functional>
 #include <string>
-#include <string_view>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -18,7 +17,7 @@ absl::StatusOr<Backend> ResolveBackend(Backend requested);
 
 /// The payload that tags the ResourceExhausted status of a build stopped by its limit of exact
 /// comparisons (EngineError kWorkLimit).
-inline constexpr std::string_view kExactComparisonLimitPayload = "galpha.dev/exact-comparison-limit";
+inline constexpr char kExactComparisonLimitPayload[] = "galpha.dev/exact-comparison-limit";
 
 /// Runs `body`, turning what the engine throws into a status: EngineError by its kind, bad_alloc
 /// as ResourceExhausted, any other exception (Thrust reports CUDA failures as system_error) as
