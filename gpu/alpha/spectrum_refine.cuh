@@ -2,23 +2,24 @@
 // instead of by exact comparisons inside each run. Runs longer than kMaxDeviceRun used to go to
 // the host whole (a three-way quicksort with exact comparisons: 44 s for a 1000 x 1000 lattice
 // perturbed by single ulps); here every entry of such a run gets a key certified within 2^-150,
-// the entries are sorted by (run, exact key value, id), and only adjacent entries the keys cannot
-// separate are compared exactly: O(n) comparisons, all in parallel, on the backend's cores.
+// the entries are radix-sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
+// and only adjacent entries the keys cannot separate are compared exactly: O(n) comparisons, all in
+// parallel, on the backend's cores.
 //
 // Why the result is exact:
 //  - Two adjacent entries whose keys are separated (RefinedKeysSeparated) have exact values in
-//    that order, and since the keys are sorted by their exact values and each is within its
-//    certified error of its entry's value, every entry before the pair is below every entry after
-//    it: a separated pair is a certified boundary.
+//    that order, and since the keys are sorted by truncations within 3 * 2^-160 of their values and
+//    each is within its certified error of its entry's value, every entry before the pair is below
+//    every entry after it: a separated pair is a certified boundary (refined_sort_words.hpp).
 //  - Between boundaries lie clusters of entries whose keys may tie. A cluster whose adjacent pairs
 //    all compare Less or Equal exactly is in exact order (order is transitive); its links are cut
 //    and the equal pairs marked as one value.
-//  - A cluster with a pair out of order or undecided ("bad": values closer than the keys' error,
-//    as a lattice nudged by single ulps has by the thousand) is sorted again, alone, on the
-//    system, by (exact value, id) with the bounded exact comparison (ExactClusterEntryLess), and
-//    judged again; its boundaries are certified, so it may be reordered freely. A cluster where
-//    some bounded comparison is undecided keeps its first order and its links, and becomes a run
-//    of its own for the existing exact repair (the host's), which may reorder it freely too.
+//  - A cluster with a pair out of order ("bad": distinct values closer than the keys' error, as a
+//    lattice nudged by single ulps has, 2^-146 to 2^-224 apart, among thousands of exact ties) is
+//    sorted again on the system by rounds of exact three-way partitions (SortBadClusters); its
+//    boundaries are certified, so it may be reordered freely. A cluster where some bounded
+//    comparison is undecided, or that needs more than kMaxPartitionRounds rounds, keeps its first
+//    order and its links, and becomes a run of its own for the host's exact repair.
 //  - A run with an entry whose key cannot be refined (exact terms beyond the bounded buffers) is
 //    left whole to the existing repair.
 //  - A long run whose values are all exactly one double (ExactDoubleRadiusSq: a grid) is settled
@@ -32,7 +33,7 @@
 #include <thrust/functional.h>
 #include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
-#include <thrust/iterator/permutation_iterator.h>
+#include <thrust/iterator/reverse_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/reduce.h>
 #include <thrust/scan.h>
@@ -200,14 +201,11 @@ struct ClusterStartAsU32 {
   GALPHA_HD uint32_t operator()(uint32_t k) const { return verdict[k] == kPairSeparated ? 1u : 0u; }
 };
 
-/// Sign of value(a) - value(b) for two entries of one bad cluster: their keys where they are
-/// separated, else a congruence proof or the bounded exact comparison. Where that is undecided the
-/// cluster is marked (it goes to the host in its first order) and the keys answer, so that the sort
-/// still sees an order. Not inlined: the merge sort instantiates its comparator in many places, and
-/// one out-of-line copy of the exact arithmetic keeps the device code small.
-GALPHA_HD GALPHA_NOINLINE inline int ExactClusterEntrySign(const SimplexPoints& simplex, const RefinedEntry& a,
-                                                           const RefinedEntry& b, uint8_t* cluster_undecided,
-                                                           uint32_t* comparisons) {
+/// Sign of value(a) - value(b) for two entries of one bad cluster `cluster`: their keys where they
+/// are separated, else a congruence proof or the bounded exact comparison (counted). Where that is
+/// undecided the cluster is marked (it goes to the host in its first order) and 0 is answered.
+GALPHA_HD inline int ExactClusterEntrySign(const SimplexPoints& simplex, const RefinedEntry& a, const RefinedEntry& b,
+                                           uint32_t cluster, uint8_t* cluster_undecided, uint32_t* comparisons) {
   if (RefinedKeysSeparated(a.key, b.key)) return -1;
   if (RefinedKeysSeparated(b.key, a.key)) return 1;
   Point2 pa[3], pb[3];
@@ -216,24 +214,9 @@ GALPHA_HD GALPHA_NOINLINE inline int ExactClusterEntrySign(const SimplexPoints& 
   AtomicIncrement(comparisons);
   const Order order = CompareRadiusSqBounded(pa, na, pb, nb);
   if (order != Order::kUndecided) return SignOf(order);
-  cluster_undecided[a.run] = 1;  // concurrent writes only ever write 1
-  return -CompareRefinedValues(a.key, b.key);
+  cluster_undecided[cluster] = 1;  // concurrent writes only ever write 1
+  return 0;
 }
-
-/// Sort order of the entries of bad clusters, whose `run` field holds their cluster here: by
-/// cluster, then exact value, then simplex id. Where every comparison is decided this is a strict
-/// total order, so both backends produce the same permutation.
-struct ExactClusterEntryLess {
-  SimplexPoints simplex;
-  uint8_t* cluster_undecided;
-  uint32_t* comparisons;  // one counter
-  GALPHA_HD bool operator()(const RefinedEntry& a, const RefinedEntry& b) const {
-    if (a.run != b.run) return a.run < b.run;
-    const int sign = ExactClusterEntrySign(simplex, a, b, cluster_undecided, comparisons);
-    if (sign != 0) return sign < 0;
-    return a.id < b.id;
-  }
-};
 
 /// 1 for sorted entries in a bad cluster.
 struct InBadCluster {
@@ -242,52 +225,103 @@ struct InBadCluster {
   GALPHA_HD bool operator()(uint32_t k) const { return cluster_bad[cluster_of[k] - 1] != 0; }
 };
 
-/// The entry at sorted position bad_k[j], with its cluster in place of its run.
-struct BadClusterEntry {
-  const RefinedEntry* entries;
-  const uint32_t* bad_k;
-  const uint32_t* cluster_of;
-  GALPHA_HD RefinedEntry operator()(uint32_t j) const {
-    RefinedEntry entry = entries[bad_k[j]];
-    entry.run = cluster_of[bad_k[j]] - 1;
-    return entry;
+// The bad clusters are sorted by rounds of three-way partitions, in parallel over all of them
+// (measured on a lattice nudged by single ulps: a bad cluster holds thousands of entries but only
+// a few distinct values, most entries exact ties that are not congruent). The entries of the bad
+// clusters sit in "slots"; a slot's segment is a contiguous range of slots, at first its cluster.
+// Each round compares every entry of an unsettled segment with the segment's middle entry (the
+// pivot) exactly, and a stable sort by (segment, sign) splits the segment into the entries below,
+// equal to and above the pivot, in that order. The equal part is settled: one exact value.
+// Every segment lies between certified bounds, each round keeps the segments in exact order, and
+// a settled segment is one value; so when no slot is unsettled the slots are in exact order. The
+// order inside a value is the key order (stable sorts), the same on both backends.
+
+/// 64-bit sort word of slot j for the next round: its segment, then its part (0 below the pivot,
+/// 1 equal or settled, 2 above).
+struct PartitionWord {
+  SimplexPoints simplex;
+  const RefinedEntry* entries;  // by sorted position k
+  const uint32_t* cluster_of;   // 1-based, by k
+  const uint32_t* item;         // slot -> k
+  const uint32_t* segment;      // slot -> segment
+  const uint32_t* segment_begin;
+  const uint32_t* segment_end;  // exclusive
+  const uint8_t* settled;
+  uint8_t* cluster_undecided;
+  uint32_t* comparisons;  // one counter
+  GALPHA_HD uint64_t operator()(uint32_t j) const {
+    const uint64_t high = uint64_t{segment[j]} << 2;
+    if (settled[j]) return high | 1;
+    const uint32_t pivot_slot = segment_begin[j] + (segment_end[j] - segment_begin[j]) / 2;
+    if (pivot_slot == j) return high | 1;
+    const uint32_t k = item[j];
+    const int sign = ExactClusterEntrySign(simplex, entries[k], entries[item[pivot_slot]], cluster_of[k] - 1,
+                                           cluster_undecided, comparisons);
+    return high | static_cast<uint64_t>(sign + 1);
   }
 };
 
-/// Puts a re-sorted bad cluster back over its own sorted positions (the clusters' positions
-/// ascend, and sorting by cluster first keeps each cluster's entries over its own), run restored,
-/// and its ids into the spectrum. An undecided cluster keeps its first order.
+/// Where slot j's segment begins (as a candidate for a maximum scan) and ends (for a minimum scan
+/// from the right).
+struct SegmentBeginCandidate {
+  const uint32_t* segment;
+  GALPHA_HD uint32_t operator()(uint32_t j) const { return j == 0 || segment[j] != segment[j - 1] ? j : 0; }
+};
+struct SegmentEndCandidate {
+  const uint32_t* segment;
+  uint32_t num_slots;
+  GALPHA_HD uint32_t operator()(uint32_t j) const {
+    return j + 1 == num_slots || segment[j] != segment[j + 1] ? j + 1 : num_slots;
+  }
+};
+
+/// After a round's sort: a new segment starts where the (segment, part) word changes; the equal
+/// part (and what was settled before) is settled.
+struct NewSegmentStart {
+  const uint64_t* word;
+  GALPHA_HD uint32_t operator()(uint32_t j) const { return j == 0 || word[j] != word[j - 1] ? 1u : 0u; }
+};
+struct SettledOfWord {
+  GALPHA_HD uint8_t operator()(uint64_t word) const { return (word & 3) == 1 ? 1 : 0; }
+};
+
+/// A slot still unsettled when the rounds run out sends its cluster to the host.
+struct GiveUpUnsettled {
+  const uint32_t* cluster_of;
+  const uint32_t* item;
+  const uint8_t* settled;
+  uint8_t* cluster_undecided;
+  GALPHA_HD void operator()(uint32_t j) const {
+    if (!settled[j]) cluster_undecided[cluster_of[item[j]] - 1] = 1;
+  }
+};
+
+/// Puts a sorted bad cluster back over its own sorted positions, its ids into the spectrum, and
+/// its verdicts: a value's first entry kPairLess (the cluster's first stays kPairSeparated), the
+/// others kPairEqual. A cluster left undecided keeps its first order and verdicts.
 struct ScatterSortedCluster {
-  const RefinedEntry* sorted;  // `run` holds the cluster
-  const uint32_t* bad_k;
+  const RefinedEntry* by_slot;  // entries[item[j]]
+  const uint32_t* bad_k;        // slot -> its position in the cluster's range (ascending)
   const uint32_t* positions;
+  const uint32_t* cluster_of;
+  const uint32_t* segment;
   const uint8_t* cluster_undecided;
   RefinedEntry* entries;
   uint32_t* ids;
+  uint8_t* verdict;
   GALPHA_HD void operator()(uint32_t j) const {
-    if (cluster_undecided[sorted[j].run]) return;
     const uint32_t k = bad_k[j];
-    RefinedEntry entry = sorted[j];
-    entry.run = entries[k].run;  // the cluster lies inside one run
-    entries[k] = entry;
-    ids[positions[k]] = entry.id;
+    if (cluster_undecided[cluster_of[k] - 1]) return;
+    entries[k] = by_slot[j];
+    ids[positions[k]] = by_slot[j].id;
+    if (verdict[k] == kPairSeparated) return;  // the cluster's first slot
+    verdict[k] = segment[j] != segment[j - 1] ? kPairLess : kPairEqual;
   }
 };
 
-/// Judges again the pairs inside a re-sorted bad cluster (its first entry stays a certified
-/// boundary); an undecided cluster keeps its verdicts.
-struct JudgeSortedClusterPair {
-  JudgeRefinedPair judge;
-  const uint32_t* bad_k;
-  const uint32_t* cluster_of;
-  const uint8_t* cluster_undecided;
-  GALPHA_HD void operator()(uint32_t j) const {
-    const uint32_t k = bad_k[j];
-    judge.comparisons[k] = 0;
-    if (judge.verdict[k] == kPairSeparated || cluster_undecided[cluster_of[k] - 1]) return;
-    judge(k);
-  }
-};
+/// Rounds of partitions before a bad cluster is given up to the host: each round at least halves
+/// the number of distinct values in a segment it splits evenly, and settles the pivot's value.
+constexpr int kMaxPartitionRounds = 64;
 
 /// Marks the clusters that hold a bad pair; concurrent writes only ever write 1.
 struct MarkBadCluster {
@@ -344,41 +378,60 @@ void SortRefinedEntries(System& sys, Buffer<RefinedEntry, System>* entries, uint
   *entries = std::move(sorted);
 }
 
-/// Sorts the entries of bad clusters again by exact comparisons (ExactClusterEntryLess) and judges
-/// them again, clearing `cluster_bad` for the clusters that come out in exact order.
+/// Sorts the entries of bad clusters exactly by rounds of three-way partitions (see above) and sets
+/// their verdicts, clearing `cluster_bad` for the clusters that come out in exact order.
 template <class System>
 void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* positions, RefinedEntry* entries,
-                     const uint8_t* run_unrefinable, const uint32_t* cluster_of, uint32_t num_clusters,
-                     uint32_t num_refined, uint32_t* ids, Buffer<uint8_t, System>* verdict,
-                     Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
+                     const uint32_t* cluster_of, uint32_t num_clusters, uint32_t num_refined, uint32_t* ids,
+                     Buffer<uint8_t, System>* verdict, Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   if (thrust::count(policy, cluster_bad->data(), cluster_bad->data() + num_clusters, uint8_t{1}) == 0) return;
   Buffer<uint32_t, System> bad_k(sys, num_refined);
-  const auto num_bad = static_cast<uint32_t>(
+  const auto num_slots = static_cast<uint32_t>(
       thrust::copy_if(policy, zero, zero + num_refined, bad_k.data(), InBadCluster{cluster_of, cluster_bad->data()}) -
       bad_k.data());
-  Buffer<RefinedEntry, System> sorted(sys, num_bad);
-  thrust::transform(policy, zero, zero + num_bad, sorted.data(), BadClusterEntry{entries, bad_k.data(), cluster_of});
+  Buffer<uint32_t, System> item(sys, num_slots);
+  thrust::copy_n(policy, bad_k.data(), num_slots, item.data());
+  Buffer<uint32_t, System> segment(sys, num_slots);
+  thrust::gather(policy, bad_k.data(), bad_k.data() + num_slots, cluster_of, segment.data());
+  Buffer<uint8_t, System> settled(sys, num_slots);
+  thrust::fill_n(policy, settled.data(), num_slots, uint8_t{0});
   Buffer<uint8_t, System> cluster_undecided(sys, num_clusters);
   thrust::fill_n(policy, cluster_undecided.data(), num_clusters, uint8_t{0});
-  Buffer<uint32_t, System> sort_comparisons(sys, 1);
-  thrust::fill_n(policy, sort_comparisons.data(), 1, uint32_t{0});
-  thrust::sort(policy, sorted.data(), sorted.data() + num_bad,
-               ExactClusterEntryLess{simplex, cluster_undecided.data(), sort_comparisons.data()});
-  counts->bounded_exact += sys.Read(sort_comparisons.data());
-  thrust::for_each_n(
-      policy, zero, num_bad,
-      ScatterSortedCluster{sorted.data(), bad_k.data(), positions, cluster_undecided.data(), entries, ids});
-  sorted.Reset();
-  Buffer<uint32_t, System> comparisons(sys, num_refined);
-  thrust::for_each_n(policy, zero, num_bad,
-                     JudgeSortedClusterPair{{simplex, entries, run_unrefinable, verdict->data(), comparisons.data()},
-                                            bad_k.data(),
-                                            cluster_of,
-                                            cluster_undecided.data()});
-  const auto judged = thrust::make_permutation_iterator(comparisons.data(), bad_k.data());
-  counts->bounded_exact += thrust::reduce(policy, judged, judged + num_bad, uint64_t{0});
+  Buffer<uint32_t, System> comparisons(sys, 1);
+  thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});
+  Buffer<uint32_t, System> segment_begin(sys, num_slots), segment_end(sys, num_slots);
+  Buffer<uint64_t, System> word(sys, num_slots);
+  bool all_settled = false;
+  for (int round = 0; round < kMaxPartitionRounds && !all_settled; ++round) {
+    const auto begins = thrust::make_transform_iterator(zero, SegmentBeginCandidate{segment.data()});
+    thrust::inclusive_scan(policy, begins, begins + num_slots, segment_begin.data(), thrust::maximum<uint32_t>());
+    const auto ends = thrust::make_transform_iterator(zero, SegmentEndCandidate{segment.data(), num_slots});
+    thrust::inclusive_scan(policy, thrust::make_reverse_iterator(ends + num_slots), thrust::make_reverse_iterator(ends),
+                           thrust::make_reverse_iterator(segment_end.data() + num_slots), thrust::minimum<uint32_t>());
+    thrust::transform(policy, zero, zero + num_slots, word.data(),
+                      PartitionWord{simplex, entries, cluster_of, item.data(), segment.data(), segment_begin.data(),
+                                    segment_end.data(), settled.data(), cluster_undecided.data(), comparisons.data()});
+    thrust::stable_sort_by_key(policy, word.data(), word.data() + num_slots, item.data());
+    const auto starts = thrust::make_transform_iterator(zero, NewSegmentStart{word.data()});
+    thrust::inclusive_scan(policy, starts, starts + num_slots, segment.data());
+    thrust::transform(policy, word.data(), word.data() + num_slots, settled.data(), SettledOfWord{});
+    all_settled = thrust::count(policy, settled.data(), settled.data() + num_slots, uint8_t{0}) == 0;
+  }
+  counts->bounded_exact += sys.Read(comparisons.data());
+  word.Reset();
+  segment_begin.Reset();
+  segment_end.Reset();
+  if (!all_settled) {
+    thrust::for_each_n(policy, zero, num_slots,
+                       GiveUpUnsettled{cluster_of, item.data(), settled.data(), cluster_undecided.data()});
+  }
+  Buffer<RefinedEntry, System> by_slot(sys, num_slots);
+  thrust::gather(policy, item.data(), item.data() + num_slots, entries, by_slot.data());
+  thrust::for_each_n(policy, zero, num_slots,
+                     ScatterSortedCluster{by_slot.data(), bad_k.data(), positions, cluster_of, segment.data(),
+                                          cluster_undecided.data(), entries, ids, verdict->data()});
   thrust::fill_n(policy, cluster_bad->data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict->data(), cluster_of, cluster_bad->data()});
 }
@@ -443,8 +496,8 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   Buffer<uint8_t, System> cluster_bad(sys, num_clusters);
   thrust::fill_n(policy, cluster_bad.data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict.data(), cluster_of.data(), cluster_bad.data()});
-  SortBadClusters(sys, simplex, positions.data(), entries.data(), run_unrefinable.data(), cluster_of.data(),
-                  num_clusters, num_refined, ids, &verdict, &cluster_bad, counts);
+  SortBadClusters(sys, simplex, positions.data(), entries.data(), cluster_of.data(), num_clusters, num_refined, ids,
+                  &verdict, &cluster_bad, counts);
   thrust::for_each_n(policy, zero, num_refined,
                      ApplyRefinedVerdicts{positions.data(), entries.data(), run_unrefinable.data(), verdict.data(),
                                           cluster_of.data(), cluster_bad.data(), link, new_value});
