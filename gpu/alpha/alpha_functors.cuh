@@ -222,6 +222,18 @@ struct RepairRun {
   }
 };
 
+/// Runs of two or more entries (the others are settled values).
+struct IsTiedRun {
+  const uint32_t* run_begin;
+  GALPHA_HD bool operator()(uint32_t r) const { return run_begin[r + 1] - run_begin[r] > 1; }
+};
+
+/// A run's length, negated as an unsigned key so that an ascending sort puts the longest first.
+struct NegatedRunLength {
+  const uint32_t* run_begin;
+  GALPHA_HD uint32_t operator()(uint32_t r) const { return ~(run_begin[r + 1] - run_begin[r]); }
+};
+
 /// 1 where a run starts (for numbering runs by a scan).
 struct RunStartAsU32 {
   const uint8_t* link;
