@@ -27,10 +27,10 @@ namespace {
 
 using testing::Edge;
 using testing::ExactThreshold;
+using ::testing::HasSubstr;
 using testing::IsOk;
 using ::testing::Not;
 using testing::StatusIs;
-using ::testing::HasSubstr;
 
 using InputTest = testing::AlphaFamilyTest;
 
