@@ -1,6 +1,6 @@
 // How many exact radius comparisons one build may make (issue "No slow inputs", item 5: a guard
-// against abuse, beside the time limit). Honest inputs need a few per point (a lattice nudged by
-// single ulps about two, a grid five, co-circular points three); an input built to defeat the
+// against abuse, beside the time limit). Honest inputs need at most a few per point (a grid five,
+// a lattice nudged by single ulps under one, co-circular points almost none); an input built to defeat the
 // certified keys needs many more, and the host's sequential repair of what the device cannot
 // decide has no bound in the input's size. Unlike the time limit, this one does not depend on
 // the machine or its load: the same input is refused everywhere.

@@ -28,7 +28,7 @@ struct BuildOptions {
   /// report counts them) the build may make; 0: no limit. A build that passes it stops and returns
   /// ResourceExhausted (IsExactComparisonLimit). The device's passes are checked as they end; the
   /// host's sequential repair, the only part whose work has no bound in the input's size, stops
-  /// within a few hundred comparisons of the limit.
+  /// within 255 comparisons a host thread of the limit.
   uint64_t max_exact_comparisons = 0;
 };
 

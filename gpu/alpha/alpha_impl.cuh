@@ -426,6 +426,7 @@ void MergeUncertified(System& sys, HostMesh<System>& host_mesh, const Buffer<uin
                               &host_new, counts)) {
     ThrowExactComparisonLimit(*counts, max_exact_comparisons);
   }
+  CheckExactComparisons(*counts, max_exact_comparisons);  // the comparator's last, unreported batch
   const uint32_t total_entries = static_cast<uint32_t>(host_ids.size());
   spectrum->ids = Buffer<uint32_t, System>(sys, total_entries);
   spectrum->new_value = Buffer<uint8_t, System>(sys, total_entries);

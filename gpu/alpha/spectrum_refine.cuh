@@ -19,7 +19,8 @@
 //    sorted again on the system by rounds of exact three-way partitions (SortBadClusters); its
 //    boundaries are certified, so it may be reordered freely. A cluster where some bounded
 //    comparison is undecided, or that needs more than kMaxPartitionRounds rounds, keeps its first
-//    order and its links, and becomes a run of its own for the host's exact repair.
+//    order and its links, and becomes a run of its own for the exact repair of short runs (a
+//    thread's insertion sort for up to kMaxDeviceRun entries, the host's beyond).
 //  - A run with an entry whose key cannot be refined (exact terms beyond the bounded buffers) is
 //    left whole to the existing repair.
 //  - A long run whose values are all exactly one double (ExactDoubleRadiusSq: a grid) is settled
@@ -65,29 +66,6 @@ struct RefinedEntry {
   uint32_t id;   // the simplex
   RefinedRadiusSq key;
 };
-
-/// Exact order of two refined keys' values: the sign of b - a, by Grow-Expansion (exact, and
-/// nonoverlapping so that the top component carries the sign), after the cheap cases.
-GALPHA_HD inline int CompareRefinedValues(const RefinedRadiusSq& a, const RefinedRadiusSq& b) {
-  using namespace exact;
-  if (a.infinite || b.infinite) return (b.infinite ? 1 : 0) - (a.infinite ? 1 : 0);
-  const int64_t gap = static_cast<int64_t>(b.exponent) - a.exponent;
-  if (gap >= 2) return 1;  // heads in [1, 2) and tails below 2^-50: the values differ by a binade
-  if (gap <= -2) return -1;
-  if (gap == 0 && a.hi == b.hi && a.mid == b.mid && a.lo == b.lo) return 0;  // translates, mostly
-  if (gap == 0) {
-    // Each value is within ulp(hi) / 2 + 2^-100 of its head: heads two ulps apart decide.
-    if (b.hi - a.hi > 0x1p-51) return 1;
-    if (a.hi - b.hi > 0x1p-51) return -1;
-  }
-  const double bs = gap == 1 ? 2.0 : 1.0, as = gap == -1 ? 2.0 : 1.0;  // to a common exponent
-  const double terms[6] = {Mul(b.lo, bs),  Mul(b.mid, bs),  Mul(b.hi, bs),
-                           -Mul(a.lo, as), -Mul(a.mid, as), -Mul(a.hi, as)};
-  double e[7];
-  int en = 0;
-  for (const double t : terms) en = GrowExpansionZeroElim(en, e, t, e);
-  return ExpansionSign(en, e);
-}
 
 /// Word `w` of entry perm[k]'s sort words (one pass of the least-significant-word-first sort).
 struct SortWordOf {
@@ -400,7 +378,6 @@ void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* 
   Buffer<uint8_t, System> cluster_undecided(sys, num_clusters);
   thrust::fill_n(policy, cluster_undecided.data(), num_clusters, uint8_t{0});
   Buffer<uint32_t, System> comparisons(sys, 1);
-  thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});
   Buffer<uint32_t, System> segment_begin(sys, num_slots), segment_end(sys, num_slots);
   Buffer<uint64_t, System> word(sys, num_slots);
   bool all_settled = false;
@@ -410,6 +387,7 @@ void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* 
     const auto ends = thrust::make_transform_iterator(zero, SegmentEndCandidate{segment.data(), num_slots});
     thrust::inclusive_scan(policy, thrust::make_reverse_iterator(ends + num_slots), thrust::make_reverse_iterator(ends),
                            thrust::make_reverse_iterator(segment_end.data() + num_slots), thrust::minimum<uint32_t>());
+    thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});  // one round's count fits 32 bits
     thrust::transform(policy, zero, zero + num_slots, word.data(),
                       PartitionWord{simplex, entries, cluster_of, item.data(), segment.data(), segment_begin.data(),
                                     segment_end.data(), settled.data(), cluster_undecided.data(), comparisons.data()});
@@ -418,8 +396,8 @@ void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* 
     thrust::inclusive_scan(policy, starts, starts + num_slots, segment.data());
     thrust::transform(policy, word.data(), word.data() + num_slots, settled.data(), SettledOfWord{});
     all_settled = thrust::count(policy, settled.data(), settled.data() + num_slots, uint8_t{0}) == 0;
+    counts->bounded_exact += sys.Read(comparisons.data());
   }
-  counts->bounded_exact += sys.Read(comparisons.data());
   word.Reset();
   segment_begin.Reset();
   segment_end.Reset();

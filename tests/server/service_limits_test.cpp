@@ -202,7 +202,7 @@ TEST(ServiceLimitsTest, ExactComparisonLimitIsAMultipleOfThePointsWithAFloor) {
 // counted once under its reason. The same input builds under the default limit.
 TEST(ServiceLimitsTest, ABuildPastItsExactComparisonLimitStops) {
   ServerOptions options = TestServerOptions();
-  options.service.exact_comparisons.per_point = 0.1;  // a lattice nudged by ulps needs about 2
+  options.service.exact_comparisons.per_point = 0.1;  // this lattice needs about 0.36 a point
   options.service.exact_comparisons.floor = 0;
   auto server = StartServer(options);
   ASSERT_NE(server, nullptr);
