@@ -326,6 +326,75 @@ GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Po
   return true;
 }
 
+/// Scaling of InCircleSignFromExactDifferences: the largest difference is brought into
+/// [2^120, 2^121), and the smallest nonzero one must then be at least 2^-80.
+constexpr int kDifferencesScaleTarget = 120;
+constexpr int kDifferencesLowestExponent = -80;
+
+/// The exact sign of the in-circle determinant when the six differences to d (adx .. cdy) are
+/// exact doubles, as for near points of a well-scaled set (Sterbenz: two doubles within a factor 2
+/// of each other subtract exactly): then the determinant is a polynomial of degree 4 in six
+/// doubles, evaluated here in expansion arithmetic in Shewchuk's form (d as the origin; 96
+/// components at most) instead of the raw-coordinate form of InCircleExpansion (384 components,
+/// four times the local memory and work). Returns false, deciding nothing, when a difference
+/// rounded or the differences span too many binary orders.
+///
+/// Why it is exact: the differences are scaled by one power of two 2^s so that the largest lies in
+/// [2^120, 2^121); each nonzero one must then be at least 2^-80 (and normal before scaling, so the
+/// scaling is exact). Every scaled difference is a multiple of 2^(-80-52) = 2^-132, so every
+/// quantity of degree k that the error-free transformations form (sums, products and their tails,
+/// Dekker's split halves) is an integer multiple of 2^(-132k) >= 2^-528, and below 2^500 in
+/// magnitude: no operation underflows or overflows, which is all Shewchuk's expansion arithmetic
+/// assumes to be exact. The result is 2^(4s) times the exact determinant: the same sign.
+GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignFromExactDifferences(Point2 a, Point2 b, Point2 c, Point2 d,
+                                                                        int* sign) {
+  using namespace exact;
+  ExactnessWitness w;
+  double v[6] = {w.Diff(a.x, d.x), w.Diff(a.y, d.y), w.Diff(b.x, d.x),
+                 w.Diff(b.y, d.y), w.Diff(c.x, d.x), w.Diff(c.y, d.y)};
+  if (!w.exact) return false;
+  double maxabs = 0.0, minabs = 0x1.fffffffffffffp1023;
+  for (const double diff : v) {
+    if (diff == 0.0) continue;
+    maxabs = Abs(diff) > maxabs ? Abs(diff) : maxabs;
+    minabs = Abs(diff) < minabs ? Abs(diff) : minabs;
+  }
+  if (maxabs == 0.0) {  // a, b, c and d coincide
+    *sign = 0;
+    return true;
+  }
+  // Subnormal differences: ExponentOf would overestimate their magnitude; leave them to the full
+  // stage.
+  if (minabs < 0x1p-1022) return false;
+  const int s = kDifferencesScaleTarget - ExponentOf(maxabs);
+  if (ExponentOf(minabs) + s < kDifferencesLowestExponent) return false;
+  for (double& diff : v) diff = ScaleByPow2(diff, s);
+  const double adx = v[0], ady = v[1], bdx = v[2], bdy = v[3], cdx = v[4], cdy = v[5];
+  // det = alift * (bdx cdy - cdx bdy) + blift * (cdx ady - adx cdy) + clift * (adx bdy - bdx ady),
+  // each lift * minor as dx * (dx * minor) + dy * (dy * minor): 4 -> 8 -> 16 components, 32 a
+  // term, 96 in all.
+  const double x[3] = {adx, bdx, cdx}, y[3] = {ady, bdy, cdy};
+  double total[2][96];
+  int total_len = 0, which = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = i == 2 ? 0 : i + 1, k = j == 2 ? 0 : j + 1;
+    double minor[4];
+    const int minor_len = Cross(x[j], y[j], x[k], y[k], minor);
+    double term[32], once[8], twice[2][16];
+    int twice_len[2];
+    for (int axis = 0; axis < 2; ++axis) {
+      const double lift_factor = axis == 0 ? x[i] : y[i];
+      const int once_len = ScaleExpansionZeroElim(minor_len, minor, lift_factor, once);
+      twice_len[axis] = ScaleExpansionZeroElim(once_len, once, lift_factor, twice[axis]);
+    }
+    const int term_len = ExpansionSumZeroElim(twice_len[0], twice[0], twice_len[1], twice[1], term);
+    total_len = ExpansionSumZeroElim(total_len, total[which], term_len, term, total[1 - which]);
+    which = 1 - which;
+  }
+  *sign = ExpansionSign(total_len, total[which]);
+  return true;
+}
+
 }  // namespace pred_detail
 
 /// Exact in-circle test: +1 if d lies strictly inside the circle through a, b, c (given
@@ -355,6 +424,7 @@ GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Poin
   if (errbound >= gate && (det > errbound || -det > errbound)) return det > 0.0 ? 1 : -1;
   int sign;
   if (pred_detail::InCircleSignIfExactInDoubles(a, b, c, d, &sign)) return sign;
+  if (pred_detail::InCircleSignFromExactDifferences(a, b, c, d, &sign)) return sign;
   double e[kInCircleExpansionCapacity];
   return ExpansionSign(InCircleExpansion(a, b, c, d, e), e);
 }

@@ -437,6 +437,58 @@ std::string FamilyName(const ::testing::TestParamInfo<const char*>& info) { retu
 INSTANTIATE_TEST_SUITE_P(All, OrientFamily, ::testing::ValuesIn(kOrientFamilies), FamilyName);
 INSTANTIATE_TEST_SUITE_P(All, InCircleFamily, ::testing::ValuesIn(kInCircleFamilies), FamilyName);
 
+// The stage for exact differences (InCircleSignFromExactDifferences), alone: wherever it decides,
+// its sign is GMP's, on every family; it decides the near-circle cases it exists for (points
+// within a factor of two of each other, so that Sterbenz makes their differences exact), and it
+// declines (leaving the full stage to decide) where a difference rounded or the differences
+// span more binary orders than its exactness argument allows.
+TEST_P(InCircleFamily, ExactDifferencesStageMatchesGmpWhereItDecides) {
+  int decided = 0;
+  for (const Quad& q : InCircleCases(GetParam(), 3000, 13)) {
+    int sign = 2;
+    if (!pred_detail::InCircleSignFromExactDifferences(q[0], q[1], q[2], q[3], &sign)) continue;
+    ++decided;
+    ASSERT_EQ(sign, sgn(Det(q))) << Show(q);
+  }
+  ::testing::Test::RecordProperty("decided", decided);
+}
+
+TEST(Predicates, ExactDifferencesStageDecidesNearPointsAndDeclinesTheRest) {
+  Gen g(14);
+  int decided = 0, filter_failed = 0;
+  for (int i = 0; i < 2000; ++i) {
+    // Four points on a circle of radius 1 around (12, 12), each coordinate nudged by up to 2
+    // ulps: every coordinate is within a factor 2 of every other, so the differences are exact,
+    // and the plain filter often cannot decide.
+    const Quad q = NearCircle(g, 12, 12, 1, 2);
+    const Q det = Det(q);
+    const double approx = InCircleApprox(q[0], q[1], q[2], q[3]);
+    filter_failed += std::fabs(approx) <= 1e-13;
+    int sign = 2;
+    ASSERT_TRUE(pred_detail::InCircleSignFromExactDifferences(q[0], q[1], q[2], q[3], &sign)) << Show(q);
+    ASSERT_EQ(sign, sgn(det)) << Show(q);
+    EXPECT_EQ(InCircleSign(q[0], q[1], q[2], q[3]), sgn(det)) << Show(q);
+    ++decided;
+  }
+  EXPECT_GT(filter_failed, 100);  // the stage is reached in InCircleSign, not only called here
+  int sign = 2;
+  // A rounded difference: 1 - 2^-60 is not a double.
+  EXPECT_FALSE(pred_detail::InCircleSignFromExactDifferences({1, 0}, {0, 1}, {-1, 0}, {0x1p-60, 0}, &sign));
+  // Exact differences spanning 2^10 .. 2^-200: beyond the stage's 200 binary orders.
+  EXPECT_FALSE(pred_detail::InCircleSignFromExactDifferences({0x1p10, 0}, {0, 0x1p-200}, {-0x1p10, 0}, {0, 0}, &sign));
+  // Subnormal differences.
+  EXPECT_FALSE(
+      pred_detail::InCircleSignFromExactDifferences({0x1p-1060, 0}, {0, 0x1p-1060}, {0x1p-1070, 0}, {0, 0}, &sign));
+  // All four points equal: zero, decided.
+  ASSERT_TRUE(pred_detail::InCircleSignFromExactDifferences({3, 4}, {3, 4}, {3, 4}, {3, 4}, &sign));
+  EXPECT_EQ(sign, 0);
+  // Exactly co-circular (a lattice circle of radius 5 at an offset): zero, decided.
+  ASSERT_TRUE(
+      pred_detail::InCircleSignFromExactDifferences({1005, 1000}, {1003, 1004}, {995, 1000}, {1004, 997}, &sign));
+  EXPECT_EQ(sign, 0);
+  EXPECT_EQ(decided, 2000);
+}
+
 TEST(Predicates, ConventionsAndApproximations) {
   const Point2 a{0, 0}, b{1, 0}, c{0, 1};
   EXPECT_EQ(Orient2dSign(a, b, c), 1);
