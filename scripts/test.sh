@@ -7,7 +7,18 @@
 # fuzz targets briefly, the Kubernetes manifests' validation and the container image's build steps.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each step's wall time, printed as it ends and summed at the end, so that CI's log shows where
+# its time goes (the goal is under 30 minutes on 2 cores).
+step_start=$SECONDS
+step_times=()
+step_done() {
+  step_times+=("$(printf '%5d s  %s' $((SECONDS - step_start)) "$1")")
+  echo "test.sh: step '$1' took $((SECONDS - step_start)) s"
+  step_start=$SECONDS
+}
+trap 'echo "test.sh: times of the steps that ended:"; printf "  %s\n" "${step_times[@]}"; echo "  $SECONDS s in all"' EXIT
 scripts/install-deps.sh
+step_done "install dependencies"
 # The CUDA configuration only where a GPU can run its tests: without one they skip, and compiling
 # the CUDA objects (about 13 minutes of nvcc on 2 cores) would test nothing but the compiler. The
 # GPU runs (bench/gpu_bundle.sh, bench/gpu_run.sh) build and test it.
@@ -15,17 +26,25 @@ preset=cpu
 if command -v nvidia-smi >/dev/null && nvidia-smi -L 2>/dev/null | grep -q '^GPU'; then preset=cuda; fi
 cmake --preset "$preset" -DGALPHA_BUILD_PYTHON=ON
 cmake --build --preset "$preset" -j"$(nproc)"
+step_done "build ($preset)"
 ctest --preset "$preset"
+step_done "ctest ($preset)"
 # Formatting and static analysis, as errors (.clang-format, .clang-tidy).
 scripts/lint.sh --build-dir "build/$preset"
+step_done "format and clang-tidy"
 # AddressSanitizer + UBSan and ThreadSanitizer on the CPU build (a chosen subset: CI's time budget).
 scripts/sanitize.sh
+step_done "sanitizer builds and tests"
 # The fuzz targets, briefly (20 s each): parsers of untrusted input must not crash.
 tests/fuzz/run.sh 20
+step_done "fuzz targets"
 # The API's style (buf lint).
 proto/lint.sh
+step_done "buf lint"
 # Deployment: the manifests against their schemas, and the container image's build steps (no
 # Docker engine here: deploy/build-server.sh is what the Dockerfile runs).
 deploy/k8s/validate.sh
+step_done "manifests"
 # The image's CUDA code only where it can be tested, as for the preset above.
 GALPHA_IMAGE_WITH_CUDA=$([ "$preset" = cuda ] && echo AUTO || echo OFF) deploy/build-server.sh build/image-root
+step_done "image build steps"
