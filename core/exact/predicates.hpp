@@ -46,6 +46,7 @@
 
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/double_double.hpp"
 #include "core/exact/expansion.hpp"
 
 #if defined(__CUDACC__)
@@ -326,54 +327,114 @@ GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Po
   return true;
 }
 
-/// Scaling of InCircleSignFromExactDifferences: the largest difference is brought into
-/// [2^120, 2^121), and the smallest nonzero one must then be at least 2^-80.
+/// Scaling of the difference stages: the largest difference is brought into [2^120, 2^121), and
+/// every nonzero part of every difference must then be at least 2^-80.
 constexpr int kDifferencesScaleTarget = 120;
 constexpr int kDifferencesLowestExponent = -80;
 
-/// The exact sign of the in-circle determinant when the six differences to d (adx .. cdy) are
-/// exact doubles, as for near points of a well-scaled set (Sterbenz: two doubles within a factor 2
-/// of each other subtract exactly): then the determinant is a polynomial of degree 4 in six
-/// doubles, evaluated here in expansion arithmetic in Shewchuk's form (d as the origin; 96
-/// components at most) instead of the raw-coordinate form of InCircleExpansion (384 components,
-/// four times the local memory and work). Returns false, deciding nothing, when a difference
-/// rounded or the differences span too many binary orders.
+/// The six differences to d as double-doubles, x = (adx, bdx, cdx) and y = (ady, bdy, cdy): each
+/// difference exactly (Two-Diff: the rounded difference and its tail), all scaled by one power of
+/// two so that the largest lies in [2^120, 2^121) (all zero when the four points coincide).
+/// `*exact` says whether every tail is zero (the differences are doubles, as for near points of a
+/// well-scaled set: Sterbenz). Returns false when a nonzero part is subnormal or the nonzero parts
+/// span more binary orders than the grid allows (the smallest must reach 2^-80 after scaling).
 ///
-/// Why it is exact: the differences are scaled by one power of two 2^s so that the largest lies in
-/// [2^120, 2^121); each nonzero one must then be at least 2^-80 (and normal before scaling, so the
-/// scaling is exact). Every scaled difference is a multiple of 2^(-80-52) = 2^-132, so every
-/// quantity of degree k that the error-free transformations form (sums, products and their tails,
-/// Dekker's split halves) is an integer multiple of 2^(-132k) >= 2^-528, and below 2^500 in
-/// magnitude: no operation underflows or overflows, which is all Shewchuk's expansion arithmetic
-/// assumes to be exact. The result is 2^(4s) times the exact determinant: the same sign.
-GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignFromExactDifferences(Point2 a, Point2 b, Point2 c, Point2 d,
-                                                                        int* sign) {
+/// The grid: every scaled part is then a multiple of 2^(-80-52) = 2^-132 and below 2^121, so every
+/// quantity of degree k that the difference stages form (sums, products, the tails of Two-Sum and
+/// Two-Product, Dekker's split halves) is an integer multiple of 2^(-132k) >= 2^-528 (a rounding
+/// keeps a value on a grid coarser than its ulp, and tails are differences of values on the grid)
+/// and below 2^500: no operation underflows or overflows, which is all that expansion arithmetic
+/// needs to be exact and all that the bounds of double_double.hpp assume.
+GALPHA_HD GALPHA_FORCEINLINE bool ScaledDifferences(Point2 a, Point2 b, Point2 c, Point2 d, exact::DoubleDouble* x,
+                                                    exact::DoubleDouble* y, bool* exact) {
   using namespace exact;
-  ExactnessWitness w;
-  double v[6] = {w.Diff(a.x, d.x), w.Diff(a.y, d.y), w.Diff(b.x, d.x),
-                 w.Diff(b.y, d.y), w.Diff(c.x, d.x), w.Diff(c.y, d.y)};
-  if (!w.exact) return false;
+  const double from[6] = {a.x, b.x, c.x, a.y, b.y, c.y};
+  double hi[6], lo[6];
   double maxabs = 0.0, minabs = 0x1.fffffffffffffp1023;
-  for (const double diff : v) {
-    if (diff == 0.0) continue;
-    maxabs = Abs(diff) > maxabs ? Abs(diff) : maxabs;
-    minabs = Abs(diff) < minabs ? Abs(diff) : minabs;
+  *exact = true;
+  for (int i = 0; i < 6; ++i) {
+    TwoDiff(from[i], i < 3 ? d.x : d.y, hi[i], lo[i]);
+    *exact = *exact && lo[i] == 0.0;
+    maxabs = Abs(hi[i]) > maxabs ? Abs(hi[i]) : maxabs;
+    if (hi[i] != 0.0 && Abs(hi[i]) < minabs) minabs = Abs(hi[i]);
+    if (lo[i] != 0.0 && Abs(lo[i]) < minabs) minabs = Abs(lo[i]);
   }
-  if (maxabs == 0.0) {  // a, b, c and d coincide
-    *sign = 0;
+  int s = 0;
+  if (maxabs > 0.0) {
+    // Subnormal parts: ExponentOf would overestimate their magnitude.
+    if (minabs < 0x1p-1022) return false;
+    s = kDifferencesScaleTarget - ExponentOf(maxabs);
+    if (ExponentOf(minabs) + s < kDifferencesLowestExponent) return false;
+  }
+  for (int i = 0; i < 3; ++i) {
+    x[i] = DoubleDouble{ScaleByPow2(hi[i], s), ScaleByPow2(lo[i], s)};
+    y[i] = DoubleDouble{ScaleByPow2(hi[3 + i], s), ScaleByPow2(lo[3 + i], s)};
+  }
+  return true;
+}
+
+/// The double-double stage decides when |det| exceeds this fraction of the permanent (its error is
+/// below 2^-100 of it: 16 times smaller).
+constexpr double kDoubleDoubleInCircleBound = 0x1p-96;
+
+/// The sign of the in-circle determinant of the scaled differences of ScaledDifferences, when a
+/// double-double evaluation (core/exact/double_double.hpp) with a rigorous error bound decides it;
+/// false otherwise (an exact zero, or a determinant below 2^-96 of its permanent). Registers only:
+/// it decides the in-circle tests that miss the plain filter by a few binary orders
+/// (near-co-circular points: 2^-50 to 2^-68 of the permanent on circle, two_lines and
+/// ulp_lattice) for a small fraction of the cost of an expansion stage, and on the GPU without
+/// their kilobytes of local memory.
+///
+/// Why the sign is exact, with u = 2^-53 (on ScaledDifferences's grid, every bound of
+/// double_double.hpp holds): for term i, with lift L_i = X_i^2 + Y_i^2 and minor
+/// m_i = X_j Y_k - X_k Y_j (j, k the next two indices, cyclically), let L'_i = x_i.hi^2 + y_i.hi^2
+/// and P'_i = |x_j.hi y_k.hi| + |x_k.hi y_j.hi|. Each product of two differences is within
+/// 8.01 u^2 of the product of their his (MulDd), each sum of two products adds 3.01 u^2 (AddDd):
+/// the lift is within 11.03 u^2 L'_i and the minor within 11.03 u^2 P'_i of their exact values.
+/// Their product adds 8.01 u^2 L'_i P'_i (MulDd) to the inputs' errors carried through: 30.1 u^2
+/// L'_i P'_i in all. The two sums of terms add 6.1 u^2 sum_i L'_i P'_i. So the computed hi + lo is
+/// within 37 u^2 perm < 2^-100.7 perm of the exact determinant, perm = sum_i L'_i P'_i, and the
+/// permanent computed below in doubles (perm_c, from the rounded products: perm_c >= (1 - 10u)
+/// perm) keeps the error under 2^-100 perm_c. When |hi| > 2^-96 perm_c, then
+/// |hi + lo| >= (1 - u) |hi| exceeds the error, and the determinant has the sign of hi.
+GALPHA_HD GALPHA_FORCEINLINE bool InCircleSignFromDoubleDouble(const exact::DoubleDouble* x,
+                                                               const exact::DoubleDouble* y, int* sign) {
+  using namespace exact;
+  DoubleDouble det;
+  double permanent = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const int j = i == 2 ? 0 : i + 1, k = j == 2 ? 0 : j + 1;
+    const DoubleDouble jk = MulDd(x[j], y[k]), kj = MulDd(x[k], y[j]);
+    const DoubleDouble xx = MulDd(x[i], x[i]), yy = MulDd(y[i], y[i]);
+    const DoubleDouble minor = AddDd(jk, kj, /*negate_b=*/true);
+    const DoubleDouble lift = AddDd(xx, yy);
+    det = AddDd(det, MulDd(lift, minor));
+    permanent = Add(permanent, Mul(Add(xx.hi, yy.hi), Add(Abs(jk.hi), Abs(kj.hi))));
+  }
+  const double bound = Mul(kDoubleDoubleInCircleBound, permanent);
+  if (det.hi > bound) {
+    *sign = 1;
     return true;
   }
-  // Subnormal differences: ExponentOf would overestimate their magnitude; leave them to the full
-  // stage.
-  if (minabs < 0x1p-1022) return false;
-  const int s = kDifferencesScaleTarget - ExponentOf(maxabs);
-  if (ExponentOf(minabs) + s < kDifferencesLowestExponent) return false;
-  for (double& diff : v) diff = ScaleByPow2(diff, s);
-  const double adx = v[0], ady = v[1], bdx = v[2], bdy = v[3], cdx = v[4], cdy = v[5];
+  if (-det.hi > bound) {
+    *sign = -1;
+    return true;
+  }
+  return false;
+}
+
+/// The exact sign of the in-circle determinant of six exact, scaled differences (ScaledDifferences
+/// with every tail zero), in expansion arithmetic: Shewchuk's form with d as the origin, 96
+/// components at most, where the raw-coordinate form of InCircleExpansion needs 384 (four times
+/// the local memory and work).
+/// The differences come by value, so that the caller's stay in registers.
+GALPHA_HD GALPHA_PRED_COLD inline int InCircleSignOfDifferencesExpansion(double adx, double bdx, double cdx, double ady,
+                                                                         double bdy, double cdy) {
+  using namespace exact;
+  const double x[3] = {adx, bdx, cdx}, y[3] = {ady, bdy, cdy};
   // det = alift * (bdx cdy - cdx bdy) + blift * (cdx ady - adx cdy) + clift * (adx bdy - bdx ady),
   // each lift * minor as dx * (dx * minor) + dy * (dy * minor): 4 -> 8 -> 16 components, 32 a
   // term, 96 in all.
-  const double x[3] = {adx, bdx, cdx}, y[3] = {ady, bdy, cdy};
   double total[2][96];
   int total_len = 0, which = 0;
   for (int i = 0; i < 3; ++i) {
@@ -391,8 +452,24 @@ GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignFromExactDifferences(Point2 a
     total_len = ExpansionSumZeroElim(total_len, total[which], term_len, term, total[1 - which]);
     which = 1 - which;
   }
-  *sign = ExpansionSign(total_len, total[which]);
-  return true;
+  return ExpansionSign(total_len, total[which]);
+}
+
+/// The exact in-circle sign once the filters have failed: the double-double stage on the exact
+/// differences to d; where it cannot decide (exact zeros, extreme near-zeros), the expansion of the
+/// differences when they are doubles, else the raw-coordinate expansion.
+GALPHA_HD GALPHA_PRED_COLD inline int InCircleSignBeyondFilters(Point2 a, Point2 b, Point2 c, Point2 d) {
+  exact::DoubleDouble x[3], y[3];
+  bool exact_differences = false;
+  if (ScaledDifferences(a, b, c, d, x, y, &exact_differences)) {
+    int sign;
+    if (InCircleSignFromDoubleDouble(x, y, &sign)) return sign;
+    if (exact_differences) {
+      return InCircleSignOfDifferencesExpansion(x[0].hi, x[1].hi, x[2].hi, y[0].hi, y[1].hi, y[2].hi);
+    }
+  }
+  double e[exact::kInCircleExpansionCapacity];
+  return exact::ExpansionSign(exact::InCircleExpansion(a, b, c, d, e), e);
 }
 
 }  // namespace pred_detail
@@ -424,9 +501,7 @@ GALPHA_HD GALPHA_FORCEINLINE int InCircleSign(Point2 a, Point2 b, Point2 c, Poin
   if (errbound >= gate && (det > errbound || -det > errbound)) return det > 0.0 ? 1 : -1;
   int sign;
   if (pred_detail::InCircleSignIfExactInDoubles(a, b, c, d, &sign)) return sign;
-  if (pred_detail::InCircleSignFromExactDifferences(a, b, c, d, &sign)) return sign;
-  double e[kInCircleExpansionCapacity];
-  return ExpansionSign(InCircleExpansion(a, b, c, d, e), e);
+  return pred_detail::InCircleSignBeyondFilters(a, b, c, d);
 }
 
 namespace pred_detail {

@@ -9,6 +9,7 @@
 
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/double_double.hpp"
 #include "core/exact/expansion.hpp"
 #include "core/exact/order.hpp"
 #include "core/exact/radius_terms.hpp"
@@ -85,37 +86,8 @@ GALPHA_HD inline bool NearestRadiusSqBounded(const Point2* p, int n, double* out
 
 namespace radius_detail {
 
-/// Double-double value h + l (|l| <= half an ulp of h after TwoSum).
-struct DoubleDouble {
-  double h, l;
-};
-
-GALPHA_HD GALPHA_FORCEINLINE DoubleDouble Normalize(double h, double l) {
-  DoubleDouble r;
-  TwoSum(h, l, r.h, r.l);
-  return r;
-}
-/// Relative error below 2^-102 (the dropped l*l term and three roundings of the tail).
-GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDMul(DoubleDouble a, DoubleDouble b) {
-  double p, e;
-  TwoProduct(a.h, b.h, p, e);
-  return Normalize(p, Add(e, Add(Mul(a.h, b.l), Mul(a.l, b.h))));
-}
-/// Absolute error below 2^-102 (|a| + |b|).
-GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDAdd(DoubleDouble a, DoubleDouble b) {
-  double s, e;
-  TwoSum(a.h, b.h, s, e);
-  return Normalize(s, Add(e, Add(a.l, b.l)));
-}
-/// Relative error below 2^-100 for positive operands.
-GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDDiv(DoubleDouble a, DoubleDouble b) {
-  const double q1 = a.h / b.h;
-  const DoubleDouble qb = DDMul(b, DoubleDouble{q1, 0.0});
-  const DoubleDouble r = DDAdd(a, DoubleDouble{-qb.h, -qb.l});
-  return Normalize(q1, r.h / b.h);
-}
-/// Exact scaled difference as a double-double.
-GALPHA_HD GALPHA_FORCEINLINE DoubleDouble DDDiff(double u, double v, int s) {
+/// Exact scaled difference (u - v) * 2^s as a double-double.
+GALPHA_HD GALPHA_FORCEINLINE DoubleDouble ScaledDifferenceDd(double u, double v, int s) {
   double hi, lo;
   TwoDiff(u, v, hi, lo);
   return DoubleDouble{ScaleByPow2(hi, s), ScaleByPow2(lo, s)};
@@ -142,35 +114,35 @@ GALPHA_HD inline bool NearestRadiusSqFast(const Point2* p, int n, double* out) {
   const int s = -ExactExponentOf(maxabs);
   DoubleDouble d[3][2];
   for (int k = 0; k < m; ++k) {
-    d[k][0] = DDDiff(p[to[k]].x, p[from[k]].x, s);
-    d[k][1] = DDDiff(p[to[k]].y, p[from[k]].y, s);
+    d[k][0] = ScaledDifferenceDd(p[to[k]].x, p[from[k]].x, s);
+    d[k][1] = ScaledDifferenceDd(p[to[k]].y, p[from[k]].y, s);
     for (int c = 0; c < 2; ++c) {
       // Tiny differences beside large ones could underflow in products: the exact path takes them.
-      if (d[k][c].h != 0.0 && Abs(d[k][c].h) < 0x1p-300) return false;
+      if (d[k][c].hi != 0.0 && Abs(d[k][c].hi) < 0x1p-300) return false;
     }
   }
   DoubleDouble len[3];
-  for (int k = 0; k < m; ++k) len[k] = DDAdd(DDMul(d[k][0], d[k][0]), DDMul(d[k][1], d[k][1]));
+  for (int k = 0; k < m; ++k) len[k] = AddDd(MulDd(d[k][0], d[k][0]), MulDd(d[k][1], d[k][1]));
   DoubleDouble value;
   double bound = 0x1p-95;
   if (n == 2) {
-    value = DoubleDouble{Mul(len[0].h, 0.25), Mul(len[0].l, 0.25)};
+    value = DoubleDouble{Mul(len[0].hi, 0.25), Mul(len[0].lo, 0.25)};
   } else {
-    const DoubleDouble left = DDMul(d[0][0], d[1][1]), right = DDMul(d[0][1], d[1][0]);
-    const DoubleDouble area = DDAdd(left, DoubleDouble{-right.h, -right.l});
-    const double sum = Add(Abs(left.h), Abs(right.h));
-    if (Abs(area.h) < 0x1p-500 || Abs(area.h) < Mul(sum, 0x1p-31)) return false;
+    const DoubleDouble left = MulDd(d[0][0], d[1][1]), right = MulDd(d[0][1], d[1][0]);
+    const DoubleDouble area = AddDd(left, right, /*negate_b=*/true);
+    const double sum = Add(Abs(left.hi), Abs(right.hi));
+    if (Abs(area.hi) < 0x1p-500 || Abs(area.hi) < Mul(sum, 0x1p-31)) return false;
     // D's relative error: 2^-101 (|left| + |right|) / |D| <= 2^-70; rho^2 gets four times that.
-    bound = Add(bound, Mul(Mul(sum / Abs(area.h), 0x1p-101), 4.0));
-    const DoubleDouble num = DDMul(DDMul(len[0], len[1]), len[2]);
-    const DoubleDouble den = DDMul(area, area);
-    value = DDDiv(num, DoubleDouble{Mul(den.h, 4.0), Mul(den.l, 4.0)});
+    bound = Add(bound, Mul(Mul(sum / Abs(area.hi), 0x1p-101), 4.0));
+    const DoubleDouble num = MulDd(MulDd(len[0], len[1]), len[2]);
+    const DoubleDouble den = MulDd(area, area);
+    value = DivDd(num, DoubleDouble{Mul(den.hi, 4.0), Mul(den.lo, 4.0)});
   }
   // Unscale (exact while normal), then decide the rounding: the exact value lies within
   // bound * value of h + l; h is its nearest double if that interval stays strictly inside
   // h's rounding interval.
-  const double h = ldexp(value.h, -2 * s);
-  const double l = ldexp(value.l, -2 * s);
+  const double h = ldexp(value.hi, -2 * s);
+  const double l = ldexp(value.lo, -2 * s);
   if (!(h >= 0x1p-900 && h <= 0x1p1000)) return false;  // l and the bound stay normal
   const double err = Mul(Mul(h, bound), 1.0 + 0x1p-20);
   const double up = Mul(Sub(NextUp(h), h), 0.5);

@@ -74,9 +74,9 @@ std::vector<Case> MakeCases() {
     }
   }
   std::vector<Case> cases;
-  for (int i = 0; i < 9000; ++i) {
+  for (int i = 0; i < 10000; ++i) {
     Case c;
-    const int family = i % 9;
+    const int family = i % 10;
     for (int k = 0; k < 4; ++k) {
       Point2& p = c.p[k];
       switch (family) {
@@ -107,6 +107,12 @@ std::vector<Case> MakeCases() {
         case 8: {  // near a unit circle around (12, 12): exact differences, the filter often fails
           const double t = U(0, 6.283185307179586);
           p = {nudge(12 + std::cos(t), 2), nudge(12 + std::sin(t), 2)};
+          break;
+        }
+        case 9: {  // near a unit circle around the origin: rounded differences with tails, which the
+                   // double-double stage decides
+          const double t = U(0, 6.283185307179586);
+          p = {nudge(std::cos(t), 2), nudge(std::sin(t), 2)};
           break;
         }
         default:

@@ -437,55 +437,108 @@ std::string FamilyName(const ::testing::TestParamInfo<const char*>& info) { retu
 INSTANTIATE_TEST_SUITE_P(All, OrientFamily, ::testing::ValuesIn(kOrientFamilies), FamilyName);
 INSTANTIATE_TEST_SUITE_P(All, InCircleFamily, ::testing::ValuesIn(kInCircleFamilies), FamilyName);
 
-// The stage for exact differences (InCircleSignFromExactDifferences), alone: wherever it decides,
-// its sign is GMP's, on every family; it decides the near-circle cases it exists for (points
-// within a factor of two of each other, so that Sterbenz makes their differences exact), and it
-// declines (leaving the full stage to decide) where a difference rounded or the differences
-// span more binary orders than its exactness argument allows.
-TEST_P(InCircleFamily, ExactDifferencesStageMatchesGmpWhereItDecides) {
-  int decided = 0;
+// The stages after the filters, each alone, on every family: the double-double stage wherever it
+// decides (never on an exact zero), the expansion of exact differences wherever the differences
+// are doubles, and the whole path after the filters (InCircleSignBeyondFilters) everywhere, all
+// with GMP's sign.
+TEST_P(InCircleFamily, StagesBeyondTheFiltersMatchGmp) {
+  int double_double = 0, differences_expansion = 0;
   for (const Quad& q : InCircleCases(GetParam(), 3000, 13)) {
+    const int exact_sign = sgn(Det(q));
+    ASSERT_EQ(pred_detail::InCircleSignBeyondFilters(q[0], q[1], q[2], q[3]), exact_sign) << Show(q);
+    exact::DoubleDouble x[3], y[3];
+    bool exact_differences = false;
+    if (!pred_detail::ScaledDifferences(q[0], q[1], q[2], q[3], x, y, &exact_differences)) continue;
     int sign = 2;
-    if (!pred_detail::InCircleSignFromExactDifferences(q[0], q[1], q[2], q[3], &sign)) continue;
-    ++decided;
-    ASSERT_EQ(sign, sgn(Det(q))) << Show(q);
+    if (pred_detail::InCircleSignFromDoubleDouble(x, y, &sign)) {
+      ++double_double;
+      ASSERT_NE(exact_sign, 0) << Show(q);
+      ASSERT_EQ(sign, exact_sign) << Show(q);
+    }
+    if (exact_differences) {
+      ++differences_expansion;
+      ASSERT_EQ(pred_detail::InCircleSignOfDifferencesExpansion(x[0].hi, x[1].hi, x[2].hi, y[0].hi, y[1].hi, y[2].hi),
+                exact_sign)
+          << Show(q);
+    }
   }
-  ::testing::Test::RecordProperty("decided", decided);
+  ::testing::Test::RecordProperty("double_double", double_double);
+  ::testing::Test::RecordProperty("differences_expansion", differences_expansion);
 }
 
-TEST(Predicates, ExactDifferencesStageDecidesNearPointsAndDeclinesTheRest) {
+// Near-co-circular points miss the plain filter by a few binary orders: the double-double stage
+// decides every nonzero one, with exact differences (points within a factor 2 of each other) and
+// without (around the origin, where differences round and carry tails). It declines exact zeros
+// and determinants far below its error bound, which the expansions then decide; and the scaling
+// refuses parts it cannot put on its grid.
+TEST(Predicates, DoubleDoubleStageDecidesNearMissesAndDeclinesZerosAndExtremes) {
   Gen g(14);
-  int approx_wrong = 0;
-  for (int i = 0; i < 2000; ++i) {
-    // Four points on a circle of radius 1 around (12, 12), each coordinate nudged by up to 2
-    // ulps: every coordinate is within a factor 2 of every other, so the differences are exact.
-    const Quad q = NearCircle(g, 12, 12, 1, 2);
+  int missed_filter = 0, with_tails = 0;
+  for (int i = 0; i < 4000; ++i) {
+    // Around (12, 12) with radius 1 every coordinate is within a factor 2 of every other (exact
+    // differences); around the origin they are not.
+    const bool centred = i % 2 == 0;
+    const Quad q = centred ? NearCircle(g, 0, 0, 1, 2) : NearCircle(g, 12, 12, 1, 2);
     const int exact_sign = sgn(Det(q));
+    exact::DoubleDouble x[3], y[3];
+    bool exact_differences = false;
+    ASSERT_TRUE(pred_detail::ScaledDifferences(q[0], q[1], q[2], q[3], x, y, &exact_differences)) << Show(q);
+    if (!centred) {
+      ASSERT_TRUE(exact_differences) << Show(q);
+    }
+    with_tails += !exact_differences;
     int sign = 2;
-    ASSERT_TRUE(pred_detail::InCircleSignFromExactDifferences(q[0], q[1], q[2], q[3], &sign)) << Show(q);
-    ASSERT_EQ(sign, exact_sign) << Show(q);
+    const bool decided = pred_detail::InCircleSignFromDoubleDouble(x, y, &sign);
+    EXPECT_EQ(decided, exact_sign != 0) << Show(q);
+    if (decided) {
+      EXPECT_EQ(sign, exact_sign) << Show(q);
+    }
     EXPECT_EQ(InCircleSign(q[0], q[1], q[2], q[3]), exact_sign) << Show(q);
     const double approx = InCircleApprox(q[0], q[1], q[2], q[3]);
-    approx_wrong += (approx > 0) - (approx < 0) != exact_sign;
+    missed_filter += (approx > 0) - (approx < 0) != exact_sign;
   }
-  // Where the plain double evaluation has the wrong sign, the filter cannot have decided, so
-  // those InCircleSign calls above went through the later exact stages.
-  EXPECT_GT(approx_wrong, 0);
+  // Some were wrong in plain doubles (beyond what the filter decides); most centred ones had tails.
+  EXPECT_GT(missed_filter, 0);
+  EXPECT_GT(with_tails, 1000);
+
+  exact::DoubleDouble x[3], y[3];
+  bool exact_differences = false;
   int sign = 2;
-  // A rounded difference: 1 - 2^-60 is not a double.
-  EXPECT_FALSE(pred_detail::InCircleSignFromExactDifferences({1, 0}, {0, 1}, {-1, 0}, {0x1p-60, 0}, &sign));
-  // Exact differences spanning 2^10 .. 2^-200: beyond the stage's 200 binary orders.
-  EXPECT_FALSE(pred_detail::InCircleSignFromExactDifferences({0x1p10, 0}, {0, 0x1p-200}, {-0x1p10, 0}, {0, 0}, &sign));
-  // Subnormal differences.
-  EXPECT_FALSE(
-      pred_detail::InCircleSignFromExactDifferences({0x1p-1060, 0}, {0, 0x1p-1060}, {0x1p-1070, 0}, {0, 0}, &sign));
-  // All four points equal: zero, decided.
-  ASSERT_TRUE(pred_detail::InCircleSignFromExactDifferences({3, 4}, {3, 4}, {3, 4}, {3, 4}, &sign));
-  EXPECT_EQ(sign, 0);
-  // Exactly co-circular (a lattice circle of radius 5 at an offset): zero, decided.
+  // Exactly co-circular (a rectangle of doubles in [1, 2), whose differences are exact): declined;
+  // the differences' expansion finds zero.
+  const double x0 = 1.2345678901, x1 = 1.9876543210, y0 = 1.1111111, y1 = 1.7777777;
+  const Quad rectangle = {Point2{x0, y0}, Point2{x1, y0}, Point2{x1, y1}, Point2{x0, y1}};
   ASSERT_TRUE(
-      pred_detail::InCircleSignFromExactDifferences({1005, 1000}, {1003, 1004}, {995, 1000}, {1004, 997}, &sign));
-  EXPECT_EQ(sign, 0);
+      pred_detail::ScaledDifferences(rectangle[0], rectangle[1], rectangle[2], rectangle[3], x, y, &exact_differences));
+  EXPECT_TRUE(exact_differences);
+  EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
+  EXPECT_EQ(pred_detail::InCircleSignOfDifferencesExpansion(x[0].hi, x[1].hi, x[2].hi, y[0].hi, y[1].hi, y[2].hi), 0);
+  EXPECT_EQ(InCircleSign(rectangle[0], rectangle[1], rectangle[2], rectangle[3]), 0);
+  // Exactly co-circular with rounded differences (the same rectangle around the origin): declined;
+  // the raw-coordinate expansion finds zero.
+  const Quad centred = {Point2{-0.7, -0.3}, Point2{0.9, -0.3}, Point2{0.9, 0.6}, Point2{-0.7, 0.6}};
+  ASSERT_TRUE(pred_detail::ScaledDifferences(centred[0], centred[1], centred[2], centred[3], x, y, &exact_differences));
+  EXPECT_FALSE(exact_differences);
+  EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
+  EXPECT_EQ(pred_detail::InCircleSignBeyondFilters(centred[0], centred[1], centred[2], centred[3]), 0);
+  // A rectangle of side 2^120 with one corner moved by 2^-80: the determinant is about 2^-200 of
+  // the permanent, below the double-double bound, and not zero: declined there, decided by the
+  // differences' expansion with GMP's sign.
+  const Quad extreme = {Point2{0x1p120, 0}, Point2{0x1p120, 0x1p120}, Point2{0x1p-80, 0x1p120}, Point2{0, 0}};
+  ASSERT_NE(sgn(Det(extreme)), 0);
+  ASSERT_TRUE(pred_detail::ScaledDifferences(extreme[0], extreme[1], extreme[2], extreme[3], x, y, &exact_differences));
+  EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
+  EXPECT_EQ(pred_detail::InCircleSignBeyondFilters(extreme[0], extreme[1], extreme[2], extreme[3]), sgn(Det(extreme)));
+  EXPECT_EQ(InCircleSign(extreme[0], extreme[1], extreme[2], extreme[3]), sgn(Det(extreme)));
+  // Parts the grid cannot hold: differences spanning 2^10 .. 2^-200, and subnormal ones.
+  EXPECT_FALSE(
+      pred_detail::ScaledDifferences({0x1p10, 0}, {0, 0x1p-200}, {-0x1p10, 0}, {0, 0}, x, y, &exact_differences));
+  EXPECT_FALSE(
+      pred_detail::ScaledDifferences({0x1p-1060, 0}, {0, 0x1p-1060}, {0x1p-1070, 0}, {0, 0}, x, y, &exact_differences));
+  // All four points equal: zero differences, declined by the double-double stage, zero after it.
+  ASSERT_TRUE(pred_detail::ScaledDifferences({3, 4}, {3, 4}, {3, 4}, {3, 4}, x, y, &exact_differences));
+  EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
+  EXPECT_EQ(pred_detail::InCircleSignBeyondFilters({3, 4}, {3, 4}, {3, 4}, {3, 4}), 0);
 }
 
 TEST(Predicates, ConventionsAndApproximations) {
