@@ -20,6 +20,7 @@
 
 #include "gpu/system/atomic_increment.cuh"
 #include "gpu/system/backend.hpp"
+#include "gpu/system/block_lanes.hpp"
 #include "gpu/system/engine_system.cuh"
 #include "gpu/system/host_copy.hpp"
 #include "gpu/system/pinned_staging.cuh"
@@ -93,6 +94,16 @@ __global__ void ForEachBelowKernel(const uint32_t* count, F f) {
   const uint32_t n = count == nullptr ? 1u : *count;
   const uint32_t stride = gridDim.x * blockDim.x;
   for (uint32_t i = blockIdx.x * blockDim.x + threadIdx.x; i < n; i += stride) f(i);
+}
+
+/// The lanes of RunInOneBlock: as many as a ForEachBelow block, so that any functor that runs
+/// there fits the block's registers.
+constexpr unsigned kOneBlockLanes = 256;
+
+/// RunInOneBlock's kernel.
+template <class F>
+__global__ void __launch_bounds__(kOneBlockLanes) OneBlockKernel(F f) {
+  f(BlockLanes{threadIdx.x, blockDim.x});
 }
 
 /// AppendIf's kernel.
@@ -230,6 +241,12 @@ class CudaSystem {
   template <class F>
   void RunSingle(F f) {
     ForEachBelowKernel<<<1, 1, 0, stream_>>>(nullptr, f);
+    CheckCuda(cudaGetLastError(), "kernel launch");
+  }
+  /// Runs f(lanes) on the lanes of one block, in stream order.
+  template <class F>
+  void RunInOneBlock(F f) {
+    OneBlockKernel<<<1, kOneBlockLanes, 0, stream_>>>(f);
     CheckCuda(cudaGetLastError(), "kernel launch");
   }
 

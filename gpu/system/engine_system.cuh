@@ -20,6 +20,7 @@
 
 #include "core/base/stage_time.hpp"
 #include "gpu/system/backend.hpp"
+#include "gpu/system/block_lanes.hpp"
 #include "gpu/system/host_copy.hpp"
 
 namespace galpha::detail {
@@ -165,6 +166,11 @@ class CpuSystem {
   template <class F>
   void RunSingle(F f) {
     f(0u);
+  }
+  /// Runs f(lanes) once, with one lane here (the CUDA system runs one block of threads).
+  template <class F>
+  void RunInOneBlock(F f) {
+    f(BlockLanes{0, 1});
   }
   /// The CUDA system records work once and replays it; here it simply runs again.
   struct Recording {};

@@ -281,8 +281,13 @@ class DelaunayBuilder {
   /// One parallel Lawson iteration over the `*count` triangles of active_: they propose flips,
   /// the winners flip and are re-linked, and what must be checked next replaces active_'s
   /// triangles, counted into `*next_count`. Stream work only (recorded by RestoreDelaunay).
-  void FlipIteration(const uint32_t* count, uint32_t* next_count, bool hull_may_change) {
+  void FlipIteration(uint32_t* count, uint32_t* next_count, bool hull_may_change) {
     uint32_t* generation = counts_.data() + kGeneration;
+    // A short list is flipped to the end in one block (it returns at once on a long one).
+    sys_.RunInOneBlock(FlipTailInOneBlock{
+        mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
+        partner_.data(), stamp_.data(), generation, candidates(), candidate_mask_.data(), count,
+        counts_.data() + kTailCount, kFlipTailMaxCount, kFlipTailMaxIterations, hull_may_change});
     sys_.RunSingle(StartFlipIteration{next_count, generation});
     sys_.ForEachBelow(count, ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(),
                                           split_count_or_nb_.data(), flip_vote_.data(), hull_may_change});
@@ -348,7 +353,14 @@ class DelaunayBuilder {
   static constexpr int kEvenIterationCount = 1;
   static constexpr int kOddIterationCount = 2;
   static constexpr int kGeneration = 3;
-  static constexpr int kNumCounts = 4;
+  static constexpr int kTailCount = 4;
+  static constexpr int kNumCounts = 5;
+  // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): four items
+  // a lane of its 256, where a grid iteration's launches cost more than the block's passes.
+  static constexpr uint32_t kFlipTailMaxCount = 1024;
+  // Far more iterations than any flip loop measured (two_lines at 1M: ~3,700 in all); past them the
+  // grid's iterations go on and the host's replay limit reports a loop that does not end.
+  static constexpr uint32_t kFlipTailMaxIterations = 1u << 20;
   Buffer<uint32_t, System> counts_;
   MeshView mesh_{};
   int32_t num_tri_ = 0;

@@ -10,6 +10,8 @@
 
 #include "core/base/hd.hpp"
 #include "core/exact/predicates.hpp"
+#include "gpu/system/atomic_increment.cuh"
+#include "gpu/system/block_lanes.hpp"
 #include "gpu/triangulation/mesh.cuh"
 
 namespace galpha::detail {
@@ -176,6 +178,70 @@ struct CollectNextActive {
         candidates[2 * i + 1] = nb;
         candidate_mask[2 * i + 1] = kCheckFlipOuterEdges;
       }
+    }
+  }
+};
+
+/// The flip iterations of a short active list, in one block: the same steps as a grid iteration
+/// (StartFlipIteration, ProposeFlips, ExecuteFlips, LinkFlips, CollectNextActive, then the append
+/// of the next list), with a barrier between steps instead of one launch each. The result of an
+/// iteration does not depend on the order in which its items run, so it is the grid's, bit for
+/// bit. Why: on collinear input a new point takes over the fan of a neighbour one flip per
+/// iteration (two_lines at 1M: ~3,700 iterations, most of them with 2 to 7 active triangles; its
+/// insertion took 122 ms on an H100, ~30 us an iteration of five launches), while an iteration in
+/// one block costs a few memory latencies.
+///
+/// Runs while the list is nonempty and at most `max_count` long (it returns at once when it starts
+/// longer: the grid's launches take over, and take it back when it is short again). The count in
+/// `*count` is the current list's on return; `scratch_count` holds the next list's count while an
+/// iteration builds it.
+struct FlipTailInOneBlock {
+  MeshView mesh;
+  int32_t* active;
+  uint8_t* active_mask;
+  int8_t* proposal_edge;
+  int32_t* proposal_nb;
+  uint32_t* flip_vote;
+  int32_t* partner;
+  uint32_t* stamp;
+  uint32_t* generation;
+  int32_t* candidates;  // two per active entry
+  uint8_t* candidate_mask;
+  uint32_t* count;
+  uint32_t* scratch_count;
+  uint32_t max_count;
+  uint32_t max_iterations;  // a guard: the host's loop reports a flip loop that does not end
+  bool hull_may_change;
+
+  GALPHA_HD void operator()(const BlockLanes& lanes) const {
+    for (uint32_t iteration = 0; iteration < max_iterations; ++iteration) {
+      const uint32_t n = *count;  // the same for every lane: written before the last barrier
+      if (n == 0 || n > max_count) return;
+      lanes.Sync();  // every lane has read the count before it changes
+      if (lanes.id == 0) StartFlipIteration{scratch_count, generation}(0);
+      lanes.Sync();
+      const ProposeFlips propose{mesh, active, active_mask, proposal_edge, proposal_nb, flip_vote, hull_may_change};
+      for (uint32_t i = lanes.id; i < n; i += lanes.count) propose(i);
+      lanes.Sync();
+      const ExecuteFlips execute{mesh, active, proposal_edge, proposal_nb, flip_vote, partner};
+      for (uint32_t i = lanes.id; i < n; i += lanes.count) execute(i);
+      lanes.Sync();
+      const LinkFlips link{mesh, active, proposal_edge, proposal_nb, partner};
+      for (uint32_t i = lanes.id; i < n; i += lanes.count) link(i);
+      lanes.Sync();
+      const CollectNextActive collect{active, proposal_edge, proposal_nb, flip_vote,     partner,
+                                      stamp,  generation,    candidates,  candidate_mask};
+      for (uint32_t i = lanes.id; i < n; i += lanes.count) collect(i);
+      lanes.Sync();
+      for (uint32_t i = lanes.id; i < 2 * n; i += lanes.count) {
+        if (candidates[i] < 0) continue;
+        const uint32_t slot = AtomicIncrement(scratch_count);
+        active[slot] = candidates[i];
+        active_mask[slot] = candidate_mask[i];
+      }
+      lanes.Sync();
+      if (lanes.id == 0) *count = *scratch_count;
+      lanes.Sync();
     }
   }
 };
