@@ -19,7 +19,10 @@
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/discard_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
 #include <thrust/iterator/zip_iterator.h>
+#include <thrust/reduce.h>
 #include <thrust/remove.h>
 #include <thrust/scan.h>
 #include <thrust/sequence.h>
@@ -180,7 +183,23 @@ Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, 
     });
     Buffer<uint64_t, System> keys(sys, m);
     thrust::transform(pol, first, first + m, keys.begin(), HilbertKey{input.data(), unique.data(), box});
-    thrust::sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
+    // Stable (ties keep the (x, y) order of `unique`), so that both backends number the same way.
+    thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
+    // Points that share a cell of the curve are ordered by a curve over their run's own box.
+    Buffer<uint32_t, System> run_number(sys, m);
+    thrust::transform_inclusive_scan(pol, first, first + m, run_number.begin(), StartsKeyRun{keys.data()},
+                                     thrust::plus<uint32_t>());
+    const uint32_t num_runs = sys.Read(run_number.data() + m - 1);
+    if (num_runs < m) {
+      Buffer<BoundingBox, System> run_box(sys, num_runs);
+      thrust::reduce_by_key(pol, keys.begin(), keys.end(),
+                            thrust::make_transform_iterator(first, PointBoxAt{input.data(), unique.data()}),
+                            thrust::make_discard_iterator(), run_box.begin(), thrust::equal_to<uint64_t>(),
+                            MergeBoxes());
+      thrust::transform(pol, first, first + m, keys.begin(),
+                        RunHilbertKey{input.data(), unique.data(), run_number.data(), run_box.data()});
+      thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
+    }
     thrust::for_each(pol, first, first + m,
                      GatherVertex{input.data(), unique.data(), vertex_points.data(), scale_exponent});
   }

@@ -112,6 +112,36 @@ struct HilbertKey {
   }
 };
 
+/// 1 where sorted position k starts a run of equal Hilbert keys (points in one cell of the curve).
+struct StartsKeyRun {
+  const uint64_t* keys;
+  GALPHA_HD uint32_t operator()(uint32_t k) const { return (k == 0 || keys[k] != keys[k - 1]) ? 1u : 0u; }
+};
+
+/// The point at sorted position k, as a box (for the boxes of the runs).
+struct PointBoxAt {
+  const Point2* pts;
+  const uint32_t* input_index;
+  GALPHA_HD BoundingBox operator()(uint32_t k) const { return PointToBox()(pts[input_index[k]]); }
+};
+
+/// The order within the runs of equal Hilbert keys: the run (its number, counted from 1 by an
+/// inclusive scan of StartsKeyRun, in the high 32 bits, so that runs keep their order) and the
+/// Hilbert key over the run's own box (its top 32 bits). A cluster far smaller than the whole set
+/// (tiny's subnormal half lies within 2^-74 of the box) falls into one cell of the curve, where it
+/// would keep its input order: random, for the insertion rounds' walks and the mesh's memory.
+struct RunHilbertKey {
+  const Point2* pts;
+  const uint32_t* input_index;
+  const uint32_t* run_number;  // from 1
+  const BoundingBox* run_box;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const uint32_t run = run_number[k] - 1;
+    const uint64_t within = HilbertKey{pts, input_index, run_box[run]}(k) >> (2 * HilbertKey::kHilbertOrder - 32);
+    return (static_cast<uint64_t>(run) << 32) | within;
+  }
+};
+
 /// The smallest nonzero magnitude among a point's coordinates (+inf when both are zero).
 struct SmallestNonzeroMagnitude {
   GALPHA_HD double operator()(const Point2& p) const {
