@@ -1,6 +1,7 @@
 // Double-double arithmetic with stated error bounds, for filters that must decide more than a
 // plain-double filter can but cost far less than expansion arithmetic: a value is hi + lo, two
-// doubles with |lo| <= u |hi| (u = 2^-53, every result below is renormalized by Two-Sum).
+// doubles with |lo| <= u |hi| (u = 2^-53), as Two-Sum, Two-Diff and Two-Product leave them and as
+// every operation below renormalizes its result (Two-Sum).
 //
 // Each operation's bound is in its comment, relative to the magnitudes of its operands (not of its
 // result: additions may cancel). The bounds assume that no operation underflows or overflows;
@@ -18,13 +19,6 @@ struct DoubleDouble {
   double hi = 0.0;
   double lo = 0.0;
 };
-
-/// a * b exactly (Two-Product).
-GALPHA_HD GALPHA_FORCEINLINE DoubleDouble ProductDd(double a, double b) {
-  DoubleDouble r;
-  TwoProduct(a, b, r.hi, r.lo);
-  return r;
-}
 
 /// A + B (or A - B with `negate_b`). Error at most 3.01 u^2 (|A.hi| + |B.hi|): the his are added
 /// exactly (Two-Sum), the los with one rounding (at most u |A.lo + B.lo| <= u^2 (|A.hi| + |B.hi|)),

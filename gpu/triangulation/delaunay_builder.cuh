@@ -280,14 +280,16 @@ class DelaunayBuilder {
 
   /// One parallel Lawson iteration over the `*count` triangles of active_: they propose flips,
   /// the winners flip and are re-linked, and what must be checked next replaces active_'s
-  /// triangles, counted into `*next_count`. Stream work only (recorded by RestoreDelaunay).
+  /// triangles, counted into `*next_count`. A short list is first flipped in one block
+  /// (FlipTailInOneBlock), as many iterations as it takes, and leaves its result in active_ and
+  /// `*count` (zero when done). Stream work only (recorded by RestoreDelaunay).
   void FlipIteration(uint32_t* count, uint32_t* next_count, bool hull_may_change) {
     uint32_t* generation = counts_.data() + kGeneration;
-    // A short list is flipped to the end in one block (it returns at once on a long one).
-    sys_.RunInOneBlock(FlipTailInOneBlock{
-        mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(), split_count_or_nb_.data(), flip_vote_.data(),
-        partner_.data(), stamp_.data(), generation, candidates(), candidate_mask_.data(), count,
-        counts_.data() + kTailCount, kFlipTailMaxCount, kFlipTailMaxIterations, hull_may_change});
+    sys_.RunInOneBlock(FlipTailInOneBlock{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(),
+                                          split_count_or_nb_.data(), flip_vote_.data(), partner_.data(), stamp_.data(),
+                                          generation, candidates(), candidate_mask_.data(), count,
+                                          counts_.data() + kTailCount, counts_.data() + kTailIterations,
+                                          kFlipTailMaxCount, kFlipTailMaxIterations, hull_may_change});
     sys_.RunSingle(StartFlipIteration{next_count, generation});
     sys_.ForEachBelow(count, ProposeFlips{mesh_, active_.data(), active_mask_.data(), proposal_edge_.data(),
                                           split_count_or_nb_.data(), flip_vote_.data(), hull_may_change});
@@ -354,12 +356,14 @@ class DelaunayBuilder {
   static constexpr int kOddIterationCount = 2;
   static constexpr int kGeneration = 3;
   static constexpr int kTailCount = 4;
-  static constexpr int kNumCounts = 5;
+  static constexpr int kTailIterations = 5;
+  static constexpr int kNumCounts = 6;
   // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): four items
   // a lane of its 256, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;
-  // Far more iterations than any flip loop measured (two_lines at 1M: ~3,700 in all); past them the
-  // grid's iterations go on and the host's replay limit reports a loop that does not end.
+  // The one-block iterations of a whole build: far more than any measured (two_lines at 1M: about
+  // 3,700 flip iterations in all), and few enough (seconds, at a few us each) that a loop that did
+  // not end soon reaches the grid's launches and the host's replay limit.
   static constexpr uint32_t kFlipTailMaxIterations = 1u << 20;
   Buffer<uint32_t, System> counts_;
   MeshView mesh_{};

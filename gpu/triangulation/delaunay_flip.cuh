@@ -194,7 +194,10 @@ struct CollectNextActive {
 /// Runs while the list is nonempty and at most `max_count` long (it returns at once when it starts
 /// longer: the grid's launches take over, and take it back when it is short again). The count in
 /// `*count` is the current list's on return; `scratch_count` holds the next list's count while an
-/// iteration builds it.
+/// iteration builds it. `*iterations_run` counts its iterations over the whole build: past
+/// `max_iterations` it runs no more, so that a flip loop that did not end would go on in the grid's
+/// launches, where the host's replay limit reports it (without the budget, each of those launches
+/// could run a loop of its own).
 struct FlipTailInOneBlock {
   MeshView mesh;
   int32_t* active;
@@ -209,15 +212,17 @@ struct FlipTailInOneBlock {
   uint8_t* candidate_mask;
   uint32_t* count;
   uint32_t* scratch_count;
+  uint32_t* iterations_run;
   uint32_t max_count;
-  uint32_t max_iterations;  // a guard: the host's loop reports a flip loop that does not end
+  uint32_t max_iterations;
   bool hull_may_change;
 
   GALPHA_HD void operator()(const BlockLanes& lanes) const {
-    for (uint32_t iteration = 0; iteration < max_iterations; ++iteration) {
-      const uint32_t n = *count;  // the same for every lane: written before the last barrier
-      if (n == 0 || n > max_count) return;
-      lanes.Sync();  // every lane has read the count before it changes
+    for (;;) {
+      // The same for every lane: written (by lane 0) before the last barrier, and not again
+      // before the next one.
+      const uint32_t n = *count;
+      if (n == 0 || n > max_count || *iterations_run >= max_iterations) return;
       if (lanes.id == 0) StartFlipIteration{scratch_count, generation}(0);
       lanes.Sync();
       const ProposeFlips propose{mesh, active, active_mask, proposal_edge, proposal_nb, flip_vote, hull_may_change};
@@ -240,7 +245,10 @@ struct FlipTailInOneBlock {
         active_mask[slot] = candidate_mask[i];
       }
       lanes.Sync();
-      if (lanes.id == 0) *count = *scratch_count;
+      if (lanes.id == 0) {
+        *count = *scratch_count;
+        *iterations_run += 1;
+      }
       lanes.Sync();
     }
   }

@@ -125,11 +125,12 @@ struct PointBoxAt {
   GALPHA_HD BoundingBox operator()(uint32_t k) const { return PointToBox()(pts[input_index[k]]); }
 };
 
-/// The order within the runs of equal Hilbert keys: the run (its number, counted from 1 by an
-/// inclusive scan of StartsKeyRun, in the high 32 bits, so that runs keep their order) and the
-/// Hilbert key over the run's own box (its top 32 bits). A cluster far smaller than the whole set
-/// (tiny's subnormal half lies within 2^-74 of the box) falls into one cell of the curve, where it
-/// would keep its input order: random, for the insertion rounds' walks and the mesh's memory.
+/// The order within the runs of equal Hilbert keys: the run's index (its number from the inclusive
+/// scan of StartsKeyRun, less one) in the high 32 bits, so that runs keep their order, and the
+/// Hilbert key over the run's own box (its top 32 bits) below. A cluster far smaller than the whole
+/// set (tiny's subnormal half lies within 2^-74 of the box) falls into one cell of the curve, where
+/// it would keep the (x, y) order it arrives in: lexicographic, so consecutive points jump across
+/// the cluster (the insertion rounds' walks and the mesh's memory lose their locality).
 struct RunHilbertKey {
   const Point2* pts;
   const uint32_t* input_index;

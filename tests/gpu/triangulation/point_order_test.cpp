@@ -35,18 +35,18 @@ void SortByKey(std::vector<uint32_t>* order, const Key& key) {
   *order = sorted;
 }
 
-// A 64 x 64 lattice of spacing 2^-60 in input order (shuffled), and one point at (1, 1): the whole
-// lattice lies in the first cell of the curve over the set's box (as tiny's subnormal half does).
-// The key within the run orders it along a curve over its own box: consecutive points are
-// lattice neighbours or nearly, instead of random.
+// 4,096 random points of a cluster 2^-40 wide, and one point at (1, 1): the whole cluster lies in
+// the first cell of the curve over the set's box (as tiny's subnormal half does), so its points
+// share one key and keep the lexicographic (x, y) order they arrive in (from the duplicate
+// removal), in which consecutive points jump across the cluster. The key within the run orders
+// them along a curve over their own box instead.
 TEST(PointOrder, AClusterInOneCellOfTheCurveIsOrderedByACurveOverItsOwnBox) {
-  const double h = 0x1p-60;
-  std::vector<Point2> pts;
-  for (int i = 1; i <= 64; ++i) {
-    for (int j = 1; j <= 64; ++j) pts.push_back({i * h, j * h});
-  }
+  const double width = 0x1p-40;
   std::mt19937_64 rng(7);
-  std::shuffle(pts.begin(), pts.end(), rng);
+  std::uniform_real_distribution<double> in_cluster(width, 2 * width);
+  std::vector<Point2> pts(4096);
+  for (Point2& p : pts) p = {in_cluster(rng), in_cluster(rng)};
+  std::sort(pts.begin(), pts.end(), [](const Point2& a, const Point2& b) { return LexLess(a, b); });
   pts.push_back({1.0, 1.0});
   const uint32_t m = static_cast<uint32_t>(pts.size());
   BoundingBox box = PointToBox()(pts[0]);
@@ -57,13 +57,16 @@ TEST(PointOrder, AClusterInOneCellOfTheCurveIsOrderedByACurveOverItsOwnBox) {
   SortByKey(&order, [&](uint32_t k) { return HilbertKey{pts.data(), order.data(), box}(k); });
   std::vector<uint64_t> keys(m);
   for (uint32_t k = 0; k < m; ++k) keys[k] = HilbertKey{pts.data(), order.data(), box}(k);
-  // The lattice is one run of equal keys, in input order.
+  // The cluster is one run of equal keys, in (x, y) order.
   std::vector<uint32_t> run_number(m);
   uint32_t runs = 0;
-  for (uint32_t k = 0; k < m; ++k) run_number[k] = runs += StartsKeyRun{keys.data()}(k);
+  for (uint32_t k = 0; k < m; ++k) {
+    runs += StartsKeyRun{keys.data()}(k);
+    run_number[k] = runs;
+  }
   ASSERT_EQ(runs, 2u);
-  std::vector<uint32_t> lattice(order.begin(), order.end() - 1);
-  const double input_order_length = PathLength(pts, lattice);
+  std::vector<uint32_t> cluster(order.begin(), order.end() - 1);
+  const double lexicographic_length = PathLength(pts, cluster);
 
   std::vector<BoundingBox> run_box(runs, BoundingBox{INFINITY, INFINITY, -INFINITY, -INFINITY});
   for (uint32_t k = 0; k < m; ++k) {
@@ -74,13 +77,12 @@ TEST(PointOrder, AClusterInOneCellOfTheCurveIsOrderedByACurveOverItsOwnBox) {
     return RunHilbertKey{pts.data(), order.data(), run_number.data(), run_box.data()}(k);
   });
   EXPECT_EQ(order.back(), m - 1);  // the runs keep their order: (1, 1) stays last
-  lattice.assign(order.begin(), order.end() - 1);
-  const double run_order_length = PathLength(pts, lattice);
-  // 4,095 steps: a curve through the lattice takes steps of about one spacing (at most 2 on
-  // average here, as the lattice does not align with the curve's cells); a random order, about a
-  // third of the lattice's width (~21 spacings) a step.
-  EXPECT_LT(run_order_length, 2.0 * 4095 * h);
-  EXPECT_GT(input_order_length, 10.0 * run_order_length);
+  cluster.assign(order.begin(), order.end() - 1);
+  const double run_order_length = PathLength(pts, cluster);
+  // A curve through n random points of a square of side w is about 0.7 w sqrt(n) long (~45 w
+  // here); the lexicographic order about n w / 3 (~1,400 w): each step crosses the square in y.
+  EXPECT_LT(run_order_length, 100 * width);
+  EXPECT_GT(lexicographic_length, 10.0 * run_order_length);
 }
 
 }  // namespace
