@@ -433,6 +433,38 @@ void CheckAgainstGmp(const std::vector<std::array<Point2, n>>& cases) {
 TEST_P(OrientFamily, MatchesGmp) { CheckAgainstGmp(OrientCases(GetParam(), 4000, 11)); }
 TEST_P(InCircleFamily, MatchesGmp) { CheckAgainstGmp(InCircleCases(GetParam(), 3000, 12)); }
 
+// The orientation's path after the filter (plain doubles where every operation is exact, else the
+// expansion), alone, on every family: GMP's sign everywhere. The collinear and grid families are
+// exact zeros in small integers, which the plain-double path decides; tiny, subnormal and huge
+// ones lie outside its range and go to the expansion.
+TEST_P(OrientFamily, PathBeyondTheFilterMatchesGmp) {
+  int zeros = 0;
+  for (const Tri& t : OrientCases(GetParam(), 4000, 17)) {
+    const int exact_sign = sgn(Det(t));
+    ASSERT_EQ(pred_detail::Orient2dSignBeyondFilter(t[0], t[1], t[2]), exact_sign) << Show(t);
+    zeros += exact_sign == 0;
+  }
+  ::testing::Test::RecordProperty("zeros", zeros);
+}
+
+// Collinear points with integer coordinates (the lines of two_lines and parallel_lines) are exact
+// zeros that the plain-double path proves; near them, one ulp off the line, the sign is GMP's; and
+// a triple whose differences reach below 2^-480 (where a zero tail could hide an underflow) is
+// still right, through the expansion.
+TEST(Predicates, OrientationPathBeyondTheFilterOnLines) {
+  for (int64_t v = -1000; v <= 1000; v += 7) {
+    const Point2 a{3.0 * v, 2.0 * v + 5}, b{3.0 * (v + 11), 2.0 * (v + 11) + 5}, c{3.0 * (v - 29), 2.0 * (v - 29) + 5};
+    EXPECT_EQ(pred_detail::Orient2dSignBeyondFilter(a, b, c), 0);
+    const Point2 off{c.x, std::nextafter(c.y, 1e300)};
+    EXPECT_EQ(pred_detail::Orient2dSignBeyondFilter(a, b, off), sgn(Det(Tri{a, b, off})));
+  }
+  const Tri tiny = {Point2{0, 0}, Point2{0x1p-490, 0x1p-491}, Point2{0x1p-489, 0x1p-490}};
+  EXPECT_EQ(pred_detail::Orient2dSignBeyondFilter(tiny[0], tiny[1], tiny[2]), sgn(Det(tiny)));
+  const Tri tiny_off = {Point2{0, 0}, Point2{0x1p-490, 0x1p-491}, Point2{0x1p-489, 0x1.0000000000001p-490}};
+  ASSERT_NE(sgn(Det(tiny_off)), 0);
+  EXPECT_EQ(pred_detail::Orient2dSignBeyondFilter(tiny_off[0], tiny_off[1], tiny_off[2]), sgn(Det(tiny_off)));
+}
+
 std::string FamilyName(const ::testing::TestParamInfo<const char*>& info) { return info.param; }
 INSTANTIATE_TEST_SUITE_P(All, OrientFamily, ::testing::ValuesIn(kOrientFamilies), FamilyName);
 INSTANTIATE_TEST_SUITE_P(All, InCircleFamily, ::testing::ValuesIn(kInCircleFamilies), FamilyName);
