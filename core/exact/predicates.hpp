@@ -281,6 +281,16 @@ struct ExactnessWitness {
   }
 };
 
+/// Whether every nonzero value among v[0..n) has its binary exponent in [lowest, highest): the
+/// range where the error-free transformations' zero tails prove an operation exact (no partial
+/// product underflows, no split overflows), for the stages that try plain doubles first.
+GALPHA_HD GALPHA_FORCEINLINE bool NonzeroExponentsWithin(const double* v, int n, int lowest, int highest) {
+  for (int i = 0; i < n; ++i) {
+    if (v[i] != 0.0 && (exact::ExponentOf(v[i]) < lowest || exact::ExponentOf(v[i]) >= highest)) return false;
+  }
+  return true;
+}
+
 /// The exact orientation sign once the filter has failed: the determinant in plain doubles when
 /// every operation in it happens to be exact (integer coordinates: grids, and points on lines, whose
 /// collinear triples are exact zeros), else the expansion. At 1M points the filter fails on 43% of
@@ -295,11 +305,7 @@ GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSignBeyondFilter(Point2 a, Point2 
   const double bax = w.Diff(b.x, a.x), bay = w.Diff(b.y, a.y);
   const double cax = w.Diff(c.x, a.x), cay = w.Diff(c.y, a.y);
   const double differences[4] = {bax, bay, cax, cay};
-  bool in_range = true;
-  for (const double v : differences) {
-    in_range = in_range && (v == 0.0 || (ExponentOf(v) >= -480 && ExponentOf(v) < 500));
-  }
-  if (w.exact && in_range) {
+  if (w.exact && NonzeroExponentsWithin(differences, 4, -480, 500)) {
     const double det = w.Diff(w.Product(bax, cay), w.Product(bay, cax));
     if (w.exact) return det > 0.0 ? 1 : (det < 0.0 ? -1 : 0);
   }
@@ -337,9 +343,7 @@ GALPHA_HD GALPHA_PRED_COLD inline bool InCircleSignIfExactInDoubles(Point2 a, Po
   const double cdx = w.Diff(c.x, d.x), cdy = w.Diff(c.y, d.y);
   if (!w.exact) return false;
   const double differences[6] = {adx, ady, bdx, bdy, cdx, cdy};
-  for (double v : differences) {
-    if (v != 0.0 && (exact::ExponentOf(v) < -240 || exact::ExponentOf(v) > 240)) return false;
-  }
+  if (!NonzeroExponentsWithin(differences, 6, -240, 241)) return false;
   const double ma = w.Diff(w.Product(bdx, cdy), w.Product(cdx, bdy));
   const double mb = w.Diff(w.Product(cdx, ady), w.Product(adx, cdy));
   const double mc = w.Diff(w.Product(adx, bdy), w.Product(bdx, ady));
@@ -370,8 +374,8 @@ constexpr int kDifferencesLowestExponent = -80;
 /// keeps a value on a grid coarser than its ulp, and tails are differences of values on the grid)
 /// and below 2^500: no operation underflows or overflows, which is all that expansion arithmetic
 /// needs to be exact and all that the bounds of double_double.hpp assume.
-GALPHA_HD GALPHA_FORCEINLINE bool ScaledDifferences(Point2 a, Point2 b, Point2 c, Point2 d, exact::DoubleDouble* x,
-                                                    exact::DoubleDouble* y, bool* exact) {
+GALPHA_HD GALPHA_FORCEINLINE bool ScaledDifferencesToD(Point2 a, Point2 b, Point2 c, Point2 d, exact::DoubleDouble* x,
+                                                       exact::DoubleDouble* y, bool* exact) {
   using namespace exact;
   const double from[6] = {a.x, b.x, c.x, a.y, b.y, c.y};
   double hi[6], lo[6];
@@ -402,7 +406,7 @@ GALPHA_HD GALPHA_FORCEINLINE bool ScaledDifferences(Point2 a, Point2 b, Point2 c
 /// below 2^-100 of it: 16 times smaller).
 constexpr double kDoubleDoubleInCircleBound = 0x1p-96;
 
-/// The sign of the in-circle determinant of the scaled differences of ScaledDifferences, when a
+/// The sign of the in-circle determinant of the scaled differences of ScaledDifferencesToD, when a
 /// double-double evaluation (core/exact/double_double.hpp) with a rigorous error bound decides it;
 /// false otherwise (an exact zero, or a determinant below 2^-96 of its permanent). Registers only:
 /// it decides the in-circle tests that miss the plain filter by a few binary orders
@@ -410,7 +414,7 @@ constexpr double kDoubleDoubleInCircleBound = 0x1p-96;
 /// ulp_lattice) for a small fraction of the cost of an expansion stage, and on the GPU without
 /// their kilobytes of local memory.
 ///
-/// Why the sign is exact, with u = 2^-53 (on ScaledDifferences's grid, every bound of
+/// Why the sign is exact, with u = 2^-53 (on ScaledDifferencesToD's grid, every bound of
 /// double_double.hpp holds): for term i, with lift L_i = X_i^2 + Y_i^2 and minor
 /// m_i = X_j Y_k - X_k Y_j (j, k the next two indices, cyclically), let L'_i = x_i.hi^2 + y_i.hi^2
 /// and P'_i = |x_j.hi y_k.hi| + |x_k.hi y_j.hi|. Each product of two differences is within
@@ -448,7 +452,7 @@ GALPHA_HD GALPHA_FORCEINLINE bool InCircleSignFromDoubleDouble(const exact::Doub
   return false;
 }
 
-/// The exact sign of the in-circle determinant of six exact, scaled differences (ScaledDifferences
+/// The exact sign of the in-circle determinant of six exact, scaled differences (ScaledDifferencesToD
 /// with every tail zero), in expansion arithmetic: Shewchuk's form with d as the origin, 96
 /// components at most, where the raw-coordinate form of InCircleExpansion needs 384 (four times
 /// the local memory and work).
@@ -486,7 +490,7 @@ GALPHA_HD GALPHA_PRED_COLD inline int InCircleSignOfDifferencesExpansion(double 
 GALPHA_HD GALPHA_PRED_COLD inline int InCircleSignBeyondFilters(Point2 a, Point2 b, Point2 c, Point2 d) {
   exact::DoubleDouble x[3], y[3];
   bool exact_differences = false;
-  if (ScaledDifferences(a, b, c, d, x, y, &exact_differences)) {
+  if (ScaledDifferencesToD(a, b, c, d, x, y, &exact_differences)) {
     int sign;
     if (InCircleSignFromDoubleDouble(x, y, &sign)) return sign;
     if (exact_differences) {

@@ -480,7 +480,7 @@ TEST_P(InCircleFamily, StagesBeyondTheFiltersMatchGmp) {
     ASSERT_EQ(pred_detail::InCircleSignBeyondFilters(q[0], q[1], q[2], q[3]), exact_sign) << Show(q);
     exact::DoubleDouble x[3], y[3];
     bool exact_differences = false;
-    if (!pred_detail::ScaledDifferences(q[0], q[1], q[2], q[3], x, y, &exact_differences)) continue;
+    if (!pred_detail::ScaledDifferencesToD(q[0], q[1], q[2], q[3], x, y, &exact_differences)) continue;
     int sign = 2;
     if (pred_detail::InCircleSignFromDoubleDouble(x, y, &sign)) {
       ++double_double;
@@ -514,7 +514,7 @@ TEST(Predicates, DoubleDoubleStageDecidesNearMissesAndDeclinesZerosAndExtremes) 
     const int exact_sign = sgn(Det(q));
     exact::DoubleDouble x[3], y[3];
     bool exact_differences = false;
-    ASSERT_TRUE(pred_detail::ScaledDifferences(q[0], q[1], q[2], q[3], x, y, &exact_differences)) << Show(q);
+    ASSERT_TRUE(pred_detail::ScaledDifferencesToD(q[0], q[1], q[2], q[3], x, y, &exact_differences)) << Show(q);
     if (!centred) {
       ASSERT_TRUE(exact_differences) << Show(q);
     }
@@ -540,8 +540,8 @@ TEST(Predicates, DoubleDoubleStageDecidesNearMissesAndDeclinesZerosAndExtremes) 
   // the differences' expansion finds zero.
   const double x0 = 1.2345678901, x1 = 1.9876543210, y0 = 1.1111111, y1 = 1.7777777;
   const Quad rectangle = {Point2{x0, y0}, Point2{x1, y0}, Point2{x1, y1}, Point2{x0, y1}};
-  ASSERT_TRUE(
-      pred_detail::ScaledDifferences(rectangle[0], rectangle[1], rectangle[2], rectangle[3], x, y, &exact_differences));
+  ASSERT_TRUE(pred_detail::ScaledDifferencesToD(rectangle[0], rectangle[1], rectangle[2], rectangle[3], x, y,
+                                                &exact_differences));
   EXPECT_TRUE(exact_differences);
   EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
   EXPECT_EQ(pred_detail::InCircleSignOfDifferencesExpansion(x[0].hi, x[1].hi, x[2].hi, y[0].hi, y[1].hi, y[2].hi), 0);
@@ -549,7 +549,8 @@ TEST(Predicates, DoubleDoubleStageDecidesNearMissesAndDeclinesZerosAndExtremes) 
   // Exactly co-circular with rounded differences (the same rectangle around the origin): declined;
   // the raw-coordinate expansion finds zero.
   const Quad centred = {Point2{-0.7, -0.3}, Point2{0.9, -0.3}, Point2{0.9, 0.6}, Point2{-0.7, 0.6}};
-  ASSERT_TRUE(pred_detail::ScaledDifferences(centred[0], centred[1], centred[2], centred[3], x, y, &exact_differences));
+  ASSERT_TRUE(
+      pred_detail::ScaledDifferencesToD(centred[0], centred[1], centred[2], centred[3], x, y, &exact_differences));
   EXPECT_FALSE(exact_differences);
   EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
   EXPECT_EQ(pred_detail::InCircleSignBeyondFilters(centred[0], centred[1], centred[2], centred[3]), 0);
@@ -558,17 +559,18 @@ TEST(Predicates, DoubleDoubleStageDecidesNearMissesAndDeclinesZerosAndExtremes) 
   // differences' expansion with GMP's sign.
   const Quad extreme = {Point2{0x1p120, 0}, Point2{0x1p120, 0x1p120}, Point2{0x1p-80, 0x1p120}, Point2{0, 0}};
   ASSERT_NE(sgn(Det(extreme)), 0);
-  ASSERT_TRUE(pred_detail::ScaledDifferences(extreme[0], extreme[1], extreme[2], extreme[3], x, y, &exact_differences));
+  ASSERT_TRUE(
+      pred_detail::ScaledDifferencesToD(extreme[0], extreme[1], extreme[2], extreme[3], x, y, &exact_differences));
   EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
   EXPECT_EQ(pred_detail::InCircleSignBeyondFilters(extreme[0], extreme[1], extreme[2], extreme[3]), sgn(Det(extreme)));
   EXPECT_EQ(InCircleSign(extreme[0], extreme[1], extreme[2], extreme[3]), sgn(Det(extreme)));
   // Parts the grid cannot hold: differences spanning 2^10 .. 2^-200, and subnormal ones.
   EXPECT_FALSE(
-      pred_detail::ScaledDifferences({0x1p10, 0}, {0, 0x1p-200}, {-0x1p10, 0}, {0, 0}, x, y, &exact_differences));
-  EXPECT_FALSE(
-      pred_detail::ScaledDifferences({0x1p-1060, 0}, {0, 0x1p-1060}, {0x1p-1070, 0}, {0, 0}, x, y, &exact_differences));
+      pred_detail::ScaledDifferencesToD({0x1p10, 0}, {0, 0x1p-200}, {-0x1p10, 0}, {0, 0}, x, y, &exact_differences));
+  EXPECT_FALSE(pred_detail::ScaledDifferencesToD({0x1p-1060, 0}, {0, 0x1p-1060}, {0x1p-1070, 0}, {0, 0}, x, y,
+                                                 &exact_differences));
   // All four points equal: zero differences, declined by the double-double stage, zero after it.
-  ASSERT_TRUE(pred_detail::ScaledDifferences({3, 4}, {3, 4}, {3, 4}, {3, 4}, x, y, &exact_differences));
+  ASSERT_TRUE(pred_detail::ScaledDifferencesToD({3, 4}, {3, 4}, {3, 4}, {3, 4}, x, y, &exact_differences));
   EXPECT_FALSE(pred_detail::InCircleSignFromDoubleDouble(x, y, &sign));
   EXPECT_EQ(pred_detail::InCircleSignBeyondFilters({3, 4}, {3, 4}, {3, 4}, {3, 4}), 0);
 }
