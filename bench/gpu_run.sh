@@ -18,6 +18,8 @@
 #           in the same run at 1M uniform and at 100K on the hard generators) and 10M uniform
 #   profile Nsight Systems (nsys, when the machine has it) over one 1M-point family build: the
 #           kernels and the CUDA API calls (waits) by total time
+#   kernels Nsight Compute's kernel times, summed by name, of one 1M-point family build of each
+#           input in GALPHA_KERNEL_DISTS (default uniform): where a slow input's stages go
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
 #           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
@@ -96,6 +98,20 @@ for phase in "${phases[@]}"; do
         --format csv --output "$out/family_1m" "$out/family_1m.nsys-rep"
       rm -f "$out/family_1m.nsys-rep" "$out/family_1m.sqlite"
       for f in "$out"/family_1m_*.csv; do echo "== $f"; head -n 16 "$f"; done
+      ;;
+    kernels)
+      # Kernel times by name (Nsight Compute, one pass, clocks left alone) of one 1M-point family
+      # build per input in GALPHA_KERNEL_DISTS: where a slow input's stages spend their time.
+      [ -x .carry/bin/alpha_bench ] || { echo "no alpha_bench in .carry"; status=1; continue; }
+      for dist in ${GALPHA_KERNEL_DISTS:-uniform}; do
+        run_step "kernels_$dist" 240 ncu --csv --page raw --print-units base --clock-control none \
+          --metrics gpu__time_duration.sum --kernel-name-base demangled \
+          .carry/bin/alpha_bench --backend=cuda --sizes=1000000 --dists="$dist" --repeat=1 --cgal-max=0
+        echo "== $dist"
+        python3 bench/ncu_kernels.py "$out/kernels_$dist.log" 30 | cut -c1-220
+        grep -E "^\| $dist \| 1000000 \| (validate|upload)" "$out/kernels_$dist.log" | cut -c1-400
+        rm -f "$out/kernels_$dist.log"
+      done
       ;;
     hard)
       [ -x .carry/bin/alpha_bench ] || { echo "no alpha_bench in .carry"; status=1; continue; }

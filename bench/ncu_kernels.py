@@ -23,7 +23,7 @@ def main() -> int:
     launches = defaultdict(int)
     for row in reader:
         name = row.get("Kernel Name", "")
-        value = row.get("gpu__time_duration.sum", "")
+        value = row.get("gpu__time_duration.sum") or ""  # a cut-off last row has none
         try:
             ns = float(value.replace(",", ""))
         except ValueError:

@@ -95,11 +95,19 @@ GALPHA_HD GALPHA_FORCEINLINE DoubleDouble ScaledDifferenceDd(double u, double v,
 
 }  // namespace radius_detail
 
-/// The double nearest to rho^2 of p[0..n) by double-double arithmetic with a certified error
-/// bound (about 2^-95 relative): decides the rounding unless the value lies within that bound of a
-/// midpoint between two doubles or outside the normal range, where it returns false and the
-/// exact NearestRadiusSqBounded decides. The fast path of the published spectrum.
-GALPHA_HD inline bool NearestRadiusSqFast(const Point2* p, int n, double* out) {
+/// rho^2 of a simplex enclosed by double-double arithmetic: the exact value lies within `err` of
+/// hi + lo (err already rounded up).
+struct RadiusSqEnclosure {
+  double hi;
+  double lo;
+  double err;
+};
+
+/// rho^2 of p[0..n) in double-double arithmetic with a certified error bound (about 2^-95
+/// relative; more for thin triangles, whose cross product cancels, and none beyond 2^-66): true
+/// with *out set, or false where the differences, the cancellation or the result's range are too
+/// extreme for the bound (the caller then uses exact arithmetic).
+GALPHA_HD inline bool EncloseRadiusSq(const Point2* p, int n, RadiusSqEnclosure* out) {
   using namespace radius_detail;
   const int from[3] = {0, 0, 1}, to[3] = {1, 2, 2};
   const int m = n == 2 ? 1 : 3;
@@ -138,16 +146,39 @@ GALPHA_HD inline bool NearestRadiusSqFast(const Point2* p, int n, double* out) {
     const DoubleDouble den = MulDd(area, area);
     value = DivDd(num, DoubleDouble{Mul(den.hi, 4.0), Mul(den.lo, 4.0)});
   }
-  // Unscale (exact while normal), then decide the rounding: the exact value lies within
-  // bound * value of h + l; h is its nearest double if that interval stays strictly inside
-  // h's rounding interval.
+  // Unscale (exact while normal): the exact value lies within bound * value of h + l.
   const double h = ldexp(value.hi, -2 * s);
   const double l = ldexp(value.lo, -2 * s);
   if (!(h >= 0x1p-900 && h <= 0x1p1000)) return false;  // l and the bound stay normal
-  const double err = Mul(Mul(h, bound), 1.0 + 0x1p-20);
+  *out = RadiusSqEnclosure{h, l, Mul(Mul(h, bound), 1.0 + 0x1p-20)};
+  return true;
+}
+
+/// Whether b's exact value is certainly above a's: the enclosures do not meet. The sign of
+/// (b.hi + b.lo - b.err) - (a.hi + a.lo + a.err) is taken exactly (Grow-Expansion keeps the
+/// expansion nonoverlapping, Shewchuk 1997, Theorem 10, so its top component carries the sign).
+GALPHA_HD inline bool EnclosuresSeparated(const RadiusSqEnclosure& a, const RadiusSqEnclosure& b) {
+  using namespace exact;
+  const double terms[6] = {b.lo, b.hi, -b.err, -a.lo, -a.hi, -a.err};
+  double e[7];
+  int en = 0;
+  for (const double t : terms) en = GrowExpansionZeroElim(en, e, t, e);
+  return ExpansionSign(en, e) > 0;
+}
+
+/// The double nearest to rho^2 of p[0..n) from its double-double enclosure (EncloseRadiusSq):
+/// decides the rounding unless the value lies within the bound of a midpoint between two doubles
+/// or outside the normal range, where it returns false and the exact NearestRadiusSqBounded
+/// decides. The fast path of the published spectrum.
+GALPHA_HD inline bool NearestRadiusSqFast(const Point2* p, int n, double* out) {
+  using namespace radius_detail;
+  RadiusSqEnclosure v;
+  if (!EncloseRadiusSq(p, n, &v)) return false;
+  // h is the nearest double if the enclosure stays strictly inside h's rounding interval.
+  const double h = v.hi;
   const double up = Mul(Sub(NextUp(h), h), 0.5);
   const double down = Mul(Sub(h, NextDown(h)), 0.5);
-  if (!(Add(l, err) < up && Sub(l, err) > -down)) return false;
+  if (!(Add(v.lo, v.err) < up && Sub(v.lo, v.err) > -down)) return false;
   *out = h;
   return true;
 }

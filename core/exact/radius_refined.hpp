@@ -5,7 +5,8 @@
 // keys orders every pair of values more than 2^-146 apart exactly, so that the exact comparisons
 // left are those of adjacent entries whose keys cannot separate them: O(n) of them, most of them
 // exact ties, which RadiusCongruent proves without arithmetic when the two simplices are
-// congruent by a lattice symmetry (translation, rotation by quarter turns, mirror). Host and device alike.
+// congruent with the same edge coordinates up to sign and order (a lattice's translated, turned
+// and mirrored cells). Host and device alike.
 //
 // Why the error is certified (rho^2 = Num / (4 Den) * 2^(-2s), exact expansions from
 // radius_terms.hpp, both positive, each compressed; Q = Num / Den):
@@ -154,97 +155,99 @@ GALPHA_HD inline bool RefinedKeysSeparated(const RefinedRadiusSq& a, const Refin
 
 namespace radius_detail {
 
-/// An edge vector in error-free form (Two-Diff heads and tails, unique for a real number), with
-/// its sign normalized so that the vector and its negation compare equal.
-struct ExactEdgeVector {
-  double x_head, x_tail, y_head, y_tail;
+/// An edge vector's two coordinates in error-free form (Two-Diff heads and tails: unique for a
+/// real number, and ordered as the numbers are) up to their signs and their order, the larger
+/// magnitude first. The edge's squared length is a function of these alone.
+struct EdgeLengthForm {
+  double major_head, major_tail, minor_head, minor_tail;
 };
 
-GALPHA_HD inline ExactEdgeVector EdgeVectorUpToSign(const Point2& from, const Point2& to) {
+GALPHA_HD inline bool HeadTailLess(double a_head, double a_tail, double b_head, double b_tail) {
+  return a_head != b_head ? a_head < b_head : a_tail < b_tail;
+}
+
+GALPHA_HD inline EdgeLengthForm EdgeLengthFormOf(const Point2& from, const Point2& to) {
   using namespace exact;
-  ExactEdgeVector v;
-  TwoDiff(to.x, from.x, v.x_head, v.x_tail);
-  TwoDiff(to.y, from.y, v.y_head, v.y_tail);
+  double xh, xt, yh, yt;
+  TwoDiff(to.x, from.x, xh, xt);
+  TwoDiff(to.y, from.y, yh, yt);
   // A head has its difference's sign and is zero only when the difference is.
-  if (v.x_head < 0.0 || (v.x_head == 0.0 && v.y_head < 0.0)) {
-    v = {-v.x_head, -v.x_tail, -v.y_head, -v.y_tail};
+  if (xh < 0.0) {
+    xh = -xh;
+    xt = -xt;
   }
-  return v;
+  if (yh < 0.0) {
+    yh = -yh;
+    yt = -yt;
+  }
+  if (HeadTailLess(xh, xt, yh, yt)) return {yh, yt, xh, xt};
+  return {xh, xt, yh, yt};
 }
 
-GALPHA_HD inline bool EdgeVectorLess(const ExactEdgeVector& a, const ExactEdgeVector& b) {
-  if (a.x_head != b.x_head) return a.x_head < b.x_head;
-  if (a.x_tail != b.x_tail) return a.x_tail < b.x_tail;
-  if (a.y_head != b.y_head) return a.y_head < b.y_head;
-  return a.y_tail < b.y_tail;
+GALPHA_HD inline bool EdgeLengthFormLess(const EdgeLengthForm& a, const EdgeLengthForm& b) {
+  if (a.major_head != b.major_head || a.major_tail != b.major_tail) {
+    return HeadTailLess(a.major_head, a.major_tail, b.major_head, b.major_tail);
+  }
+  return HeadTailLess(a.minor_head, a.minor_tail, b.minor_head, b.minor_tail);
 }
 
-GALPHA_HD inline bool EdgeVectorEqual(const ExactEdgeVector& a, const ExactEdgeVector& b) {
-  return a.x_head == b.x_head && a.x_tail == b.x_tail && a.y_head == b.y_head && a.y_tail == b.y_tail;
-}
-
-/// The edge vectors of a simplex up to sign, sorted (one for an edge, three for a triangle), after
-/// the symmetry `t` of the square (bit 0: negate x, bit 1: negate y, bit 2: swap x and y).
-GALPHA_HD inline void TransformedEdgeVectors(const ExactEdgeVector* raw, int m, int t, ExactEdgeVector* out) {
-  for (int i = 0; i < m; ++i) {
-    ExactEdgeVector v = raw[i];
-    if (t & 1) v = {-v.x_head, -v.x_tail, v.y_head, v.y_tail};
-    if (t & 2) v = {v.x_head, v.x_tail, -v.y_head, -v.y_tail};
-    if (t & 4) v = {v.y_head, v.y_tail, v.x_head, v.x_tail};
-    if (v.x_head < 0.0 || (v.x_head == 0.0 && v.y_head < 0.0)) v = {-v.x_head, -v.x_tail, -v.y_head, -v.y_tail};
-    int j = i;
-    while (j > 0 && EdgeVectorLess(v, out[j - 1])) {
-      out[j] = out[j - 1];
-      --j;
-    }
-    out[j] = v;
-  }
-}
-
-/// The canonical edge vectors of a simplex: the least, in lexicographic order, of its sorted edge
-/// vectors up to sign under the eight symmetries of the square. Simplices related by those
-/// symmetries, by translations and by half-turns get the same ones.
-GALPHA_HD inline int CanonicalEdgeVectors(const Point2* p, int n, ExactEdgeVector* out) {
-  const int m = n == 2 ? 1 : 3;
-  ExactEdgeVector raw[3] = {};
-  raw[0] = EdgeVectorUpToSign(p[0], p[1]);
-  if (n == 3) {
-    raw[1] = EdgeVectorUpToSign(p[0], p[2]);
-    raw[2] = EdgeVectorUpToSign(p[1], p[2]);
-  }
-  TransformedEdgeVectors(raw, m, 0, out);
-  for (int t = 1; t < 8; ++t) {
-    ExactEdgeVector candidate[3] = {};
-    TransformedEdgeVectors(raw, m, t, candidate);
-    int k = 0;
-    while (k < m && EdgeVectorEqual(candidate[k], out[k])) ++k;
-    if (k < m && EdgeVectorLess(candidate[k], out[k])) {
-      for (int i = 0; i < m; ++i) out[i] = candidate[i];
-    }
-  }
-  return m;
+GALPHA_HD inline bool EdgeLengthFormEqual(const EdgeLengthForm& a, const EdgeLengthForm& b) {
+  return a.major_head == b.major_head && a.major_tail == b.major_tail && a.minor_head == b.minor_head &&
+         a.minor_tail == b.minor_tail;
 }
 
 }  // namespace radius_detail
 
-/// Whether rho^2(a) and rho^2(b) are equal because the simplices are congruent by a symmetry of
-/// the square lattice: translations, half-turns, quarter-turns and mirrors in the axes and
-/// diagonals (a lattice's cells in every orientation). rho^2 is a function of the multiset of edge
-/// vectors up to sign alone (the squared lengths do not see a sign, and |D|, twice the area, is
-/// |cross(u, v)| for any two of a triangle's three edge vectors, whatever their signs), and is
-/// invariant under the symmetries; so equal canonical edge vectors mean equal values. The vectors
-/// are compared exactly in error-free form; an overflowing difference compares unequal (NaN).
-/// False proves nothing.
-GALPHA_HD inline bool RadiusCongruent(const Point2* a, int na, const Point2* b, int nb) {
+/// A simplex's edges in EdgeLengthForm, sorted (one for an edge, three for a triangle): what
+/// RadiusCongruent compares.
+struct CongruenceForm {
+  int n = 0;  // the simplex's points: 2 (an edge) or 3 (a triangle)
+  radius_detail::EdgeLengthForm edge[3] = {};
+};
+
+GALPHA_HD inline CongruenceForm CongruenceFormOf(const Point2* p, int n) {
   using namespace radius_detail;
-  if (na != nb) return false;
-  ExactEdgeVector va[3] = {}, vb[3] = {};
-  const int m = CanonicalEdgeVectors(a, na, va);
-  CanonicalEdgeVectors(b, nb, vb);
+  CongruenceForm form;
+  form.n = n;
+  form.edge[0] = EdgeLengthFormOf(p[0], p[1]);
+  if (n == 3) {
+    form.edge[1] = EdgeLengthFormOf(p[0], p[2]);
+    form.edge[2] = EdgeLengthFormOf(p[1], p[2]);
+    for (int i = 1; i < 3; ++i) {
+      const EdgeLengthForm x = form.edge[i];
+      int j = i;
+      while (j > 0 && EdgeLengthFormLess(x, form.edge[j - 1])) {
+        form.edge[j] = form.edge[j - 1];
+        --j;
+      }
+      form.edge[j] = x;
+    }
+  }
+  return form;
+}
+
+/// Whether two forms prove equal values: the simplices have the same squared edge lengths, each
+/// read from its edge vector's coordinates up to their signs and order (so translations,
+/// half-turns, quarter-turns and mirrors in the axes and diagonals, the copies a lattice's cells
+/// come in, and more). A triangle's rho^2 is a symmetric function of its three squared edge
+/// lengths (abc / 4A with Heron's formula for A: equal side lengths, congruent triangles), an
+/// edge's is its squared length / 4; so equal forms mean equal values. The coordinates are
+/// compared exactly in error-free form; an overflowing difference compares unequal (NaN). False
+/// proves nothing (equal lengths from other coordinates, (3, 4) and (5, 0), are not seen).
+GALPHA_HD inline bool SameCongruenceForm(const CongruenceForm& a, const CongruenceForm& b) {
+  if (a.n != b.n) return false;
+  const int m = a.n == 2 ? 1 : 3;
   for (int k = 0; k < m; ++k) {
-    if (!EdgeVectorEqual(va[k], vb[k])) return false;
+    if (!radius_detail::EdgeLengthFormEqual(a.edge[k], b.edge[k])) return false;
   }
   return true;
+}
+
+/// Whether rho^2(a) and rho^2(b) are equal because the simplices are congruent, seen by their
+/// edges' coordinates (SameCongruenceForm). False proves nothing.
+GALPHA_HD inline bool RadiusCongruent(const Point2* a, int na, const Point2* b, int nb) {
+  if (na != nb) return false;
+  return SameCongruenceForm(CongruenceFormOf(a, na), CongruenceFormOf(b, nb));
 }
 
 }  // namespace galpha

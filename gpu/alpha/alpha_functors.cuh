@@ -151,20 +151,32 @@ struct IsRunStart {
 /// Largest run sorted in place by one thread; longer runs go to the host's three-way quicksort.
 constexpr uint32_t kMaxDeviceRun = 16;
 
-/// Exact order of two simplices' squared radii (sign of a - b) for the short runs: congruent
-/// simplices (RadiusCongruent: a translated, turned or mirrored copy, which quantized data such as
-/// centimetre LiDAR has by the million) are equal without arithmetic; others take the bounded
-/// exact comparison, counted. Not inlined: RepairRun calls it from two loops.
+/// Exact order of two simplices' squared radii (sign of a - b) for the short runs, cheapest proof
+/// first: congruent simplices (RadiusCongruent: the same edge coordinates up to sign and order, as
+/// the copies of quantized data such as centimetre LiDAR are, by the million) are equal without
+/// arithmetic; disjoint double-double enclosures (EncloseRadiusSq, about 2^-95 relative) order the
+/// near ties that the 64-bit keys cannot (a circle's are 2^-40 to 2^-100 apart); the rest, exact
+/// ties of simplices that are not copies (a lattice's co-circular triangles) and values closer
+/// than the enclosures, take the bounded exact comparison, counted. Everything but that last step
+/// stays in registers: on the device a thread per run is bound by its local memory. Not inlined:
+/// RepairRun calls it from two loops.
 GALPHA_HD GALPHA_NOINLINE inline Order CompareRunEntries(const Point2* pa, int na, const Point2* pb, int nb,
                                                          uint32_t* count) {
   if (RadiusCongruent(pa, na, pb, nb)) return Order::kEqual;
+  RadiusSqEnclosure ea, eb;
+  if (EncloseRadiusSq(pa, na, &ea) && EncloseRadiusSq(pb, nb, &eb)) {
+    if (EnclosuresSeparated(ea, eb)) return Order::kLess;
+    if (EnclosuresSeparated(eb, ea)) return Order::kGreater;
+  }
   ++*count;
   return CompareRadiusSqBounded(pa, na, pb, nb);
 }
 
-/// Sorts one short run of linked entries exactly (insertion sort with the bounded comparison) and
-/// marks where a new exact value starts. A run that the bounded arithmetic cannot decide, or that
-/// is too long, is left for the host (`needs_host`).
+/// Sorts one short run of linked entries exactly (insertion sort with CompareRunEntries) and marks
+/// where a new exact value starts. Entries proven equal while sorting share a class, and the pass
+/// that marks new values does not compare them again (a tie the bounded arithmetic proved costs
+/// one comparison, not two). A run that the bounded arithmetic cannot decide, or that is too long,
+/// is left for the host (`needs_host`).
 struct RepairRun {
   SimplexPoints simplex;
   const uint32_t* run_begin;
@@ -182,14 +194,17 @@ struct RepairRun {
       needs_host[r] = 1;
       return;
     }
-    uint32_t local[kMaxDeviceRun];
-    for (uint32_t i = b; i < e; ++i) local[i - b] = ids[i];
     const uint32_t n = e - b;
+    uint32_t local[kMaxDeviceRun];       // the entries in sorted order
+    uint8_t equal_class[kMaxDeviceRun];  // per sorted position: its class's first entry
+    for (uint32_t i = 0; i < n; ++i) local[i] = ids[b + i];
+    equal_class[0] = 0;
     uint32_t count = 0;
     Point2 pa[3], pb[3];
     for (uint32_t i = 1; i < n; ++i) {
       const uint32_t x = local[i];
       const int nx = simplex(x, pa);
+      uint8_t x_class = static_cast<uint8_t>(i);
       uint32_t j = i;
       while (j > 0) {
         const int ny = simplex(local[j - 1], pb);
@@ -199,14 +214,21 @@ struct RepairRun {
           comparisons[r] = count;
           return;
         }
+        if (c == Order::kEqual) x_class = equal_class[j - 1];
         if (c != Order::kGreater) break;
         local[j] = local[j - 1];
+        equal_class[j] = equal_class[j - 1];
         --j;
       }
       local[j] = x;
+      equal_class[j] = x_class;
     }
     new_value[b] = 1;
     for (uint32_t i = 1; i < n; ++i) {
+      if (equal_class[i] == equal_class[i - 1]) {
+        new_value[b + i] = 0;
+        continue;
+      }
       const int na = simplex(local[i - 1], pa);
       const int nb = simplex(local[i], pb);
       const Order c = CompareRunEntries(pa, na, pb, nb, &count);
@@ -446,6 +468,13 @@ struct FillMasterEntries {
 constexpr uint32_t kMaxThreadSegment = 64;
 
 /// Pass 3: sorts every short rank segment (insertion sort); flags the long ones.
+/// Master-list positions in a long segment (rank_of: each position's rank).
+struct InLongSegment {
+  const uint32_t* rank_of;
+  const uint8_t* long_segment;
+  GALPHA_HD bool operator()(uint32_t position) const { return long_segment[rank_of[position]] != 0; }
+};
+
 struct SortMasterSegment {
   const uint32_t* begin;
   uint64_t* entries;

@@ -16,6 +16,7 @@
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/reduce.h>
 #include <thrust/scan.h>
+#include <thrust/scatter.h>
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
 #include <thrust/transform.h>
@@ -571,44 +572,57 @@ constexpr size_t kMaxSeparateSegmentSorts = 32;
 
 template <class System>
 void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t num_items, uint32_t num_ranks,
-                        const Buffer<uint32_t, System>& master_begin, Buffer<uint64_t, System>* master_entries) {
+                        uint32_t num_master, const Buffer<uint32_t, System>& master_begin,
+                        Buffer<uint64_t, System>* master_entries) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   Buffer<uint8_t, System> long_segment(sys, static_cast<size_t>(num_ranks) + 1);
   thrust::for_each_n(policy, zero, num_ranks + 1,
                      SortMasterSegment{master_begin.data(), master_entries->data(), long_segment.data()});
-  if (thrust::count(policy, long_segment.data(), long_segment.data() + (num_ranks + 1), uint8_t{1}) > 0) {
+  const auto num_long = static_cast<size_t>(
+      thrust::count(policy, long_segment.data(), long_segment.data() + (num_ranks + 1), uint8_t{1}));
+  if (num_long == 0) return;
+  if constexpr (System::kHostMemory) {
+    // One pass over the simplices in order writes the long segments already sorted (items
+    // come by kind, then id, each with its end points in order): no sort of exact ties.
+    const uint8_t* host_long = long_segment.data();
+    std::vector<uint32_t> cursor(master_begin.data(), master_begin.data() + (num_ranks + 1));
+    uint64_t* entries = master_entries->data();
+    auto place = [&](uint32_t rank, uint64_t packed) {
+      if (host_long[rank]) entries[cursor[rank]++] = packed;
+    };
+    for (uint32_t item = 0; item < num_items; ++item) endpoints.Visit(item, place);
+  } else if (num_long <= kMaxSeparateSegmentSorts) {
     const std::vector<uint8_t> host_long = long_segment.ToHostVector(num_ranks + 1);
     const std::vector<uint32_t> host_begin = master_begin.ToHostVector(num_ranks + 2);
-    if constexpr (System::kHostMemory) {
-      // One pass over the simplices in order writes the long segments already sorted (items
-      // come by kind, then id, each with its end points in order): no sort of exact ties.
-      std::vector<uint32_t> cursor(host_begin.begin(), host_begin.end() - 1);
-      uint64_t* entries = master_entries->data();
-      auto place = [&](uint32_t rank, uint64_t packed) {
-        if (host_long[rank]) entries[cursor[rank]++] = packed;
-      };
-      for (uint32_t item = 0; item < num_items; ++item) endpoints.Visit(item, place);
-    } else {
-      const auto num_long = static_cast<size_t>(std::count(host_long.begin(), host_long.end(), uint8_t{1}));
-      if (num_long <= kMaxSeparateSegmentSorts) {
-        for (uint32_t r = 0; r <= num_ranks; ++r) {
-          if (host_long[r]) {
-            thrust::sort(policy, master_entries->data() + host_begin[r], master_entries->data() + host_begin[r + 1]);
-          }
-        }
-      } else {
-        // Many long segments (lattices: thousands of ranks of exact ties): one sort per segment
-        // would cost a launch and a wait each. Two stable radix sorts of the whole list instead,
-        // by entry and then by rank, give every segment sorted in place, the same order.
-        const uint32_t num_master = host_begin[num_ranks + 1];
-        Buffer<uint32_t, System> rank_of(sys, num_master);
-        thrust::upper_bound(policy, master_begin.data() + 1, master_begin.data() + (num_ranks + 2), zero,
-                            zero + num_master, rank_of.data());
-        thrust::stable_sort_by_key(policy, master_entries->data(), master_entries->data() + num_master, rank_of.data());
-        thrust::stable_sort_by_key(policy, rank_of.data(), rank_of.data() + num_master, master_entries->data());
+    for (uint32_t r = 0; r <= num_ranks; ++r) {
+      if (host_long[r]) {
+        thrust::sort(policy, master_entries->data() + host_begin[r], master_entries->data() + host_begin[r + 1]);
       }
     }
+  } else {
+    // Many long segments (lattices: thousands of ranks of exact ties; centimetre LiDAR: 4,786
+    // holding a quarter of the list at 1M): one sort per segment would cost a launch and a wait
+    // each. The entries of the long segments are gathered (their positions ascend, a segment's
+    // contiguous), sorted by two stable radix sorts, by entry and then by rank, and put back at
+    // the same positions: every long segment gets its own entries sorted, the order one sort per
+    // segment gives, and the short segments' entries (most of the list) are not sorted again.
+    Buffer<uint32_t, System> rank_of(sys, num_master);
+    thrust::upper_bound(policy, master_begin.data() + 1, master_begin.data() + (num_ranks + 2), zero, zero + num_master,
+                        rank_of.data());
+    Buffer<uint32_t, System> position(sys, num_master);
+    const auto num_gathered =
+        static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_master, position.data(),
+                                              InLongSegment{rank_of.data(), long_segment.data()}) -
+                              position.data());
+    Buffer<uint64_t, System> entry(sys, num_gathered);
+    Buffer<uint32_t, System> rank(sys, num_gathered);
+    thrust::gather(policy, position.data(), position.data() + num_gathered, master_entries->data(), entry.data());
+    thrust::gather(policy, position.data(), position.data() + num_gathered, rank_of.data(), rank.data());
+    rank_of.Reset();
+    thrust::stable_sort_by_key(policy, entry.data(), entry.data() + num_gathered, rank.data());
+    thrust::stable_sort_by_key(policy, rank.data(), rank.data() + num_gathered, entry.data());
+    thrust::scatter(policy, entry.data(), entry.data() + num_gathered, position.data(), master_entries->data());
   }
 }
 
@@ -636,7 +650,7 @@ MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, con
     thrust::copy_n(policy, master_begin.data(), num_ranks + 2, cursor.data());
     thrust::for_each_n(policy, zero, num_items, FillMasterEntries{endpoints, cursor.data(), master_entries.data()});
   }
-  SortMasterSegments(sys, endpoints, num_items, num_ranks, master_begin, &master_entries);
+  SortMasterSegments(sys, endpoints, num_items, num_ranks, num_master, master_begin, &master_entries);
   return {std::move(master_begin), std::move(master_entries), num_master};
 }
 

@@ -227,6 +227,21 @@ TEST(RefinedRadiusSqTest, TranslatesAreProvenEqual) {
   EXPECT_FALSE(RadiusCongruent(e1, 2, e2, 2));
   EXPECT_TRUE(RadiusCongruent(e1, 2, e3, 2));
   EXPECT_TRUE(RadiusCongruent(e1, 2, e4, 2));  // (4, -3): (3, 4) turned a quarter
+  // The form reads each edge's coordinates with their rounding errors: differences that round to
+  // the same double but are not equal (far-apart magnitudes) are not claimed equal.
+  const Point2 far1[2] = {{0x1p-10, 0.0}, {0x1p53, 1.0}}, far2[2] = {{0x1p-11, 0.0}, {0x1p53, 1.0}};
+  ASSERT_NE(CompareRadiusSqRational(far1, 2, far2, 2), 0);
+  EXPECT_FALSE(RadiusCongruent(far1, 2, far2, 2));
+  const Point2 far3[3] = {{0x1p-10, 0.0}, {0x1p53, 1.0}, {0.0, 3.0}},
+               far4[3] = {{0x1p-11, 0.0}, {0x1p53, 1.0}, {0.0, 3.0}};
+  ASSERT_NE(CompareRadiusSqRational(far3, 3, far4, 3), 0);
+  EXPECT_FALSE(RadiusCongruent(far3, 3, far4, 3));
+  // Congruent copies that no symmetry of the square lattice maps onto each other: a right
+  // isosceles triangle and its mirror image in its own leg AB (direction (2, 1)). Each edge keeps
+  // its coordinates up to sign and order, so the equal values are proven.
+  const Point2 right1[3] = {{0, 0}, {2, 1}, {1, 3}}, right2[3] = {{0, 0}, {2, 1}, {3, -1}};
+  ASSERT_EQ(CompareRadiusSqRational(right1, 3, right2, 3), 0);
+  EXPECT_TRUE(RadiusCongruent(right1, 3, right2, 3));
   // Mirrors and quarter turns of a perturbed triangle, against GMP; and a shape that is no symmetry
   // of it (a shear that keeps one edge) is never claimed, equal or not.
   const Point2 tri[3] = {{Ulps(1000.0, 1), 2000.0}, {1000.125, Ulps(2000.0, -2)}, {Ulps(1000.0, -1), 2000.25}};

@@ -166,6 +166,61 @@ TEST_P(RadiusTest, FastNearestDoubleIsExactWhenItAnswers) {
   }
 }
 
+TEST_P(RadiusTest, EnclosuresHoldTheExactValueAndSeparateOnlyInExactOrder) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 300, 19);
+  std::vector<RadiusSqEnclosure> enclosure(simplices.size());
+  std::vector<std::optional<mpq_class>> exact(simplices.size());
+  std::vector<bool> enclosed(simplices.size(), false);
+  int answered = 0;
+  for (size_t i = 0; i < simplices.size(); ++i) {
+    enclosed[i] = EncloseRadiusSq(simplices[i].p, simplices[i].n, &enclosure[i]);
+    if (!enclosed[i]) continue;
+    ++answered;
+    exact[i] = RadiusSqRational(simplices[i].p, simplices[i].n);
+    ASSERT_TRUE(exact[i].has_value()) << Show(simplices[i]);  // collinear triangles are declined
+    const RadiusSqEnclosure& e = enclosure[i];
+    const mpq_class distance = abs(*exact[i] - (mpq_class(e.hi) + mpq_class(e.lo)));
+    ASSERT_LE(distance, mpq_class(e.err)) << Show(simplices[i]);
+    // The bound is tight enough to be of use: about 2^-95 of the value, 2^-66 at worst.
+    EXPECT_LT(mpq_class(e.err), mpq_class(std::ldexp(e.hi, -60))) << Show(simplices[i]);
+  }
+  for (size_t i = 0; i < simplices.size(); ++i) {
+    for (size_t j = 0; j < simplices.size(); ++j) {
+      if (!enclosed[i] || !enclosed[j] || !EnclosuresSeparated(enclosure[i], enclosure[j])) continue;
+      ASSERT_LT(*exact[i], *exact[j]) << Show(simplices[i]) << " vs " << Show(simplices[j]);
+    }
+    // Equal values never separate, not even from themselves.
+    if (enclosed[i]) {
+      EXPECT_FALSE(EnclosuresSeparated(enclosure[i], enclosure[i])) << Show(simplices[i]);
+    }
+  }
+  if (GetParam() == "uniform" || GetParam() == "grid" || GetParam() == "nudged" || GetParam() == "offset1e9") {
+    EXPECT_GT(answered, static_cast<int>(simplices.size()) * 9 / 10);
+  }
+}
+
+// Values closer than the 64-bit keys see but farther apart than the enclosures' bounds are ordered
+// by the enclosures alone: a triangle and its copy with one vertex moved by one ulp.
+TEST(RadiusTest, EnclosuresSeparateNearTies) {
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int separated = 0;
+  for (int t = 0; t < 500; ++t) {
+    const Point2 a[3] = {
+        {1000.0 + unit(rng), unit(rng)}, {1000.0 + unit(rng), unit(rng)}, {1000.0 + unit(rng), unit(rng)}};
+    Point2 b[3] = {a[0], a[1], a[2]};
+    b[2].x = Ulps(b[2].x, 1);
+    RadiusSqEnclosure ea, eb;
+    if (!EncloseRadiusSq(a, 3, &ea) || !EncloseRadiusSq(b, 3, &eb)) continue;
+    const int exact = CompareRadiusSqRational(a, 3, b, 3);
+    if (EnclosuresSeparated(ea, eb) || EnclosuresSeparated(eb, ea)) {
+      ++separated;
+      EXPECT_EQ(exact, EnclosuresSeparated(ea, eb) ? -1 : 1);
+    }
+  }
+  EXPECT_GT(separated, 450);
+}
+
 INSTANTIATE_TEST_SUITE_P(Families, RadiusTest,
                          ::testing::Values("uniform", "grid", "nudged", "offset1e9", "offset1e15", "tiny", "subnormal",
                                            "mixed", "flat"));

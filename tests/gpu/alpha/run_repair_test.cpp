@@ -1,0 +1,151 @@
+// The exact repair of the spectrum's short runs (RepairRun in gpu/alpha/alpha_functors.cuh), run on
+// the host as the OpenMP backend runs it, against GMP rationals: runs of near ties, congruent
+// copies and exact ties that are not copies, shuffled, must come out in exact order with every
+// new value marked. The inputs are what the runs hold on real data: centimetre-quantized
+// coordinates far from the origin (copies and co-circular ties by the thousand), points on a
+// circle (values 2^-40 to 2^-100 apart, which the double-double enclosures separate without the
+// bounded arithmetic) and an ulp-perturbed lattice.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "core/exact/radius_rational.hpp"
+#include "gpu/alpha/alpha_functors.cuh"
+
+namespace galpha::detail {
+namespace {
+
+// A pool of simplices over one point array, in SimplexPoints' layout (triangles, then edges).
+struct SimplexPool {
+  std::vector<Point2> points;
+  std::vector<TriIdx> tris;
+  std::vector<EdgeIdx> edges;
+  SimplexPoints view() const {
+    return SimplexPoints{points.data(), tris.data(), edges.data(), static_cast<uint32_t>(tris.size())};
+  }
+  uint32_t size() const { return static_cast<uint32_t>(tris.size() + edges.size()); }
+};
+
+// Every triangle and edge among `count` random points, which `point` draws.
+template <class Draw>
+SimplexPool PoolOf(int count, Draw point) {
+  SimplexPool pool;
+  for (int i = 0; i < count; ++i) pool.points.push_back(point());
+  const auto n = static_cast<uint32_t>(count);
+  for (uint32_t a = 0; a < n; ++a) {
+    for (uint32_t b = a + 1; b < n; ++b) {
+      pool.edges.push_back({{a, b}});
+      for (uint32_t c = b + 1; c < n; ++c) {
+        const Point2& pa = pool.points[a];
+        const Point2& pb = pool.points[b];
+        const Point2& pc = pool.points[c];
+        // Collinear triples have no finite radius; the spectrum never holds them.
+        if ((pb.x - pa.x) * (pc.y - pa.y) != (pb.y - pa.y) * (pc.x - pa.x)) pool.tris.push_back({{a, b, c}});
+      }
+    }
+  }
+  return pool;
+}
+
+int Compare(const SimplexPool& pool, uint32_t a, uint32_t b) {
+  Point2 pa[3], pb[3];
+  const SimplexPoints simplex = pool.view();
+  const int na = simplex(a, pa);
+  const int nb = simplex(b, pb);
+  return CompareRadiusSqRational(pa, na, pb, nb);
+}
+
+struct Outcome {
+  int runs = 0;
+  int ties = 0;          // adjacent pairs of equal value in the repaired runs
+  uint64_t bounded = 0;  // comparisons that needed the bounded exact arithmetic
+};
+
+// Repairs `trials` runs of 2..16 entries drawn from the pool, each run made of simplices whose
+// values are close (the pool sorted by exact value, a window of it, shuffled), and checks each
+// against GMP.
+Outcome RepairRandomRuns(const SimplexPool& pool, int trials, uint64_t seed) {
+  std::vector<uint32_t> by_value(pool.size());
+  for (uint32_t i = 0; i < pool.size(); ++i) by_value[i] = i;
+  std::sort(by_value.begin(), by_value.end(), [&](uint32_t a, uint32_t b) { return Compare(pool, a, b) < 0; });
+  std::mt19937_64 rng(seed);
+  Outcome outcome;
+  for (int t = 0; t < trials; ++t) {
+    const uint32_t length = 2 + static_cast<uint32_t>(rng() % (kMaxDeviceRun - 1));
+    const uint32_t start = static_cast<uint32_t>(rng() % (pool.size() - length));
+    std::vector<uint32_t> ids(by_value.begin() + start, by_value.begin() + start + length);
+    std::shuffle(ids.begin(), ids.end(), rng);
+    const std::vector<uint32_t> before = ids;
+    const uint32_t begin = 0, end = length;
+    std::vector<uint8_t> new_value(length, 1);
+    uint8_t needs_host = 9;
+    uint32_t comparisons = 0;
+    RepairRun{pool.view(), &begin, &end, ids.data(), new_value.data(), &needs_host, &comparisons}(0);
+    if (needs_host != 0) {
+      EXPECT_EQ(ids, before) << "a run left for the host must keep its order";
+      continue;
+    }
+    ++outcome.runs;
+    outcome.bounded += comparisons;
+    std::vector<uint32_t> sorted_ids = ids, sorted_before = before;
+    std::sort(sorted_ids.begin(), sorted_ids.end());
+    std::sort(sorted_before.begin(), sorted_before.end());
+    EXPECT_EQ(sorted_ids, sorted_before) << "the run lost or duplicated an entry";
+    EXPECT_EQ(new_value[0], 1);
+    for (uint32_t i = 1; i < length; ++i) {
+      const int c = Compare(pool, ids[i - 1], ids[i]);
+      EXPECT_LE(c, 0) << "out of order at " << i << " in trial " << t;
+      EXPECT_EQ(new_value[i], c < 0 ? 1 : 0) << "new value mark at " << i << " in trial " << t;
+      if (c == 0) ++outcome.ties;
+    }
+  }
+  return outcome;
+}
+
+TEST(RunRepairTest, CentimetreQuantizedCoordinatesFarFromTheOrigin) {
+  std::mt19937_64 rng(11);
+  std::uniform_int_distribution<int> cm(0, 6);
+  // The LiDAR generator's arithmetic: whole centimetres times 0.01, plus a UTM-like offset.
+  const SimplexPool pool = PoolOf(14, [&] {
+    return Point2{static_cast<double>(cm(rng)) * 0.01 + 500000.0, static_cast<double>(cm(rng)) * 0.01 + 4000000.0};
+  });
+  const Outcome outcome = RepairRandomRuns(pool, 3000, 12);
+  EXPECT_GT(outcome.runs, 2500);
+  EXPECT_GT(outcome.ties, 1000);  // congruent copies and co-circular triangles
+}
+
+TEST(RunRepairTest, PointsOnACircle) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> angle(0.0, 6.283185307179586);
+  const SimplexPool pool = PoolOf(16, [&] {
+    const double a = angle(rng);
+    return Point2{1000.0 + 3.0 * std::cos(a), -250.0 + 3.0 * std::sin(a)};
+  });
+  const Outcome outcome = RepairRandomRuns(pool, 3000, 22);
+  EXPECT_GT(outcome.runs, 2900);
+  // Every triangle's value lies within rounding of the circle's: near ties, which the enclosures
+  // order without the bounded arithmetic.
+  EXPECT_LT(outcome.bounded, 100u);
+}
+
+TEST(RunRepairTest, UlpPerturbedLattice) {
+  std::mt19937_64 rng(31);
+  std::uniform_int_distribution<int> step(0, 5);
+  std::uniform_int_distribution<int> ulps(-2, 2);
+  auto nudge = [&](double v) {
+    const int n = ulps(rng);
+    for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? 1e300 : -1e300);
+    return v;
+  };
+  const SimplexPool pool = PoolOf(14, [&] {
+    return Point2{nudge(1000.0 + 0.125 * step(rng)), nudge(2000.0 + 0.125 * step(rng))};
+  });
+  const Outcome outcome = RepairRandomRuns(pool, 3000, 32);
+  EXPECT_GT(outcome.runs, 2500);
+}
+
+}  // namespace
+}  // namespace galpha::detail
