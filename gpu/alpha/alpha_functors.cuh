@@ -196,7 +196,7 @@ struct RepairRun {
     }
     const uint32_t n = e - b;
     uint32_t local[kMaxDeviceRun];       // the entries in sorted order
-    uint8_t equal_class[kMaxDeviceRun];  // per sorted position: its class's first entry
+    uint8_t equal_class[kMaxDeviceRun];  // per sorted position: where its class's first member was taken
     for (uint32_t i = 0; i < n; ++i) local[i] = ids[b + i];
     equal_class[0] = 0;
     uint32_t count = 0;
@@ -467,7 +467,6 @@ struct FillMasterEntries {
 /// triangles) are sorted by a Thrust call each.
 constexpr uint32_t kMaxThreadSegment = 64;
 
-/// Pass 3: sorts every short rank segment (insertion sort); flags the long ones.
 /// Master-list positions in a long segment (rank_of: each position's rank).
 struct InLongSegment {
   const uint32_t* rank_of;
@@ -475,6 +474,7 @@ struct InLongSegment {
   GALPHA_HD bool operator()(uint32_t position) const { return long_segment[rank_of[position]] != 0; }
 };
 
+/// Pass 3: sorts every short rank segment (insertion sort); flags the long ones.
 struct SortMasterSegment {
   const uint32_t* begin;
   uint64_t* entries;
