@@ -139,7 +139,9 @@ GALPHA_HD inline bool EncloseRadiusSq(const Point2* p, int n, RadiusSqEnclosure*
     const DoubleDouble left = MulDd(d[0][0], d[1][1]), right = MulDd(d[0][1], d[1][0]);
     const DoubleDouble area = AddDd(left, right, /*negate_b=*/true);
     const double sum = Add(Abs(left.hi), Abs(right.hi));
-    if (Abs(area.hi) < 0x1p-500 || Abs(area.hi) < Mul(sum, 0x1p-31)) return false;
+    // |D| >= 2^-450 keeps D^2 and its tail normal (below, the tail of the product would round and
+    // the bound would not hold).
+    if (Abs(area.hi) < 0x1p-450 || Abs(area.hi) < Mul(sum, 0x1p-31)) return false;
     // D's relative error: 2^-101 (|left| + |right|) / |D| <= 2^-70; rho^2 gets four times that.
     bound = Add(bound, Mul(Mul(sum / Abs(area.hi), 0x1p-101), 4.0));
     const DoubleDouble num = MulDd(MulDd(len[0], len[1]), len[2]);

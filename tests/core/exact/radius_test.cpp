@@ -199,6 +199,40 @@ TEST_P(RadiusTest, EnclosuresHoldTheExactValueAndSeparateOnlyInExactOrder) {
   }
 }
 
+// A triangle whose doubled area lies near 2^-500 (after the enclosure's scaling): its square's
+// tail would fall below the normal range and round, far beyond the bound. The enclosure must
+// decline it, or hold the exact value; and it must never order it against an edge of nearly the
+// same value the wrong way (found by review: the first guard, |D| >= 2^-500, let it through).
+TEST(RadiusTest, EnclosuresOfAreasNearTheUnderflowRangeHoldOrDecline) {
+  const Point2 tri[3] = {{0.0, 0.0}, {0x1.2265b1f236eb0p-250, 0.0}, {1.0, 0x1.d8f16ad9ac27cp-250}};
+  const Point2 edge[2] = {{0.0, 0.0}, {0x1.15242595b22b6p+249, 0x1.993d1872bae93p+223}};
+  const mpq_class exact = *RadiusSqRational(tri, 3);
+  RadiusSqEnclosure et, ee;
+  if (EncloseRadiusSq(tri, 3, &et)) {
+    EXPECT_LE(abs(exact - (mpq_class(et.hi) + mpq_class(et.lo))), mpq_class(et.err));
+    ASSERT_TRUE(EncloseRadiusSq(edge, 2, &ee));
+    const int order = CompareRadiusSqRational(tri, 3, edge, 2);
+    if (EnclosuresSeparated(et, ee)) {
+      EXPECT_LT(order, 0);
+    }
+    if (EnclosuresSeparated(ee, et)) {
+      EXPECT_GT(order, 0);
+    }
+  }
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> unit(1.0, 2.0);
+  for (int t = 0; t < 2000; ++t) {
+    // Doubled areas from 2^-510 to 2^-440 after scaling.
+    const int e = -255 + static_cast<int>(rng() % 36);
+    const Point2 p[3] = {{0.0, 0.0}, {std::ldexp(unit(rng), e), 0.0}, {1.0, std::ldexp(unit(rng), e)}};
+    RadiusSqEnclosure v;
+    if (!EncloseRadiusSq(p, 3, &v)) continue;
+    const mpq_class value = *RadiusSqRational(p, 3);
+    ASSERT_LE(abs(value - (mpq_class(v.hi) + mpq_class(v.lo))), mpq_class(v.err))
+        << Show(Simplex{{p[0], p[1], p[2]}, 3});
+  }
+}
+
 // Values closer than the 64-bit keys see but farther apart than the enclosures' bounds are ordered
 // by the enclosures alone: a triangle and its copy with one vertex moved by one ulp.
 TEST(RadiusTest, EnclosuresSeparateNearTies) {

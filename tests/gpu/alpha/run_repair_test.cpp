@@ -80,7 +80,7 @@ Outcome RepairRandomRuns(const SimplexPool& pool, int trials, uint64_t seed) {
     std::shuffle(ids.begin(), ids.end(), rng);
     const std::vector<uint32_t> before = ids;
     const uint32_t begin = 0, end = length;
-    std::vector<uint8_t> new_value(length, 1);
+    std::vector<uint8_t> new_value(length, 7);  // a sentinel: every mark must be written
     uint8_t needs_host = 9;
     uint32_t comparisons = 0;
     RepairRun{pool.view(), &begin, &end, ids.data(), new_value.data(), &needs_host, &comparisons}(0);
