@@ -103,8 +103,14 @@ for phase in "${phases[@]}"; do
       # Kernel times by name (Nsight Compute, one pass, clocks left alone) of one 1M-point family
       # build per input in GALPHA_KERNEL_DISTS: where a slow input's stages spend their time.
       [ -x .carry/bin/alpha_bench ] || { echo "no alpha_bench in .carry"; status=1; continue; }
+      ncu_bin=$(command -v ncu || ls /usr/local/cuda/bin/ncu /opt/nvidia/nsight-compute/*/ncu 2>/dev/null | head -n 1)
+      if [ -z "$ncu_bin" ]; then
+        echo "kernels: no ncu on this machine"
+        status=1
+        continue
+      fi
       for dist in ${GALPHA_KERNEL_DISTS:-uniform}; do
-        run_step "kernels_$dist" 240 ncu --csv --page raw --print-units base --clock-control none \
+        run_step "kernels_$dist" 240 "$ncu_bin" --csv --page raw --print-units base --clock-control none \
           --metrics gpu__time_duration.sum --kernel-name-base demangled \
           .carry/bin/alpha_bench --backend=cuda --sizes=1000000 --dists="$dist" --repeat=1 --cgal-max=0
         echo "== $dist"
