@@ -29,8 +29,9 @@ cmake --build --preset "$preset" -j"$(nproc)"
 step_done "build ($preset)"
 ctest --preset "$preset"
 step_done "ctest ($preset)"
-# Formatting and static analysis, as errors (.clang-format, .clang-tidy).
-scripts/lint.sh --build-dir "build/$preset"
+# Formatting and static analysis, as errors (.clang-format, .clang-tidy): clang-tidy on the shipped
+# code only (scripts/lint.sh says why; the tests and benchmarks are tidied before they are committed).
+scripts/lint.sh --build-dir "build/$preset" --tidy-scope=product
 step_done "format and clang-tidy"
 # AddressSanitizer + UBSan and ThreadSanitizer on the CPU build (a chosen subset: CI's time budget).
 scripts/sanitize.sh
