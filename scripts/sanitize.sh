@@ -16,7 +16,8 @@
 # Both presets compile at -O1 -g1 (CMAKE_CXX_FLAGS_RELWITHDEBINFO), the level the sanitizers'
 # documentation recommends, with line tables for their reports. On the 2-core machine this step
 # (both builds and their tests, from scratch) took 1,334 s at -O2 -g and 690 s at -O1 -g1; the
-# engine's two Thrust translation units, compiled side by side, 110 s and 53 s. GCC's
+# engine's two Thrust translation units, compiled side by side, 110 s and 53 s. Without the
+# service's tests in the ASan build: 534 s (in CI's script, 2026-11-26). GCC's
 # -Wmaybe-uninitialized is off in these two builds: at -O1 under the instrumentation it reports
 # false positives inside GoogleTest's own matchers. The Release build keeps the warning.
 # Usage: scripts/sanitize.sh [asan|tsan]...   (default: both)
