@@ -27,7 +27,8 @@ function(galpha_add_test)
   # fixtures gain nothing from -O3, which took twice as long to compile them (alphactl_test.cpp:
   # 56 s against 28 s on the 2-core machine), and they are 63 of the 152 units CI compiles. The
   # header-only exact arithmetic the unit tests include runs at -O1 there: the same IEEE results
-  # (no FMA contraction, no fast-math at any level), and the engine's libraries test it at -O3.
+  # (no FMA contraction, no fast-math at any level), and the engine libraries that the family tests
+  # exercise compile it at -O3.
   target_compile_options(${ARG_NAME} PRIVATE $<$<AND:$<CONFIG:Release>,$<COMPILE_LANGUAGE:CXX>>:-O1>)
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LIBS} GTest::gtest GTest::gtest_main)
   add_test(NAME ${ARG_NAME} COMMAND ${ARG_NAME})
