@@ -196,19 +196,14 @@ GALPHA_HD inline bool EdgeLengthFormEqual(const EdgeLengthForm& a, const EdgeLen
          a.minor_tail == b.minor_tail;
 }
 
-}  // namespace radius_detail
-
 /// A simplex's edges in EdgeLengthForm, sorted (one for an edge, three for a triangle): what
 /// RadiusCongruent compares.
 struct CongruenceForm {
-  int n = 0;  // the simplex's points: 2 (an edge) or 3 (a triangle)
-  radius_detail::EdgeLengthForm edge[3] = {};
+  EdgeLengthForm edge[3] = {};
 };
 
 GALPHA_HD inline CongruenceForm CongruenceFormOf(const Point2* p, int n) {
-  using namespace radius_detail;
   CongruenceForm form;
-  form.n = n;
   form.edge[0] = EdgeLengthFormOf(p[0], p[1]);
   if (n == 3) {
     form.edge[1] = EdgeLengthFormOf(p[0], p[2]);
@@ -226,28 +221,26 @@ GALPHA_HD inline CongruenceForm CongruenceFormOf(const Point2* p, int n) {
   return form;
 }
 
-/// Whether two forms prove equal values: the simplices have the same squared edge lengths, each
-/// read from its edge vector's coordinates up to their signs and order (so translations,
-/// half-turns, quarter-turns and mirrors in the axes and diagonals, the copies a lattice's cells
-/// come in, and more). A triangle's rho^2 is a symmetric function of its three squared edge
-/// lengths (abc / 4A with Heron's formula for A: equal side lengths, congruent triangles), an
-/// edge's is its squared length / 4; so equal forms mean equal values. The coordinates are
-/// compared exactly in error-free form; an overflowing difference compares unequal (NaN). False
-/// proves nothing (equal lengths from other coordinates, (3, 4) and (5, 0), are not seen).
-GALPHA_HD inline bool SameCongruenceForm(const CongruenceForm& a, const CongruenceForm& b) {
-  if (a.n != b.n) return false;
-  const int m = a.n == 2 ? 1 : 3;
+}  // namespace radius_detail
+
+/// Whether rho^2(a) and rho^2(b) are equal because the simplices have the same squared edge
+/// lengths, each read from its edge vector's coordinates up to their signs and order (so
+/// translations, half-turns, quarter-turns and mirrors in the axes and diagonals, the copies a
+/// lattice's cells come in, and more). A triangle's rho^2 is a symmetric function of its three
+/// squared edge lengths (abc / 4A with Heron's formula for A: equal side lengths, congruent
+/// triangles), an edge's is its squared length / 4; so equal forms mean equal values. The
+/// coordinates are compared exactly in error-free form; an overflowing difference compares unequal
+/// (NaN). False proves nothing (equal lengths from other coordinates, (3, 4) and (5, 0), are not
+/// seen).
+GALPHA_HD inline bool RadiusCongruent(const Point2* a, int na, const Point2* b, int nb) {
+  using namespace radius_detail;
+  if (na != nb) return false;
+  const CongruenceForm fa = CongruenceFormOf(a, na), fb = CongruenceFormOf(b, nb);
+  const int m = na == 2 ? 1 : 3;
   for (int k = 0; k < m; ++k) {
-    if (!radius_detail::EdgeLengthFormEqual(a.edge[k], b.edge[k])) return false;
+    if (!EdgeLengthFormEqual(fa.edge[k], fb.edge[k])) return false;
   }
   return true;
-}
-
-/// Whether rho^2(a) and rho^2(b) are equal because the simplices are congruent, seen by their
-/// edges' coordinates (SameCongruenceForm). False proves nothing.
-GALPHA_HD inline bool RadiusCongruent(const Point2* a, int na, const Point2* b, int nb) {
-  if (na != nb) return false;
-  return SameCongruenceForm(CongruenceFormOf(a, na), CongruenceFormOf(b, nb));
 }
 
 }  // namespace galpha
