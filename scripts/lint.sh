@@ -48,6 +48,14 @@ for step in "${steps[@]}"; do
         echo "lint: no compile_commands.json (build first, or pass --build-dir)" >&2
         exit 2
       fi
+      # With GALPHA_UNITY_TESTS on, the test files are not units of their own in the compilation
+      # database, so the whole scope would skip them without a word.
+      if [ "$tidy_scope" = all ] && grep -q '^GALPHA_UNITY_TESTS:BOOL=ON$' "$build_dir/CMakeCache.txt" 2>/dev/null; then
+        echo "lint: $build_dir compiles each test executable as one unit (GALPHA_UNITY_TESTS=ON, as" \
+          "scripts/test.sh configures it): reconfigure it with -DGALPHA_UNITY_TESTS=OFF and build, or" \
+          "pass --tidy-scope=product" >&2
+        exit 2
+      fi
       # Our translation units only: not the generated protobuf code under the build folder.
       root=$(pwd)
       dirs="core|gpu|server|client|python|proto"

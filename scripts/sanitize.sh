@@ -32,7 +32,7 @@ run_preset() {
   local preset=$1
   shift
   local tests=("$@")
-  cmake --preset "$preset" >/dev/null
+  cmake --preset "$preset" -DGALPHA_UNITY_TESTS=ON >/dev/null
   cmake --build --preset "$preset" -j"$(nproc)" --target "${tests[@]}"
   local regex
   regex="^($(IFS='|'; echo "${tests[*]}"))\$"

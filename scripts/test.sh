@@ -28,7 +28,9 @@ export OMP_WAIT_POLICY=passive
 # GPU runs (bench/gpu_bundle.sh, bench/gpu_run.sh) build and test it.
 preset=cpu
 if command -v nvidia-smi >/dev/null && nvidia-smi -L 2>/dev/null | grep -q '^GPU'; then preset=cuda; fi
-cmake --preset "$preset" -DGALPHA_BUILD_PYTHON=ON
+# Each test executable as one translation unit (GALPHA_UNITY_TESTS): its files parse GoogleTest,
+# gRPC and Thrust once (CMakeLists.txt says what it saves).
+cmake --preset "$preset" -DGALPHA_BUILD_PYTHON=ON -DGALPHA_UNITY_TESTS=ON
 cmake --build --preset "$preset" -j"$(nproc)"
 step_done "build ($preset)"
 # Two at a time, the longest first (their COST): the pytest suite and the service test spend much
