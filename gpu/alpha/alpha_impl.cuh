@@ -397,8 +397,19 @@ uint64_t RepairTiedRuns(System& sys, const PipelineMesh& mesh, HostMesh<System>&
     thrust::transform(policy, tied.data(), tied.data() + num_tied, length.data(),
                       NegatedRunLength{runs.run_begin.data()});
     thrust::sort_by_key(policy, length.data(), length.data() + num_tied, tied.data());
+    // Every pair of neighbours in the short runs compared at once (pair index major: see
+    // OrderRunNeighbours), then each run checked, and sorted only if out of order.
+    const uint32_t longest = std::min(~sys.Read(length.data()), kMaxDeviceRun);
+    const uint64_t num_pair_threads = uint64_t{num_tied} * (longest - 1);
+    if (num_pair_threads > 0xFFFFFFFFull) {
+      throw EngineError(EngineError::Kind::kInternal, "too many tied runs for one launch of neighbour comparisons");
+    }
+    Buffer<uint8_t, System> verdict(sys, spectrum->num_entries);
+    thrust::for_each_n(policy, zero, static_cast<uint32_t>(num_pair_threads),
+                       OrderRunNeighbours{mesh.simplex(), tied.data(), num_tied, runs.run_begin.data(),
+                                          spectrum->ids.data(), verdict.data()});
     thrust::for_each_n(policy, tied.data(), num_tied,
-                       RepairRun{mesh.simplex(), runs.run_begin.data(), run_end, spectrum->ids.data(),
+                       RepairRun{mesh.simplex(), runs.run_begin.data(), run_end, verdict.data(), spectrum->ids.data(),
                                  spectrum->new_value.data(), needs_host.data(), run_comparisons.data()});
   }
   tied.Reset();

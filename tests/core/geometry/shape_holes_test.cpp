@@ -22,13 +22,13 @@ using testing::IsOk;
 
 // A grid of (n + 1) x (n + 1) points with spacing 1 from (x0, y0), and the two counter-clockwise
 // triangles of every unit square except those in `empty` (squares by their lower-left corner).
-struct Grid {
+struct HoleGrid {
   std::vector<Point2> points;
   std::vector<std::array<uint32_t, 3>> triangles;
 };
 
-Grid MakeGrid(int n, double x0, double y0, const std::vector<std::array<int, 2>>& empty) {
-  Grid g;
+HoleGrid MakeGrid(int n, double x0, double y0, const std::vector<std::array<int, 2>>& empty) {
+  HoleGrid g;
   for (int j = 0; j <= n; ++j) {
     for (int i = 0; i <= n; ++i) g.points.push_back({x0 + i, y0 + j});
   }
@@ -45,7 +45,7 @@ Grid MakeGrid(int n, double x0, double y0, const std::vector<std::array<int, 2>>
   return g;
 }
 
-absl::StatusOr<ShapeGeometry> Assemble(const Grid& g) {
+absl::StatusOr<ShapeGeometry> Assemble(const HoleGrid& g) {
   ShapeComplex complex;
   complex.points = g.points;
   complex.triangles = g.triangles;
@@ -54,7 +54,7 @@ absl::StatusOr<ShapeGeometry> Assemble(const Grid& g) {
 
 TEST(ShapeHolesTest, ListsEachHoleWithItsArea) {
   // 6 x 6 squares; a 2 x 2 hole at (1, 1) and a 1 x 1 hole at (4, 4).
-  const Grid g = MakeGrid(6, 0, 0, {{1, 1}, {2, 1}, {1, 2}, {2, 2}, {4, 4}});
+  const HoleGrid g = MakeGrid(6, 0, 0, {{1, 1}, {2, 1}, {1, 2}, {2, 2}, {4, 4}});
   const absl::StatusOr<ShapeGeometry> shape = Assemble(g);
   ASSERT_THAT(shape, IsOk());
   ASSERT_EQ(shape->polygons.size(), 1u);
@@ -72,7 +72,7 @@ TEST(ShapeHolesTest, ListsEachHoleWithItsArea) {
 }
 
 TEST(ShapeHolesTest, FillsTheSmallHolesOnly) {
-  const Grid g = MakeGrid(6, 0, 0, {{1, 1}, {2, 1}, {1, 2}, {2, 2}, {4, 4}});
+  const HoleGrid g = MakeGrid(6, 0, 0, {{1, 1}, {2, 1}, {1, 2}, {2, 2}, {4, 4}});
   absl::StatusOr<ShapeGeometry> shape = Assemble(g);
   ASSERT_THAT(shape, IsOk());
   EXPECT_EQ(FillHolesSmallerThan(&*shape, g.points, 2.0), 1u);
@@ -88,7 +88,7 @@ TEST(ShapeHolesTest, FillsTheSmallHolesOnly) {
 
 TEST(ShapeHolesTest, AreasSurviveALargeOffset) {
   // At 1e9 the products of absolute coordinates would lose the unit squares; differences keep them.
-  const Grid g = MakeGrid(4, 1e9, -3e9, {{1, 1}, {2, 1}});
+  const HoleGrid g = MakeGrid(4, 1e9, -3e9, {{1, 1}, {2, 1}});
   const absl::StatusOr<ShapeGeometry> shape = Assemble(g);
   ASSERT_THAT(shape, IsOk());
   const std::vector<ShapeHole> holes = ListHoles(*shape, g.points, 0.0);

@@ -1,6 +1,7 @@
-// The exact repair of the spectrum's short runs (RepairRun in gpu/alpha/alpha_functors.cuh), run on
-// the host as the OpenMP backend runs it, against GMP rationals: runs of near ties, congruent
-// copies and exact ties that are not copies, shuffled, must come out in exact order with every
+// The exact repair of the spectrum's short runs (OrderRunNeighbours, then RepairRun, in
+// gpu/alpha/alpha_functors.cuh), run on the host as the OpenMP backend runs it, against GMP
+// rationals: runs of near ties, congruent copies and exact ties that are not copies, shuffled or
+// already in exact order (as the keys leave most runs), must come out in exact order with every
 // new value marked. The inputs are what the runs hold on real data: centimetre-quantized
 // coordinates far from the origin (copies and co-circular ties by the thousand), points on a
 // circle (values 2^-40 to 2^-100 apart, which the double-double enclosures separate without the
@@ -60,12 +61,14 @@ int Compare(const SimplexPool& pool, uint32_t a, uint32_t b) {
 
 struct Outcome {
   int runs = 0;
+  int in_order = 0;      // runs whose neighbours' verdicts were all Less or Equal: marked, not sorted
   int ties = 0;          // adjacent pairs of equal value in the repaired runs
   uint64_t bounded = 0;  // comparisons that needed the bounded exact arithmetic
 };
 
 // Repairs `trials` runs of 2..16 entries drawn from the pool, each run made of simplices whose
-// values are close (the pool sorted by exact value, a window of it, shuffled), and checks each
+// values are close (the pool sorted by exact value, a window of it: shuffled in odd trials, in
+// exact order in even ones, with its equal values in the sort's arbitrary order), and checks each
 // against GMP.
 Outcome RepairRandomRuns(const SimplexPool& pool, int trials, uint64_t seed) {
   std::vector<uint32_t> by_value(pool.size());
@@ -77,18 +80,37 @@ Outcome RepairRandomRuns(const SimplexPool& pool, int trials, uint64_t seed) {
     const uint32_t length = 2 + static_cast<uint32_t>(rng() % (kMaxDeviceRun - 1));
     const uint32_t start = static_cast<uint32_t>(rng() % (pool.size() - length));
     std::vector<uint32_t> ids(by_value.begin() + start, by_value.begin() + start + length);
-    std::shuffle(ids.begin(), ids.end(), rng);
+    if (t % 2 == 1) std::shuffle(ids.begin(), ids.end(), rng);
     const std::vector<uint32_t> before = ids;
-    const uint32_t begin = 0, end = length;
+    const uint32_t run_begin[2] = {0, length};
+    const uint32_t tied = 0;
+    std::vector<uint8_t> verdict(length, 0xFF);  // a sentinel: the last entry's stays unread
+    for (uint32_t pair = 0; pair + 1 < length; ++pair) {
+      OrderRunNeighbours{pool.view(), &tied, 1, run_begin, ids.data(), verdict.data()}(pair);
+    }
+    bool neighbours_in_order = true;
+    for (uint32_t i = 0; i + 1 < length; ++i) {
+      const int c = Compare(pool, ids[i], ids[i + 1]);
+      const Order order = DecodeVerdict(verdict[i]);
+      if (order != Order::kUndecided) {
+        EXPECT_EQ(static_cast<int>(order), c) << "verdict " << i << " in trial " << t;
+      }
+      neighbours_in_order = neighbours_in_order && c <= 0 && order != Order::kUndecided;
+    }
     std::vector<uint8_t> new_value(length, 7);  // a sentinel: every mark must be written
     uint8_t needs_host = 9;
     uint32_t comparisons = 0;
-    RepairRun{pool.view(), &begin, &end, ids.data(), new_value.data(), &needs_host, &comparisons}(0);
+    RepairRun{pool.view(), &run_begin[0], &run_begin[1], verdict.data(), ids.data(), new_value.data(), &needs_host,
+              &comparisons}(0);
     if (needs_host != 0) {
       EXPECT_EQ(ids, before) << "a run left for the host must keep its order";
       continue;
     }
     ++outcome.runs;
+    if (neighbours_in_order) {
+      ++outcome.in_order;
+      EXPECT_EQ(ids, before) << "a run in exact order must keep its order (trial " << t << ")";
+    }
     outcome.bounded += comparisons;
     std::vector<uint32_t> sorted_ids = ids, sorted_before = before;
     std::sort(sorted_ids.begin(), sorted_ids.end());
@@ -114,6 +136,7 @@ TEST(RunRepairTest, CentimetreQuantizedCoordinatesFarFromTheOrigin) {
   });
   const Outcome outcome = RepairRandomRuns(pool, 3000, 12);
   EXPECT_GT(outcome.runs, 2500);
+  EXPECT_GT(outcome.in_order, 1200);  // the even trials: marked from the neighbours' verdicts
   EXPECT_GT(outcome.ties, 1000);  // congruent copies and co-circular triangles
 }
 
@@ -126,6 +149,7 @@ TEST(RunRepairTest, PointsOnACircle) {
   });
   const Outcome outcome = RepairRandomRuns(pool, 3000, 22);
   EXPECT_GT(outcome.runs, 2900);
+  EXPECT_GT(outcome.in_order, 1400);
   // Every triangle's value lies within rounding of the circle's: near ties, which the enclosures
   // order without the bounded arithmetic.
   EXPECT_LT(outcome.bounded, 100u);
@@ -145,6 +169,7 @@ TEST(RunRepairTest, UlpPerturbedLattice) {
   });
   const Outcome outcome = RepairRandomRuns(pool, 3000, 32);
   EXPECT_GT(outcome.runs, 2500);
+  EXPECT_GT(outcome.in_order, 1200);
 }
 
 }  // namespace
