@@ -57,6 +57,7 @@ class DelaunayBuilder {
         tri_(sys, capacity_),
         nbr_(sys, capacity_),
         tri_vote_(sys, capacity_),
+        edge_vote_(sys, capacity_),
         split_count_or_nb_(sys, capacity_),
         flip_vote_(sys, capacity_),
         partner_(sys, capacity_),
@@ -78,6 +79,7 @@ class DelaunayBuilder {
   /// Frees everything but the mesh once it is final (before the output stage).
   void ReleaseWorkspace() {
     tri_vote_.Reset();
+    edge_vote_.Reset();
     split_count_or_nb_.Reset();
     flip_vote_.Reset();
     partner_.Reset();
@@ -123,32 +125,48 @@ class DelaunayBuilder {
     uint32_t* pending_count = counts_.data() + kPendingCount;
     thrust::fill(pol, pending_count, pending_count + 1, num_pending);
     Relocate(pending, location, inserted, num_pending);
+    uint32_t* second_count = counts_.data() + kSecondCount;
     for (;;) {
       ++rounds_;
       thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
-      sys_.ForEachBelow(pending_count, VoteForInsertion{mesh_, pending, location, tri_vote_.data()});
+      thrust::fill(pol, edge_vote_.data(), edge_vote_.data() + num_tri_, kNoVote);
+      thrust::fill(pol, second_count, second_count + 1, 0u);
+      sys_.ForEachBelow(pending_count,
+                        VoteForInsertion{mesh_, pending, location, tri_vote_.data(), edge_vote_.data()});
+      const thrust::counting_iterator<int32_t> tfirst(0);
+      thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                       PickSecondWinners{tri_vote_.data(), edge_vote_.data(), second_count});
       // Inclusive, so that its last entry is the number of splits.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
                                        HasWinner(), thrust::plus<int32_t>());
-      // The round's one wait: splits, pending points, and whether a relocation walk failed.
+      // The round's one wait: splits, second splits, pending points, and whether a relocation
+      // walk failed.
       int32_t num_split = 0;
+      uint32_t num_second = 0;
       int32_t walk_failed = 0;
       sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
+                     {&num_second, second_count, sizeof(uint32_t)},
                      {&num_pending, pending_count, sizeof(uint32_t)},
                      {&walk_failed, flags_.data(), sizeof(int32_t)}});
       if (walk_failed != 0) throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
       if (num_pending == 0) return;
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
-      const thrust::counting_iterator<int32_t> tfirst(0);
-      thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       SplitTriangles{mesh_, tri_vote_.data(), split_count_or_nb_.data(), pending, inserted, num_tri_});
-      thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       LinkSplitChildren{mesh_, tri_vote_.data(), split_count_or_nb_.data(), num_tri_});
-      thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       ListSplitChildren{tri_vote_.data(), split_count_or_nb_.data(), active_.data(), num_tri_});
-      num_tri_ += 2 * num_split;
-      thrust::fill(pol, active_mask_.data(), active_mask_.data() + 3 * num_split, kCheckOutsideEdge);
-      RestoreDelaunay(static_cast<uint32_t>(3 * num_split), /*hull_may_change=*/true);
+      SplitElected(pending, inserted, num_split, /*num_listed=*/3, 0);
+      if (num_second > 0) {
+        // The second winners split the children that hold them; the number of those splits is
+        // known without a wait (one per triangle that had a second winner).
+        const int32_t num_tri_before = num_tri_ - 2 * num_split;
+        thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
+        thrust::for_each(pol, tfirst, tfirst + num_tri_before,
+                         PlaceSecondWinners{mesh_, pending, edge_vote_.data(), tri_vote_.data(), flags_.data(),
+                                            m_ + 16u});
+        thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
+                                         split_count_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
+        SplitElected(pending, inserted, static_cast<int32_t>(num_second), /*num_listed=*/2, 3 * num_split);
+      }
+      const uint32_t num_active = static_cast<uint32_t>(3 * num_split) + 2 * num_second;
+      thrust::fill(pol, active_mask_.data(), active_mask_.data() + num_active, kCheckOutsideEdge);
+      RestoreDelaunay(num_active, /*hull_may_change=*/true);
 
       Relocate(pending, location, inserted, num_pending);
       auto zipped = thrust::make_zip_iterator(thrust::make_tuple(pending, location));
@@ -265,6 +283,23 @@ class DelaunayBuilder {
     return 2 * static_cast<uint32_t>(flips);
   }
 
+  /// Splits the `num_split` triangles that tri_vote_ elected (split_count_or_nb_ holds the
+  /// inclusive scan of their votes), re-links them and lists `num_listed` children of each in
+  /// active_ from `active_offset` on; the mesh grows by two triangles a split.
+  void SplitElected(const int32_t* pending, uint8_t* inserted, int32_t num_split, int num_listed,
+                    int32_t active_offset) {
+    auto pol = sys_.policy();
+    const thrust::counting_iterator<int32_t> tfirst(0);
+    thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                     SplitTriangles{mesh_, tri_vote_.data(), split_count_or_nb_.data(), pending, inserted, num_tri_});
+    thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                     LinkSplitChildren{mesh_, tri_vote_.data(), split_count_or_nb_.data(), num_tri_});
+    thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                     ListSplitChildren{tri_vote_.data(), split_count_or_nb_.data(), active_.data() + active_offset,
+                                       num_tri_, num_listed});
+    num_tri_ += 2 * num_split;
+  }
+
   int32_t* candidates() {
     static_assert(sizeof(unsigned long long) == 2 * sizeof(int32_t), "candidates share the vote buffer");
     return reinterpret_cast<int32_t*>(tri_vote_.data());
@@ -339,6 +374,8 @@ class DelaunayBuilder {
   // Insertion votes while splitting; while flipping, the same bytes hold 2 * capacity_ flip
   // candidates (int32): the two are never live at once, and sharing them saves 8 bytes a point.
   Buffer<unsigned long long, System> tri_vote_;
+  // The votes of points on an edge's line, then each triangle's second winner (VoteForInsertion).
+  Buffer<unsigned long long, System> edge_vote_;
   // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while
   // flipping: never both at once, so one buffer serves both.
   Buffer<int32_t, System> split_count_or_nb_;
@@ -357,7 +394,8 @@ class DelaunayBuilder {
   static constexpr int kGeneration = 3;
   static constexpr int kTailCount = 4;
   static constexpr int kTailIterations = 5;
-  static constexpr int kNumCounts = 6;
+  static constexpr int kSecondCount = 6;
+  static constexpr int kNumCounts = 7;
   // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): four items
   // a lane of its 256, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;

@@ -36,17 +36,28 @@ GALPHA_HD inline int ScoreExponent(double a, double b, double c, double d) {
 /// well shaped); infinite ones the point farthest outside their hull edge. The choice is a
 /// heuristic only, so approximate doubles are fine here; but ties must be rare, or the smallest
 /// index (an end of a run of points along a line, in Hilbert order) wins every round.
+///
+/// A finite triangle's points are voted in two classes: those on one of its edges' lines (in
+/// doubles; a heuristic too) in `edge_vote`, the others in `tri_vote`. PickSecondWinners then
+/// makes the better of the two the round's winner and keeps the other class's best for a second
+/// split of the same triangle in the same round. Two crossing lines of points need it: near the
+/// crossing one triangle holds the second line's points inside it and the first line's on its
+/// edge, and with one winner a round the two lines took turns there, so the second line fell
+/// behind by a factor that doubled every two rounds and its late points then took over fans of
+/// the first line's hundreds of points, one flip an iteration (bench/README.md, two_lines).
 struct VoteForInsertion {
   MeshView mesh;
-  const int32_t* pending;        // vertex of each uninserted point
-  const int32_t* location;       // triangle containing it
-  unsigned long long* tri_vote;  // per triangle, kNoVote when nobody voted
+  const int32_t* pending;         // vertex of each uninserted point
+  const int32_t* location;        // triangle containing it
+  unsigned long long* tri_vote;   // per triangle, kNoVote when nobody voted
+  unsigned long long* edge_vote;  // per triangle: the votes of points on an edge's line
 
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t t = location[i];
     const Point2 p = mesh.pts[pending[i]];
     const Tri x = mesh.tri[t];
     float score;
+    bool on_edge_line = false;
     int inf_pos = -1;
     for (int k = 0; k < 3; ++k) {
       if (x.v[k] == mesh.inf) inf_pos = k;
@@ -79,6 +90,8 @@ struct VoteForInsertion {
       const double px = ldexp(p.x - a.x, -e), py = ldexp(p.y - a.y, -e);
       const double d = bx * cy - by * cx;
       const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+      on_edge_line = bx * py - by * px == 0.0 || cx * py - cy * px == 0.0 ||
+                     (cx - bx) * (py - by) - (cy - by) * (px - bx) == 0.0;
       if (d != 0.0) {
         const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
         score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
@@ -101,8 +114,49 @@ struct VoteForInsertion {
       }
     }
     const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
-    cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(tri_vote[t]);
+    cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(on_edge_line ? edge_vote[t] : tri_vote[t]);
     slot.fetch_min(key);
+  }
+};
+
+/// Per triangle: the better of its two classes' votes becomes the round's winner (`tri_vote`),
+/// the other class's best, where both voted, its second winner (`edge_vote`, else kNoVote),
+/// counted into `*num_second`.
+struct PickSecondWinners {
+  unsigned long long* tri_vote;
+  unsigned long long* edge_vote;
+  uint32_t* num_second;
+  GALPHA_HD void operator()(int32_t t) const {
+    const unsigned long long inside = tri_vote[t], on_edge = edge_vote[t];
+    tri_vote[t] = inside < on_edge ? inside : on_edge;
+    const bool both = inside != kNoVote && on_edge != kNoVote;
+    edge_vote[t] = both ? (inside < on_edge ? on_edge : inside) : kNoVote;
+    if (both) {
+      cuda::atomic_ref<uint32_t, cuda::thread_scope_device> count(*num_second);
+      count.fetch_add(1u);
+    }
+  }
+};
+
+/// After the first splits of a round: each second winner walks from its triangle's slot (now the
+/// first split's child 2) to the child that holds it, and votes there alone (`second_vote`,
+/// cleared to kNoVote for every triangle beforehand).
+struct PlaceSecondWinners {
+  MeshView mesh;
+  const int32_t* pending;
+  const unsigned long long* edge_vote;  // PickSecondWinners's, per triangle before the splits
+  unsigned long long* second_vote;
+  int32_t* walk_failed;
+  uint32_t max_steps;
+  GALPHA_HD void operator()(int32_t t) const {
+    const unsigned long long vote = edge_vote[t];
+    if (vote == kNoVote) return;
+    const int32_t child = mesh.Locate(t, pending[static_cast<uint32_t>(vote & 0xffffffffu)], max_steps);
+    if (child < 0) {
+      *walk_failed = 1;
+      return;
+    }
+    second_vote[child] = vote;
   }
 };
 
@@ -173,16 +227,21 @@ struct LinkSplitChildren {
   }
 };
 
-/// Lists the three children of every split triangle: the first triangles to check for flips.
+/// Lists the children of every split triangle: the first triangles to check for flips. A second
+/// split lists only its two fresh children (`num_listed` 2): its child 2 keeps the slot of a
+/// first split's child, which is listed already.
 struct ListSplitChildren {
   const unsigned long long* tri_vote;
   const int32_t* split_count;  // inclusive scan of HasWinner
   int32_t* active;
   int32_t num_tri;
+  int num_listed;
 
   GALPHA_HD void operator()(int32_t t) const {
     if (tri_vote[t] == kNoVote) return;
-    for (int k = 0; k < 3; ++k) active[3 * (split_count[t] - 1) + k] = ChildSlot(t, k, split_count[t], num_tri);
+    for (int k = 0; k < num_listed; ++k) {
+      active[num_listed * (split_count[t] - 1) + k] = ChildSlot(t, k, split_count[t], num_tri);
+    }
   }
 };
 
