@@ -189,7 +189,7 @@ GALPHA_HD inline Order DecodeVerdict(uint8_t verdict) { return static_cast<Order
 /// longest first, the threads with work at each pair index are a prefix, so warps stay full.
 struct OrderRunNeighbours {
   SimplexPoints simplex;
-  const uint32_t* tied;       // runs of two entries or more, longest first
+  const uint32_t* tied;  // runs of two entries or more, longest first
   uint32_t num_tied;
   const uint32_t* run_begin;  // each run's first entry, then the number of entries
   const uint32_t* ids;        // sorted spectrum entries

@@ -131,8 +131,7 @@ class DelaunayBuilder {
       thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
       thrust::fill(pol, edge_vote_.data(), edge_vote_.data() + num_tri_, kNoVote);
       thrust::fill(pol, second_count, second_count + 1, 0u);
-      sys_.ForEachBelow(pending_count,
-                        VoteForInsertion{mesh_, pending, location, tri_vote_.data(), edge_vote_.data()});
+      sys_.ForEachBelow(pending_count, VoteForInsertion{mesh_, pending, location, tri_vote_.data(), edge_vote_.data()});
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
                        PickSecondWinners{tri_vote_.data(), edge_vote_.data(), second_count});
@@ -157,11 +156,11 @@ class DelaunayBuilder {
         // known without a wait (one per triangle that had a second winner).
         const int32_t num_tri_before = num_tri_ - 2 * num_split;
         thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
-        thrust::for_each(pol, tfirst, tfirst + num_tri_before,
-                         PlaceSecondWinners{mesh_, pending, edge_vote_.data(), tri_vote_.data(), flags_.data(),
-                                            m_ + 16u});
-        thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_,
-                                         split_count_or_nb_.data(), HasWinner(), thrust::plus<int32_t>());
+        thrust::for_each(
+            pol, tfirst, tfirst + num_tri_before,
+            PlaceSecondWinners{mesh_, pending, edge_vote_.data(), tri_vote_.data(), flags_.data(), m_ + 16u});
+        thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
+                                         HasWinner(), thrust::plus<int32_t>());
         SplitElected(pending, inserted, static_cast<int32_t>(num_second), /*num_listed=*/2, 3 * num_split);
       }
       const uint32_t num_active = static_cast<uint32_t>(3 * num_split) + 2 * num_second;

@@ -90,8 +90,8 @@ struct VoteForInsertion {
       const double px = ldexp(p.x - a.x, -e), py = ldexp(p.y - a.y, -e);
       const double d = bx * cy - by * cx;
       const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-      on_edge_line = bx * py - by * px == 0.0 || cx * py - cy * px == 0.0 ||
-                     (cx - bx) * (py - by) - (cy - by) * (px - bx) == 0.0;
+      on_edge_line =
+          bx * py - by * px == 0.0 || cx * py - cy * px == 0.0 || (cx - bx) * (py - by) - (cy - by) * (px - bx) == 0.0;
       if (d != 0.0) {
         const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
         score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)

@@ -100,8 +100,8 @@ Outcome RepairRandomRuns(const SimplexPool& pool, int trials, uint64_t seed) {
     std::vector<uint8_t> new_value(length, 7);  // a sentinel: every mark must be written
     uint8_t needs_host = 9;
     uint32_t comparisons = 0;
-    RepairRun{pool.view(), &run_begin[0], &run_begin[1], verdict.data(), ids.data(), new_value.data(), &needs_host,
-              &comparisons}(0);
+    RepairRun{pool.view(), &run_begin[0],    &run_begin[1], verdict.data(),
+              ids.data(),  new_value.data(), &needs_host,   &comparisons}(0);
     if (needs_host != 0) {
       EXPECT_EQ(ids, before) << "a run left for the host must keep its order";
       continue;
@@ -137,7 +137,7 @@ TEST(RunRepairTest, CentimetreQuantizedCoordinatesFarFromTheOrigin) {
   const Outcome outcome = RepairRandomRuns(pool, 3000, 12);
   EXPECT_GT(outcome.runs, 2500);
   EXPECT_GT(outcome.in_order, 1200);  // the even trials: marked from the neighbours' verdicts
-  EXPECT_GT(outcome.ties, 1000);  // congruent copies and co-circular triangles
+  EXPECT_GT(outcome.ties, 1000);      // congruent copies and co-circular triangles
 }
 
 TEST(RunRepairTest, PointsOnACircle) {
