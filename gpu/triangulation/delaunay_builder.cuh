@@ -66,7 +66,7 @@ class DelaunayBuilder {
         active_mask_(sys, capacity_),
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
-        flags_(sys, 2),
+        flags_(sys, 3),
         counts_(sys, kNumCounts) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
@@ -143,11 +143,16 @@ class DelaunayBuilder {
       int32_t num_split = 0;
       uint32_t num_second = 0;
       int32_t walk_failed = 0;
+      int32_t second_left_parent = 0;
       sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
                      {&num_second, second_count, sizeof(uint32_t)},
                      {&num_pending, pending_count, sizeof(uint32_t)},
-                     {&walk_failed, flags_.data(), sizeof(int32_t)}});
+                     {&walk_failed, flags_.data(), sizeof(int32_t)},
+                     {&second_left_parent, flags_.data() + 2, sizeof(int32_t)}});
       if (walk_failed != 0) throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
+      if (second_left_parent != 0) {
+        throw EngineError(EngineError::Kind::kInternal, "a second winner of an insertion round left its triangle");
+      }
       if (num_pending == 0) return;
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       SplitElected(pending, inserted, num_split, /*num_listed=*/3, 0);
@@ -158,7 +163,8 @@ class DelaunayBuilder {
         thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
         thrust::for_each(
             pol, tfirst, tfirst + num_tri_before,
-            PlaceSecondWinners{mesh_, pending, edge_vote_.data(), tri_vote_.data(), flags_.data(), m_ + 16u});
+            PlaceSecondWinners{mesh_, pending, edge_vote_.data(), split_count_or_nb_.data(), num_tri_before,
+                               tri_vote_.data(), flags_.data(), flags_.data() + 2, m_ + 16u});
         thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
                                          HasWinner(), thrust::plus<int32_t>());
         SplitElected(pending, inserted, static_cast<int32_t>(num_second), /*num_listed=*/2, 3 * num_split);
@@ -385,7 +391,8 @@ class DelaunayBuilder {
   Buffer<uint8_t, System> active_mask_;
   Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
-  Buffer<int32_t, System> flags_;  // [0] walk or repair failed, [1] serial repair flips
+  // [0] walk or repair failed, [1] serial repair flips, [2] a second winner left its triangle
+  Buffer<int32_t, System> flags_;
   // Counts kept in system memory between the host's waits, and the flip stamps' generation.
   static constexpr int kPendingCount = 0;
   static constexpr int kEvenIterationCount = 1;

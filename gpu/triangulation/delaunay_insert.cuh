@@ -16,6 +16,13 @@ namespace galpha::detail {
 
 constexpr unsigned long long kNoVote = ~0ull;
 
+/// Where the three children of a split triangle live: child 2 reuses the parent's slot, children
+/// 0 and 1 take two fresh slots after the current triangles. `split_count` is the inclusive scan of
+/// HasWinner, so a split parent is the (split_count - 1)-th split of the round.
+GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_count, int32_t num_tri) {
+  return k == 2 ? parent : num_tri + 2 * (split_count - 1) + k;
+}
+
 /// Maps a float to an unsigned key with the same order (negative values included).
 GALPHA_HD inline uint32_t OrderedFloatKey(float f) {
   uint32_t bits;
@@ -140,13 +147,18 @@ struct PickSecondWinners {
 
 /// After the first splits of a round: each second winner walks from its triangle's slot (now the
 /// first split's child 2) to the child that holds it, and votes there alone (`second_vote`,
-/// cleared to kNoVote for every triangle beforehand).
+/// cleared to kNoVote for every triangle beforehand). The walk cannot leave the three children:
+/// the point was inside its triangle by the same symbolic orientations that split it, which is
+/// also why no two second winners meet in one child. `left_parent` reports a walk that did.
 struct PlaceSecondWinners {
   MeshView mesh;
   const int32_t* pending;
   const unsigned long long* edge_vote;  // PickSecondWinners's, per triangle before the splits
+  const int32_t* split_count;           // the first splits' inclusive scan
+  int32_t num_tri_before;               // triangles before the first splits
   unsigned long long* second_vote;
   int32_t* walk_failed;
+  int32_t* left_parent;
   uint32_t max_steps;
   GALPHA_HD void operator()(int32_t t) const {
     const unsigned long long vote = edge_vote[t];
@@ -154,6 +166,11 @@ struct PlaceSecondWinners {
     const int32_t child = mesh.Locate(t, pending[static_cast<uint32_t>(vote & 0xffffffffu)], max_steps);
     if (child < 0) {
       *walk_failed = 1;
+      return;
+    }
+    if (child != t && child != ChildSlot(t, 0, split_count[t], num_tri_before) &&
+        child != ChildSlot(t, 1, split_count[t], num_tri_before)) {
+      *left_parent = 1;
       return;
     }
     second_vote[child] = vote;
@@ -164,13 +181,6 @@ struct PlaceSecondWinners {
 struct HasWinner {
   GALPHA_HD int32_t operator()(unsigned long long vote) const { return vote != kNoVote ? 1 : 0; }
 };
-
-/// Where the three children of a split triangle live: child 2 reuses the parent's slot, children
-/// 0 and 1 take two fresh slots after the current triangles. `split_count` is the inclusive scan of
-/// HasWinner, so a split parent is the (split_count - 1)-th split of the round.
-GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_count, int32_t num_tri) {
-  return k == 2 ? parent : num_tri + 2 * (split_count - 1) + k;
-}
 
 /// Splits every elected triangle (a, b, c) around its point w into (b, c, w), (c, a, w), (a, b, w):
 /// child k keeps the parent's edge opposite vertex k. Outside neighbours still name the parent
