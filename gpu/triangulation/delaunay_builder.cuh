@@ -126,15 +126,23 @@ class DelaunayBuilder {
     thrust::fill(pol, pending_count, pending_count + 1, num_pending);
     Relocate(pending, location, inserted, num_pending);
     uint32_t* second_count = counts_.data() + kSecondCount;
+    uint32_t* saw_edge_point = counts_.data() + kSawEdgePoint;
+    // Second winners need points on edges' lines; a round whose votes saw none (uniform input,
+    // every round; a circle's points) makes the next one run without them, and without the two
+    // passes they cost.
+    bool second_winners = true;
     for (;;) {
       ++rounds_;
-      thrust::fill(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, kNoVote);
-      thrust::fill(pol, edge_vote_.data(), edge_vote_.data() + num_tri_, kNoVote);
-      thrust::fill(pol, second_count, second_count + 1, 0u);
-      sys_.ForEachBelow(pending_count, VoteForInsertion{mesh_, pending, location, tri_vote_.data(), edge_vote_.data()});
+      unsigned long long* edge_vote = second_winners ? edge_vote_.data() : nullptr;
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       PickSecondWinners{tri_vote_.data(), edge_vote_.data(), second_count});
+                       ResetVotes{tri_vote_.data(), edge_vote, second_count, saw_edge_point});
+      sys_.ForEachBelow(pending_count,
+                        VoteForInsertion{mesh_, pending, location, tri_vote_.data(), edge_vote, saw_edge_point});
+      if (second_winners) {
+        thrust::for_each(pol, tfirst, tfirst + num_tri_,
+                         PickSecondWinners{tri_vote_.data(), edge_vote_.data(), second_count});
+      }
       // Inclusive, so that its last entry is the number of splits.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
                                        HasWinner(), thrust::plus<int32_t>());
@@ -144,8 +152,10 @@ class DelaunayBuilder {
       uint32_t num_second = 0;
       int32_t walk_failed = 0;
       int32_t second_left_parent = 0;
+      uint32_t saw_edge = 0;
       sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
                      {&num_second, second_count, sizeof(uint32_t)},
+                     {&saw_edge, saw_edge_point, sizeof(uint32_t)},
                      {&num_pending, pending_count, sizeof(uint32_t)},
                      {&walk_failed, flags_.data(), sizeof(int32_t)},
                      {&second_left_parent, flags_.data() + 2, sizeof(int32_t)}});
@@ -155,6 +165,7 @@ class DelaunayBuilder {
       }
       if (num_pending == 0) return;
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
+      second_winners = saw_edge != 0;
       SplitElected(pending, inserted, num_split, /*num_listed=*/3, 0);
       if (num_second > 0) {
         // The second winners split the children that hold them; the number of those splits is
@@ -401,7 +412,8 @@ class DelaunayBuilder {
   static constexpr int kTailCount = 4;
   static constexpr int kTailIterations = 5;
   static constexpr int kSecondCount = 6;
-  static constexpr int kNumCounts = 7;
+  static constexpr int kSawEdgePoint = 7;
+  static constexpr int kNumCounts = 8;
   // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): four items
   // a lane of its 256, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;

@@ -57,7 +57,9 @@ struct VoteForInsertion {
   const int32_t* pending;         // vertex of each uninserted point
   const int32_t* location;        // triangle containing it
   unsigned long long* tri_vote;   // per triangle, kNoVote when nobody voted
-  unsigned long long* edge_vote;  // per triangle: the votes of points on an edge's line
+  unsigned long long* edge_vote;  // per triangle: the votes of points on an edge's line; nullptr:
+                                  // they vote in tri_vote (a round without second winners)
+  uint32_t* saw_edge_point;       // set when a point on an edge's line voted
 
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t t = location[i];
@@ -121,8 +123,30 @@ struct VoteForInsertion {
       }
     }
     const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
-    cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(on_edge_line ? edge_vote[t] : tri_vote[t]);
+    if (on_edge_line) {
+      cuda::atomic_ref<uint32_t, cuda::thread_scope_device> seen(*saw_edge_point);
+      if (seen.load(cuda::memory_order_relaxed) == 0) seen.store(1u, cuda::memory_order_relaxed);
+    }
+    cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(
+        on_edge_line && edge_vote != nullptr ? edge_vote[t] : tri_vote[t]);
     slot.fetch_min(key);
+  }
+};
+
+/// Clears a round's votes (`edge_vote` too unless it is nullptr) and, in thread 0, its counts of
+/// second winners and of points on an edge's line: one launch for what were three.
+struct ResetVotes {
+  unsigned long long* tri_vote;
+  unsigned long long* edge_vote;
+  uint32_t* second_count;
+  uint32_t* saw_edge_point;
+  GALPHA_HD void operator()(int32_t t) const {
+    tri_vote[t] = kNoVote;
+    if (edge_vote != nullptr) edge_vote[t] = kNoVote;
+    if (t == 0) {
+      *second_count = 0;
+      *saw_edge_point = 0;
+    }
   }
 };
 
