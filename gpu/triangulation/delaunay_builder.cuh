@@ -159,10 +159,10 @@ class DelaunayBuilder {
                      {&num_pending, pending_count, sizeof(uint32_t)},
                      {&walk_failed, flags_.data(), sizeof(int32_t)},
                      {&second_left_parent, flags_.data() + 2, sizeof(int32_t)}});
-      if (walk_failed != 0) throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
       if (second_left_parent != 0) {
         throw EngineError(EngineError::Kind::kInternal, "a second winner of an insertion round left its triangle");
       }
+      if (walk_failed != 0) throw EngineError(EngineError::Kind::kInternal, "point location walk did not terminate");
       if (num_pending == 0) return;
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       second_winners = saw_edge != 0;
@@ -390,7 +390,8 @@ class DelaunayBuilder {
   // Insertion votes while splitting; while flipping, the same bytes hold 2 * capacity_ flip
   // candidates (int32): the two are never live at once, and sharing them saves 8 bytes a point.
   Buffer<unsigned long long, System> tri_vote_;
-  // The votes of points on an edge's line, then each triangle's second winner (VoteForInsertion).
+  // The votes of points on an edge's line (VoteForInsertion), then each triangle's second winner
+  // (PickSecondWinners).
   Buffer<unsigned long long, System> edge_vote_;
   // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while
   // flipping: never both at once, so one buffer serves both.

@@ -1,6 +1,7 @@
 // One insertion round of the gDel2D scheme: every triangle elects the uninserted point nearest its
 // circumcentre (atomic minimum over packed keys), elected points split their triangle 1-to-3, then
-// the split triangles' outside neighbours are re-linked.
+// the split triangles' outside neighbours are re-linked. A finite triangle may also have a second
+// winner, which splits the child that holds it in the same round (PickSecondWinners).
 #pragma once
 
 #include <cmath>
@@ -171,9 +172,12 @@ struct PickSecondWinners {
 
 /// After the first splits of a round: each second winner walks from its triangle's slot (now the
 /// first split's child 2) to the child that holds it, and votes there alone (`second_vote`,
-/// cleared to kNoVote for every triangle beforehand). The walk cannot leave the three children:
-/// the point was inside its triangle by the same symbolic orientations that split it, which is
-/// also why no two second winners meet in one child. `left_parent` reports a walk that did.
+/// cleared to kNoVote for every triangle beforehand). A parent writes only into its own
+/// children, so no two second winners meet in one child. The walk cannot leave the three
+/// children: the point was inside its triangle by the same symbolic orientations that split it.
+/// Should a walk fail or leave them anyway, the flag is raised (and read with the next round's
+/// wait, which throws) and the vote still goes to the parent's own slot, so that the round splits
+/// as many triangles as the host counted and every index stays in the mesh until then.
 struct PlaceSecondWinners {
   MeshView mesh;
   const int32_t* pending;
@@ -190,11 +194,13 @@ struct PlaceSecondWinners {
     const int32_t child = mesh.Locate(t, pending[static_cast<uint32_t>(vote & 0xffffffffu)], max_steps);
     if (child < 0) {
       *walk_failed = 1;
+      second_vote[t] = vote;
       return;
     }
     if (child != t && child != ChildSlot(t, 0, split_count[t], num_tri_before) &&
         child != ChildSlot(t, 1, split_count[t], num_tri_before)) {
       *left_parent = 1;
+      second_vote[t] = vote;
       return;
     }
     second_vote[child] = vote;
