@@ -158,9 +158,13 @@ absl::StatusOr<std::unique_ptr<AlphaService>> AlphaService::Create(const Service
     for (int i = 0; i < slots; ++i) slot_streams[static_cast<size_t>(i)] = service->streams_->stream(i);
   }
   const size_t memory = options.build_memory_bytes > 0 ? options.build_memory_bytes : DefaultMemoryBudget(backend);
-  service->cache_ = std::make_unique<FamilyCache>(options.cache_bytes, metrics);
+  service->cache_ =
+      std::make_unique<FamilyCache>(FamilyCache::Budgets{options.cache_bytes, options.compact_cache_bytes}, metrics);
   service->scheduler_ = std::make_unique<BuildScheduler>(std::move(slot_streams), options.max_queued_builds,
                                                          options.max_tenant_queued_builds, memory, metrics);
+  service->promoter_ = std::make_unique<FamilyPromoter>(
+      service->cache_.get(), service->scheduler_.get(), backend, kBuildBytesPerPoint,
+      [metrics](const BuildReport& report, double seconds) { metrics->RecordBuild(report, seconds); });
   metrics->SetBackend(service->backend_name_);
   service->SampleDeviceMemory();
   return service;
@@ -198,12 +202,11 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> AlphaService::Lookup(grpc::C
   auto tenant = Authenticate(context);
   if (!tenant.ok()) return tenant.status();
   if (absl::Status s = CheckHandle(handle); !s.ok()) return s;
-  auto family = cache_->Find(*tenant, handle);
-  if (family == nullptr) {
-    return absl::NotFoundError(
-        absl::StrCat("no family under handle ", handle, " (never built here, released or evicted): build it again"));
-  }
-  return family;
+  FamilyCache::Found found = cache_->Lookup(*tenant, handle);
+  if (found.resident != nullptr) return std::move(found.resident);
+  if (found.compact != nullptr) return promoter_->Promote(*tenant, handle, std::move(found.compact));
+  return absl::NotFoundError(
+      absl::StrCat("no family under handle ", handle, " (never built here, released or evicted): build it again"));
 }
 
 grpc::ServerReadReactor<v1::BuildRequest>* AlphaService::Build(grpc::CallbackServerContext* context,

@@ -17,6 +17,7 @@
 #include "server/build_time_limit.hpp"
 #include "server/exact_comparison_limit.hpp"
 #include "server/family_cache.hpp"
+#include "server/family_promoter.hpp"
 #include "server/metrics.hpp"
 #include "server/tenant_tokens.hpp"
 #include "server/upload_watchdog.hpp"
@@ -56,8 +57,11 @@ struct ServiceOptions {
   /// How many exact radius comparisons one build may make (server/exact_comparison_limit.hpp);
   /// past it the build stops and answers RESOURCE_EXHAUSTED.
   ExactComparisonLimitOptions exact_comparisons;
-  /// Byte budget of the family cache.
+  /// Byte budget of the family cache's resident tier (whole families, ready to answer).
   size_t cache_bytes = size_t{8} << 30;
+  /// Byte budget of its compact tier (the points of families pushed out of the resident tier,
+  /// rebuilt when a query asks for them; server/family_cache.hpp); 0: no compact tier.
+  size_t compact_cache_bytes = size_t{4} << 30;
   TenantTokens tokens;
 };
 
@@ -114,7 +118,9 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   absl::StatusOr<std::string> Authenticate(grpc::CallbackServerContext* context) const;
   /// InvalidArgument naming `handle` when it is not one (sha256- and 64 hex digits).
   static absl::Status CheckHandle(const std::string& handle);
-  /// The cached family of (tenant, handle), or NotFound / InvalidArgument.
+  /// The cached family of (tenant, handle), rebuilt first when the cache holds it in its compact
+  /// tier (the call then waits for the rebuild), or NotFound / InvalidArgument, or the rebuild's
+  /// error (FamilyPromoter::Promote).
   absl::StatusOr<std::shared_ptr<const CachedFamily>> Lookup(grpc::CallbackServerContext* context,
                                                              const std::string& handle);
   /// One query on a built family, the same for the unary and the streamed ones: times the RPC as
@@ -131,6 +137,7 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   std::string backend_name_;
   std::unique_ptr<CudaStreamPool> streams_;
   std::unique_ptr<FamilyCache> cache_;
+  std::unique_ptr<FamilyPromoter> promoter_;  // before scheduler_: its jobs call it
   InFlightBytes in_flight_;
   UploadWatchdog upload_watchdog_;
   std::atomic<bool> draining_{false};

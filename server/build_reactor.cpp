@@ -1,7 +1,5 @@
 #include "server/build_reactor.hpp"
 
-#include <malloc.h>
-
 #include <chrono>
 #include <memory>
 #include <thread>
@@ -23,14 +21,6 @@ namespace v1 = galpha::v1;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-/// Gives freed heap memory back to the system: a build frees hundreds of bytes per point at once,
-/// and without this glibc keeps it, so the process would sit at its peak forever.
-void ReturnFreedMemory() {
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
-}
 
 }  // namespace
 
@@ -120,11 +110,15 @@ void BuildReactor::EndOfStream() {
     return;
   }
   build_ = *decoded;
-  if (auto cached = service_->cache_->Find(tenant_, build_->handle)) {
-    if (build_->frame != nullptr) cached->AttachFrameIfNone(build_->frame);
-    Succeed(*cached, /*was_cached=*/true);
+  const FamilyCache::Found found = service_->cache_->Lookup(tenant_, build_->handle);
+  if (found.resident != nullptr) {
+    if (build_->frame != nullptr) found.resident->AttachFrameIfNone(build_->frame);
+    Succeed(*found.resident, /*was_cached=*/true);
     return;
   }
+  // A compact entry of these points: they are here, so they are built as uploaded (the cache then
+  // drops the entry: a promotion); the frame it kept stays attached, as on a resident hit.
+  if (found.compact != nullptr && build_->frame == nullptr) build_->frame = found.compact->frame();
   const size_t need = build_->points.size() * (kBuildBytesPerPoint + sizeof(Point2));
   absl::Status submitted = service_->scheduler_->Submit(
       tenant_, need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
@@ -159,7 +153,7 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   decoder_.ReleasePoints();
   if (!family.ok()) {
-    ReturnFreedMemory();
+    ReturnFreedHeapMemory();
     if (absl::IsCancelled(family.status()) && !cancelled_ && limited && Clock::now() > deadline) {
       Respond(TagRefusal(
           absl::DeadlineExceededError(BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time)),
@@ -176,15 +170,9 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
     return;
   }
   service_->metrics_->RecordBuild(family->report(), seconds);
-  // The last owner of a family (the cache, or a query still streaming from it after a release
-  // or an eviction) frees hundreds of megabytes: give them back to the system right then.
-  std::shared_ptr<const CachedFamily> cached(new CachedFamily(*std::move(family), build_->frame),
-                                             [](const CachedFamily* f) {
-                                               delete f;
-                                               ReturnFreedMemory();
-                                             });
+  std::shared_ptr<const CachedFamily> cached = ShareCachedFamily(*std::move(family), build_->frame);
   auto inserted = service_->cache_->Insert(tenant_, build_->handle, std::move(cached));
-  ReturnFreedMemory();  // the engine's working memory and the points
+  ReturnFreedHeapMemory();  // the engine's working memory and the points
   if (!inserted.ok()) {
     Respond(absl::IsResourceExhausted(inserted.status()) ? TagRefusal(inserted.status(), BuildRefusal::kCacheBytes)
                                                          : inserted.status());

@@ -1,5 +1,7 @@
 #include "server/cached_family.hpp"
 
+#include <malloc.h>
+
 #include <utility>
 
 #include "core/family/canonical_order.hpp"
@@ -49,6 +51,21 @@ void CachedFamily::ComputeOrders() const {
   edge_vertices_ = std::move(orders.edge_vertices);
   triangle_order_ = std::move(orders.triangle_order);
   triangle_vertices_ = std::move(orders.triangle_vertices);
+}
+
+void ReturnFreedHeapMemory() {
+#ifdef __GLIBC__
+  malloc_trim(0);
+#endif
+}
+
+std::shared_ptr<const CachedFamily> ShareCachedFamily(AlphaFamily family,
+                                                      std::shared_ptr<const CachedFamily::InputFrame> frame) {
+  return std::shared_ptr<const CachedFamily>(new CachedFamily(std::move(family), std::move(frame)),
+                                             [](const CachedFamily* f) {
+                                               delete f;
+                                               ReturnFreedHeapMemory();
+                                             });
 }
 
 }  // namespace galpha::server

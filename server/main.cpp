@@ -43,7 +43,12 @@ ABSL_FLAG(double, max_exact_comparisons_per_point, 64,
           "a build may make this many exact radius comparisons per point (honest inputs need a few), then stops "
           "with RESOURCE_EXHAUSTED; 0: no limit");
 ABSL_FLAG(uint64_t, exact_comparisons_floor, 1000000, "the exact comparison limit is never below this");
-ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30, "byte budget of the family cache (LRU eviction)");
+ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30,
+          "byte budget of the family cache's resident tier (whole families; the least recently used move to the "
+          "compact tier)");
+ABSL_FLAG(uint64_t, compact_cache_bytes, uint64_t{4} << 30,
+          "byte budget of the family cache's compact tier (16 B per point: families rebuilt when queried; 0: none, "
+          "families pushed out of the resident tier are evicted)");
 ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
 ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
 ABSL_FLAG(std::string, tls_key, "", "PEM private key");
@@ -121,6 +126,7 @@ int main(int argc, char** argv) {
   options.service.exact_comparisons.per_point = absl::GetFlag(FLAGS_max_exact_comparisons_per_point);
   options.service.exact_comparisons.floor = absl::GetFlag(FLAGS_exact_comparisons_floor);
   options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
+  options.service.compact_cache_bytes = absl::GetFlag(FLAGS_compact_cache_bytes);
   if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
     auto tokens = galpha::server::TenantTokens::ReadFile(path);
     if (!tokens.ok()) return Fail(std::string(tokens.status().message()));

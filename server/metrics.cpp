@@ -6,6 +6,7 @@
 #include <prometheus/histogram.h>
 #include <prometheus/registry.h>
 
+#include <array>
 #include <exception>
 
 #include "absl/strings/str_cat.h"
@@ -48,12 +49,16 @@ struct ServerMetrics::Families {
                      .Help("Builds refused or ended by a limit, by reason (the limit's name: in_flight_bytes, "
                            "idle_timeout, queue_full, ...; server/README.md)")
                      .Register(r)),
-        cache_bytes(
-            prometheus::BuildGauge().Name("galpha_cache_bytes").Help("Bytes of families in the cache").Register(r)),
-        cache_entries(prometheus::BuildGauge().Name("galpha_cache_entries").Help("Families in the cache").Register(r)),
+        cache_bytes(prometheus::BuildGauge()
+                        .Name("galpha_cache_bytes")
+                        .Help("Bytes of families in the cache, by tier (resident: whole families; compact: "
+                              "their points, rebuilt on use)")
+                        .Register(r)),
+        cache_entries(
+            prometheus::BuildGauge().Name("galpha_cache_entries").Help("Families in the cache, by tier").Register(r)),
         cache_hits(prometheus::BuildCounter()
                        .Name("galpha_cache_hits_total")
-                       .Help("Cache lookups that found a family")
+                       .Help("Cache lookups that found a family, by the tier it was in")
                        .Register(r)),
         cache_misses(prometheus::BuildCounter()
                          .Name("galpha_cache_misses_total")
@@ -61,8 +66,17 @@ struct ServerMetrics::Families {
                          .Register(r)),
         cache_evictions(prometheus::BuildCounter()
                             .Name("galpha_cache_evictions_total")
-                            .Help("Families evicted to stay within the cache budget")
+                            .Help("Families that left the cache to stay within its budgets, by the tier they "
+                                  "left (resident only when the compact tier cannot take them)")
                             .Register(r)),
+        cache_demotions(prometheus::BuildCounter()
+                            .Name("galpha_cache_demotions_total")
+                            .Help("Families moved from the resident tier to the compact tier")
+                            .Register(r)),
+        cache_promotions(prometheus::BuildCounter()
+                             .Name("galpha_cache_promotions_total")
+                             .Help("Families rebuilt from the compact tier into the resident tier")
+                             .Register(r)),
         builds_in_flight(
             prometheus::BuildGauge().Name("galpha_builds_in_flight").Help("Builds running on a slot").Register(r)),
         queue_length(
@@ -83,11 +97,13 @@ struct ServerMetrics::Families {
         device_exact(comparisons.Add({{"path", "device_exact"}})),
         cpu_fallback(comparisons.Add({{"path", "cpu_fallback"}})),
         build_total(build_seconds.Add({}, LatencyBuckets())),
-        hits(cache_hits.Add({})),
+        hits{&cache_hits.Add({{"tier", "resident"}}), &cache_hits.Add({{"tier", "compact"}})},
         misses(cache_misses.Add({})),
-        evictions(cache_evictions.Add({})),
-        bytes(cache_bytes.Add({})),
-        entries(cache_entries.Add({})),
+        evictions{&cache_evictions.Add({{"tier", "resident"}}), &cache_evictions.Add({{"tier", "compact"}})},
+        demotions(cache_demotions.Add({})),
+        promotions(cache_promotions.Add({})),
+        bytes{&cache_bytes.Add({{"tier", "resident"}}), &cache_bytes.Add({{"tier", "compact"}})},
+        entries{&cache_entries.Add({{"tier", "resident"}}), &cache_entries.Add({{"tier", "compact"}})},
         in_flight(builds_in_flight.Add({})),
         queued(queue_length.Add({})),
         admitted(admitted_bytes.Add({})),
@@ -107,6 +123,8 @@ struct ServerMetrics::Families {
   prometheus::Family<prometheus::Counter>& cache_hits;
   prometheus::Family<prometheus::Counter>& cache_misses;
   prometheus::Family<prometheus::Counter>& cache_evictions;
+  prometheus::Family<prometheus::Counter>& cache_demotions;
+  prometheus::Family<prometheus::Counter>& cache_promotions;
   prometheus::Family<prometheus::Gauge>& builds_in_flight;
   prometheus::Family<prometheus::Gauge>& queue_length;
   prometheus::Family<prometheus::Gauge>& admitted_bytes;
@@ -116,11 +134,14 @@ struct ServerMetrics::Families {
   prometheus::Counter& device_exact;
   prometheus::Counter& cpu_fallback;
   prometheus::Histogram& build_total;
-  prometheus::Counter& hits;
+  // Indexed by CacheTier.
+  std::array<prometheus::Counter*, 2> hits;
   prometheus::Counter& misses;
-  prometheus::Counter& evictions;
-  prometheus::Gauge& bytes;
-  prometheus::Gauge& entries;
+  std::array<prometheus::Counter*, 2> evictions;
+  prometheus::Counter& demotions;
+  prometheus::Counter& promotions;
+  std::array<prometheus::Gauge*, 2> bytes;
+  std::array<prometheus::Gauge*, 2> entries;
   prometheus::Gauge& in_flight;
   prometheus::Gauge& queued;
   prometheus::Gauge& admitted;
@@ -168,13 +189,19 @@ void ServerMetrics::SetDeviceMemoryInUse(double bytes) { families_->device.Set(b
 
 void ServerMetrics::SetBackend(const std::string& backend) { families_->backend.Add({{"backend", backend}}).Set(1); }
 
-void ServerMetrics::OnLookup(bool hit) { (hit ? families_->hits : families_->misses).Increment(); }
+void ServerMetrics::OnHit(CacheTier tier) { families_->hits[static_cast<size_t>(tier)]->Increment(); }
 
-void ServerMetrics::OnEviction() { families_->evictions.Increment(); }
+void ServerMetrics::OnMiss() { families_->misses.Increment(); }
 
-void ServerMetrics::OnSize(size_t bytes, size_t entries) {
-  families_->bytes.Set(static_cast<double>(bytes));
-  families_->entries.Set(static_cast<double>(entries));
+void ServerMetrics::OnEviction(CacheTier tier) { families_->evictions[static_cast<size_t>(tier)]->Increment(); }
+
+void ServerMetrics::OnDemotion() { families_->demotions.Increment(); }
+
+void ServerMetrics::OnPromotion() { families_->promotions.Increment(); }
+
+void ServerMetrics::OnSize(CacheTier tier, size_t bytes, size_t entries) {
+  families_->bytes[static_cast<size_t>(tier)]->Set(static_cast<double>(bytes));
+  families_->entries[static_cast<size_t>(tier)]->Set(static_cast<double>(entries));
 }
 
 void ServerMetrics::OnLoad(size_t queued, size_t running, size_t admitted_bytes) {

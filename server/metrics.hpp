@@ -38,9 +38,12 @@ class ServerMetrics final : public CacheObserver, public SchedulerObserver {
   void RecordRejectedBuild(std::string_view reason);
 
   // CacheObserver
-  void OnLookup(bool hit) override;
-  void OnEviction() override;
-  void OnSize(size_t bytes, size_t entries) override;
+  void OnHit(CacheTier tier) override;
+  void OnMiss() override;
+  void OnEviction(CacheTier tier) override;
+  void OnDemotion() override;
+  void OnPromotion() override;
+  void OnSize(CacheTier tier, size_t bytes, size_t entries) override;
   // SchedulerObserver
   void OnLoad(size_t queued, size_t running, size_t admitted_bytes) override;
 

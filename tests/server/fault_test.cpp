@@ -59,7 +59,7 @@ client::BuildCallOptions Upload() {
 /// released its handles). glibc returns freed memory lazily: allow a little slack.
 void ExpectBackToBaseline(const ServerProcess& server, size_t baseline) {
   ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_builds_in_flight") == 0.0; }, 60));
-  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_cache_entries") == 0.0; }, 10))
+  ASSERT_TRUE(WaitFor([&] { return Metric(server, "galpha_cache_entries{tier=\"resident\"}") == 0.0; }, 10))
       << "the server's metrics:\n"
       << testing::HttpGet(server.metrics_port(), "/metrics") << "\nits log:\n"
       << server.log();

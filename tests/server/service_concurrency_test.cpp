@@ -63,7 +63,7 @@ TEST(ServiceTest, ConcurrentBuildsFromSeveralClientsMatchTheLocalEngine) {
     EXPECT_EQ(spectra[static_cast<size_t>(i)], LocalFamily(inputs[static_cast<size_t>(i)]).spectrum()) << i;
   }
   // Three distinct inputs: three families, whatever the interleaving.
-  EXPECT_EQ(server->service().cache().GetStats().entries, 3u);
+  EXPECT_EQ(server->service().cache().GetStats().resident.entries, 3u);
 }
 
 TEST(ServiceTest, FullQueueAnswersResourceExhausted) {
@@ -99,7 +99,7 @@ TEST(ServiceTest, CancellationMidStreamFreesTheUpload) {
   context.TryCancel();
   EXPECT_EQ(writer->Finish().error_code(), grpc::StatusCode::CANCELLED);
   EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 10));
-  EXPECT_EQ(server->service().cache().GetStats().entries, 0u);
+  EXPECT_EQ(server->service().cache().GetStats().resident.entries, 0u);
 }
 
 TEST(ServiceTest, DeadlineStopsARunningBuild) {
@@ -131,7 +131,7 @@ TEST(ServiceTest, DeadlineStopsARunningBuild) {
   // The build stops at its next phase boundary and frees what it held.
   EXPECT_TRUE(WaitFor([&] { return ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 60));
   EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 10));
-  EXPECT_EQ(server->service().cache().GetStats().entries, 0u);
+  EXPECT_EQ(server->service().cache().GetStats().resident.entries, 0u);
 }
 
 }  // namespace

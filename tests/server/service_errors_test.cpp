@@ -72,7 +72,7 @@ TEST(ServiceTest, BuildStreamErrorsHaveClearStatuses) {
 
   // Nothing of the failed builds stays in flight or in the cache.
   EXPECT_TRUE(WaitFor([&] { return server->service().in_flight_bytes() == 0; }, 5));
-  EXPECT_EQ(server->service().cache().GetStats().entries, 0u);
+  EXPECT_EQ(server->service().cache().GetStats().resident.entries, 0u);
 }
 
 TEST(ServiceTest, MessageAndInFlightLimits) {

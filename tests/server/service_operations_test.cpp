@@ -40,6 +40,7 @@ TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
   }
   ServerOptions options = TestServerOptions();
   options.service.cache_bytes = one_family * 3 / 2;
+  options.service.compact_cache_bytes = 0;  // no compact tier: a family pushed out is gone
   auto server = StartServer(options);
   ASSERT_NE(server, nullptr);
   auto client = ClientOf(*server);
@@ -49,11 +50,97 @@ TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
   ASSERT_THAT(second, IsOk());
   EXPECT_THAT(client->Describe(first->handle).status(), StatusIs(absl::StatusCode::kNotFound));
   EXPECT_THAT(client->Describe(second->handle), IsOk());
-  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_evictions_total"), 1.0);
-  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_evictions_total{tier=\"resident\"}"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries{tier=\"resident\"}"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_demotions_total"), 0.0);
   // A family larger than the whole budget is refused, not cached half-way.
   auto huge = client->Build(gen::Uniform(20000, 23));
   EXPECT_THAT(huge.status(), StatusIs(absl::StatusCode::kResourceExhausted));
+}
+
+/// Every message of a Classify stream, serialized: two answers are the same when these are.
+absl::StatusOr<std::vector<std::string>> ClassifyMessages(client::AlphaClient& client, const std::string& handle,
+                                                          uint32_t rank) {
+  v1::ClassifyRequest request;
+  request.set_handle(handle);
+  request.mutable_threshold()->set_rank(rank);
+  std::vector<std::string> messages;
+  absl::Status status = client.Classify(request, [&](const v1::ClassifyResponse& message) {
+    messages.push_back(message.SerializeAsString());
+    return absl::OkStatus();
+  });
+  if (!status.ok()) return status;
+  return messages;
+}
+
+TEST(ServiceTest, DemotedFamiliesAreRebuiltWhenQueried) {
+  const std::vector<Point2> a = gen::Clustered(3000, 24), b = gen::Uniform(3000, 25);
+  size_t one_family = 0;
+  {
+    auto probe = StartServer(TestServerOptions());
+    ASSERT_NE(probe, nullptr);
+    auto built_a = ClientOf(*probe)->Build(a);
+    auto built_b = ClientOf(*probe)->Build(b);
+    ASSERT_THAT(built_a, IsOk());
+    ASSERT_THAT(built_b, IsOk());
+    one_family = std::max<size_t>(built_a->summary.family_bytes(), built_b->summary.family_bytes());
+  }
+  ServerOptions options = TestServerOptions();
+  options.service.cache_bytes = one_family * 3 / 2;  // one family resident at a time
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  auto first = client->Build(a);
+  ASSERT_THAT(first, IsOk());
+  const auto before = ClassifyMessages(*client, first->handle, 40);
+  ASSERT_THAT(before, IsOk());
+  ASSERT_GT(before->size(), 2u);
+  const std::vector<double> spectrum_before = testing::SpectrumRemote(*client, first->handle, 500);
+
+  auto second = client->Build(b);
+  ASSERT_THAT(second, IsOk());
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_demotions_total"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries{tier=\"resident\"}"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries{tier=\"compact\"}"), 1.0);
+  // The compact entry is the points: 16 bytes each, next to hundreds for the family.
+  const double compact_bytes = ScrapeMetric(*server, "galpha_cache_bytes{tier=\"compact\"}");
+  EXPECT_GE(compact_bytes, 16.0 * static_cast<double>(a.size()));
+  EXPECT_LE(compact_bytes, 64.0 * static_cast<double>(a.size()));
+
+  // A query of the demoted family answers as before: it is rebuilt, transparently.
+  const auto after = ClassifyMessages(*client, first->handle, 40);
+  ASSERT_THAT(after, IsOk());
+  EXPECT_EQ(*after, *before) << "the rebuilt family answers byte for byte as the first build";
+  EXPECT_EQ(testing::SpectrumRemote(*client, first->handle, 500), spectrum_before);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_promotions_total"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_demotions_total"), 2.0) << "b made room";
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_hits_total{tier=\"compact\"}"), 1.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_build_seconds_count"), 3.0) << "two uploads and one rebuild";
+
+  // The client's check before an upload (a Describe) promotes a demoted family: no upload.
+  auto again = client->Build(b);
+  ASSERT_THAT(again, IsOk());
+  EXPECT_EQ(again->handle, second->handle);
+  EXPECT_TRUE(again->cached);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_promotions_total"), 2.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_build_seconds_count"), 4.0);
+
+  // An upload of demoted points (no check first) is built as uploaded and takes the entry's place.
+  std::vector<double> coordinates;
+  for (const Point2& p : a) coordinates.insert(coordinates.end(), {p.x, p.y});
+  v1::BuildResponse uploaded;
+  ASSERT_THAT(testing::RawBuild(*client, {testing::Header(a.size()), testing::Chunk(coordinates)}, &uploaded), IsOk());
+  EXPECT_EQ(uploaded.handle(), first->handle);
+  EXPECT_FALSE(uploaded.cached());
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_promotions_total"), 3.0);
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries{tier=\"compact\"}"), 1.0) << "b, demoted again";
+
+  // Release reaches the compact tier too.
+  auto released = client->Release(second->handle);
+  ASSERT_THAT(released, IsOk());
+  EXPECT_TRUE(released->released());
+  EXPECT_THAT(client->Describe(second->handle).status(), StatusIs(absl::StatusCode::kNotFound));
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_cache_entries{tier=\"compact\"}"), 0.0);
 }
 
 TEST(ServiceTest, MetricsAreScrapedOverHttp) {
@@ -80,9 +167,10 @@ TEST(ServiceTest, MetricsAreScrapedOverHttp) {
             static_cast<double>(counts.device_exact()));
   EXPECT_EQ(MetricValue(page, "galpha_radius_comparisons_total{path=\"cpu_fallback\"}"),
             static_cast<double>(counts.cpu_fallback()));
-  EXPECT_EQ(MetricValue(page, "galpha_cache_entries"), 1.0);
-  EXPECT_EQ(MetricValue(page, "galpha_cache_bytes"), static_cast<double>(built->summary.family_bytes()));
-  EXPECT_EQ(MetricValue(page, "galpha_cache_hits_total"), 1.0);
+  EXPECT_EQ(MetricValue(page, "galpha_cache_entries{tier=\"resident\"}"), 1.0);
+  EXPECT_EQ(MetricValue(page, "galpha_cache_bytes{tier=\"resident\"}"),
+            static_cast<double>(built->summary.family_bytes()));
+  EXPECT_EQ(MetricValue(page, "galpha_cache_hits_total{tier=\"resident\"}"), 1.0);
   EXPECT_EQ(MetricValue(page, "galpha_cache_misses_total"), 3.0);  // skip check, build, unknown handle
   // The slot is handed back just after the response is sent: the gauge settles to 0 right after.
   EXPECT_TRUE(testing::WaitFor([&] { return testing::ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 5.0));

@@ -289,7 +289,7 @@ TEST(ServiceTest, DescribeReleaseAndTheCache) {
   auto described = client->Describe(first->handle);
   ASSERT_THAT(described, IsOk());
   EXPECT_EQ(described->summary().name(), "") << "a name is its Build call's label; the family keeps none";
-  EXPECT_EQ(server->service().cache().GetStats().entries, 1u);
+  EXPECT_EQ(server->service().cache().GetStats().resident.entries, 1u);
 
   auto released = client->Release(first->handle);
   ASSERT_THAT(released, IsOk());
