@@ -1,9 +1,10 @@
 // service_bench: the service under load, in one process on loopback (a real gRPC server and real
 // clients over TCP): the cost of the transport against the in-process engine, the streaming rate
-// of Classify, build throughput with N concurrent clients, and query latency percentiles under
-// concurrent load. CGAL's Alpha_shape_2 (exact constructions) on the same points, in the same run,
-// is the competitor's reference. With --links naming tc rates (root only), the build and Classify
-// are also measured over a veth pair between two network namespaces shaped to each rate.
+// of Classify, build throughput with N concurrent clients, query latency percentiles under
+// concurrent load, and the first query of a family demoted to the cache's compact tier (its rebuild). CGAL's
+// Alpha_shape_2 (exact constructions) on the same points, in the same run, is the competitor's reference. With --links
+// naming tc rates (root only), the build and Classify are also measured over a veth pair between two network namespaces
+// shaped to each rate.
 //
 //   service_bench [--backend=auto|cpu|cuda] [--points=N] [--clients=1,2,4,8] [--repeat=R]
 //                 [--query-seconds=S] [--query-clients=Q] [--build-slots=K] [--cgal-max=N]
@@ -381,6 +382,60 @@ LinkMeasure MeasureLink(client::AlphaClient& client, const std::vector<Point2>& 
 
 double Megabytes(uint64_t bytes) { return static_cast<double>(bytes) / 1e6; }
 
+/// 5. The compact tier: a server whose resident tier holds one family, two families queried in
+/// turn, so that every Describe finds its family demoted and rebuilds it (a promotion), against a
+/// Describe of a resident family and against the client's alternative when the family is gone
+/// (`upload_seconds`: a Build RPC over loopback, measured above).
+int MeasurePromotion(const Options& options, const std::vector<Point2>& points, double upload_seconds) {
+  const std::vector<Point2> other = gen::Uniform(options.points, 2);
+  server::ServerOptions server_options = BenchServerOptions(options, "127.0.0.1:0");
+  {
+    BuildOptions build;
+    build.backend = options.backend;
+    auto family = BuildAlphaFamily(points, build);
+    if (!family.ok()) return 1;
+    // Room for one family of either set (their sizes differ by a few percent).
+    server_options.service.cache_bytes = server::CachedFamily(*std::move(family)).bytes() * 5 / 4;
+  }
+  auto server = server::GalphaServer::Start(server_options);
+  if (!server.ok()) {
+    std::fprintf(stderr, "service_bench: %s\n", std::string(server.status().message()).c_str());
+    return 1;
+  }
+  auto client = Client((*server)->port());
+  const std::string first = PointSetHandle(points), second = PointSetHandle(other);
+  if (!client->Build(points).ok() || !client->Build(other).ok()) return 1;  // `points` demoted
+  double resident = std::numeric_limits<double>::infinity();
+  std::vector<double> promotions;
+  for (int r = 0; r < options.repeat; ++r) {
+    for (const std::string* handle : {&first, &second}) {
+      auto start = Clock::now();
+      if (!client->Describe(*handle).ok()) return 1;  // a promotion: the other one is demoted
+      promotions.push_back(SecondsSince(start));
+      start = Clock::now();
+      if (!client->Describe(*handle).ok()) return 1;  // resident now
+      resident = std::min(resident, SecondsSince(start));
+    }
+  }
+  const server::FamilyCache::Stats stats = (*server)->service().cache().GetStats();
+  const double promoted = *std::min_element(promotions.begin(), promotions.end());
+  std::printf(
+      "\n| a family of %zu points, when the first query after a while finds it... | Describe ms (best of %zu) | "
+      "vs resident | bytes a point held for it |\n|---|---:|---:|---:|\n",
+      options.points, promotions.size());
+  std::printf("| resident (whole) | %.2f | 1 | %.0f |\n", resident * 1e3,
+              static_cast<double>(stats.resident.bytes) / static_cast<double>(options.points));
+  std::printf("| in the compact tier (its points): rebuilt on a slot, promoted | %.1f | %.0f | %.0f |\n",
+              promoted * 1e3, promoted / resident,
+              static_cast<double>(stats.compact.bytes) / static_cast<double>(options.points));
+  std::printf("| evicted: the client uploads it again (Build RPC over loopback, above) | %.1f | %.0f | 0 |\n",
+              upload_seconds * 1e3, upload_seconds / resident);
+  std::printf("\npromotions %llu, demotions %llu (cache statistics)\n",
+              static_cast<unsigned long long>(stats.promotions), static_cast<unsigned long long>(stats.demotions));
+  (*server)->Drain();
+  return 0;
+}
+
 int Run(const Options& options) {
   // Shaped links first: the namespaces must exist before this process starts any thread.
   std::vector<std::string> links;
@@ -554,7 +609,7 @@ int Run(const Options& options) {
                 Percentile(values, 0.9) * 1e3, Percentile(values, 0.99) * 1e3);
   }
   (*server)->Drain();
-  return 0;
+  return MeasurePromotion(options, points, loopback.build_seconds);
 }
 
 }  // namespace
