@@ -33,6 +33,7 @@ size_t FamilyPromoter::in_flight() const {
 
 absl::StatusOr<std::shared_ptr<const CachedFamily>> FamilyPromoter::Promote(
     const std::string& tenant, const std::string& handle, std::shared_ptr<const CompactFamily> compact) {
+  if (compact == nullptr) return absl::InvalidArgumentError(absl::StrCat("handle ", handle, ": nothing to rebuild"));
   auto rebuild = std::make_shared<Rebuild>();
   rebuild->key = absl::StrCat(tenant, std::string(1, '\0'), handle);
   std::shared_future<Result> result;

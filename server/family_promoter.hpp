@@ -39,7 +39,7 @@ class FamilyPromoter {
   /// another caller promoted it meanwhile). Blocks until then. Errors name the handle and why:
   /// the scheduler's refusals (ResourceExhausted: queue full; Unavailable: draining), the
   /// engine's (ResourceExhausted when it ran out of memory), the cache's (a family larger than the
-  /// resident budget).
+  /// resident budget), and InvalidArgument for a null `compact`.
   absl::StatusOr<std::shared_ptr<const CachedFamily>> Promote(const std::string& tenant, const std::string& handle,
                                                               std::shared_ptr<const CompactFamily> compact);
 

@@ -20,6 +20,7 @@
 
 #include "gtest/gtest.h"
 #include "server/build_refusal.hpp"
+#include "tests/support/one_shot_gate.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
@@ -38,27 +39,7 @@ constexpr size_t kNoTenantCap = 1000;
 
 void* FakeStream(uintptr_t value) { return reinterpret_cast<void*>(value); }
 
-// A one-shot signal that several threads may wait on.
-class Gate {
- public:
-  void Open() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    open_ = true;
-    changed_.notify_all();
-  }
-  // Whether the gate opened within `timeout`.
-  template <typename Duration>
-  bool WaitFor(Duration timeout) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    return changed_.wait_for(lock, timeout, [&] { return open_; });
-  }
-  bool Wait() { return WaitFor(kDeadlock); }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  bool open_ = false;
-};
+using Gate = galpha::testing::OneShotGate;
 
 struct Load {
   size_t queued = 0;

@@ -6,8 +6,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
-#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -18,6 +16,7 @@
 #include "server/build_scheduler.hpp"
 #include "server/family_cache.hpp"
 #include "tests/server/cached_family_fixture.hpp"
+#include "tests/support/one_shot_gate.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
 
@@ -28,26 +27,7 @@ using galpha::testing::IsOk;
 using galpha::testing::StatusIs;
 using ::testing::HasSubstr;
 
-constexpr std::chrono::seconds kDeadlock{20};
-
-// A one-shot signal.
-class Gate {
- public:
-  void Open() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    open_ = true;
-    changed_.notify_all();
-  }
-  bool Wait() {
-    std::unique_lock<std::mutex> lock(mutex_);
-    return changed_.wait_for(lock, kDeadlock, [&] { return open_; });
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  bool open_ = false;
-};
+using Gate = galpha::testing::OneShotGate;
 
 // A cache whose resident tier holds one of the test's families, with `a` demoted by `b`.
 class FamilyPromoterTest : public ::testing::Test {
@@ -68,6 +48,19 @@ class FamilyPromoterTest : public ::testing::Test {
   // A scheduler of one CPU slot; `max_queue` jobs may wait for it.
   static std::unique_ptr<BuildScheduler> OneSlot(size_t max_queue) {
     return std::make_unique<BuildScheduler>(std::vector<void*>{nullptr}, max_queue, max_queue, 0, nullptr);
+  }
+
+  // Runs a job on the scheduler's only slot that holds it until `release` opens.
+  static void HoldTheSlot(BuildScheduler& scheduler, Gate* release) {
+    // Shared: the job may still be inside Open() when this returns.
+    auto holding = std::make_shared<Gate>();
+    ASSERT_THAT(scheduler.Submit("t", 0,
+                                 [holding, release](const BuildSlot&, bool) {
+                                   holding->Open();
+                                   release->Wait();
+                                 }),
+                IsOk());
+    ASSERT_TRUE(holding->Wait());
   }
 
   FamilyPromoter MakePromoter(BuildScheduler* scheduler) {
@@ -111,14 +104,8 @@ TEST_F(FamilyPromoterTest, ConcurrentCallersShareOneRebuild) {
   auto scheduler = OneSlot(4);
   FamilyPromoter promoter = MakePromoter(scheduler.get());
   // The only slot is held until every caller has asked, so that their calls overlap the rebuild.
-  Gate release, holding;
-  ASSERT_THAT(scheduler->Submit("t", 0,
-                                [&](const BuildSlot&, bool) {
-                                  holding.Open();
-                                  release.Wait();
-                                }),
-              IsOk());
-  ASSERT_TRUE(holding.Wait());
+  Gate release;
+  ASSERT_NO_FATAL_FAILURE(HoldTheSlot(*scheduler, &release));
   constexpr int kCallers = 6;
   std::vector<absl::StatusOr<std::shared_ptr<const CachedFamily>>> results(kCallers, absl::UnknownError("not run"));
   std::atomic<int> asking{0};
@@ -145,14 +132,8 @@ TEST_F(FamilyPromoterTest, ConcurrentCallersShareOneRebuild) {
 TEST_F(FamilyPromoterTest, AFullQueueRefusesTheRebuildAndKeepsTheEntry) {
   auto scheduler = OneSlot(0);
   FamilyPromoter promoter = MakePromoter(scheduler.get());
-  Gate release, holding;
-  ASSERT_THAT(scheduler->Submit("t", 0,
-                                [&](const BuildSlot&, bool) {
-                                  holding.Open();
-                                  release.Wait();
-                                }),
-              IsOk());
-  ASSERT_TRUE(holding.Wait());
+  Gate release;
+  ASSERT_NO_FATAL_FAILURE(HoldTheSlot(*scheduler, &release));
   const auto refused = promoter.Promote("t", "h-a", compact_);
   release.Open();
   EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kResourceExhausted));

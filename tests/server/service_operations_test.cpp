@@ -28,16 +28,27 @@ using testing::StartServer;
 using testing::TestServerOptions;
 using testing::WaitFor;
 
+/// The largest `family_bytes` a server charges for the families of `sets` (0 when a build fails,
+/// with a test failure).
+size_t LargestFamilyBytes(const std::vector<std::vector<Point2>>& sets) {
+  auto probe = StartServer(TestServerOptions());
+  if (probe == nullptr) return 0;
+  size_t largest = 0;
+  for (const std::vector<Point2>& points : sets) {
+    auto built = ClientOf(*probe)->Build(points);
+    if (!built.ok()) {
+      ADD_FAILURE() << built.status();
+      return 0;
+    }
+    largest = std::max<size_t>(largest, built->summary.family_bytes());
+  }
+  return largest;
+}
+
 TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
   const std::vector<Point2> a = gen::Uniform(3000, 21), b = gen::Uniform(3000, 22);
-  size_t one_family = 0;
-  {
-    auto probe = StartServer(TestServerOptions());
-    ASSERT_NE(probe, nullptr);
-    auto built = ClientOf(*probe)->Build(a);
-    ASSERT_THAT(built, IsOk());
-    one_family = built->summary.family_bytes();
-  }
+  const size_t one_family = LargestFamilyBytes({a});
+  ASSERT_GT(one_family, 0u);
   ServerOptions options = TestServerOptions();
   options.service.cache_bytes = one_family * 3 / 2;
   options.service.compact_cache_bytes = 0;  // no compact tier: a family pushed out is gone
@@ -75,16 +86,8 @@ absl::StatusOr<std::vector<std::string>> ClassifyMessages(client::AlphaClient& c
 
 TEST(ServiceTest, DemotedFamiliesAreRebuiltWhenQueried) {
   const std::vector<Point2> a = gen::Clustered(3000, 24), b = gen::Uniform(3000, 25);
-  size_t one_family = 0;
-  {
-    auto probe = StartServer(TestServerOptions());
-    ASSERT_NE(probe, nullptr);
-    auto built_a = ClientOf(*probe)->Build(a);
-    auto built_b = ClientOf(*probe)->Build(b);
-    ASSERT_THAT(built_a, IsOk());
-    ASSERT_THAT(built_b, IsOk());
-    one_family = std::max<size_t>(built_a->summary.family_bytes(), built_b->summary.family_bytes());
-  }
+  const size_t one_family = LargestFamilyBytes({a, b});
+  ASSERT_GT(one_family, 0u);
   ServerOptions options = TestServerOptions();
   options.service.cache_bytes = one_family * 3 / 2;  // one family resident at a time
   auto server = StartServer(options);
