@@ -3,9 +3,7 @@
 namespace galpha::server {
 
 CompactFamily::CompactFamily(const CachedFamily& cached)
-    : points_(cached.family().points().begin(), cached.family().points().end()),
-      frame_(cached.Frame()),
-      resident_bytes_(cached.bytes()) {
+    : points_(cached.family().points().begin(), cached.family().points().end()), frame_(cached.Frame()) {
   bytes_ = sizeof(*this) + points_.capacity() * sizeof(Point2);
   // The frame may also be held by a resident copy that a query still streams from; it is
   // charged here all the same, since it stays for as long as this entry does.

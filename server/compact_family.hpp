@@ -25,14 +25,11 @@ class CompactFamily {
   const std::shared_ptr<const CachedFamily::InputFrame>& frame() const { return frame_; }
   /// Bytes charged to the compact tier: the points, the frame's input points and this object.
   size_t bytes() const { return bytes_; }
-  /// Bytes the family took in the resident tier: what a promotion will charge there again.
-  size_t resident_bytes() const { return resident_bytes_; }
 
  private:
   std::vector<Point2> points_;
   std::shared_ptr<const CachedFamily::InputFrame> frame_;
   size_t bytes_ = 0;
-  size_t resident_bytes_ = 0;
 };
 
 }  // namespace galpha::server

@@ -84,6 +84,13 @@ class FamilyCacheTest : public ::testing::Test {
     ASSERT_LT(two_fit_, a_->bytes() + b_->bytes() + c_->bytes());
   }
 
+  // Caches a, b and c under h-a, h-b and h-c, in that order.
+  void InsertInTurn(FamilyCache& cache) const {
+    ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
+    ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
+    ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
+  }
+
   std::shared_ptr<const CachedFamily> a_, b_, c_;
   size_t two_fit_ = 0;
 };
@@ -333,6 +340,13 @@ TEST_F(FamilyCacheTest, ConcurrentLookupsAndInsertsAreCounted) {
 
 // ---- The compact tier ------------------------------------------------------------------------------
 
+/// `compact` holds exactly the points `family` was built from.
+void ExpectPointsOf(const CachedFamily& family, const CompactFamily& compact) {
+  const auto& points = family.family().points();
+  EXPECT_TRUE(std::equal(points.begin(), points.end(), compact.points().begin(), compact.points().end(),
+                         [](const Point2& p, const Point2& q) { return p.x == q.x && p.y == q.y; }));
+}
+
 /// The compact entry a demotion of `family` makes: its bytes are what the compact tier charges.
 size_t CompactBytes(const std::shared_ptr<const CachedFamily>& family) { return CompactFamily(*family).bytes(); }
 
@@ -340,9 +354,7 @@ TEST_F(FamilyCacheTest, PushedOutFamiliesAreDemotedWithTheirPoints) {
   RecordingObserver observer;
   FamilyCache cache({two_fit_, size_t{1} << 30}, &observer);
   EXPECT_EQ(cache.compact_byte_budget(), size_t{1} << 30);
-  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
+  ASSERT_NO_FATAL_FAILURE(InsertInTurn(cache));
 
   FamilyCache::Stats stats = cache.GetStats();
   EXPECT_EQ(stats.demotions, 1u);
@@ -356,10 +368,7 @@ TEST_F(FamilyCacheTest, PushedOutFamiliesAreDemotedWithTheirPoints) {
   const FamilyCache::Found found = cache.Lookup("", "h-a");
   EXPECT_EQ(found.resident, nullptr);
   ASSERT_NE(found.compact, nullptr);
-  const auto& points = a_->family().points();
-  EXPECT_TRUE(std::equal(points.begin(), points.end(), found.compact->points().begin(), found.compact->points().end(),
-                         [](const Point2& p, const Point2& q) { return p.x == q.x && p.y == q.y; }));
-  EXPECT_EQ(found.compact->resident_bytes(), a_->bytes());
+  ExpectPointsOf(*a_, *found.compact);
   EXPECT_EQ(cache.Find("", "h-a"), nullptr) << "Find answers the resident tier only";
   stats = cache.GetStats();
   EXPECT_EQ(stats.compact.hits, 2u);
@@ -391,9 +400,7 @@ TEST_F(FamilyCacheTest, CompactEntriesHoldSixteenBytesAPoint) {
 TEST_F(FamilyCacheTest, InsertOfADemotedFamilyPromotesIt) {
   RecordingObserver observer;
   FamilyCache cache({two_fit_, size_t{1} << 30}, &observer);
-  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());  // a demoted
+  ASSERT_NO_FATAL_FAILURE(InsertInTurn(cache));  // a demoted
   const FamilyCache::Found found = cache.Lookup("", "h-a");
   ASSERT_NE(found.compact, nullptr);
 
@@ -415,7 +422,9 @@ TEST_F(FamilyCacheTest, InsertOfADemotedFamilyPromotesIt) {
   EXPECT_EQ(stats.demotions, 2u) << "b, now the least recently used, made room";
   EXPECT_EQ(stats.compact.entries, 1u);
   EXPECT_EQ(cache.Find("", "h-a").get(), rebuilt.get());
-  EXPECT_EQ(cache.Lookup("", "h-b").compact->resident_bytes(), b_->bytes());
+  const FamilyCache::Found b = cache.Lookup("", "h-b");
+  ASSERT_NE(b.compact, nullptr);
+  ExpectPointsOf(*b_, *b.compact);
   ExpectObserverAgrees(observer, cache);
 }
 
@@ -446,9 +455,7 @@ TEST_F(FamilyCacheTest, CompactTierEvictsItsLeastRecentlyUsed) {
 TEST_F(FamilyCacheTest, FamilyTooLargeForTheCompactTierIsEvicted) {
   RecordingObserver observer;
   FamilyCache cache({two_fit_, CompactBytes(a_) - 1}, &observer);
-  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
+  ASSERT_NO_FATAL_FAILURE(InsertInTurn(cache));
   const FamilyCache::Stats stats = cache.GetStats();
   EXPECT_EQ(stats.demotions, 0u);
   EXPECT_EQ(stats.resident.evictions, 1u);
@@ -461,9 +468,7 @@ TEST_F(FamilyCacheTest, FamilyTooLargeForTheCompactTierIsEvicted) {
 TEST_F(FamilyCacheTest, EraseDropsACompactEntry) {
   RecordingObserver observer;
   FamilyCache cache({two_fit_, size_t{1} << 30}, &observer);
-  ASSERT_THAT(cache.Insert("", "h-a", a_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
-  ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());  // a demoted
+  ASSERT_NO_FATAL_FAILURE(InsertInTurn(cache));  // a demoted
   EXPECT_FALSE(cache.Erase("other", "h-a"));
   EXPECT_TRUE(cache.Erase("", "h-a"));
   EXPECT_FALSE(cache.Erase("", "h-a"));
