@@ -33,6 +33,7 @@ test_packages=(
   curl                   # the README's service walk-through scrapes /metrics
   clang libclang-rt-14-dev  # libFuzzer: the fuzz targets run briefly in CI
   clang-format clang-tidy   # scripts/lint.sh: the format check and static analysis, as errors
+  ccache                 # scripts/test.sh: the image build reuses the CPU build's objects
   pybind11-dev python3-dev python3-numpy python3-pytest  # galpha._engine (GALPHA_BUILD_PYTHON) and its tests
   python3-grpcio python3-protobuf  # the Python package's network client (stubs: protobuf-compiler-grpc above)
   python3-zstandard      # its compressed point chunks (EncodedPointChunk)

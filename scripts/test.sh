@@ -23,6 +23,17 @@ step_done "install dependencies"
 # with two tests at a time (ctest -j below), alphactl_test took 137 s instead of 28. Waiting
 # threads sleep instead; the engine's results do not depend on it.
 export OMP_WAIT_POLICY=passive
+# Every build below compiles through ccache, in a cache inside this tree: the container image's
+# build (the last step) then takes the CPU build's objects for the units they share (same flags:
+# CMakeLists.txt makes all code position-independent). Depend mode hashes the compiler's own
+# dependency list instead of running the preprocessor once more on a miss, which the sanitizer
+# builds, all misses, would pay for every unit. CMake reads the launcher from the environment when
+# it configures a tree for the first time; an existing tree keeps what it has.
+if command -v ccache >/dev/null; then
+  export CMAKE_CXX_COMPILER_LAUNCHER=ccache CMAKE_C_COMPILER_LAUNCHER=ccache
+  export CCACHE_DIR=${CCACHE_DIR:-$PWD/build/ccache} CCACHE_BASEDIR=$PWD CCACHE_DEPEND=1 CCACHE_MAXSIZE=${CCACHE_MAXSIZE:-5G}
+  ccache --zero-stats >/dev/null
+fi
 # The CUDA configuration only where a GPU can run its tests: without one they skip, and compiling
 # the CUDA objects (about 13 minutes of nvcc on 2 cores) would test nothing but the compiler. The
 # GPU runs (bench/gpu_bundle.sh, bench/gpu_run.sh) build and test it.
@@ -57,3 +68,4 @@ step_done "manifests"
 # The image's CUDA code only where it can be tested, as for the preset above.
 GALPHA_IMAGE_WITH_CUDA=$([ "$preset" = cuda ] && echo AUTO || echo OFF) deploy/build-server.sh build/image-root
 step_done "image build steps"
+if command -v ccache >/dev/null; then ccache --show-stats | grep -iE 'hits|misses' || true; fi

@@ -126,18 +126,6 @@ def alphactl_wkt_type(geometry) -> str:
     return "Polygon" if polygons is not None and len(polygons.geoms) == 1 else "MultiPolygon"
 
 
-def coordinates_of(geometry) -> list:
-    """Every ring, line and point of a multi-geometry as coordinate arrays, in order."""
-    out = []
-    for g in geometry.geoms:
-        if g.geom_type == "Polygon":
-            out.append(np.asarray(g.exterior.coords).tobytes())
-            out.extend(np.asarray(h.coords).tobytes() for h in g.interiors)
-        else:
-            out.append(np.asarray(g.coords).tobytes())
-    return out
-
-
 def test_every_shape_is_valid_and_equals_alphactl(any_client, alphactl: str, data_set: pathlib.Path) -> None:
     family = any_client.build(read_bin(data_set))
     for rank in ranks_of(family.spectrum_size):
@@ -155,5 +143,7 @@ def test_every_shape_is_valid_and_equals_alphactl(any_client, alphactl: str, dat
             expected = parts_by_type(wkt)
             assert got.keys() == expected.keys(), f"rank {rank} {mode}"
             for kind, part in got.items():
-                # Exactly the same vertices in the same canonical order (the input doubles).
-                assert coordinates_of(part) == coordinates_of(expected[kind]), f"rank {rank} {mode} {kind}"
+                # Exactly the same vertices in the same canonical order (the input doubles): the same
+                # well-known binary, byte for byte (one GEOS call, where comparing member by
+                # member took most of this test's time on the 110K-point data set).
+                assert part.wkb == expected[kind].wkb, f"rank {rank} {mode} {kind}"

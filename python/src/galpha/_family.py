@@ -16,6 +16,7 @@ import numpy as np
 
 from ._backend import FamilyBackend
 from ._crs import Frame
+from . import _wkb
 from ._errors import InvalidInput
 from ._types import (
     BettiCurves,
@@ -201,9 +202,8 @@ def holes_from_rings(rings: ShapeRings, points: np.ndarray, min_area: float) -> 
 def holes_geodataframe(holes: List[Hole], points: np.ndarray, crs: Any) -> Any:
     """One row per hole: ``polygon``, ``area`` and the hole as a shapely Polygon, in ``crs``."""
     import geopandas
-    from shapely.geometry import Polygon
 
-    geometries = [Polygon(points[h.ring]) for h in holes]
+    geometries = [_wkb.load(_wkb.polygon_wkb(points, h.ring, [])) for h in holes]
     columns = {
         "polygon": np.array([h.polygon for h in holes], dtype=np.int64),
         "area": np.array([h.area for h in holes], dtype=np.float64),
@@ -214,21 +214,17 @@ def holes_geodataframe(holes: List[Hole], points: np.ndarray, crs: Any) -> Any:
 def rings_to_shapely(rings: ShapeRings, points: np.ndarray, mode: Mode) -> Any:
     """A MultiPolygon (regularized), or a GeometryCollection of the MultiPolygon, the singular edges
     as a MultiLineString and the isolated points as a MultiPoint, each present when not empty
-    (general)."""
-    import shapely.wkt
-    from shapely.geometry import GeometryCollection, MultiLineString, MultiPoint, MultiPolygon, Polygon
-
-    polygons = [Polygon(points[p.outer], [points[h] for h in p.holes]) for p in rings.polygons]
-    # Typed even when empty (shapely 1.8 turns MultiPolygon([]) into a GeometryCollection).
-    multipolygon = MultiPolygon(polygons) if polygons else shapely.wkt.loads("MULTIPOLYGON EMPTY")
+    (general). Made in one GEOS call (_wkb.py says why)."""
+    # Typed even when empty (a MultiPolygon of no members: MULTIPOLYGON EMPTY).
+    multipolygon = _wkb.multipolygon_wkb(points, rings.polygons)
     if mode == Mode.REGULARIZED:
-        return multipolygon
-    parts: List[Any] = [multipolygon] if polygons else []
+        return _wkb.load(multipolygon)
+    parts: List[bytes] = [multipolygon] if rings.polygons else []
     if len(rings.singular_edges):
-        parts.append(MultiLineString([points[e] for e in rings.singular_edges]))
+        parts.append(_wkb.multilinestring_wkb(points, rings.singular_edges))
     if len(rings.isolated_points):
-        parts.append(MultiPoint(points[rings.isolated_points]))
-    return GeometryCollection(parts)
+        parts.append(_wkb.multipoint_wkb(points, rings.isolated_points))
+    return _wkb.load(_wkb.collection_wkb(parts))
 
 
 class Family:
@@ -364,19 +360,16 @@ class Family:
 
     def _geodataframe(self, rings: ShapeRings) -> Any:
         import geopandas
-        from shapely.geometry import MultiLineString, MultiPoint, Polygon
 
-        kinds: List[str] = []
-        geometries: List[Any] = []
-        for p in rings.polygons:
-            kinds.append("polygon")
-            geometries.append(Polygon(self._points[p.outer], [self._points[h] for h in p.holes]))
+        # The polygons in one GEOS call, as in rings_to_shapely; one row each.
+        geometries: List[Any] = list(_wkb.load(_wkb.multipolygon_wkb(self._points, rings.polygons)).geoms)
+        kinds: List[str] = ["polygon"] * len(geometries)
         if len(rings.singular_edges):
             kinds.append("singular_edges")
-            geometries.append(MultiLineString([self._points[e] for e in rings.singular_edges]))
+            geometries.append(_wkb.load(_wkb.multilinestring_wkb(self._points, rings.singular_edges)))
         if len(rings.isolated_points):
             kinds.append("isolated_points")
-            geometries.append(MultiPoint(self._points[rings.isolated_points]))
+            geometries.append(_wkb.load(_wkb.multipoint_wkb(self._points, rings.isolated_points)))
         frame = geopandas.GeoDataFrame({"kind": kinds}, geometry=geometries, crs=self.crs)
         if self.projection is None:
             frame["area"] = [g.area if k == "polygon" else 0.0 for k, g in zip(kinds, geometries)]
