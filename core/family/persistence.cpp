@@ -2,6 +2,8 @@
 
 #include <gmpxx.h>
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <future>
@@ -10,18 +12,21 @@
 #include <tuple>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/host_vector.hpp"
 
 namespace galpha {
 namespace {
 
-/// Union-find with path halving and union by size; each root keeps a representative chosen by
-/// the caller (the eldest member under the elder rule).
-class ElderForest {
+/// Union-find whose root is always its component's eldest member: nodes are numbered so that
+/// age is their order (H0: a vertex's index, the smaller the elder; H1: a dual node's position in
+/// the filtration, the larger the elder), and a join links the younger root under the elder. The
+/// forest is then one array of parents, with no eldest or size beside it: each step of the passes
+/// below touches one word a node, where the representative, size and parent of the general form
+/// were three random reads. Path halving keeps the finds short (amortized logarithmic without a
+/// union by size; in practice one or two hops).
+class AgeOrderedForest {
  public:
-  explicit ElderForest(size_t n) : parent_(n), eldest_(n), size_(n, 1) {
-    std::iota(parent_.begin(), parent_.end(), uint32_t{0});
-    std::iota(eldest_.begin(), eldest_.end(), uint32_t{0});
-  }
+  explicit AgeOrderedForest(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), uint32_t{0}); }
   uint32_t Find(uint32_t x) {
     while (parent_[x] != x) {
       parent_[x] = parent_[parent_[x]];
@@ -29,18 +34,73 @@ class ElderForest {
     }
     return x;
   }
-  uint32_t eldest(uint32_t root) const { return eldest_[root]; }
-  /// Joins two roots; the joined component's eldest is `eldest`.
-  void Join(uint32_t a, uint32_t b, uint32_t eldest) {
-    if (size_[a] < size_[b]) std::swap(a, b);
-    parent_[b] = a;
-    size_[a] += size_[b];
-    eldest_[a] = eldest;
-  }
+  /// Starts loading a node the loop will find a few steps later: the passes read the forest at
+  /// random (the filtration order has no locality), and waiting for each read one at a time is
+  /// what they spent their time on.
+  void Prefetch(uint32_t x) const { __builtin_prefetch(&parent_[x]); }
+  bool IsRoot(uint32_t x) const { return parent_[x] == x; }
+  void Link(uint32_t younger_root, uint32_t elder_root) { parent_[younger_root] = elder_root; }
 
  private:
-  std::vector<uint32_t> parent_, eldest_, size_;
+  std::vector<uint32_t> parent_;
 };
+
+/// How many steps ahead the passes prefetch the forest's nodes.
+constexpr size_t kPrefetchAhead = 16;
+
+uint32_t RankOfKey(uint64_t key) { return static_cast<uint32_t>(key >> 32); }
+uint32_t PositionOfKey(uint64_t key) { return static_cast<uint32_t>(key); }
+
+/// Filtration keys of the simplices of one dimension: birth rank in the high word, canonical
+/// position in the low word, sorted. The keys are made in canonical order, so a stable sort by
+/// rank alone sorts them: a least-significant-digit radix sort over the ranks' width (11 bits a
+/// pass; two passes for up to 4M ranks; kNeverRank as the bucket after rank K), each pass a count
+/// per thread, one prefix sum and a stable scatter. A comparison sort of the 64-bit keys took most
+/// of the diagram's time.
+template <class RankOf>
+HostVector<uint64_t> SortedFiltrationKeys(absl::Span<const uint32_t> order, size_t num_ranks, RankOf rank_of) {
+  const size_t n = order.size();
+  HostVector<uint64_t> keys(n), scratch(n);
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < static_cast<int64_t>(n); ++i) {
+    keys[i] = (uint64_t{rank_of(order[i])} << 32) | static_cast<uint64_t>(i);
+  }
+  const uint64_t never_bucket = uint64_t{num_ranks} + 1;
+  auto bucket = [never_bucket](uint64_t key) {
+    const uint32_t rank = RankOfKey(key);
+    return rank == kNeverRank ? never_bucket : uint64_t{rank};
+  };
+  constexpr int kDigitBits = 11;
+  constexpr size_t kDigits = size_t{1} << kDigitBits;
+  std::vector<size_t> offsets(static_cast<size_t>(omp_get_max_threads()) * kDigits);
+  for (int shift = 0; (never_bucket >> shift) != 0; shift += kDigitBits) {
+    std::fill(offsets.begin(), offsets.end(), 0);
+#pragma omp parallel
+    {
+      const auto threads = static_cast<size_t>(omp_get_num_threads());
+      const auto thread = static_cast<size_t>(omp_get_thread_num());
+      const size_t begin = n * thread / threads, end = n * (thread + 1) / threads;
+      size_t* mine = &offsets[thread * kDigits];
+      for (size_t i = begin; i < end; ++i) ++mine[(bucket(keys[i]) >> shift) & (kDigits - 1)];
+#pragma omp barrier
+#pragma omp single
+      {
+        // Digit major, thread minor: each thread's items of a digit follow the earlier threads'.
+        size_t next = 0;
+        for (size_t d = 0; d < kDigits; ++d) {
+          for (size_t t = 0; t < threads; ++t) {
+            const size_t count = offsets[t * kDigits + d];
+            offsets[t * kDigits + d] = next;
+            next += count;
+          }
+        }
+      }
+      for (size_t i = begin; i < end; ++i) scratch[mine[(bucket(keys[i]) >> shift) & (kDigits - 1)]++] = keys[i];
+    }
+    keys.swap(scratch);
+  }
+  return keys;
+}
 
 /// Sorts each run of consecutive items that `same_run` puts together by `less`: the lists below
 /// come out of the union-finds already ordered but for ties, so sorting the runs is linear.
@@ -53,23 +113,6 @@ void SortRuns(std::vector<PersistencePair>::iterator begin, std::vector<Persiste
     if (run_end - begin > 1) std::sort(begin, run_end, less);
     begin = run_end;
   }
-}
-
-/// Ids in filtration order within ranks: `order` lists ids in canonical order; the result lists
-/// them by rank (kNeverRank last), canonical order within a rank (a stable counting sort).
-template <class RankOf>
-std::vector<uint32_t> SortByRank(absl::Span<const uint32_t> order, size_t num_ranks, RankOf rank_of) {
-  // Bucket K + 1 holds kNeverRank.
-  std::vector<uint32_t> start(num_ranks + 3, 0);
-  auto bucket = [&](uint32_t id) -> size_t {
-    const uint32_t r = rank_of(id);
-    return r == kNeverRank ? num_ranks + 1 : r;
-  };
-  for (uint32_t id : order) ++start[bucket(id) + 1];
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<uint32_t> sorted(order.size());
-  for (uint32_t id : order) sorted[start[bucket(id)]++] = id;
-  return sorted;
 }
 
 }  // namespace
@@ -116,74 +159,79 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family)
 
 namespace {
 
+/// The edges in filtration order, each step with what the passes read of it, gathered once (in
+/// parallel) so that the passes scan them in sequence.
+struct EdgeStep {
+  uint32_t a, b;      // vertices (H0 nodes)
+  uint32_t sides[2];  // the triangles on its two sides as dual nodes (filtration positions; the outer face last)
+  uint32_t birth;     // rank
+  uint32_t id;        // the family's edge id
+  uint32_t position;  // canonical position (ties in the diagram's order)
+};
+
 /// H0: every distinct point is born at rank 0; an edge joining two components kills the one whose
 /// oldest vertex (lowest index: vertices of one rank are ordered by index) comes later. An edge
-/// inside one component closes a loop (it creates an H1 class): marked in `closes_loop`. Pairs in
-/// Kruskal's order (death ascending), then the essential classes (ordered by the caller).
-std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const std::vector<uint32_t>& edges_in_order,
+/// inside one component closes a loop (it creates an H1 class): marked in `closes_loop` (by step).
+/// Pairs in Kruskal's order (death ascending), then the essential classes (ordered by the caller).
+std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const HostVector<EdgeStep>& steps,
                                             std::vector<uint8_t>* closes_loop) {
-  const AlphaRanks& r = family.ranks();
   const auto num_points = static_cast<uint32_t>(family.points().size());
   std::vector<PersistencePair> pairs;
   pairs.reserve(family.num_unique());
-  ElderForest forest(num_points);
-  for (uint32_t e : edges_in_order) {
-    const uint32_t a = forest.Find(family.edges()[e][0]), b = forest.Find(family.edges()[e][1]);
+  AgeOrderedForest forest(num_points);  // roots: their component's lowest index
+  for (size_t i = 0; i < steps.size(); ++i) {
+    if (i + kPrefetchAhead < steps.size()) {
+      forest.Prefetch(steps[i + kPrefetchAhead].a);
+      forest.Prefetch(steps[i + kPrefetchAhead].b);
+    }
+    const EdgeStep& step = steps[i];
+    const uint32_t a = forest.Find(step.a), b = forest.Find(step.b);
     if (a == b) {
-      (*closes_loop)[e] = 1;
+      (*closes_loop)[i] = 1;
       continue;
     }
-    const uint32_t oldest_a = forest.eldest(a), oldest_b = forest.eldest(b);
-    const uint32_t young = oldest_a < oldest_b ? b : a, old = young == a ? b : a;
-    const uint32_t death = EdgeBirthRank(r, e);
-    if (death > 0) pairs.push_back({0, 0, death, forest.eldest(young), death == kNeverRank ? kNoSimplex : e});
-    forest.Join(a, b, forest.eldest(old));
+    const uint32_t young = std::max(a, b), old = std::min(a, b);
+    if (step.birth > 0) pairs.push_back({0, 0, step.birth, young, step.birth == kNeverRank ? kNoSimplex : step.id});
+    forest.Link(young, old);
   }
+  // One essential class a component, created by its oldest vertex (its root).
   for (uint32_t v = 0; v < num_points; ++v) {
-    // One essential class a component, created by its oldest vertex (not its root: the forest
-    // joins by size).
-    if (family.representative()[v] == v && forest.Find(v) == v) {
-      pairs.push_back({0, 0, kNeverRank, forest.eldest(v), kNoSimplex});
-    }
+    if (family.representative()[v] == v && forest.IsRoot(v)) pairs.push_back({0, 0, kNeverRank, v, kNoSimplex});
   }
   return pairs;
 }
 
-/// H1 through the dual: nodes are the triangles and the outer face (node num_tri), joined in
-/// reverse filtration order by the edges; an edge whose two sides are already one component of
-/// the complement is a spanning-forest edge of the primal (planar duality: the complement of a
-/// minimum spanning forest is a maximum spanning tree of the dual, both in the one filtration
-/// order), marked in `joins_dual` false. Of two joining components the one whose eldest member (in
-/// reverse order: the latest triangle; the outer face before all) comes first in the filtration
-/// dies: the loop the edge made is filled last by that triangle. Pairs in reverse filtration order
-/// of their creators.
-std::vector<PersistencePair> PairHoles(const AlphaFamily& family, const std::vector<uint32_t>& edges_in_order,
-                                       const std::vector<uint32_t>& triangle_position,
+/// H1 through the dual: nodes are the triangles (by filtration position) and the outer face (last
+/// of all), joined in reverse filtration order by the edges; an edge whose two sides are already
+/// one component of the complement is a spanning-forest edge of the primal (planar duality: the
+/// complement of a minimum spanning forest is a maximum spanning tree of the dual, both in the one
+/// filtration order), marked in `joins_dual` false (by step). Of two joining components the one
+/// whose eldest member (in reverse order: the latest triangle; the outer face before all) comes
+/// first in the filtration dies: the loop the edge made is filled last by that triangle. Pairs in
+/// reverse filtration order of their creators. Here an H1 pair's `creator` is the edge's canonical
+/// position and its `killer` the triangle's filtration position: the caller orders the pairs by
+/// the first, then maps both to ids.
+std::vector<PersistencePair> PairHoles(const HostVector<EdgeStep>& steps, const HostVector<uint64_t>& triangle_keys,
                                        std::vector<uint8_t>* joins_dual) {
-  const AlphaRanks& r = family.ranks();
-  const auto num_tri = static_cast<uint32_t>(family.triangles().size());
-  const uint32_t outer = num_tri;
+  const auto num_tri = static_cast<uint32_t>(triangle_keys.size());
   std::vector<PersistencePair> pairs;
   pairs.reserve(num_tri);
-  ElderForest forest(size_t{num_tri} + 1);
-  // Filtration key of a dual node; the outer face is never filled.
-  auto key = [&](uint32_t node) {
-    if (node == outer) return std::make_tuple(uint64_t{1} << 33, uint32_t{0});
-    return std::make_tuple(uint64_t{r.tri_rank[node]}, triangle_position[node]);
-  };
-  for (auto it = edges_in_order.rbegin(); it != edges_in_order.rend(); ++it) {
-    const uint32_t e = *it;
-    const auto sides = r.edge_triangles[e];
-    const uint32_t a = forest.Find(sides[0] < 0 ? outer : static_cast<uint32_t>(sides[0]));
-    const uint32_t b = forest.Find(sides[1] < 0 ? outer : static_cast<uint32_t>(sides[1]));
+  AgeOrderedForest forest(size_t{num_tri} + 1);  // roots: their component's latest position
+  for (size_t i = steps.size(); i-- > 0;) {
+    if (i >= kPrefetchAhead) {
+      forest.Prefetch(steps[i - kPrefetchAhead].sides[0]);
+      forest.Prefetch(steps[i - kPrefetchAhead].sides[1]);
+    }
+    const EdgeStep& step = steps[i];
+    const uint32_t a = forest.Find(step.sides[0]), b = forest.Find(step.sides[1]);
     if (a == b) continue;
-    (*joins_dual)[e] = 1;
-    const bool a_elder = key(forest.eldest(a)) > key(forest.eldest(b));
-    const uint32_t old = a_elder ? a : b, young = a_elder ? b : a;
-    const uint32_t killer = forest.eldest(young);
-    const uint32_t birth = EdgeBirthRank(r, e), death = r.tri_rank[killer];
-    if (death > birth) pairs.push_back({1, birth, death, e, death == kNeverRank ? kNoSimplex : killer});
-    forest.Join(a, b, forest.eldest(old));
+    (*joins_dual)[i] = 1;
+    // The outer face (num_tri) is never the younger: only two of its own sides would make it so.
+    const uint32_t young = std::min(a, b), old = std::max(a, b);
+    const uint32_t death = RankOfKey(triangle_keys[young]);
+    if (death > step.birth)
+      pairs.push_back({1, step.birth, death, step.position, death == kNeverRank ? kNoSimplex : young});
+    forest.Link(young, old);
   }
   return pairs;
 }
@@ -193,34 +241,49 @@ std::vector<PersistencePair> PairHoles(const AlphaFamily& family, const std::vec
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, absl::Span<const uint32_t> edge_order,
                                                       absl::Span<const uint32_t> triangle_order) {
   const AlphaRanks& r = family.ranks();
-  const auto num_edges = static_cast<uint32_t>(family.edges().size());
   const auto num_tri = static_cast<uint32_t>(family.triangles().size());
-  const size_t num_ranks = r.spectrum.size();
 
-  // Canonical positions break ties between simplices of one rank and dimension.
-  std::vector<uint32_t> edge_position(num_edges), triangle_position(num_tri);
-  for (uint32_t i = 0; i < num_edges; ++i) edge_position[edge_order[i]] = i;
-  for (uint32_t i = 0; i < num_tri; ++i) triangle_position[triangle_order[i]] = i;
-  const std::vector<uint32_t> edges_in_order =
-      SortByRank(edge_order, num_ranks, [&](uint32_t e) { return EdgeBirthRank(r, e); });
+  // The filtration: each dimension sorted by (birth rank, canonical position).
+  const HostVector<uint64_t> triangle_keys =
+      SortedFiltrationKeys(triangle_order, r.spectrum.size(), [&](uint32_t t) { return r.tri_rank[t]; });
+  const HostVector<uint64_t> edge_keys =
+      SortedFiltrationKeys(edge_order, r.spectrum.size(), [&](uint32_t e) { return EdgeBirthRank(r, e); });
+  // Dual nodes: a triangle's filtration position; the outer face after every triangle.
+  HostVector<uint32_t> dual_node(num_tri);
+#pragma omp parallel for schedule(static)
+  for (int64_t j = 0; j < static_cast<int64_t>(num_tri); ++j) {
+    dual_node[triangle_order[PositionOfKey(triangle_keys[j])]] = static_cast<uint32_t>(j);
+  }
+  HostVector<EdgeStep> steps(edge_keys.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < static_cast<int64_t>(steps.size()); ++i) {
+    const uint32_t position = PositionOfKey(edge_keys[i]);
+    const uint32_t e = edge_order[position];
+    const auto sides = r.edge_triangles[e];
+    steps[i] = {family.edges()[e][0],
+                family.edges()[e][1],
+                {sides[0] < 0 ? num_tri : dual_node[sides[0]], sides[1] < 0 ? num_tri : dual_node[sides[1]]},
+                RankOfKey(edge_keys[i]),
+                e,
+                position};
+  }
 
   // The two passes are independent (the dual decides for itself which edges close loops): the
   // holes on a second thread, the components here.
-  std::vector<uint8_t> closes_loop(num_edges, 0), joins_dual(num_edges, 0);
+  std::vector<uint8_t> closes_loop(steps.size(), 0), joins_dual(steps.size(), 0);
   std::future<std::vector<PersistencePair>> holes =
-      std::async(std::launch::async, [&] { return PairHoles(family, edges_in_order, triangle_position, &joins_dual); });
-  std::vector<PersistencePair> components = PairComponents(family, edges_in_order, &closes_loop);
+      std::async(std::launch::async, [&] { return PairHoles(steps, triangle_keys, &joins_dual); });
+  std::vector<PersistencePair> components = PairComponents(family, steps, &closes_loop);
   std::vector<PersistencePair> h1 = holes.get();
   // Alexander duality, checked: an edge closes a loop exactly when it joins two components of the
   // complement.
   if (closes_loop != joins_dual) {
-    size_t e = 0;
-    while (closes_loop[e] == joins_dual[e]) ++e;
-    return absl::InternalError(absl::StrCat("persistence: edge ", e, (closes_loop[e] ? " closes" : " does not close"),
-                                            " a loop but ", (joins_dual[e] ? "joins" : "does not join"),
-                                            " two components of the complement"));
+    size_t i = 0;
+    while (closes_loop[i] == joins_dual[i]) ++i;
+    return absl::InternalError(
+        absl::StrCat("persistence: edge ", steps[i].id, (closes_loop[i] ? " closes" : " does not close"),
+                     " a loop but ", (joins_dual[i] ? "joins" : "does not join"), " two components of the complement"));
   }
-
   // The order: dimension, birth, death (kNeverRank sorts last), creator's canonical position. H0
   // pairs came in Kruskal's order (birth 0, death ascending; the essential classes last); H1 pairs
   // in reverse filtration order of their creators (birth descending): reversed, only runs of equal
@@ -230,10 +293,10 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
   pairs = std::move(components);
   const size_t num_h0 = pairs.size();
   pairs.insert(pairs.end(), h1.rbegin(), h1.rend());
-  auto position = [&](const PersistencePair& p) { return p.dimension == 0 ? p.creator : edge_position[p.creator]; };
-  auto by_key = [&](const PersistencePair& x, const PersistencePair& y) {
-    return std::make_tuple(x.birth_rank, x.death_rank, position(x)) <
-           std::make_tuple(y.birth_rank, y.death_rank, position(y));
+  // Every creator is its canonical position here (a vertex's is its index; H1's were recorded so).
+  auto by_key = [](const PersistencePair& x, const PersistencePair& y) {
+    return std::make_tuple(x.birth_rank, x.death_rank, x.creator) <
+           std::make_tuple(y.birth_rank, y.death_rank, y.creator);
   };
   const auto h1_begin = pairs.begin() + static_cast<std::ptrdiff_t>(num_h0);
   SortRuns(
@@ -242,6 +305,11 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
   SortRuns(
       h1_begin, pairs.end(),
       [](const PersistencePair& x, const PersistencePair& y) { return x.birth_rank == y.birth_rank; }, by_key);
+  // H1's creators and killers by id.
+  for (auto it = h1_begin; it != pairs.end(); ++it) {
+    it->creator = edge_order[it->creator];
+    if (it->killer != kNoSimplex) it->killer = triangle_order[PositionOfKey(triangle_keys[it->killer])];
+  }
   diagram.dimension_begin[0] = 0;
   diagram.dimension_begin[1] = num_h0;
   diagram.dimension_begin[2] = pairs.size();

@@ -49,9 +49,9 @@ struct PersistenceDiagram {
   size_t dimension_begin[3] = {0, 0, 0};
 };
 
-/// O((V + E + T) log n) after O(E + T + K) counting sorts; `edge_order` and `triangle_order` are
-/// the canonical orders (CanonicalOrders' fields). Internal error only if the family contradicts
-/// planar duality.
+/// Two parallel sorts of (rank, canonical position) keys, then two union-finds (nearly linear);
+/// `edge_order` and `triangle_order` are the canonical orders (CanonicalOrders' fields). Internal
+/// error only if the family contradicts planar duality.
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, absl::Span<const uint32_t> edge_order,
                                                       absl::Span<const uint32_t> triangle_order);
 /// The same, computing the canonical orders first.
