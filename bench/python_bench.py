@@ -5,7 +5,11 @@
     C++ client (alphactl --server ... bench: the same Build call, after a Release each time);
   * in process: galpha.local().build() vs the engine's own time for the same build in alphactl
     bench (the sum of its stage times, best of --repeat);
-  * classify at one alpha: NumPy arrays per second, both clients.
+  * classify at one alpha: NumPy arrays per second, both clients;
+  * the shape at that alpha as shapely geometry (mode general: polygons, singular edges, isolated
+    points), local: Family.shape() (one GEOS call through WKB) vs the same geometry built from
+    Family.shape_rings() with shapely's constructors, one object a member (what Family.shape did
+    before, and what a caller of shape_rings would write).
 
     /usr/bin/python3 bench/python_bench.py [--points 1000000] [--repeat 3] [--backend cpu]
         [--build-dir build/cpu] [--server HOST:PORT] [--encoding auto|raw]
@@ -51,6 +55,35 @@ def classify_rate(family, alpha: float) -> tuple:
     return best, size / best / 1e9
 
 
+def shapely_constructors(rings, points):
+    """The general shape from rings, member by member (the competitor of Family.shape)."""
+    from shapely.geometry import GeometryCollection, MultiLineString, MultiPoint, MultiPolygon, Polygon
+
+    parts = [MultiPolygon([Polygon(points[p.outer], [points[h] for h in p.holes]) for p in rings.polygons])]
+    if len(rings.singular_edges):
+        parts.append(MultiLineString([points[e] for e in rings.singular_edges]))
+    if len(rings.isolated_points):
+        parts.append(MultiPoint(points[rings.isolated_points]))
+    return GeometryCollection(parts)
+
+
+def shape_times(family, points, alpha: float, repeat: int) -> tuple:
+    """Best wall times (s) of Family.shape() and of shapely's constructors on the same rings."""
+    rings = family.shape_rings(alpha=alpha, mode="general")
+    ours = theirs = float("inf")
+    for _ in range(repeat):
+        start = time.perf_counter()
+        family.shape(alpha=alpha, mode="general")
+        ours = min(ours, time.perf_counter() - start)
+        start = time.perf_counter()
+        shapely_constructors(rings, points)
+        theirs = min(theirs, time.perf_counter() - start)
+    # Family.shape also computes the rings: charge the competitor for them too.
+    start = time.perf_counter()
+    family.shape_rings(alpha=alpha, mode="general")
+    return ours, theirs + (time.perf_counter() - start)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--points", type=int, default=1_000_000)
@@ -84,6 +117,7 @@ def main() -> int:
             py_wall = min(py_wall, time.perf_counter() - start)
             py_engine = min(py_engine, sum(family.summary.stage_times.values()))
         local_classify = classify_rate(family, alpha)
+        shape_ours, shape_constructors = shape_times(family, points, alpha, args.repeat)
 
         # Over the network.
         server_process = None
@@ -135,6 +169,9 @@ def main() -> int:
     print(f"{'network: Python upload, bytes a point (' + args.encoding + ')':52}{upload_bytes / args.points:10.2f}")
     print(f"{'classify, local: ms / GB/s':52}{ms(local_classify[0])}  {local_classify[1]:.2f} GB/s")
     print(f"{'classify, network: ms / GB/s':52}{ms(net_classify[0])}  {net_classify[1]:.2f} GB/s")
+    print(f"{'shape, local: Family.shape(), general':52}{ms(shape_ours)}")
+    print(f"{'shape, local: shapely constructors from shape_rings':52}{ms(shape_constructors)}")
+    print(f"ratio shape (constructors / Family.shape):     {shape_constructors / shape_ours:.1f}")
     print(f"ratio local (Python wall / C++ engine stages): {py_wall * 1e3 / cpp_local:.3f}  (target <= 1.05)")
     print(f"ratio network (Python / C++ client, wall):     {net_wall * 1e3 / cpp_rpc:.3f}  (target <= 1.10)")
     print(f"client overhead beyond the server's stages: Python {net_overhead * 1e3:.1f} ms, C++ {cpp_overhead:.1f} ms")

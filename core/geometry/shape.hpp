@@ -15,6 +15,11 @@
 // guess). Holes belong to their piece by construction: no point-in-polygon test. Rings may touch
 // other rings at vertices, which OGC allows; no ring touches itself. Pieces inside another piece's
 // hole are polygons of their own.
+//
+// Cost: the triangles' sides are sorted by undirected edge (a parallel sort), so that an edge's two
+// sides are neighbours and one scan finds the pieces and the boundary; the orientation checks and
+// the areas run on every core. O(n log n), about a second for the 2M triangles of a 1M-point shape
+// on 2 cores (it was 10 s with a binary search for each side's twin).
 #pragma once
 
 #include <array>
