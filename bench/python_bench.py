@@ -6,8 +6,8 @@
   * in process: galpha.local().build() vs the engine's own time for the same build in alphactl
     bench (the sum of its stage times, best of --repeat);
   * classify at one alpha: NumPy arrays per second, both clients;
-  * the shape at that alpha as shapely geometry (mode general: polygons, singular edges, isolated
-    points), local: Family.shape() (one GEOS call through WKB) vs the same geometry built from
+  * the shape at that alpha and at a fifth of it (a fragmented shape: many small polygons,
+    singular edges and isolated points) as shapely geometry (mode general), local: Family.shape() (one GEOS call through WKB) vs the same geometry built from
     Family.shape_rings() with shapely's constructors, one object a member (what Family.shape did
     before, and what a caller of shape_rings would write).
 
@@ -117,7 +117,7 @@ def main() -> int:
             py_wall = min(py_wall, time.perf_counter() - start)
             py_engine = min(py_engine, sum(family.summary.stage_times.values()))
         local_classify = classify_rate(family, alpha)
-        shape_ours, shape_constructors = shape_times(family, points, alpha, args.repeat)
+        shapes = {label: shape_times(family, points, a, args.repeat) for label, a in (("alpha", alpha), ("alpha/5", alpha / 5))}
 
         # Over the network.
         server_process = None
@@ -169,9 +169,10 @@ def main() -> int:
     print(f"{'network: Python upload, bytes a point (' + args.encoding + ')':52}{upload_bytes / args.points:10.2f}")
     print(f"{'classify, local: ms / GB/s':52}{ms(local_classify[0])}  {local_classify[1]:.2f} GB/s")
     print(f"{'classify, network: ms / GB/s':52}{ms(net_classify[0])}  {net_classify[1]:.2f} GB/s")
-    print(f"{'shape, local: Family.shape(), general':52}{ms(shape_ours)}")
-    print(f"{'shape, local: shapely constructors from shape_rings':52}{ms(shape_constructors)}")
-    print(f"ratio shape (constructors / Family.shape):     {shape_constructors / shape_ours:.1f}")
+    for label, (ours, constructors) in shapes.items():
+        print(f"{'shape at ' + label + ', local: Family.shape(), general':52}{ms(ours)}")
+        print(f"{'shape at ' + label + ', local: shapely constructors':52}{ms(constructors)}")
+        print(f"ratio shape at {label} (constructors / Family.shape): {constructors / ours:.1f}")
     print(f"ratio local (Python wall / C++ engine stages): {py_wall * 1e3 / cpp_local:.3f}  (target <= 1.05)")
     print(f"ratio network (Python / C++ client, wall):     {net_wall * 1e3 / cpp_rpc:.3f}  (target <= 1.10)")
     print(f"client overhead beyond the server's stages: Python {net_overhead * 1e3:.1f} ms, C++ {cpp_overhead:.1f} ms")
