@@ -14,6 +14,7 @@ set_name=${1:-engine}
 cd "$(dirname "$0")/.."
 # Without GDAL and PROJ: alphactl would carry GDAL and the hundred libraries it pulls in, and PROJ
 # its database (the GPU machine reads .bin files only, without a CRS).
+scripts/drop-stale-build-dir.sh cuda
 cmake --preset cuda -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_PROJ=OFF -DGALPHA_WITH_GEMMI=OFF >/dev/null
 cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib

@@ -6,7 +6,7 @@
 // Per input: the family build (the engine's stages, the Betti curves among them: the "components"
 // stage computes the component and hole curves of both complexes in one pass), the persistence
 // diagram from the built family (host: the canonical orders, which the service computes once per
-// cached family, then the diagram: counting sorts and two union-finds), and GUDHI's
+// cached family, then the diagram: radix sorts by rank and two union-finds), and GUDHI's
 // AlphaComplex (exact) + persistent cohomology over Z/2Z on the same points, with both diagrams'
 // numbers of intervals of positive length (they may differ by a few where GUDHI's doubles reorder
 // near-ties: tests/gpu/alpha/persistence_gudhi_test.cpp compares the diagrams themselves).

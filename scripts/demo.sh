@@ -6,6 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
+scripts/drop-stale-build-dir.sh cpu
 cmake --preset cpu >/dev/null
 cmake --build --preset cpu --target alphactl -j"$(nproc)"
 alphactl=build/cpu/client/alphactl

@@ -32,6 +32,7 @@ run_preset() {
   local preset=$1
   shift
   local tests=("$@")
+  scripts/drop-stale-build-dir.sh "$preset"
   cmake --preset "$preset" -DGALPHA_UNITY_TESTS=ON >/dev/null
   cmake --build --preset "$preset" -j"$(nproc)" --target "${tests[@]}"
   local regex

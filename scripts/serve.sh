@@ -8,6 +8,7 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 preset=cpu
 if [ -x /usr/local/cuda/bin/nvcc ] || command -v nvcc >/dev/null; then preset=cuda; fi
+scripts/drop-stale-build-dir.sh "$preset"
 cmake --preset "$preset" >/dev/null
 cmake --build --preset "$preset" --target galpha_server alphactl -j"$(nproc)"
 exec "build/$preset/server/galpha_server" "$@"

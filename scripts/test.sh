@@ -23,7 +23,8 @@ step_done "install dependencies"
 # with two tests at a time (ctest -j below), alphactl_test took 137 s instead of 28. Waiting
 # threads sleep instead; the engine's results do not depend on it.
 export OMP_WAIT_POLICY=passive
-# Every build below compiles through ccache, in a cache inside this tree: the container image's
+# Every CMake build below compiles its C and C++ through ccache (not nvcc's CUDA units, nor the
+# fuzz targets, which clang++ compiles directly), in a cache inside this tree: the container image's
 # build (the last step) then takes the CPU build's objects for the units they share (same flags:
 # CMakeLists.txt makes all code position-independent). Depend mode hashes the compiler's own
 # dependency list instead of running the preprocessor once more on a miss, which the sanitizer
@@ -41,6 +42,7 @@ preset=cpu
 if command -v nvidia-smi >/dev/null && nvidia-smi -L 2>/dev/null | grep -q '^GPU'; then preset=cuda; fi
 # Each test executable as one translation unit (GALPHA_UNITY_TESTS): its files parse GoogleTest,
 # gRPC and Thrust once (CMakeLists.txt says what it saves).
+scripts/drop-stale-build-dir.sh "$preset"
 cmake --preset "$preset" -DGALPHA_BUILD_PYTHON=ON -DGALPHA_UNITY_TESTS=ON
 cmake --build --preset "$preset" -j"$(nproc)"
 step_done "build ($preset)"

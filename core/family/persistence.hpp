@@ -49,7 +49,8 @@ struct PersistenceDiagram {
   size_t dimension_begin[3] = {0, 0, 0};
 };
 
-/// Two parallel sorts of (rank, canonical position) keys, then two union-finds (nearly linear);
+/// Two parallel sorts of (rank, canonical position) keys, then two union-finds (path halving:
+/// amortized logarithmic a find, one or two hops in practice);
 /// `edge_order` and `triangle_order` are the canonical orders (CanonicalOrders' fields). Internal
 /// error only if the family contradicts planar duality.
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family, absl::Span<const uint32_t> edge_order,
