@@ -1,48 +1,61 @@
 #include "core/family/canonical_order.hpp"
 
-#include <parallel/algorithm>
-
 #include <algorithm>
 #include <array>
-#include <utility>
+#include <cstdint>
+
+#include "core/base/host_vector.hpp"
+#include "core/family/radix_sort.hpp"
 
 namespace galpha {
+namespace {
+
+/// A simplex by its ascending vertices, and its id.
+template <size_t kVertices>
+struct SimplexRecord {
+  std::array<uint32_t, kVertices> vertices;
+  uint32_t id;
+};
+
+/// The ids of `count` simplices in lexicographic order of their ascending vertices, and those
+/// vertices in that order, flat. A radix sort over the vertices, last to first (a vertex's bits a
+/// field: two passes of 11 bits each up to 4M points): the tuples are unique, so this is the one
+/// order. A parallel comparison sort of (tuple, id) pairs took 0.2 s at 1M points on 16 cores.
+template <size_t kVertices, class VerticesOf>
+void SortLexicographically(size_t count, size_t num_points, VerticesOf vertices_of, std::vector<uint32_t>* order,
+                           std::vector<uint32_t>* flat_vertices) {
+  HostVector<SimplexRecord<kVertices>> records(count), scratch;
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < static_cast<int64_t>(count); ++i) {
+    records[i] = {vertices_of(static_cast<uint32_t>(i)), static_cast<uint32_t>(i)};
+  }
+  const int bits = detail::BitWidth(num_points == 0 ? 0 : num_points - 1);
+  for (size_t field = kVertices; field-- > 0;) {
+    detail::StableRadixSort(records, scratch, bits,
+                            [field](const SimplexRecord<kVertices>& r) { return uint64_t{r.vertices[field]}; });
+  }
+  order->resize(count);
+  flat_vertices->resize(kVertices * count);
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < static_cast<int64_t>(count); ++i) {
+    (*order)[i] = records[i].id;
+    std::copy(records[i].vertices.begin(), records[i].vertices.end(), flat_vertices->begin() + kVertices * i);
+  }
+}
+
+}  // namespace
 
 CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family) {
   CanonicalOrders orders;
-  // 64-bit keys (smaller << 32 | larger) sort as the pairs do: one pass of std::sort over plain
-  // integers instead of a comparator over indirections.
+  const size_t num_points = family.points().size();
   const auto& edges = family.edges();
-  std::vector<std::pair<uint64_t, uint32_t>> edge_keys(edges.size());
-  for (uint32_t e = 0; e < edges.size(); ++e) {
-    const uint32_t a = std::min(edges[e][0], edges[e][1]), b = std::max(edges[e][0], edges[e][1]);
-    edge_keys[e] = {(uint64_t{a} << 32) | b, e};
-  }
-  // Keys are unique, so the parallel sort's order is the one order (libstdc++'s parallel mode,
-  // on the OpenMP threads the family library already uses).
-  __gnu_parallel::sort(edge_keys.begin(), edge_keys.end());
-  orders.edge_order.resize(edges.size());
-  orders.edge_vertices.resize(2 * edges.size());
-  for (size_t i = 0; i < edge_keys.size(); ++i) {
-    orders.edge_order[i] = edge_keys[i].second;
-    orders.edge_vertices[2 * i] = static_cast<uint32_t>(edge_keys[i].first >> 32);
-    orders.edge_vertices[2 * i + 1] = static_cast<uint32_t>(edge_keys[i].first);
-  }
-
+  SortLexicographically<2>(
+      edges.size(), num_points, [&](uint32_t e) { return SortedEdge(edges[e]); }, &orders.edge_order,
+      &orders.edge_vertices);
   const auto& triangles = family.triangles();
-  std::vector<std::pair<std::array<uint32_t, 3>, uint32_t>> triangle_keys(triangles.size());
-  for (uint32_t t = 0; t < triangles.size(); ++t) {
-    std::array<uint32_t, 3> key = triangles[t];
-    std::sort(key.begin(), key.end());
-    triangle_keys[t] = {key, t};
-  }
-  __gnu_parallel::sort(triangle_keys.begin(), triangle_keys.end());
-  orders.triangle_order.resize(triangles.size());
-  orders.triangle_vertices.resize(3 * triangles.size());
-  for (size_t i = 0; i < triangle_keys.size(); ++i) {
-    orders.triangle_order[i] = triangle_keys[i].second;
-    for (size_t k = 0; k < 3; ++k) orders.triangle_vertices[3 * i + k] = triangle_keys[i].first[k];
-  }
+  SortLexicographically<3>(
+      triangles.size(), num_points, [&](uint32_t t) { return SortedTriangle(triangles[t]); }, &orders.triangle_order,
+      &orders.triangle_vertices);
   return orders;
 }
 

@@ -2,8 +2,6 @@
 
 #include <gmpxx.h>
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cmath>
 #include <future>
@@ -13,6 +11,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/host_vector.hpp"
+#include "core/family/radix_sort.hpp"
 
 namespace galpha {
 namespace {
@@ -53,52 +52,22 @@ uint32_t PositionOfKey(uint64_t key) { return static_cast<uint32_t>(key); }
 
 /// Filtration keys of the simplices of one dimension: birth rank in the high word, canonical
 /// position in the low word, sorted. The keys are made in canonical order, so a stable sort by
-/// rank alone sorts them: a least-significant-digit radix sort over the ranks' width (11 bits a
-/// pass; two passes for up to 4M ranks; kNeverRank as the bucket after rank K), each pass a count
-/// per thread, one prefix sum and a stable scatter. A comparison sort of the 64-bit keys took most
-/// of the diagram's time.
+/// rank alone sorts them (a radix sort over the ranks' width, kNeverRank as the bucket after rank
+/// K: two passes up to 4M ranks). A comparison sort of the 64-bit keys took most of the diagram's
+/// time.
 template <class RankOf>
 HostVector<uint64_t> SortedFiltrationKeys(absl::Span<const uint32_t> order, size_t num_ranks, RankOf rank_of) {
   const size_t n = order.size();
-  HostVector<uint64_t> keys(n), scratch(n);
+  HostVector<uint64_t> keys(n), scratch;
 #pragma omp parallel for schedule(static)
   for (int64_t i = 0; i < static_cast<int64_t>(n); ++i) {
     keys[i] = (uint64_t{rank_of(order[i])} << 32) | static_cast<uint64_t>(i);
   }
   const uint64_t never_bucket = uint64_t{num_ranks} + 1;
-  auto bucket = [never_bucket](uint64_t key) {
+  detail::StableRadixSort(keys, scratch, detail::BitWidth(never_bucket), [never_bucket](uint64_t key) {
     const uint32_t rank = RankOfKey(key);
     return rank == kNeverRank ? never_bucket : uint64_t{rank};
-  };
-  constexpr int kDigitBits = 11;
-  constexpr size_t kDigits = size_t{1} << kDigitBits;
-  std::vector<size_t> offsets(static_cast<size_t>(omp_get_max_threads()) * kDigits);
-  for (int shift = 0; (never_bucket >> shift) != 0; shift += kDigitBits) {
-    std::fill(offsets.begin(), offsets.end(), 0);
-#pragma omp parallel
-    {
-      const auto threads = static_cast<size_t>(omp_get_num_threads());
-      const auto thread = static_cast<size_t>(omp_get_thread_num());
-      const size_t begin = n * thread / threads, end = n * (thread + 1) / threads;
-      size_t* mine = &offsets[thread * kDigits];
-      for (size_t i = begin; i < end; ++i) ++mine[(bucket(keys[i]) >> shift) & (kDigits - 1)];
-#pragma omp barrier
-#pragma omp single
-      {
-        // Digit major, thread minor: each thread's items of a digit follow the earlier threads'.
-        size_t next = 0;
-        for (size_t d = 0; d < kDigits; ++d) {
-          for (size_t t = 0; t < threads; ++t) {
-            const size_t count = offsets[t * kDigits + d];
-            offsets[t * kDigits + d] = next;
-            next += count;
-          }
-        }
-      }
-      for (size_t i = begin; i < end; ++i) scratch[mine[(bucket(keys[i]) >> shift) & (kDigits - 1)]++] = keys[i];
-    }
-    keys.swap(scratch);
-  }
+  });
   return keys;
 }
 
