@@ -29,7 +29,8 @@ inline std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
   return t;
 }
 
-/// O(n log n); the orders depend only on the triangulation, so callers compute them once.
+/// Linear passes on every core (a radix sort: core/family/radix_sort.hpp); the orders depend only
+/// on the triangulation, so callers compute them once.
 CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family);
 
 }  // namespace galpha
