@@ -55,8 +55,18 @@ def test_geodataframe_round_trip(any_client, file: str, crs: str) -> None:
     assert back.crs == frame.crs
     assert all(a.equals(b) for a, b in zip(back.geometry, shape.geometry))
     # The general shape also has its singular parts as rows, in the same CRS.
-    general = family.shape(rank=max(1, optimal.rank // 2), mode="general", as_geodataframe=True)
+    rank = max(1, optimal.rank // 2)
+    general = family.shape(rank=rank, mode="general", as_geodataframe=True)
     assert general.crs == frame.crs and general.geometry.is_valid.all()
+    # One row a polygon, then one for the singular edges and one for the isolated points: the
+    # members of the shape itself, in its order.
+    rings = family.shape_rings(rank=rank, mode="general")
+    kinds = ["polygon"] * len(rings.polygons)
+    kinds += ["singular_edges"] * bool(len(rings.singular_edges)) + ["isolated_points"] * bool(len(rings.isolated_points))
+    assert list(general["kind"]) == kinds
+    whole = list(family.shape(rank=rank, mode="general").geoms)
+    members = (list(whole.pop(0).geoms) if rings.polygons else []) + whole
+    assert [g.wkb for g in general.geometry] == [g.wkb for g in members]
 
 
 def test_shapely_inputs(any_client) -> None:

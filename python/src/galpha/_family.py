@@ -361,15 +361,15 @@ class Family:
     def _geodataframe(self, rings: ShapeRings) -> Any:
         import geopandas
 
-        # The polygons in one GEOS call, as in rings_to_shapely; one row each.
-        geometries: List[Any] = list(_wkb.load(_wkb.multipolygon_wkb(self._points, rings.polygons)).geoms)
+        # The general shape's parts (one GEOS call); one row a polygon, then one a part.
+        parts = list(rings_to_shapely(rings, self._points, Mode.GENERAL).geoms)
+        geometries: List[Any] = list(parts.pop(0).geoms) if rings.polygons else []
         kinds: List[str] = ["polygon"] * len(geometries)
         if len(rings.singular_edges):
             kinds.append("singular_edges")
-            geometries.append(_wkb.load(_wkb.multilinestring_wkb(self._points, rings.singular_edges)))
         if len(rings.isolated_points):
             kinds.append("isolated_points")
-            geometries.append(_wkb.load(_wkb.multipoint_wkb(self._points, rings.isolated_points)))
+        geometries += parts
         frame = geopandas.GeoDataFrame({"kind": kinds}, geometry=geometries, crs=self.crs)
         if self.projection is None:
             frame["area"] = [g.area if k == "polygon" else 0.0 for k, g in zip(kinds, geometries)]
