@@ -4,11 +4,17 @@
 //
 //   delaunay_bench [--backend=auto|cpu|cuda] [--repeat=3] [--sizes=100000,1000000]
 //                  [--dists=uniform,gaussian,clustered,grid] [--seed=1] [--data FILE.bin]...
+//                  [--weights=KIND]
+//
+// With --weights (a kind of tests/support/weight_generators.hpp: uniform, signed, one_huge,
+// many_hidden, ...), the regular triangulation: galpha::TriangulateWeighted against CGAL's
+// Regular_triangulation_2, with the hidden points counted.
 //
 // With --data and no --dists/--sizes, only the files run. Times are the best of --repeat runs;
 // point generation and conversion are not timed.
 #include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Regular_triangulation_2.h>
 
 #include <algorithm>
 #include <chrono>
@@ -26,17 +32,20 @@
 #include "core/io/point_io.hpp"
 #include "gpu/triangulation/delaunay.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/weight_generators.hpp"
 
 namespace galpha {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using CgalDelaunay = CGAL::Delaunay_triangulation_2<Kernel>;
+using CgalRegular = CGAL::Regular_triangulation_2<Kernel>;
 
 // One input to time: a generated distribution at a size, or a file.
 struct BenchInput {
   std::string name;
   std::vector<Point2> points;
+  std::vector<double> weights;  // empty: unweighted
 };
 
 struct BenchResult {
@@ -49,13 +58,15 @@ struct BenchResult {
   double cgal_ms = 0;
   size_t galpha_triangles = 0;
   size_t cgal_triangles = 0;
+  size_t galpha_hidden = 0;  // weighted only
+  size_t cgal_hidden = 0;
   std::vector<StageTime> stages;  // of galpha's best run
   std::string error;              // galpha's failure, if any: the row says so, the run goes on
 };
 
 constexpr char kUsage[] =
     "usage: delaunay_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...]\n"
-    "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]...\n";
+    "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]... [--weights=KIND]\n";
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -74,7 +85,9 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
   triangulate_options.backend = options.backend;
   for (int r = 0; r < options.repeat; ++r) {
     const auto start = std::chrono::steady_clock::now();
-    absl::StatusOr<Triangulation> t = Triangulate(input.points, triangulate_options);
+    absl::StatusOr<Triangulation> t = input.weights.empty()
+                                          ? Triangulate(input.points, triangulate_options)
+                                          : TriangulateWeighted(input.points, input.weights, triangulate_options);
     const double ms = MillisecondsSince(start);
     if (!t.ok()) {
       result.error = t.status().ToString();
@@ -84,6 +97,7 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
       result.galpha_ms = ms;
       result.backend = t->backend;
       result.galpha_triangles = t->triangles.size();
+      result.galpha_hidden = t->hidden.size();
       result.stages = t->stage_times;
       result.galpha_peak_bytes = t->peak_memory_bytes;
       result.galpha_compute_ms = 0;
@@ -93,6 +107,21 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
     }
   }
 
+  if (!input.weights.empty()) {
+    std::vector<Kernel::Weighted_point_2> cgal_points;
+    cgal_points.reserve(input.points.size());
+    for (size_t i = 0; i < input.points.size(); ++i) {
+      cgal_points.emplace_back(Kernel::Point_2(input.points[i].x, input.points[i].y), input.weights[i]);
+    }
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      const CgalRegular rt(cgal_points.begin(), cgal_points.end());
+      result.cgal_ms = std::min(result.cgal_ms, MillisecondsSince(start));
+      result.cgal_triangles = rt.dimension() == 2 ? rt.number_of_faces() : 0;
+      result.cgal_hidden = rt.number_of_hidden_vertices();
+    }
+    return result;
+  }
   std::vector<Kernel::Point_2> cgal_points;
   cgal_points.reserve(input.points.size());
   for (const Point2& p : input.points) cgal_points.emplace_back(p.x, p.y);
@@ -120,23 +149,27 @@ std::string StageSummary(const std::vector<StageTime>& stages) {
 void PrintHeader() {
   std::printf(
       "| distribution | n | galpha backend | galpha ms (no transfers) | transfers+host copies ms | CGAL ms | "
-      "CGAL/galpha (no transfers) | CGAL/galpha (whole call) | peak bytes/point | triangles |\n"
-      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
+      "CGAL/galpha (no transfers) | CGAL/galpha (whole call) | peak bytes/point | triangles | hidden (CGAL's) |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
 }
 
 // One row as soon as its input is measured (flushed), so that a run cut short keeps its rows.
 void PrintRow(const BenchResult& r) {
   if (!r.error.empty()) {
-    std::printf("| %s | %zu | - | error: %s | | | | | | |\n", r.name.c_str(), r.n, r.error.c_str());
+    std::printf("| %s | %zu | - | error: %s | | | | | | | |\n", r.name.c_str(), r.n, r.error.c_str());
   } else {
     const std::string triangles = r.galpha_triangles == r.cgal_triangles
                                       ? absl::StrCat(r.galpha_triangles)
                                       : absl::StrCat(r.galpha_triangles, " (CGAL ", r.cgal_triangles, ": MISMATCH)");
-    std::printf("| %s | %zu | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %s |\n", r.name.c_str(), r.n,
+    // CGAL counts a point hidden only once per position and weight; ours lists every copy.
+    const std::string hidden = r.cgal_hidden == 0 && r.galpha_hidden == 0
+                                   ? std::string("-")
+                                   : absl::StrCat(r.galpha_hidden, " (", r.cgal_hidden, ")");
+    std::printf("| %s | %zu | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %.0f | %s | %s |\n", r.name.c_str(), r.n,
                 BackendName(r.backend), r.galpha_compute_ms, r.galpha_ms - r.galpha_compute_ms, r.cgal_ms,
                 r.cgal_ms / r.galpha_compute_ms, r.cgal_ms / r.galpha_ms,
                 static_cast<double>(r.galpha_peak_bytes) / static_cast<double>(std::max<size_t>(r.n, 1)),
-                triangles.c_str());
+                triangles.c_str(), hidden.c_str());
   }
   std::fflush(stdout);
 }
@@ -150,19 +183,37 @@ void PrintStageTable(const std::vector<BenchResult>& results) {
 }
 
 int Main(int argc, char** argv) {
-  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(argc, argv, nullptr);
+  // --weights is this benchmark's own; the shared parser gets the rest.
+  std::string weight_kind;
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--weights=", 0) == 0) {
+      weight_kind = arg.substr(10);
+      const std::vector<std::string> kinds = gen::WeightKinds();
+      if (std::find(kinds.begin(), kinds.end(), weight_kind) == kinds.end()) {
+        std::fprintf(stderr, "unknown --weights kind '%s'\n%s", weight_kind.c_str(), kUsage);
+        return 2;
+      }
+    } else {
+      args.push_back(argv[i]);
+    }
+  }
+  const absl::StatusOr<BenchOptions> options = ParseBenchArgs(static_cast<int>(args.size()), args.data(), nullptr);
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
     return 2;
   }
-  std::printf("delaunay_bench: backend %s requested (CUDA %s), best of %d, %u host threads\n\n",
+  std::printf("delaunay_bench: backend %s requested (CUDA %s), best of %d, %u host threads%s\n\n",
               BackendName(options->backend), CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
-              std::thread::hardware_concurrency());
+              std::thread::hardware_concurrency(),
+              weight_kind.empty() ? "" : absl::StrCat("; weights ", weight_kind, " (regular triangulations)").c_str());
 
   PrintHeader();
   std::vector<BenchResult> results;
   bool failed = false;
-  auto run = [&](const BenchInput& input) {
+  auto run = [&](BenchInput input) {
+    if (!weight_kind.empty()) input.weights = gen::Weights(weight_kind, input.points, options->seed);
     std::fprintf(stderr, "running %s n=%zu\n", input.name.c_str(), input.points.size());
     BenchResult result = RunOne(input, *options);
     failed |= !result.error.empty() || result.galpha_triangles != result.cgal_triangles;
@@ -171,7 +222,7 @@ int Main(int argc, char** argv) {
   };
   for (const std::string& name : options->distributions) {
     for (size_t n : options->sizes) {
-      run({name, gen::FindDistribution(name)->generate(n, options->seed)});
+      run({name, gen::FindDistribution(name)->generate(n, options->seed), {}});
     }
   }
   for (const std::string& file : options->data_files) {
@@ -181,7 +232,7 @@ int Main(int argc, char** argv) {
       return 1;
     }
     const size_t slash = file.find_last_of('/');
-    run({slash == std::string::npos ? file : file.substr(slash + 1), *std::move(points)});
+    run({slash == std::string::npos ? file : file.substr(slash + 1), *std::move(points), {}});
   }
   PrintStageTable(results);
   // An engine error, or a triangle count unlike CGAL's for the same point set, fails the run.

@@ -72,7 +72,7 @@ for phase in "${phases[@]}"; do
       grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race" "$out/sanitize.log" | sort | uniq -c | head -n 20
       ;;
     test)
-      for t in predicates_test predicates_device_test radius_test triangulation_checks_test delaunay_test \
+      for t in predicates_test predicates_device_test power_test radius_test triangulation_checks_test delaunay_test regular_test regular_cgal_test \
                delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test persistence_gudhi_test alpha_backend_identity_test; do
         [ -x ".carry/bin/$t" ] || continue
         # One process per test, so that a hang names its test and the rest still run.

@@ -85,4 +85,55 @@ absl::Status ValidatePoints(absl::Span<const Point2> points) {
   return absl::OkStatus();
 }
 
+absl::Status ValidateWeights(absl::Span<const Point2> points, absl::Span<const double> weights) {
+  if (weights.size() != points.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(weights.size(), " weights for ", points.size(), " points: give one weight per point"));
+  }
+  const int64_t n = static_cast<int64_t>(points.size());
+  int64_t first_bad = n;
+  double largest = 0.0, smallest = kMaxAbsCoordinate;  // spread magnitudes, as in ValidatePoints
+#pragma omp parallel for reduction(min : first_bad, smallest) reduction(max : largest) schedule(static)
+  for (int64_t i = 0; i < n; ++i) {
+    const double w = weights[static_cast<size_t>(i)];
+    if (!(std::fabs(w) < kMaxAbsWeight) && i < first_bad) first_bad = i;  // NaN, inf or too large
+    const Point2& p = points[static_cast<size_t>(i)];
+    for (const double c : {p.x, p.y, std::sqrt(std::fabs(w))}) {
+      const double m = SpreadMagnitude(c);
+      largest = m > largest ? m : largest;
+      if (m > 0.0 && m < smallest) smallest = m;
+    }
+  }
+  if (first_bad < n) {
+    const double w = weights[static_cast<size_t>(first_bad)];
+    if (!std::isfinite(w)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("weight ", first_bad, " is not finite: ", w, "; weights must be finite doubles"));
+    }
+    return absl::InvalidArgumentError(absl::StrCat("weight ", first_bad, " (", ShortestDouble(w),
+                                                   ") has a magnitude of 2^1000 (~1.07e301) or more; every |weight| "
+                                                   "must be below 2^1000 (a radius below 2^500)"));
+  }
+  if (largest > 0.0 && std::ldexp(smallest, kMaxSpreadLog2) <= largest) {
+    const double floor = std::ldexp(largest, -kMaxSpreadLog2);
+    for (int64_t i = 0; i < n; ++i) {
+      const double w = weights[static_cast<size_t>(i)];
+      const double m = SpreadMagnitude(std::sqrt(std::fabs(w)));
+      if (m > 0.0 && (m <= floor || m >= largest)) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            "weight ", i, " (", ShortestDouble(w),
+            ") is out of scale with the set: the square roots of the "
+            "weights count as coordinate magnitudes, and the exact power test needs all magnitudes of one point "
+            "set within a ratio of 2^",
+            kMaxSpreadLog2,
+            " (~3.5e131) of each other; round such weights to 0 or "
+            "scale the set"));
+      }
+    }
+    // Not reached for points that ValidatePoints accepts: some weight is then at an end.
+    return absl::InvalidArgumentError("the weights and coordinates span more than 2^437 in magnitude");
+  }
+  return absl::OkStatus();
+}
+
 }  // namespace galpha

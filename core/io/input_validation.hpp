@@ -35,4 +35,14 @@ inline constexpr double kSpreadFloor = 0x1p-1022;
 /// it breaks; ResourceExhausted gives the count limit.
 absl::Status ValidatePoints(absl::Span<const Point2> points);
 
+/// Every |weight| must be below 2^1000 (a radius below 2^500, as coordinates).
+inline constexpr double kMaxAbsWeight = 0x1p1000;
+
+/// OK when `weights` (squared radii, one per point; negative ones are valid) may be triangulated
+/// with `points` (already valid): as many as the points, every one finite, every |weight| below
+/// kMaxAbsWeight, and sqrt(|weight|) counted as a coordinate magnitude in the spread of
+/// ValidatePoints (the power test is exact within it: core/exact/power.hpp). InvalidArgument names
+/// the first weight outside the domain and the bound it breaks.
+absl::Status ValidateWeights(absl::Span<const Point2> points, absl::Span<const double> weights);
+
 }  // namespace galpha

@@ -41,8 +41,13 @@ struct Triangulation {
   std::vector<Point2> points;
   /// For every input index, the input index of its first occurrence (itself when not a duplicate).
   std::vector<uint32_t> representative;
-  /// Number of distinct points.
+  /// Number of distinct points (weighted: distinct in position and weight).
   uint32_t num_unique = 0;
+  /// Weighted (TriangulateWeighted): the input indices, ascending, of the points that are not
+  /// vertices of the regular triangulation (their lifted point lies above the lower hull of the
+  /// lifts, or on it where the tie rule hides it; at one position only the heaviest point can be
+  /// a vertex). Empty for Triangulate.
+  std::vector<uint32_t> hidden;
 
   /// Finite triangles: three input indices, counter-clockwise.
   std::vector<std::array<uint32_t, 3>> triangles;
@@ -71,5 +76,19 @@ struct Triangulation {
 /// and there is none; Internal when a device call fails. 0, 1 or 2 distinct points and collinear
 /// input are valid: no triangles, and the edges join the points in sorted order along their line.
 absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points, const TriangulateOptions& options = {});
+
+/// The regular (weighted Delaunay) triangulation of the points with `weights` (one per point: the
+/// squared radius of a disk centred at it; negative values are valid, as in CGAL): the projection
+/// of the lower convex hull of the lifted points (x, y, x^2 + y^2 - w). Same algorithm and output as
+/// Triangulate, with the power test in place of the in-circle test, the points it hides listed in
+/// `hidden`, and exact ties broken as CGAL's Regular_triangulation_2 breaks them where its first
+/// perturbation term decides (core/exact/power.hpp). Points at one position with one weight are
+/// duplicates (represented by the first); with different weights only the heaviest (the first of
+/// them) can be a vertex. Collinear input gives the chain of the points that are not hidden.
+///
+/// Errors: Triangulate's, and InvalidArgument for weights outside the input domain
+/// (ValidateWeights in core/io/input_validation.hpp, naming the first bad index).
+absl::StatusOr<Triangulation> TriangulateWeighted(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                                  const TriangulateOptions& options = {});
 
 }  // namespace galpha

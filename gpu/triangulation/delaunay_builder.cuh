@@ -14,16 +14,20 @@
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/zip_iterator.h>
+#include <thrust/remove.h>
 #include <thrust/scan.h>
 #include <thrust/sort.h>
 #include <thrust/transform_scan.h>
 #include <thrust/unique.h>
+#include <cuda/atomic>
 
+#include "core/exact/power.hpp"
 #include "core/exact/predicates.hpp"
 #include "gpu/system/engine_system.cuh"
 #include "gpu/triangulation/delaunay_flip.cuh"
 #include "gpu/triangulation/delaunay_insert.cuh"
 #include "gpu/triangulation/mesh.cuh"
+#include "gpu/triangulation/regular_removal.cuh"
 
 namespace galpha::detail {
 
@@ -45,13 +49,65 @@ struct IsFlatFiniteTriangle {
   GALPHA_HD bool operator()(int32_t t) const { return IsFlatTriangle(mesh, t); }
 };
 
+/// Weighted, after the flips and the hull repair: marks the vertices the mesh shows hidden, the
+/// reflex vertex of every non-regular edge that could not flip (MeshView::BlockedVertex) and every
+/// hull vertex that lies between its two hull neighbours on their line with its lift above theirs,
+/// and counts the marks (a vertex may be counted twice; only zero matters). Marks are
+/// kHiddenInMesh: hidden, still in the mesh.
+struct MarkRedundantVertices {
+  MeshView mesh;
+  uint8_t* hidden;  // per vertex
+  uint32_t* count;
+  GALPHA_HD void Mark(int32_t v) const {
+    if (hidden[v] != 0) return;
+    hidden[v] = kHiddenInMesh;
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(*count).fetch_add(1u);
+  }
+  GALPHA_HD void operator()(int32_t t) const {
+    const Tri x = mesh.tri[t];
+    if (IsDeadTriangle(x)) return;
+    int inf_pos = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (x.v[k] == mesh.inf) inf_pos = k;
+    }
+    if (inf_pos < 0) {
+      for (int k = 0; k < 3; ++k) {
+        const int32_t v = mesh.BlockedVertex(t, k);
+        if (v >= 0) Mark(v);
+      }
+      return;
+    }
+    // Hull edge u -> w; w's other hull edge lies in the infinite triangle across (w, inf).
+    const int32_t u = x.v[Next(inf_pos)], w = x.v[Prev(inf_pos)];
+    const Tri y = mesh.tri[mesh.nbr[t].n[Next(inf_pos)]];
+    int32_t other = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (y.v[k] != mesh.inf) continue;
+      other = y.v[Next(k)] == w ? y.v[Prev(k)] : y.v[Next(k)];
+    }
+    if (other < 0 || other == u) return;
+    const Point2* pts = mesh.pts;
+    if (Orient2dSign(pts[u], pts[w], pts[other]) == 0 && mesh.OnOpenSegment(u, other, w) &&
+        CollinearPowerSign(pts[u], mesh.weight[u], pts[other], mesh.weight[other], pts[w], mesh.weight[w]) < 0) {
+      Mark(w);
+    }
+  }
+};
+
 /// The working state of one triangulation and the steps that change it.
+///
+/// Weighted (`weight` set), it builds the regular triangulation of the points it is given, with
+/// the points it finds hidden on the way marked in `hidden` (per vertex) and left out; a point that
+/// turns out hidden only after it was inserted is found by MarkRedundant and removed in place by
+/// RemoveMarked (regular_removal.cuh), or, on the hull, by the caller building again without it
+/// (delaunay_impl.cuh).
 template <class System>
 class DelaunayBuilder {
  public:
-  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, uint32_t m, int32_t a, int32_t b,
-                  int32_t c)
+  DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, const uint32_t* sos_rank,
+                  const double* weight, uint8_t* hidden, uint32_t m, int32_t a, int32_t b, int32_t c)
       : sys_(sys),
+        hidden_(hidden),
         m_(m),
         capacity_(2 * m),
         tri_(sys, capacity_),
@@ -68,7 +124,7 @@ class DelaunayBuilder {
         proposal_edge_(sys, capacity_),
         flags_(sys, 3),
         counts_(sys, kNumCounts) {
-    mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c};
+    mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c, sos_rank, weight};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
     thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
     thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
@@ -125,6 +181,13 @@ class DelaunayBuilder {
     uint32_t* pending_count = counts_.data() + kPendingCount;
     thrust::fill(pol, pending_count, pending_count + 1, num_pending);
     Relocate(pending, location, inserted, num_pending);
+    if (hidden_ != nullptr) {
+      // The points the first triangle hides leave before the first votes (later rounds drop theirs
+      // after relocating). The host learns the new count with the first round's wait.
+      auto zipped = thrust::make_zip_iterator(thrust::make_tuple(pending, location));
+      sys_.SelectFlaggedInPlace(zipped, inserted, num_pending, IsClear(), pending_count);
+      thrust::fill(pol, inserted, inserted + num_pending, uint8_t{0});
+    }
     uint32_t* second_count = counts_.data() + kSecondCount;
     uint32_t* saw_edge_point = counts_.data() + kSawEdgePoint;
     // Second winners need points on edges' lines; a round whose votes saw none (uniform input,
@@ -189,6 +252,57 @@ class DelaunayBuilder {
       sys_.SelectFlaggedInPlace(zipped, inserted, num_pending, IsClear(), pending_count);
       thrust::fill(pol, inserted, inserted + num_pending, uint8_t{0});
     }
+  }
+
+  /// Weighted: marks the vertices the finished mesh shows hidden (MarkRedundantVertices) and
+  /// returns how many it marked; zero means the mesh is the regular triangulation of its vertices.
+  uint32_t MarkRedundant() {
+    uint32_t* count = counts_.data() + kRedundantCount;
+    thrust::fill(sys_.policy(), count, count + 1, 0u);
+    const thrust::counting_iterator<int32_t> tfirst(0);
+    thrust::for_each(sys_.policy(), tfirst, tfirst + num_tri_, MarkRedundantVertices{mesh_, hidden_, count});
+    return sys_.Read(count);
+  }
+
+  /// Weighted: removes the vertices MarkRedundant marked from the mesh in place, in rounds of
+  /// independent stars (regular_removal.cuh), then flips what they left to regular. Returns how
+  /// many marked vertices are left in the mesh (hull vertices, or too many neighbours): the caller
+  /// builds again without them.
+  uint32_t RemoveMarked() {
+    auto pol = sys_.policy();
+    const thrust::counting_iterator<int32_t> vfirst(0);
+    const thrust::counting_iterator<int32_t> tfirst(0);
+    const thrust::counting_iterator<uint32_t> first(0);
+    Buffer<int32_t, System> candidates(sys_, m_);
+    auto num_candidates = static_cast<uint32_t>(
+        thrust::copy_if(pol, vfirst, vfirst + m_, candidates.data(), IsHiddenInMesh{hidden_}) - candidates.data());
+    if (num_candidates == 0) return 0;
+    Buffer<int32_t, System> vertex_tri(sys_, m_);
+    thrust::fill(pol, vertex_tri.begin(), vertex_tri.end(), -1);
+    Buffer<uint32_t, System> claim(sys_, static_cast<size_t>(num_tri_));
+    Buffer<uint8_t, System> created(sys_, static_cast<size_t>(num_tri_));
+    thrust::fill(pol, created.begin(), created.end(), uint8_t{0});
+    uint32_t* removed = counts_.data() + kRedundantCount;
+    for (;;) {
+      thrust::for_each(pol, tfirst, tfirst + num_tri_, FindStarStart{mesh_, hidden_, vertex_tri.data()});
+      thrust::fill(pol, claim.begin(), claim.end(), kNoClaim);
+      thrust::fill(pol, removed, removed + 1, 0u);
+      thrust::for_each(pol, first, first + num_candidates,
+                       ClaimStar{mesh_, candidates.data(), vertex_tri.data(), claim.data()});
+      thrust::for_each(pol, first, first + num_candidates,
+                       RemoveClaimedStar{mesh_, candidates.data(), vertex_tri.data(), claim.data(), hidden_,
+                                         created.data(), removed});
+      if (sys_.Read(removed) == 0) break;
+      num_candidates = static_cast<uint32_t>(
+          thrust::remove_if(pol, candidates.data(), candidates.data() + num_candidates, RemovedFromMesh{hidden_}) -
+          candidates.data());
+      if (num_candidates == 0) break;
+    }
+    const auto num_active = static_cast<uint32_t>(
+        thrust::copy_if(pol, tfirst, tfirst + num_tri_, created.data(), active_.data(), IsSet()) - active_.data());
+    thrust::fill(pol, active_mask_.data(), active_mask_.data() + num_active, kCheckAllEdges);
+    RestoreDelaunay(num_active, /*hull_may_change=*/false);
+    return num_candidates;
   }
 
   /// Removes symbolically flat hull triangles, then re-flips the finite triangles to Delaunay
@@ -275,6 +389,8 @@ class DelaunayBuilder {
         MeshView host_mesh = mesh_;
         host_mesh.pts = pts.data();
         host_mesh.sos = nullptr;  // the repair decides by exact orientation only, never by SoS
+        host_mesh.sos_rank = nullptr;
+        host_mesh.weight = nullptr;  // nor by weights
         host_mesh.tri = tri.data();
         host_mesh.nbr = nbr.data();
         int32_t failed = 0;
@@ -323,10 +439,10 @@ class DelaunayBuilder {
 
   /// Walks every pending point not inserted to the triangle that holds it now. A walk that fails
   /// leaves the point's old triangle and raises a flag, read with the round's count.
-  void Relocate(const int32_t* pending, int32_t* location, const uint8_t* inserted, uint32_t num_pending) {
+  void Relocate(const int32_t* pending, int32_t* location, uint8_t* inserted, uint32_t num_pending) {
     const thrust::counting_iterator<uint32_t> first(0);
     thrust::for_each(sys_.policy(), first, first + num_pending,
-                     RelocatePoint{mesh_, pending, inserted, location, flags_.data(), m_ + 16u});
+                     RelocatePoint{mesh_, pending, inserted, location, hidden_, flags_.data(), m_ + 16u});
   }
 
   /// One parallel Lawson iteration over the `*count` triangles of active_: they propose flips,
@@ -383,6 +499,7 @@ class DelaunayBuilder {
   }
 
   System& sys_;
+  uint8_t* hidden_;  // per vertex, weighted only
   uint32_t m_;
   uint32_t capacity_;
   Buffer<Tri, System> tri_;
@@ -414,7 +531,8 @@ class DelaunayBuilder {
   static constexpr int kTailIterations = 5;
   static constexpr int kSecondCount = 6;
   static constexpr int kSawEdgePoint = 7;
-  static constexpr int kNumCounts = 8;
+  static constexpr int kRedundantCount = 8;
+  static constexpr int kNumCounts = 9;
   // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): four items
   // a lane of its 256, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;

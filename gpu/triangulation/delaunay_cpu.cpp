@@ -5,9 +5,9 @@
 
 namespace galpha::detail {
 
-void TriangulateOnCpu(const Point2* points, uint32_t n, DelaunayOutput* out) {
+void TriangulateOnCpu(const Point2* points, const double* weights, uint32_t n, DelaunayOutput* out) {
   CpuSystem system;
-  RunTriangulation(system, points, n, out);
+  RunTriangulation(system, points, weights, n, out);
 }
 
 }  // namespace galpha::detail

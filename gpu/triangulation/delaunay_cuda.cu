@@ -7,15 +7,15 @@
 
 namespace galpha::detail {
 
-void TriangulateOnCuda(const Point2* points, uint32_t n, void* stream, DelaunayOutput* out) {
+void TriangulateOnCuda(const Point2* points, const double* weights, uint32_t n, void* stream, DelaunayOutput* out) {
   if (stream != nullptr) {
     CudaSystem system(static_cast<cudaStream_t>(stream));
-    RunTriangulation(system, points, n, out);
+    RunTriangulation(system, points, weights, n, out);
     return;
   }
   OwnedStream owned;
   CudaSystem system(owned.get());
-  RunTriangulation(system, points, n, out);
+  RunTriangulation(system, points, weights, n, out);
 }
 
 }  // namespace galpha::detail

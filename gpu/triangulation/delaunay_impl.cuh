@@ -18,6 +18,7 @@
 #include <thrust/find.h>
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
+#include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/discard_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
@@ -58,6 +59,21 @@ struct NotInitialVertex {
   GALPHA_HD bool operator()(int32_t v) const { return v != a && v != b && v != c; }
 };
 
+/// Weighted: input_hidden[input index] = 1 for every vertex found hidden.
+struct RecordHiddenVertex {
+  const uint32_t* unique;
+  const uint8_t* vertex_hidden;
+  uint8_t* input_hidden;
+  GALPHA_HD void operator()(uint32_t v) const {
+    if (vertex_hidden[v] != 0) input_hidden[unique[v]] = 1;
+  }
+};
+
+struct IsOwnRepresentative {
+  const uint32_t* representative;
+  GALPHA_HD bool operator()(uint32_t i) const { return representative[i] == i; }
+};
+
 struct IsFiniteTri {
   MeshView mesh;
   GALPHA_HD bool operator()(int32_t t) const { return !mesh.IsInfinite(t); }
@@ -68,12 +84,21 @@ struct IsFiniteTri {
 template <class System>
 struct SystemTriangulation {
   explicit SystemTriangulation(System& sys)
-      : points(sys, 0), representative(sys, 0), tri(sys, 0), nbr(sys, 0), edge_begin(sys, 0), edges(sys, 0) {}
+      : points(sys, 0),
+        representative(sys, 0),
+        hidden(sys, 0),
+        tri(sys, 0),
+        nbr(sys, 0),
+        edge_begin(sys, 0),
+        edges(sys, 0) {}
   /// The input as given (kept only when asked for).
   Buffer<Point2, System> points;
   /// For every input index, its first occurrence.
   Buffer<uint32_t, System> representative;
   uint32_t num_unique = 0;
+  /// Weighted: 1 for every input index whose point is hidden (not a vertex of the regular
+  /// triangulation; duplicates are marked through their representative by the caller); else empty.
+  Buffer<uint8_t, System> hidden;
   /// Finite triangles (input indices, counter-clockwise), neighbours (-1 on the hull), the first
   /// owned edge of each triangle, and the edges by the ownership rule.
   Buffer<Tri, System> tri;
@@ -89,10 +114,23 @@ static_assert(sizeof(std::array<uint32_t, 2>) == sizeof(EdgePair), "edge layout"
 
 /// The distinct points of the input: the input index of each one's first occurrence, sorted by
 /// (x, y), then in Hilbert order (the mesh's vertex ids; Simulation of Simplicity reads them).
+/// Weighted, "distinct" means distinct in position and weight, and only the heaviest point of a
+/// position is kept.
 template <class System>
 struct DistinctPoints {
   Buffer<uint32_t, System> unique;
   uint32_t m;
+};
+
+/// Weighted input, per mesh vertex (Hilbert order): its scaled weight, its Simulation-of-Simplicity
+/// rank and whether the build found it hidden. All empty when unweighted.
+template <class System>
+struct VertexWeights {
+  explicit VertexWeights(System& sys) : weight(sys, 0), sos_rank(sys, 0), hidden(sys, 0) {}
+  Buffer<double, System> weight;
+  Buffer<uint32_t, System> sos_rank;
+  Buffer<uint8_t, System> hidden;
+  bool weighted() const { return weight.size() > 0; }
 };
 
 /// The input as given, in the system's memory.
@@ -104,9 +142,11 @@ Buffer<Point2, System> UploadPoints(System& sys, const Point2* host_points, uint
 }
 
 /// Exact duplicates: sort by (point, index); each run's head is the first occurrence. Writes every
-/// input index's representative into `result`.
+/// input index's representative into `result`. Weighted (`weights` set: per input index), sorted by
+/// (point, weight descending, index): a run is one point with one weight, and a run lighter than
+/// another at its position is hidden (result->hidden) and is no vertex.
 template <class System>
-DistinctPoints<System> FindDistinctPoints(System& sys, const Buffer<Point2, System>& input,
+DistinctPoints<System> FindDistinctPoints(System& sys, const Buffer<Point2, System>& input, const double* weights,
                                           SystemTriangulation<System>* result) {
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
@@ -121,20 +161,40 @@ DistinctPoints<System> FindDistinctPoints(System& sys, const Buffer<Point2, Syst
     thrust::sequence(pol, sorted.begin(), sorted.end());
     {
       Buffer<uint64_t, System> keys(sys, n);
+      if (weights != nullptr) {
+        thrust::transform(pol, first, first + n, keys.begin(), DescendingWeightKey{weights, sorted.data()});
+        thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
+      }
       for (const CoordinateKey::Axis axis : {CoordinateKey::kY, CoordinateKey::kX}) {
         thrust::transform(pol, first, first + n, keys.begin(), CoordinateKey{input.data(), sorted.data(), axis});
         thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
       }
     }
-    thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data()});
+    if (weights != nullptr) {
+      thrust::transform(pol, first, first + n, head.begin(),
+                        WeightedRunHeadPosition{input.data(), weights, sorted.data()});
+    } else {
+      thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data()});
+    }
     thrust::inclusive_scan(pol, head.begin(), head.end(), head.begin(), thrust::maximum<uint32_t>());
     thrust::for_each(pol, first, first + n,
                      WriteRepresentative{sorted.data(), head.data(), result->representative.data()});
-    m = static_cast<uint32_t>(
-        thrust::copy_if(pol, sorted.begin(), sorted.end(), first, unique.begin(), IsRunHead{head.data()}) -
-        unique.begin());
+    const uint8_t* hidden = nullptr;
+    if (weights != nullptr) {
+      result->hidden = Buffer<uint8_t, System>(sys, n);
+      thrust::for_each(pol, first, first + n,
+                       MarkLighterAtSamePosition{input.data(), sorted.data(), head.data(), result->hidden.data()});
+      hidden = result->hidden.data();
+    }
+    m = static_cast<uint32_t>(thrust::copy_if(pol, sorted.begin(), sorted.end(), first, unique.begin(),
+                                              IsVisibleRunHead{head.data(), sorted.data(), hidden}) -
+                              unique.begin());
   }
-  result->num_unique = m;
+  // Weighted, the lighter points at a position are distinct points that are not vertices.
+  result->num_unique = weights == nullptr
+                           ? m
+                           : static_cast<uint32_t>(thrust::count_if(
+                                 pol, first, first + n, IsOwnRepresentative{result->representative.data()}));
   return {std::move(unique), m};
 }
 
@@ -164,23 +224,73 @@ void WriteCollinearChain(System& sys, DistinctPoints<System>* distinct, SystemTr
   distinct->unique.Reset();
 }
 
+/// Weighted, no triangles: the regular triangulation of points on one line is the lower hull of
+/// their lifts along it, a chain from which the points above it are hidden. Computed on the host
+/// (a monotone chain over the sorted points, one exact collinear power test a step): input that is
+/// all on one line is rare and the chain is sequential by nature. `unique` is not needed after it.
+template <class System>
+void WriteWeightedCollinearChain(System& sys, const Buffer<Point2, System>& input, const double* weights,
+                                 DistinctPoints<System>* distinct, SystemTriangulation<System>* result) {
+  const uint32_t m = distinct->m;
+  const size_t n = input.size();
+  std::vector<uint32_t> order = distinct->unique.ToHostVector(m);
+  distinct->unique.Reset();
+  const std::vector<Point2> pts = input.ToHostVector(n);
+  std::vector<double> w(n);
+  sys.ToHost(w.data(), weights, n);
+  std::vector<uint8_t> hidden = result->hidden.ToHostVector(n);
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return LexLess(pts[a], pts[b]); });
+  std::vector<uint32_t> chain;
+  for (const uint32_t c : order) {
+    while (chain.size() >= 2) {
+      const uint32_t a = chain[chain.size() - 2], b = chain.back();
+      if (CollinearPowerSign(pts[a], w[a], pts[c], w[c], pts[b], w[b]) >= 0) break;
+      hidden[b] = 1;
+      chain.pop_back();
+    }
+    chain.push_back(c);
+  }
+  sys.FromHost(result->hidden.data(), hidden.data(), n);
+  std::vector<EdgePair> edges;
+  for (size_t i = 0; i + 1 < chain.size(); ++i) {
+    const uint32_t a = chain[i], b = chain[i + 1];
+    edges.push_back(EdgePair{{a < b ? a : b, a < b ? b : a}});
+  }
+  result->edges = Buffer<EdgePair, System>(sys, edges.size());
+  if (!edges.empty()) sys.FromHost(result->edges.data(), edges.data(), edges.size());
+}
+
 /// Hilbert order of the distinct points: neighbours in the order are neighbours in the plane.
 /// Returns the points in that order, scaled by an exact power of two (ExactScaleExponent), as the
 /// mesh's vertices; `unique` is put in the same order. The output keeps the input's coordinates.
+///
+/// Weighted (`weights` per input index), also fills `vertex_weights`: the weights, scaled by the
+/// square of the points' power of two, and the ranks in decreasing (x, y) order (`unique` arrives
+/// in (x, y) order).
 template <class System>
-Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, DistinctPoints<System>* distinct) {
+Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, const double* weights,
+                                    DistinctPoints<System>* distinct, VertexWeights<System>* vertex_weights) {
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
   const uint32_t m = distinct->m;
   Buffer<uint32_t, System>& unique = distinct->unique;
   Buffer<Point2, System> vertex_points(sys, m);
+  Buffer<uint32_t, System> lexicographic_position(sys, weights != nullptr ? input.size() : 0);
+  if (weights != nullptr) {
+    thrust::for_each(pol, first, first + m, WriteLexicographicPosition{unique.data(), lexicographic_position.data()});
+  }
   {
     const BoundingBox box = thrust::transform_reduce(pol, input.begin(), input.end(), PointToBox(),
                                                      PointToBox()(sys.Read(input.data())), MergeBoxes());
-    const int scale_exponent = ExactScaleExponent(box, [&] {
+    int scale_exponent = ExactScaleExponent(box, [&] {
       return thrust::transform_reduce(pol, input.begin(), input.end(), SmallestNonzeroMagnitude(),
                                       static_cast<double>(INFINITY), Minimum());
     });
+    if (weights != nullptr) {
+      scale_exponent = WeightedScaleExponent(
+          scale_exponent, thrust::transform_reduce(pol, weights, weights + input.size(), SmallestNonzeroWeight(),
+                                                   static_cast<double>(INFINITY), Minimum()));
+    }
     Buffer<uint64_t, System> keys(sys, m);
     thrust::transform(pol, first, first + m, keys.begin(), HilbertKey{input.data(), unique.data(), box});
     // Stable (ties keep the (x, y) order of `unique`), so that both backends number the same way.
@@ -202,6 +312,16 @@ Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, 
     }
     thrust::for_each(pol, first, first + m,
                      GatherVertex{input.data(), unique.data(), vertex_points.data(), scale_exponent});
+    if (weights != nullptr) {
+      vertex_weights->weight = Buffer<double, System>(sys, m);
+      vertex_weights->sos_rank = Buffer<uint32_t, System>(sys, m);
+      vertex_weights->hidden = Buffer<uint8_t, System>(sys, m);
+      thrust::fill(pol, vertex_weights->hidden.begin(), vertex_weights->hidden.end(), uint8_t{0});
+      thrust::for_each(
+          pol, first, first + m,
+          GatherWeightedVertex{weights, unique.data(), lexicographic_position.data(), m, vertex_weights->weight.data(),
+                               vertex_weights->sos_rank.data(), scale_exponent});
+    }
   }
   return vertex_points;
 }
@@ -245,12 +365,46 @@ void InsertRemainingVertices(System& sys, DelaunayBuilder<System>* builder, Firs
 /// vertex by insertion rounds with Lawson flips. Held in an optional so that the mesh can be freed
 /// as soon as the output holds its triangles.
 template <class System>
-void BuildMesh(System& sys, const Buffer<Point2, System>& vertex_points, const DistinctPoints<System>& distinct,
-               std::optional<DelaunayBuilder<System>>* builder) {
+void BuildMesh(System& sys, const Buffer<Point2, System>& vertex_points, DistinctPoints<System>& distinct,
+               VertexWeights<System>& vertex_weights, std::optional<DelaunayBuilder<System>>* builder) {
   const FirstTriangle first = FindFirstTriangle(sys, vertex_points, distinct.m);
-  builder->emplace(sys, vertex_points.data(), distinct.unique.data(), distinct.m, first.a, first.b, first.c);
+  const bool weighted = vertex_weights.weighted();
+  builder->emplace(sys, vertex_points.data(), distinct.unique.data(),
+                   weighted ? vertex_weights.sos_rank.data() : distinct.unique.data(),
+                   weighted ? vertex_weights.weight.data() : nullptr, weighted ? vertex_weights.hidden.data() : nullptr,
+                   distinct.m, first.a, first.b, first.c);
   (*builder)->Start(first.a, first.b, first.c);
   InsertRemainingVertices(sys, &**builder, first, distinct.m);
+}
+
+/// Replaces `buffer` by its entries at the first `num_kept` positions of `kept`.
+template <class T, class System>
+void GatherKept(System& sys, Buffer<uint32_t, System>& kept, uint32_t num_kept, Buffer<T, System>* buffer) {
+  Buffer<T, System> next(sys, num_kept);
+  thrust::gather(sys.policy(), kept.begin(), kept.begin() + num_kept, buffer->begin(), next.begin());
+  *buffer = std::move(next);
+}
+
+/// Weighted: records the vertices found hidden in the input's flags (`result->hidden`) and removes
+/// them from the vertices (Hilbert order kept), for a build without them.
+template <class System>
+void DropHiddenVertices(System& sys, Buffer<Point2, System>* vertex_points, DistinctPoints<System>* distinct,
+                        VertexWeights<System>* vertex_weights, SystemTriangulation<System>* result) {
+  auto pol = sys.policy();
+  const thrust::counting_iterator<uint32_t> first(0);
+  const uint32_t m = distinct->m;
+  const uint8_t* hidden = vertex_weights->hidden.data();
+  thrust::for_each(pol, first, first + m, RecordHiddenVertex{distinct->unique.data(), hidden, result->hidden.data()});
+  Buffer<uint32_t, System> kept(sys, m);
+  const auto num_kept =
+      static_cast<uint32_t>(thrust::copy_if(pol, first, first + m, hidden, kept.begin(), IsClear()) - kept.begin());
+  GatherKept(sys, kept, num_kept, vertex_points);
+  GatherKept(sys, kept, num_kept, &distinct->unique);
+  GatherKept(sys, kept, num_kept, &vertex_weights->weight);
+  GatherKept(sys, kept, num_kept, &vertex_weights->sos_rank);
+  vertex_weights->hidden = Buffer<uint8_t, System>(sys, num_kept);
+  thrust::fill(pol, vertex_weights->hidden.begin(), vertex_weights->hidden.end(), uint8_t{0});
+  distinct->m = num_kept;
 }
 
 /// Output, first part: the finite triangles of the mesh by input index, and their neighbours.
@@ -293,34 +447,77 @@ void OutputEdges(System& sys, SystemTriangulation<System>* result) {
 /// Triangulates `n` host points on `sys`; the result stays in the system's memory. With
 /// `keep_points` the uploaded input is kept in the result (else it is freed as soon as possible).
 /// One stage a call.
+///
+/// Weighted (`host_weights` set, one per point): the regular triangulation. Points found hidden
+/// while inserting are left out as they are found; a point that turns out hidden only after its
+/// insertion (MarkRedundant) is removed from the mesh in place (RemoveMarked), and the flips go on;
+/// on the hull, it makes the mesh be built again without every point found hidden so far. Both end:
+/// each pass removes at least one more. Stage "regular_check": the checks, removals and rebuilds.
 template <class System>
-SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_points, uint32_t n, bool keep_points,
-                                                StageTimer<System>& timer) {
+SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_points, const double* host_weights,
+                                                uint32_t n, bool keep_points, StageTimer<System>& timer) {
   SystemTriangulation<System> result(sys);
   // The input as given; freed once the distinct points are gathered in Hilbert order.
   Buffer<Point2, System> input = UploadPoints(sys, host_points, n);
+  Buffer<double, System> input_weights(sys, host_weights != nullptr ? n : 0);
+  if (host_weights != nullptr) sys.FromHost(input_weights.data(), host_weights, n);
+  const double* weights = host_weights != nullptr ? input_weights.data() : nullptr;
   timer.EndStage("upload");
-  DistinctPoints<System> distinct = FindDistinctPoints(sys, input, &result);
+  DistinctPoints<System> distinct = FindDistinctPoints(sys, input, weights, &result);
   timer.EndStage("dedupe");
-  if (AllCollinear(sys, input, distinct)) {
-    WriteCollinearChain(sys, &distinct, &result);
+  auto finish_on_a_line = [&] {
+    if (weights != nullptr) {
+      WriteWeightedCollinearChain(sys, input, weights, &distinct, &result);
+    } else {
+      WriteCollinearChain(sys, &distinct, &result);
+    }
     if (keep_points) result.points = std::move(input);
     timer.EndStage("collinear_chain");
+  };
+  if (AllCollinear(sys, input, distinct)) {
+    finish_on_a_line();
     return result;
   }
-  Buffer<Point2, System> vertex_points = HilbertOrder(sys, input, &distinct);
-  if (keep_points) {
-    result.points = std::move(input);
-  } else {
-    input.Reset();
-  }
+  VertexWeights<System> vertex_weights(sys);
+  Buffer<Point2, System> vertex_points = HilbertOrder(sys, input, weights, &distinct, &vertex_weights);
+  auto release_input = [&] {
+    if (keep_points) {
+      result.points = std::move(input);
+    } else {
+      input.Reset();
+    }
+  };
+  if (weights == nullptr) release_input();  // weighted, a rebuild may need it (AllCollinear)
   timer.EndStage("hilbert_sort");
   std::optional<DelaunayBuilder<System>> builder;
-  BuildMesh(sys, vertex_points, distinct, &builder);
+  BuildMesh(sys, vertex_points, distinct, vertex_weights, &builder);
   timer.EndStage("insert_and_flip");
   builder->RepairHull();
-  builder->ReleaseWorkspace();
   timer.EndStage("hull_repair");
+  if (weights != nullptr) {
+    for (;;) {
+      // Points hidden by points inserted after them: removed in place; those on the hull (or with
+      // too many neighbours) by building again without every point found hidden so far.
+      if (builder->MarkRedundant() == 0) break;
+      if (builder->RemoveMarked() == 0) continue;
+      builder.reset();
+      DropHiddenVertices(sys, &vertex_points, &distinct, &vertex_weights, &result);
+      if (AllCollinear(sys, input, distinct)) {
+        vertex_points.Reset();
+        finish_on_a_line();
+        return result;
+      }
+      BuildMesh(sys, vertex_points, distinct, vertex_weights, &builder);
+      builder->RepairHull();
+    }
+    thrust::for_each(sys.policy(), thrust::counting_iterator<uint32_t>(0),
+                     thrust::counting_iterator<uint32_t>(distinct.m),
+                     RecordHiddenVertex{distinct.unique.data(), vertex_weights.hidden.data(), result.hidden.data()});
+    timer.EndStage("regular_check");
+  }
+  if (weights != nullptr) release_input();
+  input_weights.Reset();
+  builder->ReleaseWorkspace();
   OutputTriangles(sys, *builder, &result);
   builder.reset();  // the mesh, as soon as the output holds its triangles
   vertex_points.Reset();
@@ -332,9 +529,10 @@ SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_
 
 /// Runs the whole triangulation of `n` host points on `sys` and downloads it into `out`.
 template <class System>
-void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, DelaunayOutput* out) {
+void RunTriangulation(System& sys, const Point2* host_points, const double* host_weights, uint32_t n,
+                      DelaunayOutput* out) {
   StageTimer<System> timer(sys, &out->stage_times);
-  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, n, /*keep_points=*/false, timer);
+  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, host_weights, n, /*keep_points=*/false, timer);
   out->num_unique = t.num_unique;
   out->triangles.resize(t.tri.size());
   out->neighbors.resize(t.nbr.size());
@@ -346,6 +544,12 @@ void RunTriangulation(System& sys, const Point2* host_points, uint32_t n, Delaun
                 {out->tri_edge_begin.data(), t.edge_begin.data(), t.edge_begin.size() * sizeof(uint32_t)},
                 {out->edges.data(), t.edges.data(), t.edges.size() * sizeof(EdgePair)},
                 {out->representative.data(), t.representative.data(), size_t{n} * sizeof(uint32_t)}});
+  if (host_weights != nullptr) {
+    const std::vector<uint8_t> hidden = t.hidden.ToHostVector(n);
+    for (uint32_t i = 0; i < n; ++i) {
+      if (hidden[out->representative[i]] != 0) out->hidden.push_back(i);
+    }
+  }
   timer.EndStage("download");
   timer.Finish();
   out->peak_memory_bytes = sys.peak_bytes();

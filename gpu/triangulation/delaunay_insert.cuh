@@ -83,9 +83,22 @@ struct VoteForInsertion {
       const double outside = wx * py - wy * px;
       if (outside > 0.0) {
         score = -static_cast<float>(outside);
-      } else {
+      } else if (mesh.weight == nullptr) {
         const double dx = px - 0.5 * wx, dy = py - 0.5 * wy;
         score = static_cast<float>(dx * dx + dy * dy);
+      } else {
+        // Weighted: the point whose lift lies deepest below the lifted segment u-w (its power
+        // with respect to the segment's smallest orthogonal circle), so that a heavy point on a
+        // hull line is inserted before the points of the line it hides. A point on a hull line
+        // is hidden or not by the points of that line alone.
+        const double wu = mesh.weight[x.v[Next(inf_pos)]];
+        const double lift_w = wx * wx + wy * wy - ldexp(mesh.weight[x.v[Prev(inf_pos)]] - wu, -2 * e);
+        const double lift_p = px * px + py * py - ldexp(mesh.weight[pending[i]] - wu, -2 * e);
+        const double along = wx * wx + wy * wy;
+        const double t = along > 0.0 ? (wx * px + wy * py) / along : 0.0;
+        const double depth = lift_p - t * lift_w;
+        score = (depth == depth && depth < 3.0e38 && depth > -3.0e38) ? static_cast<float>(depth)
+                                                                      : (depth < 0 ? -3.0e38f : 3.0e38f);
       }
     } else {
       // Nearest the circumcentre o means the smallest power |p - o|^2 - R^2 (same order), but the
@@ -103,7 +116,18 @@ struct VoteForInsertion {
       on_edge_line =
           bx * py - by * px == 0.0 || cx * py - cy * px == 0.0 || (cx - bx) * (py - by) - (cy - by) * (px - bx) == 0.0;
       if (d != 0.0) {
-        const double power = (px * px + py * py) - (px * (cy * b2 - by * c2) + py * (bx * c2 - cx * b2)) / d;
+        // Weighted, the same height of p's lift over the triangle's lifted plane, with lifts less
+        // their weight relative to a's: the deepest point wins, and a heavy point, which hides the
+        // points around it, is inserted before them (they are then hidden on relocation, not
+        // after their own insertion, which would cost a rebuild).
+        double lift_b = b2, lift_c = c2, lift_p = px * px + py * py;
+        if (mesh.weight != nullptr) {
+          const double wa = mesh.weight[x.v[0]];
+          lift_b -= ldexp(mesh.weight[x.v[1]] - wa, -2 * e);
+          lift_c -= ldexp(mesh.weight[x.v[2]] - wa, -2 * e);
+          lift_p -= ldexp(mesh.weight[pending[i]] - wa, -2 * e);
+        }
+        const double power = lift_p - (px * (cy * lift_b - by * lift_c) + py * (bx * lift_c - cx * lift_b)) / d;
         score = (power == power && power < 3.0e38 && power > -3.0e38) ? static_cast<float>(power)
                                                                       : (power < 0 ? -3.0e38f : 3.0e38f);
       } else {
@@ -285,12 +309,15 @@ struct ListSplitChildren {
   }
 };
 
-/// Relocates a point that is still uninserted, walking from the triangle that held it.
+/// Relocates a point that is still uninserted, walking from the triangle that held it. Weighted, a
+/// point the triangle hides (MeshView::Hidden) is marked in `hidden` and leaves the pending points
+/// with the inserted ones (`inserted` 2).
 struct RelocatePoint {
   MeshView mesh;
   const int32_t* pending;
-  const uint8_t* inserted;
+  uint8_t* inserted;
   int32_t* location;
+  uint8_t* hidden;  // per vertex; nullptr when unweighted
   int32_t* walk_failed;
   uint32_t max_steps;
 
@@ -302,6 +329,10 @@ struct RelocatePoint {
       return;
     }
     location[i] = t;
+    if (hidden != nullptr && mesh.Hidden(t, pending[i])) {
+      hidden[pending[i]] = 1;
+      inserted[i] = 2;
+    }
   }
 };
 

@@ -4,7 +4,7 @@
 
 namespace galpha::detail {
 
-void TriangulateOnCuda(const Point2*, uint32_t, void*, DelaunayOutput*) {
+void TriangulateOnCuda(const Point2*, const double*, uint32_t, void*, DelaunayOutput*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 

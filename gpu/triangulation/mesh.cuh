@@ -11,6 +11,7 @@
 
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/power.hpp"
 #include "core/exact/predicates.hpp"
 
 namespace galpha::detail {
@@ -26,9 +27,13 @@ GALPHA_HD inline int Next(int k) { return k == 2 ? 0 : k + 1; }
 GALPHA_HD inline int Prev(int k) { return k == 0 ? 2 : k - 1; }
 
 /// Mutable view of the mesh; copied by value into functors.
+///
+/// Weighted (a regular triangulation: `weight` set): the in-circle test becomes the power test
+/// (core/exact/power.hpp), a flip also needs its quadrilateral convex, and points whose lift lies
+/// above the mesh's lifted surface are hidden (Hidden).
 struct MeshView {
   const Point2* pts;    // vertex coordinates, Hilbert order
-  const uint32_t* sos;  // input index of each vertex: the Simulation-of-Simplicity rank
+  const uint32_t* sos;  // input index of each vertex
   Tri* tri;
   TriNbr* nbr;
   int32_t inf;  // id of the vertex at infinity (= number of finite vertices)
@@ -37,6 +42,12 @@ struct MeshView {
   // vertices split the outside into disjoint sectors, one per infinite triangle, so points
   // inserted outside the hull in the same round never overlap.
   int32_t center_a, center_b, center_c;
+  // The Simulation-of-Simplicity rank of each vertex: its input index (`sos`) when unweighted; when
+  // weighted, its position in decreasing lexicographic order (CGAL's tie rule, power.hpp).
+  const uint32_t* sos_rank;
+  // Weight of each vertex, scaled with `pts` (by the square of their power of two); nullptr:
+  // unweighted, a Delaunay triangulation.
+  const double* weight;
 
   /// Sign of orient(center, w, p): orient is affine in its first point, so it is the first
   /// nonzero of the exact signs with a, b, c in its place (never zero: a, b, c are not collinear).
@@ -54,7 +65,7 @@ struct MeshView {
 
   /// Exact, never-zero orientation of three finite vertices.
   GALPHA_HD int Orient(int32_t a, int32_t b, int32_t c) const {
-    return Orient2dSoS(pts[a], sos[a], pts[b], sos[b], pts[c], sos[c]);
+    return Orient2dSoS(pts[a], sos_rank[a], pts[b], sos_rank[b], pts[c], sos_rank[c]);
   }
 
   /// Whether finite vertex s is in conflict with the hull edge u->w (outside on its left): strictly
@@ -64,9 +75,18 @@ struct MeshView {
   /// sink would hang from the few that stick out in long fans of flat triangles: every later point on
   /// that line would then start a flip cascade along the fan (two parallel lines of points took
   /// hundreds of sequential flip iterations a round).
+  ///
+  /// Weighted, a point on the segment is in conflict unless its lift lies strictly above the
+  /// lifted segment (then it is hidden; a tie joins the hull, as in CGAL).
   GALPHA_HD bool HullEdgeConflict(int32_t u, int32_t w, int32_t s) const {
     const int o = Orient2dSign(pts[u], pts[w], pts[s]);
     if (o != 0) return o > 0;
+    if (!OnOpenSegment(u, w, s)) return false;
+    return weight == nullptr || CollinearPowerSign(pts[u], weight[u], pts[w], weight[w], pts[s], weight[s]) >= 0;
+  }
+
+  /// Whether s, on the line through u and w, lies strictly between them.
+  GALPHA_HD bool OnOpenSegment(int32_t u, int32_t w, int32_t s) const {
     const Point2 a = pts[u], b = pts[w], m = pts[s];
     return (LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a));
   }
@@ -81,7 +101,47 @@ struct MeshView {
       if (x.v[k] == inf) return HullEdgeConflict(x.v[Next(k)], x.v[Prev(k)], s);
     }
     const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
-    return InCircleSoS(pts[a], sos[a], pts[b], sos[b], pts[c], sos[c], pts[s], sos[s]) > 0;
+    if (weight != nullptr) {
+      return PowerSoS(pts[a], weight[a], sos_rank[a], pts[b], weight[b], sos_rank[b], pts[c], weight[c], sos_rank[c],
+                      pts[s], weight[s], sos_rank[s]) > 0;
+    }
+    return InCircleSoS(pts[a], sos_rank[a], pts[b], sos_rank[b], pts[c], sos_rank[c], pts[s], sos_rank[s]) > 0;
+  }
+
+  /// Weighted: whether vertex s, located in triangle t (Locate), is hidden: its lift lies above
+  /// the lifted triangle (finite t, not flat), or it lies on t's hull segment strictly between its
+  /// ends with its lift above theirs. The mesh only gains vertices and its lifted surface only
+  /// sinks as points are inserted, so a point hidden now is hidden in the final triangulation.
+  GALPHA_HD bool Hidden(int32_t t, int32_t s) const {
+    const Tri& x = tri[t];
+    for (int k = 0; k < 3; ++k) {
+      if (x.v[k] == inf) {
+        const int32_t u = x.v[Next(k)], w = x.v[Prev(k)];
+        return Orient2dSign(pts[u], pts[w], pts[s]) == 0 && OnOpenSegment(u, w, s) &&
+               CollinearPowerSign(pts[u], weight[u], pts[w], weight[w], pts[s], weight[s]) < 0;
+      }
+    }
+    const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
+    if (Orient2dSign(pts[a], pts[b], pts[c]) == 0) return false;
+    return PowerSoS(pts[a], weight[a], sos_rank[a], pts[b], weight[b], sos_rank[b], pts[c], weight[c], sos_rank[c],
+                    pts[s], weight[s], sos_rank[s]) < 0;
+  }
+
+  /// Weighted: the vertex a locally non-regular edge cannot be flipped around (the edge of t
+  /// opposite position k, whose quadrilateral r, p, s, q is not convex at p or at q), or -1 when
+  /// the edge is regular or can be flipped. Such a vertex is hidden: with p inside the triangle
+  /// r, s, q, the lower hull of the four lifts either has p below the plane of r, s, q (and then
+  /// the triangles r, p, q and s, q, p are on it, so the edge would be regular) or p above it.
+  GALPHA_HD int32_t BlockedVertex(int32_t t, int k) const {
+    const Tri& x = tri[t];
+    const int32_t r = x.v[k], p = x.v[Next(k)], q = x.v[Prev(k)];
+    if (r == inf || p == inf || q == inf) return -1;
+    const int32_t nb = nbr[t].n[k];
+    const int32_t s = tri[nb].v[EdgePos(nb, q, p)];
+    if (s == inf || !InConflict(t, s)) return -1;
+    if (Orient(r, p, s) < 0) return p;
+    if (Orient(s, q, r) < 0) return q;
+    return -1;
   }
 
   /// Position in triangle t of the edge running from a to b (the edge opposite that position), or -1.
@@ -151,7 +211,10 @@ struct MeshView {
       return r == inf ? HullEdgeConflict(p, q, s) : HullEdgeConflict(q, p, r);
     }
     if ((p == inf || q == inf) && !hull_may_change) return false;
-    return InConflict(t, s);
+    if (!InConflict(t, s)) return false;
+    // A regular triangulation may meet a non-regular edge whose quadrilateral is not convex: it
+    // cannot flip (the flip would fold the mesh); its reflex vertex is hidden (BlockedVertex).
+    return weight == nullptr || p == inf || q == inf || (Orient(r, p, s) > 0 && Orient(s, q, r) > 0);
   }
 };
 

@@ -57,6 +57,48 @@ struct IsRunHead {
   GALPHA_HD bool operator()(uint32_t k) const { return head[k] == k; }
 };
 
+/// Weighted input: the sort key of the weight of the input point a permutation entry names, heaviest
+/// first. Sorted stably by it before y and x, the points are ordered by (x, y, weight descending,
+/// index): at one position the heaviest point leads and hides the others.
+struct DescendingWeightKey {
+  const double* weights;
+  const uint32_t* order;
+  GALPHA_HD uint64_t operator()(uint32_t k) const { return ~OrderedDoubleKey(weights[order[k]]); }
+};
+
+/// RunHeadPosition for weighted points: a run is one position and one weight.
+struct WeightedRunHeadPosition {
+  const Point2* pts;
+  const double* weights;
+  const uint32_t* sorted;
+  GALPHA_HD uint32_t operator()(uint32_t k) const {
+    if (k == 0) return 0u;
+    const uint32_t i = sorted[k], j = sorted[k - 1];
+    return (pts[i] == pts[j] && weights[i] + 0.0 == weights[j] + 0.0) ? 0u : k;
+  }
+};
+
+/// Weighted input: a run head at the position of the run before it is lighter than that run (the
+/// sort put the heaviest first): hidden, with every point of its run.
+struct MarkLighterAtSamePosition {
+  const Point2* pts;
+  const uint32_t* sorted;
+  const uint32_t* head;
+  uint8_t* hidden;  // per input index
+  GALPHA_HD void operator()(uint32_t k) const {
+    const uint32_t h = head[k];
+    hidden[sorted[k]] = (h > 0 && pts[sorted[h]] == pts[sorted[h - 1]]) ? 1 : 0;
+  }
+};
+
+/// The distinct points that become mesh vertices: heads of runs that are not hidden.
+struct IsVisibleRunHead {
+  const uint32_t* head;
+  const uint32_t* sorted;
+  const uint8_t* hidden;  // per input index; nullptr: unweighted
+  GALPHA_HD bool operator()(uint32_t k) const { return head[k] == k && (hidden == nullptr || !hidden[sorted[k]]); }
+};
+
 struct BoundingBox {
   double min_x, min_y, max_x, max_y;
 };
@@ -187,5 +229,44 @@ struct GatherVertex {
     vertex_points[v] = Point2{ldexp(p.x, scale_exponent), ldexp(p.y, scale_exponent)};
   }
 };
+
+/// Weighted input: each vertex's weight, scaled by the square of the points' power of two (the power
+/// test's sign is unchanged: every lift scales by it), and its Simulation-of-Simplicity rank, its
+/// position in decreasing lexicographic order (core/exact/power.hpp).
+struct GatherWeightedVertex {
+  const double* input_weights;
+  const uint32_t* input_index;
+  const uint32_t* lexicographic_position;  // per input index, among the m distinct points
+  uint32_t m;
+  double* vertex_weights;
+  uint32_t* sos_rank;
+  int scale_exponent;
+  GALPHA_HD void operator()(uint32_t v) const {
+    const uint32_t i = input_index[v];
+    vertex_weights[v] = ldexp(input_weights[i], 2 * scale_exponent);
+    sos_rank[v] = m - 1 - lexicographic_position[i];
+  }
+};
+
+/// Scatters each distinct point's position in the (x, y) order to its input index.
+struct WriteLexicographicPosition {
+  const uint32_t* unique;
+  uint32_t* position;
+  GALPHA_HD void operator()(uint32_t j) const { position[unique[j]] = j; }
+};
+
+/// The smallest nonzero |weight| (+inf for 0).
+struct SmallestNonzeroWeight {
+  GALPHA_HD double operator()(double w) const { return w != 0.0 ? fabs(w) : INFINITY; }
+};
+
+/// ExactScaleExponent for weighted points: weights scale by twice the exponent, so scaling down is
+/// further limited to keep the smallest nonzero weight normal (exact).
+inline int WeightedScaleExponent(int point_exponent, double smallest_nonzero_weight) {
+  if (point_exponent >= 0 || !(smallest_nonzero_weight < INFINITY)) return point_exponent;
+  const int allowed = -((ilogb(smallest_nonzero_weight) - DBL_MIN_EXP + 1) / 2);
+  if (allowed >= 0) return 0;
+  return point_exponent > allowed ? point_exponent : allowed;
+}
 
 }  // namespace galpha::detail
