@@ -10,6 +10,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
+#include "client/point_input.hpp"
 #include "client/text_output.hpp"
 #include "gpu/triangulation/delaunay.hpp"
 #include "nlohmann/json.hpp"
@@ -17,18 +18,39 @@
 namespace galpha::alphactl {
 
 int RunTriangulate(Args args) {
-  auto common = ParseCommon("triangulate", args, {});
+  auto common = ParseCommon("triangulate", args, {"weights", "weight-property"});
   if (!common.ok()) return UsageError(common.status());
   if (!common->server.empty()) {
     return UsageError(absl::InvalidArgumentError(
         "triangulate runs locally only: a server builds whole families (use summary or bench with --server)"));
   }
+  if (const std::string* weights = common->line.Find("weights")) {
+    if (*weights == "radius") {
+      common->input.weights = InputOptions::Weights::kRadius;
+    } else if (*weights == "squared") {
+      common->input.weights = InputOptions::Weights::kSquared;
+    } else {
+      return UsageError(absl::InvalidArgumentError(
+          absl::StrCat("--weights is radius or squared (what the third value of a point is), not '", *weights, "'")));
+    }
+  }
+  if (const std::string* property = common->line.Find("weight-property")) {
+    if (property->empty()) return UsageError(absl::InvalidArgumentError("--weight-property needs a property's name"));
+    common->input.weight_property = *property;
+  }
   TriangulateOptions options;
   options.backend = common->backend;
 
-  auto points = ReadPoints(*common);
-  if (!points.ok()) return Failure(points.status());
-  auto tri = Triangulate(*points, options);
+  const bool weighted = common->input.weights != InputOptions::Weights::kNone;
+  absl::StatusOr<GeoreferencedPoints> read;
+  try {
+    read = ReadInputPointsAndCrs(common->file, common->input);
+  } catch (const std::exception& e) {
+    read = absl::DataLossError(absl::StrCat("points file '", common->file, "' cannot be read: ", e.what()));
+  }
+  if (!read.ok()) return Failure(read.status());
+  const std::vector<Point2>* points = &read->points;
+  auto tri = weighted ? TriangulateWeighted(*points, read->weights, options) : Triangulate(*points, options);
   if (!tri.ok()) return Failure(tri.status());
 
   size_t hull_edges = 0;
@@ -44,17 +66,19 @@ int RunTriangulate(Args args) {
     stages[s.stage] = ms(s.seconds);
     total += s.seconds;
   }
-  const nlohmann::ordered_json json = {{"file", common->file},
-                                       {"points", points->size()},
-                                       {"distinct_points", tri->num_unique},
-                                       {"duplicates", points->size() - tri->num_unique},
-                                       {"triangles", tri->triangles.size()},
-                                       {"edges", tri->edges.size()},
-                                       {"hull_edges", hull_edges},
-                                       {"backend", BackendName(tri->backend)},
-                                       {"peak_memory_bytes", tri->peak_memory_bytes},
-                                       {"total_ms", ms(total)},
-                                       {"stage_ms", std::move(stages)}};
+  const nlohmann::ordered_json json = {
+      {"file", common->file},
+      {"points", points->size()},
+      {"distinct_points", tri->num_unique},
+      {"duplicates", points->size() - tri->num_unique},
+      {"hidden_points", weighted ? nlohmann::ordered_json(tri->hidden.size()) : nlohmann::ordered_json(nullptr)},
+      {"triangles", tri->triangles.size()},
+      {"edges", tri->edges.size()},
+      {"hull_edges", hull_edges},
+      {"backend", BackendName(tri->backend)},
+      {"peak_memory_bytes", tri->peak_memory_bytes},
+      {"total_ms", ms(total)},
+      {"stage_ms", std::move(stages)}};
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;
 }

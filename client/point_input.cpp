@@ -30,6 +30,7 @@ constexpr size_t kReadChunkBytes = size_t{64} << 10;
 
 /// The first line of every batch after the one that held the input's first record (below).
 constexpr absl::string_view kSentinelLine = "0 0\n";
+constexpr absl::string_view kWeightedSentinelLine = "0 0 0\n";
 
 // The lines ParsePointsText skips (empty after trimming, or a '#' comment). Only used to know when
 // the input's first other line, the one that may be a header, has been parsed.
@@ -50,7 +51,9 @@ absl::Status TooManyPoints(const std::string& source, uint64_t max_points) {
 /// as it would be in one whole parse.
 class TextBatches {
  public:
-  TextBatches(const std::string& source, const InputOptions& options) : source_(source), options_(options) {}
+  /// `weighted`: records are x, y and a weight (ParseWeightedPointsText).
+  TextBatches(const std::string& source, const InputOptions& options, bool weighted = false)
+      : source_(source), options_(options), weighted_(weighted) {}
 
   /// Appends `bytes`, parsing each batch as it fills.
   absl::Status Append(absl::string_view bytes) {
@@ -77,24 +80,40 @@ class TextBatches {
     return absl::OkStatus();
   }
 
-  /// Parses the last batch (its last line may lack a '\n') and hands over the points.
-  absl::StatusOr<std::vector<Point2>> Finish() && {
-    if (batch_.size() > (sentinel_ ? kSentinelLine.size() : 0)) GALPHA_RETURN_IF_ERROR(ParseBatch());
-    return std::move(points_);
+  /// Parses the last batch (its last line may lack a '\n') and hands over the points (and, weighted,
+  /// their weights).
+  absl::StatusOr<GeoreferencedPoints> Finish() && {
+    if (batch_.size() > (sentinel_ ? Sentinel().size() : 0)) GALPHA_RETURN_IF_ERROR(ParseBatch());
+    GeoreferencedPoints out;
+    out.points = std::move(points_);
+    out.weights = std::move(weights_);
+    return out;
   }
 
  private:
+  absl::string_view Sentinel() const { return weighted_ ? kWeightedSentinelLine : kSentinelLine; }
+
+  absl::StatusOr<GeoreferencedPoints> Parse(const std::string& text) const {
+    if (weighted_) return ParseWeightedPointsText(text, source_);
+    GALPHA_ASSIGN_OR_RETURN(std::vector<Point2> points, ParsePointsText(text, source_));
+    GeoreferencedPoints out;
+    out.points = std::move(points);
+    return out;
+  }
+
   absl::Status ParseBatch() {
-    absl::StatusOr<std::vector<Point2>> parsed = ParsePointsText(batch_, source_);
+    absl::StatusOr<GeoreferencedPoints> parsed = Parse(batch_);
     if (!parsed.ok()) return Renumbered(parsed.status());
-    points_.insert(points_.end(), parsed->begin() + (sentinel_ ? 1 : 0), parsed->end());
+    const size_t skip = sentinel_ ? 1 : 0;
+    points_.insert(points_.end(), parsed->points.begin() + skip, parsed->points.end());
+    if (weighted_) weights_.insert(weights_.end(), parsed->weights.begin() + skip, parsed->weights.end());
     if (points_.size() > options_.max_points) return TooManyPoints(source_, options_.max_points);
     header_decided_ = header_decided_ || batch_has_record_;
     batch_has_record_ = false;
     batch_first_line_ = lines_ + 1;
     sentinel_ = header_decided_;
     batch_.clear();  // keeps its capacity for the next batch
-    if (sentinel_) batch_.append(kSentinelLine.data(), kSentinelLine.size());
+    if (sentinel_) batch_.append(Sentinel().data(), Sentinel().size());
     line_start_ = batch_.size();
     return absl::OkStatus();
   }
@@ -106,13 +125,15 @@ class TextBatches {
     if (batch_first_line_ == 1) return batch_error;
     std::string padded(batch_first_line_ - 1 - (sentinel_ ? 1 : 0), '\n');
     padded += batch_;
-    absl::StatusOr<std::vector<Point2>> again = ParsePointsText(padded, source_);
+    absl::StatusOr<GeoreferencedPoints> again = Parse(padded);
     return again.ok() ? batch_error : again.status();
   }
 
   const std::string& source_;
   const InputOptions& options_;
+  bool weighted_;
   std::vector<Point2> points_;
+  std::vector<double> weights_;
   std::string batch_;              // whole lines, then the start of the next; after the sentinel if sentinel_
   bool sentinel_ = false;          // batch_ starts with kSentinelLine
   bool header_decided_ = false;    // an earlier batch held a line the parser does not skip
@@ -162,6 +183,10 @@ absl::StatusOr<T> WithMaxPointsHint(absl::StatusOr<T> read) {
   return WithMaxPointsHint(read.status());
 }
 
+/// Delimited text from `fd` in batches (TextBatches), weighted or not.
+absl::StatusOr<GeoreferencedPoints> ReadTextInput(int fd, const std::string& source, const InputOptions& options,
+                                                  bool weighted);
+
 absl::StatusOr<std::vector<Point2>> CheckCount(absl::StatusOr<std::vector<Point2>> points, const std::string& source,
                                                uint64_t max_points) {
   if (points.ok() && points->size() > max_points) return TooManyPoints(source, max_points);
@@ -171,7 +196,15 @@ absl::StatusOr<std::vector<Point2>> CheckCount(absl::StatusOr<std::vector<Point2
 }  // namespace
 
 absl::StatusOr<std::vector<Point2>> ReadTextPoints(int fd, const std::string& source, const InputOptions& options) {
-  TextBatches batches(source, options);
+  GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadTextInput(fd, source, options, /*weighted=*/false));
+  return std::move(read.points);
+}
+
+namespace {
+
+absl::StatusOr<GeoreferencedPoints> ReadTextInput(int fd, const std::string& source, const InputOptions& options,
+                                                  bool weighted) {
+  TextBatches batches(source, options, weighted);
   std::string buffer(kReadChunkBytes, '\0');
   while (true) {
     const ssize_t got = read(fd, buffer.data(), buffer.size());
@@ -182,6 +215,57 @@ absl::StatusOr<std::vector<Point2>> ReadTextPoints(int fd, const std::string& so
   }
   return std::move(batches).Finish();
 }
+
+/// The weighted read of ReadInputPointsAndCrs (weights as stored; the caller squares radii).
+absl::StatusOr<GeoreferencedPoints> ReadWeightedInput(const std::string& file, const InputOptions& options,
+                                                      bool molecule, bool las) {
+  const std::string extension = absl::AsciiStrToLower(std::filesystem::path(file).extension().string());
+  struct stat info {};
+  if (file == "-") {
+    if (fstat(STDIN_FILENO, &info) != 0) return absl::ErrnoToStatus(errno, "cannot inspect standard input");
+    if (!IsReadable(info.st_mode)) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("standard input is ", KindOf(info.st_mode), ": pipe the points in, or name a file"));
+    }
+    return ReadTextInput(STDIN_FILENO, "standard input", options, /*weighted=*/true);
+  }
+  const std::string named = absl::StrCat("points file '", file, "'");
+  if (molecule || las || IsVectorPointsExtension(extension)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(named,
+                     " carries no weights that --weights reads: weighted points come as delimited text (x, y, weight), "
+                     ".npy (N, 3), weighted .bin or GeoJSON with --weight-property"));
+  }
+  if (stat(file.c_str(), &info) != 0) {
+    if (errno == ENOENT) return absl::NotFoundError(absl::StrCat(named, " does not exist"));
+    return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
+  }
+  if (!IsReadable(info.st_mode)) {
+    return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info.st_mode),
+                                                   ": alphactl reads regular files, named pipes and '-' "
+                                                   "(standard input)"));
+  }
+  const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json";
+  if (S_ISFIFO(info.st_mode) && !text) {
+    return absl::InvalidArgumentError(absl::StrCat(named, " is a named pipe: only delimited text is read from pipes"));
+  }
+  if (text) {
+    OwnedFd fd(open(file.c_str(), O_RDONLY | O_CLOEXEC));
+    if (fd.get() < 0) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open ", named));
+    return ReadTextInput(fd.get(), file, options, /*weighted=*/true);
+  }
+  if (extension == ".bin" && static_cast<uint64_t>(info.st_size) >= 8 &&
+      (static_cast<uint64_t>(info.st_size) - 8) / 24 > options.max_points) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(named, " has ", info.st_size, " bytes, room for ", (static_cast<uint64_t>(info.st_size) - 8) / 24,
+                     " weighted points: more than ", options.max_points, ", the limit (--max-points raises it)"));
+  }
+  GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadWeightedPointsFile(file, options.weight_property));
+  if (read.points.size() > options.max_points) return TooManyPoints(named, options.max_points);
+  return read;
+}
+
+}  // namespace
 
 absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, const InputOptions& options) {
   GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadInputPointsAndCrs(file, options));
@@ -210,6 +294,33 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
     return absl::InvalidArgumentError(
         absl::StrCat("--layer applies to Shapefiles, GeoPackages and FlatGeobuf files (.shp, .gpkg, .fgb), not to ",
                      file == "-" ? "standard input" : absl::StrCat("'", file, "'")));
+  }
+  if (options.weights == InputOptions::Weights::kNone && !options.weight_property.empty()) {
+    return absl::InvalidArgumentError("--weight-property names where the weights are: it needs --weights");
+  }
+  if (options.weights != InputOptions::Weights::kNone) {
+    if (!options.weight_property.empty() && (file == "-" || !geojson)) {
+      return absl::InvalidArgumentError(absl::StrCat("--weight-property applies to GeoJSON features, not to ",
+                                                     file == "-" ? "standard input" : absl::StrCat("'", file, "'")));
+    }
+    if (geojson && options.weight_property.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "'", file, "' is GeoJSON: name the feature property that holds the weights (--weight-property)"));
+    }
+    const bool las = extension == ".las" || extension == ".laz";
+    GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints weighted, ReadWeightedInput(file, options, molecule, las));
+    if (options.weights == InputOptions::Weights::kRadius) {
+      for (size_t i = 0; i < weighted.weights.size(); ++i) {
+        const double r = weighted.weights[i];
+        if (r < 0.0) {
+          return absl::InvalidArgumentError(absl::StrCat(
+              "point ", i, " has a negative radius (", r,
+              "); radii must be >= 0 (--weights squared reads the values as squared radii, which may be negative)"));
+        }
+        weighted.weights[i] = r * r;
+      }
+    }
+    return weighted;
   }
   struct stat info {};
   GeoreferencedPoints read;

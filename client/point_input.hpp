@@ -52,6 +52,12 @@ struct InputOptions {
   /// A column whose values group the points (--group-by): a GeoJSON feature property or a field of
   /// a GDAL layer; the result's `groups` then holds each point's value. Empty: none.
   std::string group_by;
+  /// Weighted points (--weights): none, each point's third value a radius (squared here: the
+  /// weight is its square; a negative radius is an error) or a squared radius as it is.
+  enum class Weights { kNone, kRadius, kSquared };
+  Weights weights = Weights::kNone;
+  /// The GeoJSON feature property that holds the weights (--weight-property; GeoJSON only).
+  std::string weight_property;
 };
 
 /// Reads the points of `file`, or of standard input when `file` is "-", as the header comment
@@ -68,6 +74,11 @@ absl::StatusOr<std::vector<Point2>> ReadInputPoints(const std::string& file, con
 /// nullopt for the others. Errors as ReadInputPoints's, and InvalidArgument for options.layer with
 /// an input that is not a GDAL vector source, for --plane/--slab with one that is no structure, or
 /// for a compressed LAS (.laz) file.
+///
+/// With options.weights, the points come with a weight each (GeoreferencedPoints::weights, as
+/// squared radii): from delimited text (x, y, weight; pipes and standard input too), .npy (N, 3),
+/// weighted .bin and GeoJSON with options.weight_property (point_formats.hpp); other formats are
+/// InvalidArgument, as is weight_property without weights or with another format.
 absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& file, const InputOptions& options);
 
 /// Parses the delimited text (ParsePointsText's format) read from descriptor `fd` until its end, in

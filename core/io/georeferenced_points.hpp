@@ -20,6 +20,9 @@ struct GeoreferencedPoints {
   /// When a group column was asked for (alphactl --group-by): each point's value of it as text,
   /// point for point (nullopt where its feature has none or null); empty otherwise.
   std::vector<std::optional<std::string>> groups;
+  /// Weighted input (ReadWeightedPointsFile and the weighted parsers): each point's weight as
+  /// stored, point for point; empty otherwise.
+  std::vector<double> weights;
 };
 
 }  // namespace galpha

@@ -18,6 +18,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
+#include "core/base/status_macros.hpp"
 #include "core/io/las_reader.hpp"
 #include "core/io/point_io.hpp"
 #include "core/io/vector_points.hpp"
@@ -26,10 +27,10 @@
 namespace galpha {
 namespace {
 
-// Up to the first two fields of a line; returns how many it found (0, 1 or 2). A line with a
+// Up to the first `wanted` fields of a line into `out`; returns how many it found. A line with a
 // comma, semicolon or tab is split on that delimiter and keeps its empty fields ("1,,2" has an
 // empty y, not y = 2); otherwise runs of spaces separate the fields.
-int FirstTwoFields(absl::string_view line, absl::string_view* x, absl::string_view* y) {
+int FirstFields(absl::string_view line, int wanted, absl::string_view* out) {
   const size_t delimiter_at = line.find_first_of(",;\t");
   std::vector<absl::string_view> fields;
   if (delimiter_at != absl::string_view::npos) {
@@ -37,9 +38,8 @@ int FirstTwoFields(absl::string_view line, absl::string_view* x, absl::string_vi
   } else {
     fields = absl::StrSplit(line, ' ', absl::SkipWhitespace());
   }
-  const int found = fields.size() >= 2 ? 2 : static_cast<int>(fields.size());
-  if (found >= 1) *x = absl::StripAsciiWhitespace(fields[0]);
-  if (found >= 2) *y = absl::StripAsciiWhitespace(fields[1]);
+  const int found = static_cast<int>(std::min<size_t>(fields.size(), static_cast<size_t>(wanted)));
+  for (int i = 0; i < found; ++i) out[i] = absl::StripAsciiWhitespace(fields[static_cast<size_t>(i)]);
   return found;
 }
 
@@ -221,34 +221,71 @@ absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, c
   return std::move(read->points);
 }
 
-absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source) {
-  std::vector<Point2> points;
+namespace {
+
+// Delimited text with `columns` numeric fields a record (x, y[, weight]), into `values` (row by
+// row). The header rule and the errors of ParsePointsText, over the first `columns` fields.
+absl::Status ParseTextColumns(absl::string_view text, const std::string& source, int columns,
+                              std::vector<double>* values) {
   bool first_line = true;
   size_t line_number = 0;
   for (absl::string_view line : absl::StrSplit(text, '\n')) {
     ++line_number;
     line = absl::StripAsciiWhitespace(line);  // also drops the '\r' of CRLF files
     if (line.empty() || line[0] == '#') continue;
-    absl::string_view xs, ys;
-    Point2 p;
-    const int fields = FirstTwoFields(line, &xs, &ys);
-    const bool x_numeric = fields >= 1 && ParseCoordinate(xs, &p.x);
-    const bool y_numeric = fields >= 2 && ParseCoordinate(ys, &p.y);
-    // A header names its columns: one of its first two fields is not a number.
-    const bool header = first_line && ((fields >= 1 && !x_numeric) || (fields >= 2 && !y_numeric));
+    absl::string_view fields[3];
+    double parsed[3] = {0.0, 0.0, 0.0};
+    const int found = FirstFields(line, columns, fields);
+    bool numeric = found == columns, some_text = false;
+    for (int i = 0; i < found; ++i) {
+      const bool number = ParseCoordinate(fields[i], &parsed[i]);
+      numeric = numeric && number;
+      some_text = some_text || !number;
+    }
+    // A header names its columns: one of its first fields is not a number.
+    const bool header = first_line && some_text;
     first_line = false;
     if (header) continue;
-    if (!x_numeric || !y_numeric) {
-      return absl::InvalidArgumentError(absl::StrCat(source, ":", line_number,
-                                                     ": expected x and y as the first two numeric fields, got '",
-                                                     line.substr(0, 80), "'"));
+    if (!numeric) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(source, ":", line_number,
+                       columns == 2 ? ": expected x and y as the first two numeric fields, got '"
+                                    : ": expected x, y and a weight as the first three numeric fields, got '",
+                       line.substr(0, 80), "'"));
     }
-    points.push_back(p);
+    values->insert(values->end(), parsed, parsed + columns);
   }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source) {
+  std::vector<double> values;
+  GALPHA_RETURN_IF_ERROR(ParseTextColumns(text, source, 2, &values));
+  std::vector<Point2> points(values.size() / 2);
+  for (size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
   return points;
 }
 
-absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, const std::string& source) {
+absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsText(absl::string_view text, const std::string& source) {
+  std::vector<double> values;
+  GALPHA_RETURN_IF_ERROR(ParseTextColumns(text, source, 3, &values));
+  GeoreferencedPoints out;
+  out.points.resize(values.size() / 3);
+  out.weights.resize(values.size() / 3);
+  for (size_t i = 0; i < out.points.size(); ++i) {
+    out.points[i] = {values[3 * i], values[3 * i + 1]};
+    out.weights[i] = values[3 * i + 2];
+  }
+  return out;
+}
+
+namespace {
+
+// A float64 .npy array of shape (N, columns), row by row into `values`.
+absl::Status ParseNpyColumns(absl::string_view bytes, const std::string& source, uint64_t columns_wanted,
+                             std::vector<double>* values) {
   constexpr absl::string_view kMagic("\x93NUMPY", 6);
   if (bytes.size() < 10 || bytes.substr(0, 6) != kMagic) {
     return absl::InvalidArgumentError(absl::StrCat(source, ": not a .npy file (no \\x93NUMPY magic)"));
@@ -294,22 +331,66 @@ absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, cons
     }
     std::vector<absl::string_view> dims = absl::StrSplit(inside, ',', absl::SkipWhitespace());
     if (dims.size() != 2 || !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[0]), &n) ||
-        !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[1]), &columns) || columns != 2) {
-      return absl::InvalidArgumentError(absl::StrCat(source, ": the array's shape is ", shape, "; (N, 2) is needed"));
+        !absl::SimpleAtoi(absl::StripAsciiWhitespace(dims[1]), &columns) || columns != columns_wanted) {
+      return absl::InvalidArgumentError(absl::StrCat(source, ": the array's shape is ", shape, "; (N, ", columns_wanted,
+                                                     ") is needed",
+                                                     columns_wanted == 3 ? " (x, y and a weight a row)" : ""));
     }
   }
   const uint64_t data_bytes = bytes.size() - data_offset;
-  if (n > data_bytes / 16 || data_bytes != n * 16) {
-    return absl::DataLossError(absl::StrCat(source, ": the .npy header announces ", n, " points (", n * 16,
+  const uint64_t row_bytes = 8 * columns_wanted;
+  if (n > data_bytes / row_bytes || data_bytes != n * row_bytes) {
+    return absl::DataLossError(absl::StrCat(source, ": the .npy header announces ", n, " points (", n * row_bytes,
                                             " bytes) but the file holds ", data_bytes, " bytes of data"));
   }
-  std::vector<Point2> points(n);
+  values->resize(n * columns_wanted);
   for (uint64_t i = 0; i < n; ++i) {
-    const uint64_t x_at = fortran_order ? i : 2 * i, y_at = fortran_order ? n + i : 2 * i + 1;
-    points[i].x = DoubleAt(bytes, data_offset + 8 * x_at, little_endian);
-    points[i].y = DoubleAt(bytes, data_offset + 8 * y_at, little_endian);
+    for (uint64_t c = 0; c < columns_wanted; ++c) {
+      const uint64_t at = fortran_order ? c * n + i : columns_wanted * i + c;
+      (*values)[columns_wanted * i + c] = DoubleAt(bytes, data_offset + 8 * at, little_endian);
+    }
   }
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, const std::string& source) {
+  std::vector<double> values;
+  GALPHA_RETURN_IF_ERROR(ParseNpyColumns(bytes, source, 2, &values));
+  std::vector<Point2> points(values.size() / 2);
+  for (size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
   return points;
+}
+
+absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsNpy(absl::string_view bytes, const std::string& source) {
+  std::vector<double> values;
+  GALPHA_RETURN_IF_ERROR(ParseNpyColumns(bytes, source, 3, &values));
+  GeoreferencedPoints out;
+  out.points.resize(values.size() / 3);
+  out.weights.resize(values.size() / 3);
+  for (size_t i = 0; i < out.points.size(); ++i) {
+    out.points[i] = {values[3 * i], values[3 * i + 1]};
+    out.weights[i] = values[3 * i + 2];
+  }
+  return out;
+}
+
+absl::StatusOr<GeoreferencedPoints> ParseWeightedGeoJson(absl::string_view text, const std::string& source,
+                                                         const std::string& weight_property) {
+  GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints out, ParseGeoreferencedGeoJson(text, source, weight_property));
+  out.weights.resize(out.points.size());
+  for (size_t i = 0; i < out.points.size(); ++i) {
+    const std::optional<std::string>& value = out.groups[i];
+    if (!value.has_value() || !absl::SimpleAtod(*value, &out.weights[i])) {
+      return absl::InvalidArgumentError(absl::StrCat(source, ": point ", i, " (in document order) has ",
+                                                     value.has_value() ? absl::StrCat("'", *value, "' as") : "no",
+                                                     " property '", weight_property,
+                                                     "': every point's feature needs a numeric weight there"));
+    }
+  }
+  out.groups.clear();
+  return out;
 }
 
 absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path) {
@@ -353,6 +434,41 @@ absl::StatusOr<GeoreferencedPoints> ReadGeoreferencedPointsFile(const std::strin
   if (extension == ".npy") return plain(ParsePointsNpy(bytes, path));
   if (extension == ".geojson" || extension == ".json") return ParseGeoreferencedGeoJson(bytes, path);
   return plain(ParsePointsText(bytes, path));
+}
+
+absl::StatusOr<GeoreferencedPoints> ReadWeightedPointsFile(const std::string& path,
+                                                           const std::string& weight_property) {
+  const std::string extension = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  const bool geojson = extension == ".geojson" || extension == ".json";
+  if (geojson && weight_property.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points file '", path, "' is GeoJSON: name the property that holds the weights"));
+  }
+  if (!geojson && !weight_property.empty()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("a weight property applies to GeoJSON features, not to points file '", path, "'"));
+  }
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) {
+    return absl::NotFoundError(absl::StrCat("points file '", path, "' does not exist"));
+  }
+  if (std::filesystem::is_directory(path, error)) {
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' is a directory"));
+  }
+  if (extension == ".bin") return ReadWeightedPointsBin(path);
+  if (extension == ".las" || extension == ".laz" || IsVectorPointsExtension(extension)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "points file '", path,
+        "' holds no weights galpha reads: weighted points come as delimited text (x, y, weight), .npy (N, 3), "
+        "weighted .bin or GeoJSON with a weight property"));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open points file '", path, "'"));
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return absl::DataLossError(absl::StrCat("cannot read points file '", path, "'"));
+  if (extension == ".npy") return ParseWeightedPointsNpy(bytes, path);
+  if (geojson) return ParseWeightedGeoJson(bytes, path, weight_property);
+  return ParseWeightedPointsText(bytes, path);
 }
 
 }  // namespace galpha

@@ -51,6 +51,19 @@ absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, c
 absl::StatusOr<GeoreferencedPoints> ParseGeoreferencedGeoJson(absl::string_view text, const std::string& source,
                                                               const std::string& group_property = "");
 
+/// ParsePointsText for weighted points: x, y and the weight are the first three fields of a record
+/// (a header when one of them is not a number). Errors name the line, as ParsePointsText's.
+absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsText(absl::string_view text, const std::string& source);
+
+/// ParsePointsNpy for weighted points: a float64 array of shape (N, 3), rows (x, y, weight).
+absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsNpy(absl::string_view bytes, const std::string& source);
+
+/// ParseGeoreferencedGeoJson with a weight per point: the number in its feature's property
+/// `weight_property` (a JSON number, or a string holding one; every point of a MultiPoint takes its
+/// feature's). InvalidArgument names the first point (in document order) without one.
+absl::StatusOr<GeoreferencedPoints> ParseWeightedGeoJson(absl::string_view text, const std::string& source,
+                                                         const std::string& weight_property);
+
 /// Reads a point file, choosing the format by extension: `.bin` (raw, point_io.hpp), `.npy`,
 /// `.geojson` or `.json`, `.las` (las_reader.hpp), anything else as delimited text
 /// except the formats refused by name: `.laz` (compressed LAS) and the GDAL vector sources of
@@ -62,5 +75,13 @@ absl::StatusOr<std::vector<Point2>> ReadPointsFile(const std::string& path);
 /// ReadPointsFile with the CRS the file states: a LAS file's (las_reader.hpp), a GeoJSON
 /// document's (ParseGeoreferencedGeoJson); nullopt for the formats that state none.
 absl::StatusOr<GeoreferencedPoints> ReadGeoreferencedPointsFile(const std::string& path);
+
+/// Reads a weighted point file (GeoreferencedPoints::weights set, one per point, as stored: the
+/// caller decides whether they are radii or squared radii): `.bin` with the weighted flag
+/// (point_io.hpp), `.npy` (N, 3), GeoJSON with `weight_property` (required for GeoJSON and
+/// refused for the others), anything else as delimited text (x, y, weight). LAS and GDAL sources
+/// hold no weights: InvalidArgument. Errors name the file, as ReadPointsFile's.
+absl::StatusOr<GeoreferencedPoints> ReadWeightedPointsFile(const std::string& path,
+                                                           const std::string& weight_property = "");
 
 }  // namespace galpha

@@ -5,8 +5,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
+#include <string>
 #include <system_error>
 #include <type_traits>
 
@@ -24,6 +27,7 @@ static_assert(sizeof(double) == sizeof(uint64_t) && std::numeric_limits<double>:
 
 constexpr uint64_t kHeaderBytes = sizeof(uint64_t);
 constexpr uint64_t kBytesPerPoint = sizeof(Point2);
+constexpr uint64_t kBytesPerWeightedPoint = 3 * sizeof(double);
 
 constexpr bool HostIsLittleEndian() { return __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__; }
 
@@ -83,6 +87,10 @@ absl::StatusOr<std::vector<Point2>> ReadPointsBin(const std::string& path) {
     return absl::DataLossError(absl::StrCat("cannot read the header of points file '", path, "'"));
   }
   const uint64_t count = HostFileOrder(header);
+  if ((count & kWeightedBinFlag) != 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("points file '", path, "' is weighted (x, y, weight triples): read it as weighted points"));
+  }
   const uint64_t body_bytes = file_bytes - kHeaderBytes;
   // Compare counts rather than count * 16 so that a corrupt header cannot overflow.
   if (count != body_bytes / kBytesPerPoint || body_bytes % kBytesPerPoint != 0) {
@@ -99,6 +107,74 @@ absl::StatusOr<std::vector<Point2>> ReadPointsBin(const std::string& path) {
   }
   if (!HostIsLittleEndian()) SwapPointBytes(&points);
   return points;
+}
+
+absl::StatusOr<GeoreferencedPoints> ReadWeightedPointsBin(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::ErrnoToStatus(errno, absl::StrCat("cannot open points file '", path, "'"));
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return absl::DataLossError(absl::StrCat("cannot read points file '", path, "'"));
+  if (bytes.size() < kHeaderBytes) {
+    return absl::InvalidArgumentError(absl::StrCat("points file '", path, "' has ", bytes.size(),
+                                                   " bytes, fewer than its 8-byte header (uint64 point count)"));
+  }
+  uint64_t header;
+  std::memcpy(&header, bytes.data(), sizeof header);
+  header = HostFileOrder(header);
+  if ((header & kWeightedBinFlag) == 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "points file '", path, "' holds (x, y) pairs without weights (its header lacks the weighted flag, bit 63)"));
+  }
+  const uint64_t count = header & ~kWeightedBinFlag;
+  const uint64_t body_bytes = bytes.size() - kHeaderBytes;
+  if (count != body_bytes / kBytesPerWeightedPoint || body_bytes % kBytesPerWeightedPoint != 0) {
+    return absl::DataLossError(
+        absl::StrCat("points file '", path, "': header says ", count, " weighted points but the file has room for ",
+                     body_bytes / kBytesPerWeightedPoint, " (", bytes.size(), " bytes; 24 a point)"));
+  }
+  GeoreferencedPoints out;
+  out.points.resize(count);
+  out.weights.resize(count);
+  for (uint64_t i = 0; i < count; ++i) {
+    uint64_t bits[3];
+    std::memcpy(bits, bytes.data() + kHeaderBytes + kBytesPerWeightedPoint * i, sizeof bits);
+    double v[3];
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t host = HostFileOrder(bits[k]);
+      std::memcpy(&v[k], &host, sizeof host);
+    }
+    out.points[i] = {v[0], v[1]};
+    out.weights[i] = v[2];
+  }
+  return out;
+}
+
+absl::Status WriteWeightedPointsBin(const std::string& path, absl::Span<const Point2> points,
+                                    absl::Span<const double> weights) {
+  if (weights.size() != points.size()) {
+    return absl::InvalidArgumentError(absl::StrCat(weights.size(), " weights for ", points.size(), " points"));
+  }
+  std::string bytes(kHeaderBytes + kBytesPerWeightedPoint * points.size(), '\0');
+  const uint64_t header = HostFileOrder(points.size() | kWeightedBinFlag);
+  std::memcpy(bytes.data(), &header, sizeof header);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const double v[3] = {points[i].x, points[i].y, weights[i]};
+    for (int k = 0; k < 3; ++k) {
+      uint64_t bits;
+      std::memcpy(&bits, &v[k], sizeof bits);
+      bits = HostFileOrder(bits);
+      std::memcpy(bytes.data() + kHeaderBytes + kBytesPerWeightedPoint * i + 8 * k, &bits, sizeof bits);
+    }
+  }
+  FilePtr file(std::fopen(path.c_str(), "wb"));
+  if (file == nullptr) return OpenError(path, "writing", errno);
+  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file.get()) == bytes.size();
+  const bool closed = std::fclose(file.release()) == 0;
+  if (!written || !closed) {
+    return absl::DataLossError(
+        absl::StrCat("cannot write ", points.size(), " weighted points to points file '", path, "'"));
+  }
+  return absl::OkStatus();
 }
 
 absl::Status WritePointsBin(const std::string& path, absl::Span<const Point2> points) {

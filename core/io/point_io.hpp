@@ -1,5 +1,6 @@
 // Reading and writing the raw binary point format (data/README.md; docs/design.md, "Formats"):
-// little-endian uint64 N, then N pairs of little-endian float64 (x, y). Nothing is deduplicated,
+// little-endian uint64 N, then N pairs of little-endian float64 (x, y); weighted, the header's
+// top bit set and N triples (x, y, weight). Nothing is deduplicated,
 // rounded or validated for finiteness here: the engine's validation layer does that.
 #pragma once
 
@@ -10,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "absl/types/span.h"
 #include "core/base/point.hpp"
+#include "core/io/georeferenced_points.hpp"
 
 namespace galpha {
 
@@ -24,5 +26,14 @@ absl::StatusOr<std::vector<Point2>> ReadPointsBin(const std::string& path);
 /// Writes `points` as a points `.bin` file, replacing any file at `path`. Errors name the file:
 /// errno-derived codes when it cannot be opened, DataLoss when a write or the close fails.
 absl::Status WritePointsBin(const std::string& path, absl::Span<const Point2> points);
+
+/// The weighted variant of the format: the header's bit 63 set (a flag no point count reaches;
+/// ReadPointsBin refuses such a file by name), the count in the other bits, then N triples of
+/// little-endian float64 (x, y, weight). Same errors as ReadPointsBin, and InvalidArgument for a
+/// file without the flag.
+inline constexpr uint64_t kWeightedBinFlag = uint64_t{1} << 63;
+absl::StatusOr<GeoreferencedPoints> ReadWeightedPointsBin(const std::string& path);
+absl::Status WriteWeightedPointsBin(const std::string& path, absl::Span<const Point2> points,
+                                    absl::Span<const double> weights);
 
 }  // namespace galpha

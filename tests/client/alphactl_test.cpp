@@ -147,6 +147,34 @@ TEST(AlphactlTest, TriangulatesACsvAndPrintsOneJsonObject) {
   std::filesystem::remove(path);
 }
 
+TEST(AlphactlTest, TriangulatesWeightedPointsWithRadiiOrSquaredRadii) {
+  // Unit disks at (0,0), (4,0), (0,4) lift to -1, 15, 15; (2,2) with radius 3 lifts to -1, below
+  // their plane z = 4x + 4y - 1 (15 there): a vertex. (1,1) with radius 0.1 lifts to 1.99, above
+  // the plane of (0,0), (2,2) and (4,0) (z = 4x - 4y - 1: -1 there): hidden. As squared radii (3
+  // and 0.1: lifts 5 and 1.9, that plane z = 4x - y - 1 at 2), nothing is hidden.
+  const std::string path = WriteFile("alphactl_disks.csv", "x,y,r\n0,0,1\n4,0,1\n0,4,1\n1,1,0.1\n2,2,3\n");
+  const nlohmann::json radius =
+      nlohmann::json::parse(Alphactl("triangulate " + Quote(path) + " --backend=cpu --weights radius").out);
+  EXPECT_EQ(radius["hidden_points"], 1);
+  EXPECT_EQ(radius["triangles"], 2);
+  const nlohmann::json squared =
+      nlohmann::json::parse(Alphactl("triangulate " + Quote(path) + " --backend=cpu --weights squared").out);
+  EXPECT_EQ(squared["hidden_points"], 0);
+  EXPECT_EQ(squared["triangles"], 4);
+  EXPECT_TRUE(
+      nlohmann::json::parse(Alphactl("triangulate " + Quote(path) + " --backend=cpu").out)["hidden_points"].is_null());
+  ExpectError(Alphactl("triangulate " + Quote(path) + " --weights diameter"), 2, "radius or squared");
+  ExpectError(Alphactl("triangulate " + Quote(path) + " --weights radius --weight-property r"), 1,
+              "applies to GeoJSON features");
+  const std::string negative = WriteFile("alphactl_negative_radius.csv", "0 0 1\n1 0 -2\n0 1 1\n");
+  ExpectError(Alphactl("triangulate " + Quote(negative) + " --weights radius"), 1, "point 1 has a negative radius");
+  // As squared radii, negative values are valid.
+  EXPECT_EQ(Alphactl("triangulate " + Quote(negative) + " --backend=cpu --weights squared").exit_code, 0);
+  ExpectError(Alphactl("summary " + Quote(path) + " --rank 0 --weights radius"), 2, "unknown option '--weights'");
+  std::filesystem::remove(path);
+  std::filesystem::remove(negative);
+}
+
 TEST(AlphactlTest, FileNamesAreEscapedInTheJson) {
   const std::string path = WriteFile("alphactl_we\"ird\\name.csv", "0 0\n1 0\n0 1\n");
   const CommandResult run = Alphactl("triangulate " + Quote(path) + " --backend=cpu");
@@ -194,7 +222,9 @@ TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
                            "--dimension",
                            "--min-area",
                            "--min-hole-area",
-                           "text|csv|json|svg"}) {
+                           "text|csv|json|svg",
+                           "--weights radius|squared",
+                           "--weight-property"}) {
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   }
   const CommandResult none = Alphactl("");

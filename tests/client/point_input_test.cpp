@@ -84,6 +84,45 @@ TEST(PointInputTest, BatchesAgreeWithOneWholeParse) {
   }
 }
 
+// The same for weighted text (x, y, weight): batches agree with ParseWeightedPointsText on the
+// whole, through the weighted read (ReadInputPointsAndCrs with --weights squared).
+TEST(PointInputTest, WeightedBatchesAgreeWithOneWholeParse) {
+  const std::vector<std::string> texts = {
+      "x,y,r\n" + Lines(40, "1,2,0.5\n3.5,-4,-1\n"),
+      Lines(30, "# comment\n\n") + "x y w\n" + Lines(20, "5 6 7\r\n"),
+      Lines(25, "1;2;3\n") + "4;5\n" + Lines(25, "3;4;5\n"),
+      Lines(20, "5 6 1\n") + "7 8 2",
+  };
+  for (size_t t = 0; t < texts.size(); ++t) {
+    const absl::StatusOr<GeoreferencedPoints> whole = ParseWeightedPointsText(texts[t], "input.csv");
+    TempFile file("weighted.csv", texts[t]);
+    for (size_t batch_bytes : {1, 5, 16, 100, 1 << 20}) {
+      SCOPED_TRACE(absl::StrCat("text ", t, ", batches of ", batch_bytes, " bytes"));
+      InputOptions options;
+      options.batch_bytes = batch_bytes;
+      options.weights = InputOptions::Weights::kSquared;
+      const absl::StatusOr<GeoreferencedPoints> batched = ReadInputPointsAndCrs(file.path(), options);
+      ASSERT_EQ(batched.ok(), whole.ok()) << batched.status();
+      if (!whole.ok()) {
+        // The line number is the same; the source is the file's path here.
+        const std::string line = std::string(whole.status().message()).substr(std::string("input.csv").size());
+        EXPECT_NE(batched.status().message().find(line.substr(0, line.find(' '))), absl::string_view::npos)
+            << batched.status() << " vs " << whole.status();
+        continue;
+      }
+      ExpectSamePoints(batched->points, whole->points);
+      EXPECT_EQ(batched->weights, whole->weights);
+    }
+  }
+  // Radii are squared on the way in.
+  TempFile radii("radii.csv", "0 0 3\n1 0 0.5\n");
+  InputOptions options;
+  options.weights = InputOptions::Weights::kRadius;
+  const absl::StatusOr<GeoreferencedPoints> read = ReadInputPointsAndCrs(radii.path(), options);
+  ASSERT_TRUE(read.ok()) << read.status();
+  EXPECT_EQ(read->weights, std::vector<double>({9.0, 0.25}));
+}
+
 TEST(PointInputTest, MorePointsThanTheLimitIsResourceExhausted) {
   InputOptions options;
   options.max_points = 10;

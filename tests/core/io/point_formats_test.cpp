@@ -245,5 +245,80 @@ TEST_F(ReadPointsFileTest, TruncatedBinIsDataLoss) {
   EXPECT_THAT(ReadPointsFile(bin).status(), StatusIs(absl::StatusCode::kDataLoss));
 }
 
+// Weighted points: (x, y, weight) in every format that carries a weight.
+void ExpectWeighted(const absl::StatusOr<GeoreferencedPoints>& got, const std::vector<Point2>& points,
+                    const std::vector<double>& weights) {
+  ASSERT_THAT(got, IsOk());
+  ExpectPoints(got->points, points);
+  EXPECT_EQ(got->weights, weights);
+}
+
+TEST(WeightedPointsTest, TextTakesTheThirdFieldAsTheWeight) {
+  ExpectWeighted(ParseWeightedPointsText("x,y,radius,name\n1,2,0.5,a\n# note\n3 4 -1e-3\n", "w.csv"),
+                 Points({{1, 2}, {3, 4}}), {0.5, -1e-3});
+  const auto two = ParseWeightedPointsText("1,2,3\n4,5\n", "two.csv");
+  ASSERT_THAT(two.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_NE(two.status().message().find("two.csv:2: expected x, y and a weight"), absl::string_view::npos)
+      << two.status();
+  const auto word = ParseWeightedPointsText("1,2,3\n4,5,big\n", "word.csv");
+  EXPECT_NE(word.status().message().find("word.csv:2"), absl::string_view::npos) << word.status();
+}
+
+TEST(WeightedPointsTest, NpyOfThreeColumnsInBothOrders) {
+  ExpectWeighted(ParseWeightedPointsNpy(
+                     Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (2, 3), }", {1, 2, 3, 4, 5, 6}), "c.npy"),
+                 Points({{1, 2}, {4, 5}}), {3, 6});
+  ExpectWeighted(ParseWeightedPointsNpy(
+                     Npy("{'descr': '<f8', 'fortran_order': True, 'shape': (2, 3), }", {1, 4, 2, 5, 3, 6}), "f.npy"),
+                 Points({{1, 2}, {4, 5}}), {3, 6});
+  const auto pairs =
+      ParseWeightedPointsNpy(Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 2), }", {1, 2}), "2.npy");
+  ASSERT_THAT(pairs.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_NE(pairs.status().message().find("(N, 3) is needed"), absl::string_view::npos) << pairs.status();
+}
+
+TEST(WeightedPointsTest, GeoJsonTakesTheNamedProperty) {
+  const std::string doc = R"({"type": "FeatureCollection", "features": [
+      {"type": "Feature", "properties": {"r": 1.5}, "geometry": {"type": "Point", "coordinates": [1, 2]}},
+      {"type": "Feature", "properties": {"r": "0.25"},
+       "geometry": {"type": "MultiPoint", "coordinates": [[3, 4], [5, 6]]}}]})";
+  ExpectWeighted(ParseWeightedGeoJson(doc, "w.geojson", "r"), Points({{1, 2}, {3, 4}, {5, 6}}), {1.5, 0.25, 0.25});
+  const std::string missing = R"({"type": "FeatureCollection", "features": [
+      {"type": "Feature", "properties": {"r": 1}, "geometry": {"type": "Point", "coordinates": [1, 2]}},
+      {"type": "Feature", "properties": {"r": null}, "geometry": {"type": "Point", "coordinates": [3, 4]}}]})";
+  const auto got = ParseWeightedGeoJson(missing, "m.geojson", "r");
+  ASSERT_THAT(got.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_NE(got.status().message().find("point 1 (in document order) has no property 'r'"), absl::string_view::npos)
+      << got.status();
+}
+
+TEST_F(ReadPointsFileTest, WeightedFilesByExtensionAndTheWeightedBinFlag) {
+  ExpectWeighted(ReadWeightedPointsFile(Write("w.csv", "1,2,3\n")), Points({{1, 2}}), {3});
+  ExpectWeighted(ReadWeightedPointsFile(
+                     Write("w.npy", Npy("{'descr': '<f8', 'fortran_order': False, 'shape': (1, 3), }", {7, 8, 9}))),
+                 Points({{7, 8}}), {9});
+  const std::string geojson = Write("w.geojson", R"({"type": "Feature", "properties": {"w": 4},
+      "geometry": {"type": "Point", "coordinates": [5, 6]}})");
+  ExpectWeighted(ReadWeightedPointsFile(geojson, "w"), Points({{5, 6}}), {4});
+  EXPECT_THAT(ReadWeightedPointsFile(geojson).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_THAT(ReadWeightedPointsFile(Write("x.csv", "1,2,3\n"), "w").status(),
+              StatusIs(absl::StatusCode::kInvalidArgument));
+  const std::string bin = (dir_ / "w.bin").string();
+  ASSERT_THAT(WriteWeightedPointsBin(bin, Points({{5, 6}, {-7, 8}}), std::vector<double>{0.5, -2}), IsOk());
+  ExpectWeighted(ReadWeightedPointsFile(bin), Points({{5, 6}, {-7, 8}}), {0.5, -2});
+  EXPECT_EQ(std::filesystem::file_size(bin), 8u + 2 * 24);
+  // Each kind of .bin refuses to be read as the other, by name.
+  const auto as_plain = ReadPointsFile(bin);
+  ASSERT_THAT(as_plain.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_NE(as_plain.status().message().find("is weighted"), absl::string_view::npos) << as_plain.status();
+  const std::string plain = (dir_ / "p.bin").string();
+  ASSERT_THAT(WritePointsBin(plain, Points({{1, 2}})), IsOk());
+  const auto as_weighted = ReadWeightedPointsFile(plain);
+  ASSERT_THAT(as_weighted.status(), StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_NE(as_weighted.status().message().find("without weights"), absl::string_view::npos) << as_weighted.status();
+  std::filesystem::resize_file(bin, 8 + 24 + 8);
+  EXPECT_THAT(ReadWeightedPointsFile(bin).status(), StatusIs(absl::StatusCode::kDataLoss));
+}
+
 }  // namespace
 }  // namespace galpha
