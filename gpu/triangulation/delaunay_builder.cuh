@@ -279,12 +279,12 @@ class DelaunayBuilder {
     if (num_candidates == 0) return 0;
     Buffer<int32_t, System> vertex_tri(sys_, m_);
     thrust::fill(pol, vertex_tri.begin(), vertex_tri.end(), -1);
-    Buffer<uint32_t, System> claim(sys_, static_cast<size_t>(num_tri_));
+    Buffer<unsigned long long, System> claim(sys_, static_cast<size_t>(num_tri_));
     Buffer<uint8_t, System> created(sys_, static_cast<size_t>(num_tri_));
     thrust::fill(pol, created.begin(), created.end(), uint8_t{0});
     uint32_t* removed = counts_.data() + kRedundantCount;
+    thrust::for_each(pol, tfirst, tfirst + num_tri_, FindStarStart{mesh_, hidden_, vertex_tri.data()});
     for (;;) {
-      thrust::for_each(pol, tfirst, tfirst + num_tri_, FindStarStart{mesh_, hidden_, vertex_tri.data()});
       thrust::fill(pol, claim.begin(), claim.end(), kNoClaim);
       thrust::fill(pol, removed, removed + 1, 0u);
       thrust::for_each(pol, first, first + num_candidates,

@@ -23,6 +23,7 @@
 #include <thrust/iterator/discard_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/iterator/zip_iterator.h>
+#include <thrust/partition.h>
 #include <thrust/reduce.h>
 #include <thrust/remove.h>
 #include <thrust/scan.h>
@@ -346,9 +347,27 @@ FirstTriangle FindFirstTriangle(System& sys, const Buffer<Point2, System>& verte
   return {a, b, c};
 }
 
+/// Weighted: whether a vertex is heavy enough to hide many others (its weight above the mean by 16
+/// times the squared typical spacing: a disk covering some fifty points).
+struct IsHeavyVertex {
+  const double* weight;
+  double threshold;
+  GALPHA_HD bool operator()(int32_t v) const { return weight[v] > threshold; }
+};
+
+/// The most heavy vertices inserted before the others (InsertRemainingVertices): the others then
+/// walk from the first triangle through a mesh of at most this many vertices.
+constexpr uint32_t kMaxHeavyFirst = 1024;
+
 /// Inserts every vertex but the first triangle's into the builder's mesh, in rounds.
+///
+/// Weighted, a few heavy vertices (IsHeavyVertex, at most kMaxHeavyFirst) are inserted first: the
+/// points their disks hide are then hidden on relocation, instead of being inserted before them
+/// and removed afterwards ring by ring (measured: one disk over a quarter of 1M points took 404 ms
+/// on an H100 that way).
 template <class System>
-void InsertRemainingVertices(System& sys, DelaunayBuilder<System>* builder, FirstTriangle first, uint32_t m) {
+void InsertRemainingVertices(System& sys, DelaunayBuilder<System>* builder, FirstTriangle first, uint32_t m,
+                             const Buffer<Point2, System>& vertex_points, const VertexWeights<System>& weights) {
   auto pol = sys.policy();
   const thrust::counting_iterator<int32_t> vfirst(0);
   const uint32_t num_pending = m - 3;
@@ -358,7 +377,24 @@ void InsertRemainingVertices(System& sys, DelaunayBuilder<System>* builder, Firs
   thrust::copy_if(pol, vfirst, vfirst + m, pending.begin(), NotInitialVertex{first.a, first.b, first.c});
   thrust::fill(pol, location.begin(), location.end(), 0);
   thrust::fill(pol, inserted.begin(), inserted.end(), uint8_t{0});
-  builder->InsertAll(pending.data(), location.data(), inserted.data(), num_pending);
+  uint32_t num_heavy = 0;
+  if (weights.weighted()) {
+    const Point2* pts = vertex_points.data();
+    const BoundingBox box =
+        thrust::transform_reduce(pol, pts, pts + m, PointToBox(), PointToBox()(sys.Read(pts)), MergeBoxes());
+    const double spacing_sq = (box.max_x - box.min_x) * (box.max_y - box.min_y) / m;
+    const double mean = thrust::reduce(pol, weights.weight.data(), weights.weight.data() + m, 0.0) / m;
+    const auto heavy = IsHeavyVertex{weights.weight.data(), mean + 16.0 * spacing_sq};
+    num_heavy = static_cast<uint32_t>(thrust::count_if(pol, pending.begin(), pending.end(), heavy));
+    if (num_heavy > kMaxHeavyFirst) {
+      num_heavy = 0;
+    } else if (num_heavy > 0) {
+      thrust::stable_partition(pol, pending.begin(), pending.end(), heavy);
+      builder->InsertAll(pending.data(), location.data(), inserted.data(), num_heavy);
+    }
+  }
+  builder->InsertAll(pending.data() + num_heavy, location.data() + num_heavy, inserted.data() + num_heavy,
+                     num_pending - num_heavy);
 }
 
 /// The Delaunay mesh of the distinct points (Hilbert order): the first triangle, then every other
@@ -374,7 +410,7 @@ void BuildMesh(System& sys, const Buffer<Point2, System>& vertex_points, Distinc
                    weighted ? vertex_weights.weight.data() : nullptr, weighted ? vertex_weights.hidden.data() : nullptr,
                    distinct.m, first.a, first.b, first.c);
   (*builder)->Start(first.a, first.b, first.c);
-  InsertRemainingVertices(sys, &**builder, first, distinct.m);
+  InsertRemainingVertices(sys, &**builder, first, distinct.m, vertex_points, vertex_weights);
 }
 
 /// Replaces `buffer` by its entries at the first `num_kept` positions of `kept`.

@@ -14,7 +14,22 @@
 #include "core/exact/power.hpp"
 #include "core/exact/predicates.hpp"
 
+// The weighted predicates stay out of line: inlined, they would enlarge every kernel that calls
+// the mesh's predicates (registers, occupancy) although unweighted builds never run them.
+#if defined(__CUDACC__)
+#define GALPHA_WEIGHTED_COLD __noinline__
+#else
+#define GALPHA_WEIGHTED_COLD __attribute__((noinline))
+#endif
+
 namespace galpha::detail {
+
+/// PowerSoS of triangle (a, b, c) and vertex s > 0: s's lift below the triangle's lifted plane.
+GALPHA_HD GALPHA_WEIGHTED_COLD inline bool PowerConflict(const Point2* pts, const double* weight, const uint32_t* rank,
+                                                         int32_t a, int32_t b, int32_t c, int32_t s) {
+  return PowerSoS(pts[a], weight[a], rank[a], pts[b], weight[b], rank[b], pts[c], weight[c], rank[c], pts[s], weight[s],
+                  rank[s]) > 0;
+}
 
 struct Tri {
   int32_t v[3];
@@ -101,10 +116,7 @@ struct MeshView {
       if (x.v[k] == inf) return HullEdgeConflict(x.v[Next(k)], x.v[Prev(k)], s);
     }
     const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
-    if (weight != nullptr) {
-      return PowerSoS(pts[a], weight[a], sos_rank[a], pts[b], weight[b], sos_rank[b], pts[c], weight[c], sos_rank[c],
-                      pts[s], weight[s], sos_rank[s]) > 0;
-    }
+    if (weight != nullptr) return PowerConflict(pts, weight, sos_rank, a, b, c, s);
     return InCircleSoS(pts[a], sos_rank[a], pts[b], sos_rank[b], pts[c], sos_rank[c], pts[s], sos_rank[s]) > 0;
   }
 
@@ -112,7 +124,7 @@ struct MeshView {
   /// the lifted triangle (finite t, not flat), or it lies on t's hull segment strictly between its
   /// ends with its lift above theirs. The mesh only gains vertices and its lifted surface only
   /// sinks as points are inserted, so a point hidden now is hidden in the final triangulation.
-  GALPHA_HD bool Hidden(int32_t t, int32_t s) const {
+  GALPHA_HD GALPHA_WEIGHTED_COLD bool Hidden(int32_t t, int32_t s) const {
     const Tri& x = tri[t];
     for (int k = 0; k < 3; ++k) {
       if (x.v[k] == inf) {
@@ -123,8 +135,7 @@ struct MeshView {
     }
     const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
     if (Orient2dSign(pts[a], pts[b], pts[c]) == 0) return false;
-    return PowerSoS(pts[a], weight[a], sos_rank[a], pts[b], weight[b], sos_rank[b], pts[c], weight[c], sos_rank[c],
-                    pts[s], weight[s], sos_rank[s]) < 0;
+    return !PowerConflict(pts, weight, sos_rank, a, b, c, s);
   }
 
   /// Weighted: the vertex a locally non-regular edge cannot be flipped around (the edge of t
@@ -219,3 +230,5 @@ struct MeshView {
 };
 
 }  // namespace galpha::detail
+
+#undef GALPHA_WEIGHTED_COLD

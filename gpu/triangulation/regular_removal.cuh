@@ -11,7 +11,9 @@
 // hidden vertices, which the next pass removes.
 //
 // Many vertices are removed at once, one thread each. A thread claims its star and the triangles
-// across the star's outer edges (whose links it rewrites) by an atomic minimum of its vertex id;
+// across the star's outer edges (whose links it rewrites) by an atomic minimum of its key (a hash
+// of its vertex id, the id below it: vertices next to each other along a chain have unrelated
+// keys, so about a third of a chain wins a round, where ids in Hilbert order would let one win);
 // it proceeds only if it holds them all, so that no two threads touch one triangle. Losers retry
 // in the next round. Hull vertices, and vertices with more than kMaxRemovalDegree neighbours, are
 // left to the caller (which rebuilds without them).
@@ -28,14 +30,26 @@ namespace galpha::detail {
 
 /// The most neighbours a vertex may have to be removed in place (its star is kept in registers).
 constexpr int kMaxRemovalDegree = 32;
-constexpr uint32_t kNoClaim = ~0u;
+constexpr unsigned long long kNoClaim = ~0ull;
+
+/// The claim key of vertex v: a 32-bit mix of v (murmur3's finalizer), then v (unique keys).
+GALPHA_HD inline unsigned long long ClaimKey(int32_t v) {
+  uint32_t h = static_cast<uint32_t>(v);
+  h ^= h >> 16;
+  h *= 0x85ebca6bu;
+  h ^= h >> 13;
+  h *= 0xc2b2ae35u;
+  h ^= h >> 16;
+  return (static_cast<unsigned long long>(h) << 32) | static_cast<uint32_t>(v);
+}
 /// MarkRedundantVertices' mark: hidden, and still a vertex of the mesh.
 constexpr uint8_t kHiddenInMesh = 2;
 
 /// A dead slot: the vertex at infinity three times (IsInfinite: no output, never active).
 GALPHA_HD inline bool IsDeadTriangle(const Tri& x) { return x.v[0] == x.v[1]; }
 
-/// For every vertex still marked kHiddenInMesh, one live triangle holding it.
+/// For every vertex still marked kHiddenInMesh, one live triangle holding it (once; removals keep
+/// the map current for the vertices of the triangles they write).
 struct FindStarStart {
   MeshView mesh;
   const uint8_t* hidden;
@@ -74,37 +88,39 @@ struct ClaimStar {
   MeshView mesh;
   const int32_t* candidates;
   const int32_t* vertex_tri;
-  uint32_t* claim;  // per triangle
+  unsigned long long* claim;  // per triangle
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t v = candidates[i];
     if (vertex_tri[v] < 0) return;
+    const unsigned long long key = ClaimKey(v);
     int32_t star[kMaxRemovalDegree], link[kMaxRemovalDegree];
     const int d = WalkStar(mesh, v, vertex_tri[v], star, link);
     if (d < 0) return;
     for (int j = 0; j < d; ++j) {
-      cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(claim[star[j]]).fetch_min(static_cast<uint32_t>(v));
+      cuda::atomic_ref<unsigned long long, cuda::thread_scope_device>(claim[star[j]]).fetch_min(key);
       const Tri x = mesh.tri[star[j]];
       int k = 0;
       while (x.v[k] != v) ++k;
       const int32_t outer = mesh.nbr[star[j]].n[k];
-      cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(claim[outer]).fetch_min(static_cast<uint32_t>(v));
+      cuda::atomic_ref<unsigned long long, cuda::thread_scope_device>(claim[outer]).fetch_min(key);
     }
   }
 };
 
 /// Round step 2: a candidate that holds every claim it made removes its vertex (see the file
-/// comment), marks it hidden (1), counts itself and flags the triangles it wrote in `created`.
+/// comment), marks it hidden (1), counts itself, flags the triangles it wrote in `created` and
+/// points `vertex_tri` of their vertices that are still candidates at them.
 struct RemoveClaimedStar {
   MeshView mesh;
   const int32_t* candidates;
-  const int32_t* vertex_tri;
-  const uint32_t* claim;
+  int32_t* vertex_tri;
+  const unsigned long long* claim;
   uint8_t* hidden;
   uint8_t* created;  // per triangle
   uint32_t* removed;
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t v = candidates[i];
-    const auto me = static_cast<uint32_t>(v);
+    const unsigned long long me = ClaimKey(v);
     const int32_t start = vertex_tri[v];
     if (start < 0 || claim[start] != me) return;  // another thread may be rewriting it: read nothing more
     int32_t star[kMaxRemovalDegree], link[kMaxRemovalDegree], outer[kMaxRemovalDegree];
@@ -151,6 +167,9 @@ struct RemoveClaimedStar {
       mesh.tri[slot] = Tri{{a, b, c}};
       mesh.nbr[slot] = TriNbr{{across_bc, across_ca, across_ab}};
       created[slot] = 1;
+      for (const int32_t u : {a, b, c}) {
+        if (hidden[u] == kHiddenInMesh) vertex_tri[u] = slot;
+      }
       if (across_bc >= 0) mesh.nbr[across_bc].n[mesh.EdgePos(across_bc, c, b)] = slot;
       if (across_ab >= 0) mesh.nbr[across_ab].n[mesh.EdgePos(across_ab, b, a)] = slot;
       if (across_ca >= 0) mesh.nbr[across_ca].n[mesh.EdgePos(across_ca, a, c)] = slot;
