@@ -13,6 +13,10 @@
 #   hard    alpha_bench over every generator (the hard ones: lattices, circles, lines, offsets,
 #           ulp-perturbed lattices, centimetre LiDAR) at 100K and 1M with CGAL at 100K, at 10M on
 #           the GPU alone, and the CPU backend at 1M on this machine's cores
+#   regular the regular (weighted) triangulation: delaunay_bench --weights (CGAL's
+#           Regular_triangulation_2 in the same run) at 1M for every kind of weights, the unweighted
+#           1M rows beside them, 10M with uniform weights; then compute-sanitizer memcheck of the
+#           weighted tests on CUDA (regular_test's small cases)
 #   identity the CUDA/CPU identity test alone
 #   topology topology_bench: Betti curves and persistence diagrams at 1M (GUDHI's exact persistence
 #           in the same run at 1M uniform and at 100K on the hard generators) and 10M uniform
@@ -60,6 +64,19 @@ for phase in "${phases[@]}"; do
         done
       done
       grep -E '"backend"' "$out/smoke.log" | sed -E 's/"stage_ms".*//' 
+      ;;
+    regular)
+      run_step regular 300 .carry/bin/delaunay_bench --backend=cuda --sizes=1000000 \
+        --dists=uniform,gaussian,clustered --repeat=3
+      for w in uniform signed many_hidden one_huge integers; do
+        run_step regular 300 .carry/bin/delaunay_bench --backend=cuda --sizes=1000000 \
+          --dists=uniform,gaussian,clustered --repeat=3 --weights=$w
+      done
+      run_step regular 300 .carry/bin/delaunay_bench --backend=cuda --sizes=10000000 --dists=uniform --repeat=2 \
+        --weights=uniform
+      run_step regular 300 compute-sanitizer --tool memcheck --error-exitcode 9 .carry/bin/regular_test \
+        --gtest_filter='Backends/RegularTest.*/cuda'
+      grep -E '^\| [a-z_]+ \| [0-9]+ \| cuda|weights |ERROR SUMMARY' "$out/regular.log"
       ;;
     sanitize)
       small=data/ourairports_medium_large.bin

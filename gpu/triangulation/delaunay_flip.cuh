@@ -48,7 +48,9 @@ constexpr uint8_t kCheckOutsideEdge = 0b100;
 constexpr uint8_t kCheckFlipOuterEdges = 0b101;
 constexpr uint8_t kCheckAllEdges = 0b111;
 
-/// Each active triangle proposes its first edge that must flip and votes on both triangles.
+/// Each active triangle proposes its first edge that must flip and votes on both triangles
+/// (kWeighted: by the regular triangulation's predicates, MeshView::ShouldFlip).
+template <bool kWeighted>
 struct ProposeFlips {
   MeshView mesh;
   const int32_t* active;
@@ -63,7 +65,7 @@ struct ProposeFlips {
     proposal_edge[i] = -1;
     const uint8_t mask = active_mask[i];
     for (int k = 0; k < 3; ++k) {
-      if (((mask >> k) & 1u) && mesh.ShouldFlip(t, k, hull_may_change)) {
+      if (((mask >> k) & 1u) && mesh.template ShouldFlip<kWeighted>(t, k, hull_may_change)) {
         const int32_t nb = mesh.nbr[t].n[k];
         proposal_edge[i] = static_cast<int8_t>(k);
         proposal_nb[i] = nb;
@@ -198,6 +200,7 @@ struct CollectNextActive {
 /// `max_iterations` it runs no more, so that a flip loop that did not end would go on in the grid's
 /// launches, where the host's replay limit reports it (without the budget, each of those launches
 /// could run a loop of its own).
+template <bool kWeighted>
 struct FlipTailInOneBlock {
   MeshView mesh;
   int32_t* active;
@@ -225,7 +228,8 @@ struct FlipTailInOneBlock {
       if (n == 0 || n > max_count || *iterations_run >= max_iterations) return;
       if (lanes.id == 0) StartFlipIteration{scratch_count, generation}(0);
       lanes.Sync();
-      const ProposeFlips propose{mesh, active, active_mask, proposal_edge, proposal_nb, flip_vote, hull_may_change};
+      const ProposeFlips<kWeighted> propose{mesh,        active,    active_mask,    proposal_edge,
+                                            proposal_nb, flip_vote, hull_may_change};
       for (uint32_t i = lanes.id; i < n; i += lanes.count) propose(i);
       lanes.Sync();
       const ExecuteFlips execute{mesh, active, proposal_edge, proposal_nb, flip_vote, partner};

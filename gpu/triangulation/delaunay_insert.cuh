@@ -53,6 +53,7 @@ GALPHA_HD inline int ScoreExponent(double a, double b, double c, double d) {
 /// edge, and with one winner a round the two lines took turns there, so the second line fell
 /// behind by a factor that doubled every two rounds and its late points then took over fans of
 /// the first line's hundreds of points, one flip an iteration (bench/README.md, two_lines).
+template <bool kWeighted>
 struct VoteForInsertion {
   MeshView mesh;
   const int32_t* pending;         // vertex of each uninserted point
@@ -83,7 +84,7 @@ struct VoteForInsertion {
       const double outside = wx * py - wy * px;
       if (outside > 0.0) {
         score = -static_cast<float>(outside);
-      } else if (mesh.weight == nullptr) {
+      } else if constexpr (!kWeighted) {
         const double dx = px - 0.5 * wx, dy = py - 0.5 * wy;
         score = static_cast<float>(dx * dx + dy * dy);
       } else {
@@ -121,7 +122,7 @@ struct VoteForInsertion {
         // points around it, is inserted before them (they are then hidden on relocation, not
         // after their own insertion, which would cost a rebuild).
         double lift_b = b2, lift_c = c2, lift_p = px * px + py * py;
-        if (mesh.weight != nullptr) {
+        if constexpr (kWeighted) {
           const double wa = mesh.weight[x.v[0]];
           lift_b -= ldexp(mesh.weight[x.v[1]] - wa, -2 * e);
           lift_c -= ldexp(mesh.weight[x.v[2]] - wa, -2 * e);
@@ -312,12 +313,13 @@ struct ListSplitChildren {
 /// Relocates a point that is still uninserted, walking from the triangle that held it. Weighted, a
 /// point the triangle hides (MeshView::Hidden) is marked in `hidden` and leaves the pending points
 /// with the inserted ones (`inserted` 2).
+template <bool kWeighted>
 struct RelocatePoint {
   MeshView mesh;
   const int32_t* pending;
   uint8_t* inserted;
   int32_t* location;
-  uint8_t* hidden;  // per vertex; nullptr when unweighted
+  uint8_t* hidden;  // per vertex; weighted only
   int32_t* walk_failed;
   uint32_t max_steps;
 
@@ -329,9 +331,11 @@ struct RelocatePoint {
       return;
     }
     location[i] = t;
-    if (hidden != nullptr && mesh.Hidden(t, pending[i])) {
-      hidden[pending[i]] = 1;
-      inserted[i] = 2;
+    if constexpr (kWeighted) {
+      if (mesh.Hidden(t, pending[i])) {
+        hidden[pending[i]] = 1;
+        inserted[i] = 2;
+      }
     }
   }
 };

@@ -91,13 +91,20 @@ struct MeshView {
   /// that line would then start a flip cascade along the fan (two parallel lines of points took
   /// hundreds of sequential flip iterations a round).
   ///
-  /// Weighted, a point on the segment is in conflict unless its lift lies strictly above the
-  /// lifted segment (then it is hidden; a tie joins the hull, as in CGAL).
+  /// Weighted (kWeighted: the predicates of the regular triangulation, compiled apart so that the
+  /// Delaunay kernels carry none of their code), a point on the segment is in conflict unless its
+  /// lift lies strictly above the lifted segment (then it is hidden; a tie joins the hull, as in
+  /// CGAL).
+  template <bool kWeighted = false>
   GALPHA_HD bool HullEdgeConflict(int32_t u, int32_t w, int32_t s) const {
     const int o = Orient2dSign(pts[u], pts[w], pts[s]);
     if (o != 0) return o > 0;
     if (!OnOpenSegment(u, w, s)) return false;
-    return weight == nullptr || CollinearPowerSign(pts[u], weight[u], pts[w], weight[w], pts[s], weight[s]) >= 0;
+    if constexpr (kWeighted) {
+      return CollinearPowerSign(pts[u], weight[u], pts[w], weight[w], pts[s], weight[s]) >= 0;
+    } else {
+      return true;
+    }
   }
 
   /// Whether s, on the line through u and w, lies strictly between them.
@@ -108,16 +115,20 @@ struct MeshView {
 
   /// Whether vertex s lies inside the (symbolically perturbed) circumcircle of triangle t. For an
   /// infinite triangle the "circle" is the half-plane beyond its hull edge, closed on the edge's
-  /// open segment (HullEdgeConflict).
+  /// open segment (HullEdgeConflict). Weighted: the power test's (s's lift below the plane).
+  template <bool kWeighted = false>
   GALPHA_HD bool InConflict(int32_t t, int32_t s) const {
     if (s == inf) return false;
     const Tri& x = tri[t];
     for (int k = 0; k < 3; ++k) {
-      if (x.v[k] == inf) return HullEdgeConflict(x.v[Next(k)], x.v[Prev(k)], s);
+      if (x.v[k] == inf) return HullEdgeConflict<kWeighted>(x.v[Next(k)], x.v[Prev(k)], s);
     }
     const int32_t a = x.v[0], b = x.v[1], c = x.v[2];
-    if (weight != nullptr) return PowerConflict(pts, weight, sos_rank, a, b, c, s);
-    return InCircleSoS(pts[a], sos_rank[a], pts[b], sos_rank[b], pts[c], sos_rank[c], pts[s], sos_rank[s]) > 0;
+    if constexpr (kWeighted) {
+      return PowerConflict(pts, weight, sos_rank, a, b, c, s);
+    } else {
+      return InCircleSoS(pts[a], sos_rank[a], pts[b], sos_rank[b], pts[c], sos_rank[c], pts[s], sos_rank[s]) > 0;
+    }
   }
 
   /// Weighted: whether vertex s, located in triangle t (Locate), is hidden: its lift lies above
@@ -149,7 +160,7 @@ struct MeshView {
     if (r == inf || p == inf || q == inf) return -1;
     const int32_t nb = nbr[t].n[k];
     const int32_t s = tri[nb].v[EdgePos(nb, q, p)];
-    if (s == inf || !InConflict(t, s)) return -1;
+    if (s == inf || !InConflict<true>(t, s)) return -1;
     if (Orient(r, p, s) < 0) return p;
     if (Orient(s, q, r) < 0) return q;
     return -1;
@@ -211,6 +222,7 @@ struct MeshView {
   /// triangles flips when its finite vertex is not convex, and a hull edge flips when the finite
   /// triangle on it is flat with its apex on the edge (the apex joins the hull). Otherwise hull edges
   /// never flip.
+  template <bool kWeighted = false>
   GALPHA_HD bool ShouldFlip(int32_t t, int k, bool hull_may_change) const {
     const Tri& x = tri[t];
     const int32_t r = x.v[k], p = x.v[Next(k)], q = x.v[Prev(k)];
@@ -219,13 +231,17 @@ struct MeshView {
     const int32_t s = tri[nb].v[j];
     if (r == inf || s == inf) {
       if (!hull_may_change || (r == inf && s == inf)) return false;
-      return r == inf ? HullEdgeConflict(p, q, s) : HullEdgeConflict(q, p, r);
+      return r == inf ? HullEdgeConflict<kWeighted>(p, q, s) : HullEdgeConflict<kWeighted>(q, p, r);
     }
     if ((p == inf || q == inf) && !hull_may_change) return false;
-    if (!InConflict(t, s)) return false;
-    // A regular triangulation may meet a non-regular edge whose quadrilateral is not convex: it
-    // cannot flip (the flip would fold the mesh); its reflex vertex is hidden (BlockedVertex).
-    return weight == nullptr || p == inf || q == inf || (Orient(r, p, s) > 0 && Orient(s, q, r) > 0);
+    if (!InConflict<kWeighted>(t, s)) return false;
+    if constexpr (kWeighted) {
+      // A regular triangulation may meet a non-regular edge whose quadrilateral is not convex: it
+      // cannot flip (the flip would fold the mesh); its reflex vertex is hidden (BlockedVertex).
+      return p == inf || q == inf || (Orient(r, p, s) > 0 && Orient(s, q, r) > 0);
+    } else {
+      return true;
+    }
   }
 };
 
