@@ -766,7 +766,8 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
 template <class System>
 void RunFamilyBuild(System& sys, const Point2* host_points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out) {
   StageTimer<System> timer(sys, &out->stage_times);
-  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, /*host_weights=*/nullptr, n, /*keep_points=*/true, timer);
+  SystemTriangulation<System> t =
+      TriangulateOnSystem(sys, host_points, /*host_weights=*/nullptr, n, /*keep_points=*/true, timer);
   if (hooks.after_triangulation) hooks.after_triangulation();
   RunAlphaPipeline(sys, t, host_points, timer, hooks.max_exact_comparisons, out);
   timer.Finish();
