@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -317,7 +318,12 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
               "point ", i, " has a negative radius (", r,
               "); radii must be >= 0 (--weights squared reads the values as squared radii, which may be negative)"));
         }
+        // The weight is the double nearest r^2; a radius of 2^500 or more has no weight in the domain.
         weighted.weights[i] = r * r;
+        if (std::isfinite(r) && !(weighted.weights[i] < 0x1p1000)) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("point ", i, " has a radius of ", r, ": radii must be below 2^500 (~3.27e150)"));
+        }
       }
     }
     return weighted;

@@ -378,7 +378,19 @@ absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsNpy(absl::string_view byt
 
 absl::StatusOr<GeoreferencedPoints> ParseWeightedGeoJson(absl::string_view text, const std::string& source,
                                                          const std::string& weight_property) {
-  GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints out, ParseGeoreferencedGeoJson(text, source, weight_property));
+  if (weight_property.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(source, ": name the feature property that holds the weights"));
+  }
+  absl::StatusOr<GeoreferencedPoints> read = ParseGeoreferencedGeoJson(text, source, weight_property);
+  if (!read.ok()) {
+    // The group reader's word for a property that no feature has.
+    if (absl::StrContains(read.status().message(), "(to group the points by)")) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(source, ": no feature has a property '", weight_property, "' (to take the weights from)"));
+    }
+    return read.status();
+  }
+  GeoreferencedPoints out = *std::move(read);
   out.weights.resize(out.points.size());
   for (size_t i = 0; i < out.points.size(); ++i) {
     const std::optional<std::string>& value = out.groups[i];

@@ -177,8 +177,10 @@ struct MeshView {
 
   /// Visibility walk from triangle t to a triangle containing vertex p: a finite triangle with p
   /// inside (SoS orientation: never on an edge), or an infinite triangle whose hull edge p sees.
-  /// Terminates on a Delaunay triangulation (Edelsbrunner's acyclicity theorem); returns -1 if it
-  /// exceeds `max_steps`, which the caller reports as an internal error.
+  /// Terminates on a Delaunay (or regular) triangulation (Edelsbrunner's acyclicity theorem); a
+  /// weighted mesh between rounds may hold non-regular edges that could not flip, where that
+  /// argument does not hold: returns -1 if it exceeds `max_steps` (never measured), which the
+  /// caller reports as an internal error.
   GALPHA_HD int32_t Locate(int32_t t, int32_t p, uint32_t max_steps) const {
     for (uint32_t step = 0; step < max_steps; ++step) {
       const Tri x = tri[t];

@@ -78,9 +78,29 @@ GALPHA_HD inline int WalkStar(const MeshView& mesh, int32_t v, int32_t start, in
     star[d] = t;
     link[d] = a;
     t = mesh.nbr[t].n[Next(k)];  // across the edge from x.v[Prev(k)] to v: the next counter-clockwise
+    // -1: a triangle another thread is rewriting (an ear's open side, a dead slot); the caller then
+    // does not hold it and gives up.
+    if (t < 0) return -1;
     if (t == start) return d + 1;
   }
   return -1;
+}
+
+/// Rotates the star and its link so that the link starts at its smallest vertex.
+GALPHA_HD inline void RotateToSmallestLink(int32_t* star, int32_t* link, int d) {
+  int first = 0;
+  for (int j = 1; j < d; ++j) {
+    if (link[j] < link[first]) first = j;
+  }
+  int32_t s[kMaxRemovalDegree], l[kMaxRemovalDegree];
+  for (int j = 0; j < d; ++j) {
+    s[j] = star[(first + j) % d];
+    l[j] = link[(first + j) % d];
+  }
+  for (int j = 0; j < d; ++j) {
+    star[j] = s[j];
+    link[j] = l[j];
+  }
 }
 
 /// Round step 1: each candidate claims its star and the triangles across its link edges.
@@ -129,6 +149,10 @@ struct RemoveClaimedStar {
     for (int j = 0; j < d; ++j) {
       if (claim[star[j]] != me) return;
     }
+    // Start the star at its smallest link vertex: which triangle `vertex_tri` names depends on the
+    // order of racing writes, and the ears (so the slots the new triangles take, and the output's
+    // order) must not; from here on everything is a function of the mesh alone.
+    RotateToSmallestLink(star, link, d);
     for (int j = 0; j < d; ++j) {
       const Tri x = mesh.tri[star[j]];
       int k = 0;

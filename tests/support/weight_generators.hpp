@@ -16,8 +16,8 @@ namespace galpha::gen {
 ///  "equal"       every weight the same positive value (the unweighted triangulation again);
 ///  "uniform"     uniform in [0, s^2], s the typical spacing (bounding box / sqrt(n));
 ///  "signed"      uniform in [-s^2, s^2] (negative weights are valid);
-///  "one_huge"    0 everywhere but one point, whose disk covers a quarter of the box: it hides
-///                every point near it;
+///  "one_huge"    0 everywhere but one point, whose disk's radius is a quarter of the box's side
+///                (about a fifth of a square box's area): it hides every point near it;
 ///  "many_hidden" every other point (by index) 4 s^2, the rest 0: many light points hidden;
 ///  "integers"    small integers times s^2 rounded to a power of two: with integer coordinates
 ///                (grids, lines) exact power ties everywhere.
