@@ -339,6 +339,15 @@ TEST(CollinearPowerSign, MatchesGmp) {
                 std::ldexp(w, 2 * scale)};
     }
     if (pts[0].p == pts[1].p || pts[1].p == pts[2].p) continue;
+    if (i % 4 == 3 && (k[0] + k[2]) % 2 == 0) {
+      // An exact tie: the middle point's lift set on the chord (its weight |p|^2 minus the mean
+      // of its neighbours' lifts, exact for these small numbers).
+      const double mx = ox + ((k[0] + k[2]) / 2) * dx, my = oy + ((k[0] + k[2]) / 2) * dy;
+      pts[1].p = {mx + offset, my};
+      const auto lift = [](const WeightedPoint& a) { return a.p.x * a.p.x + a.p.y * a.p.y - a.w; };
+      pts[1].w = pts[1].p.x * pts[1].p.x + pts[1].p.y * pts[1].p.y - 0.5 * (lift(pts[0]) + lift(pts[2]));
+      if (pts[1].p == pts[0].p || pts[1].p == pts[2].p) continue;
+    }
     const WeightedPoint& u = pts[i % 2 ? 0 : 2];
     const WeightedPoint& w = pts[i % 2 ? 2 : 0];
     const int exact = ExactCollinearPowerSign(u, w, pts[1]);
