@@ -217,17 +217,39 @@ absl::StatusOr<GeoreferencedPoints> ReadTextInput(int fd, const std::string& sou
   return std::move(batches).Finish();
 }
 
+/// fstat of standard input, refused unless it is a pipe or a regular file (a terminal, a
+/// character device, most likely means the pipe was forgotten).
+absl::Status CheckStandardInput(struct stat* info) {
+  if (fstat(STDIN_FILENO, info) != 0) return absl::ErrnoToStatus(errno, "cannot inspect standard input");
+  if (!IsReadable(info->st_mode)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("standard input is ", KindOf(info->st_mode), ": pipe the points in, or name a file"));
+  }
+  return absl::OkStatus();
+}
+
+/// stat of `file` (`named` in messages), refused before it is opened unless it is a regular file
+/// or a named pipe: opening a device can block or act (a terminal, a tape).
+absl::Status CheckNamedInput(const std::string& file, const std::string& named, struct stat* info) {
+  if (stat(file.c_str(), info) != 0) {
+    if (errno == ENOENT) return absl::NotFoundError(absl::StrCat(named, " does not exist"));
+    return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
+  }
+  if (!IsReadable(info->st_mode)) {
+    return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info->st_mode),
+                                                   ": alphactl reads regular files, named pipes and '-' "
+                                                   "(standard input)"));
+  }
+  return absl::OkStatus();
+}
+
 /// The weighted read of ReadInputPointsAndCrs (weights as stored; the caller squares radii).
 absl::StatusOr<GeoreferencedPoints> ReadWeightedInput(const std::string& file, const InputOptions& options,
                                                       bool molecule, bool las) {
   const std::string extension = absl::AsciiStrToLower(std::filesystem::path(file).extension().string());
   struct stat info {};
   if (file == "-") {
-    if (fstat(STDIN_FILENO, &info) != 0) return absl::ErrnoToStatus(errno, "cannot inspect standard input");
-    if (!IsReadable(info.st_mode)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("standard input is ", KindOf(info.st_mode), ": pipe the points in, or name a file"));
-    }
+    GALPHA_RETURN_IF_ERROR(CheckStandardInput(&info));
     return ReadTextInput(STDIN_FILENO, "standard input", options, /*weighted=*/true);
   }
   const std::string named = absl::StrCat("points file '", file, "'");
@@ -237,15 +259,7 @@ absl::StatusOr<GeoreferencedPoints> ReadWeightedInput(const std::string& file, c
                      " carries no weights that --weights reads: weighted points come as delimited text (x, y, weight), "
                      ".npy (N, 3), weighted .bin or GeoJSON with --weight-property"));
   }
-  if (stat(file.c_str(), &info) != 0) {
-    if (errno == ENOENT) return absl::NotFoundError(absl::StrCat(named, " does not exist"));
-    return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
-  }
-  if (!IsReadable(info.st_mode)) {
-    return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info.st_mode),
-                                                   ": alphactl reads regular files, named pipes and '-' "
-                                                   "(standard input)"));
-  }
+  GALPHA_RETURN_IF_ERROR(CheckNamedInput(file, named, &info));
   const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json";
   if (S_ISFIFO(info.st_mode) && !text) {
     return absl::InvalidArgumentError(absl::StrCat(named, " is a named pipe: only delimited text is read from pipes"));
@@ -332,27 +346,13 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
   GeoreferencedPoints read;
   if (file == "-") {
     const std::string source = "standard input";
-    if (fstat(STDIN_FILENO, &info) != 0) return absl::ErrnoToStatus(errno, "cannot inspect standard input");
-    // A terminal (a character device) most likely means the pipe was forgotten.
-    if (!IsReadable(info.st_mode)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("standard input is ", KindOf(info.st_mode), ": pipe the points in, or name a file"));
-    }
+    GALPHA_RETURN_IF_ERROR(CheckStandardInput(&info));
     GALPHA_ASSIGN_OR_RETURN(read.points, ReadTextPoints(STDIN_FILENO, source, options));
     return read;
   }
 
   const std::string named = absl::StrCat("points file '", file, "'");
-  if (stat(file.c_str(), &info) != 0) {
-    if (errno == ENOENT) return absl::NotFoundError(absl::StrCat(named, " does not exist"));
-    return absl::ErrnoToStatus(errno, absl::StrCat("cannot inspect ", named));
-  }
-  // Refused before opening: opening a device can block or act (a terminal, a tape).
-  if (!IsReadable(info.st_mode)) {
-    return absl::InvalidArgumentError(absl::StrCat(named, " is ", KindOf(info.st_mode),
-                                                   ": alphactl reads regular files, named pipes and '-' "
-                                                   "(standard input)"));
-  }
+  GALPHA_RETURN_IF_ERROR(CheckNamedInput(file, named, &info));
   const bool las = extension == ".las" || extension == ".laz";
   const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json" &&
                     !las && !IsVectorPointsExtension(extension) && !molecule;

@@ -223,6 +223,24 @@ absl::StatusOr<std::vector<Point2>> ParsePointsGeoJson(absl::string_view text, c
 
 namespace {
 
+// Rows of (x, y) into points, rows of (x, y, weight) into weighted points.
+std::vector<Point2> PointsOfRows(const std::vector<double>& values) {
+  std::vector<Point2> points(values.size() / 2);
+  for (size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
+  return points;
+}
+
+GeoreferencedPoints WeightedPointsOfRows(const std::vector<double>& values) {
+  GeoreferencedPoints out;
+  out.points.resize(values.size() / 3);
+  out.weights.resize(values.size() / 3);
+  for (size_t i = 0; i < out.points.size(); ++i) {
+    out.points[i] = {values[3 * i], values[3 * i + 1]};
+    out.weights[i] = values[3 * i + 2];
+  }
+  return out;
+}
+
 // Delimited text with `columns` numeric fields a record (x, y[, weight]), into `values` (row by
 // row). The header rule and the errors of ParsePointsText, over the first `columns` fields.
 absl::Status ParseTextColumns(absl::string_view text, const std::string& source, int columns,
@@ -263,22 +281,13 @@ absl::Status ParseTextColumns(absl::string_view text, const std::string& source,
 absl::StatusOr<std::vector<Point2>> ParsePointsText(absl::string_view text, const std::string& source) {
   std::vector<double> values;
   GALPHA_RETURN_IF_ERROR(ParseTextColumns(text, source, 2, &values));
-  std::vector<Point2> points(values.size() / 2);
-  for (size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
-  return points;
+  return PointsOfRows(values);
 }
 
 absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsText(absl::string_view text, const std::string& source) {
   std::vector<double> values;
   GALPHA_RETURN_IF_ERROR(ParseTextColumns(text, source, 3, &values));
-  GeoreferencedPoints out;
-  out.points.resize(values.size() / 3);
-  out.weights.resize(values.size() / 3);
-  for (size_t i = 0; i < out.points.size(); ++i) {
-    out.points[i] = {values[3 * i], values[3 * i + 1]};
-    out.weights[i] = values[3 * i + 2];
-  }
-  return out;
+  return WeightedPointsOfRows(values);
 }
 
 namespace {
@@ -358,22 +367,13 @@ absl::Status ParseNpyColumns(absl::string_view bytes, const std::string& source,
 absl::StatusOr<std::vector<Point2>> ParsePointsNpy(absl::string_view bytes, const std::string& source) {
   std::vector<double> values;
   GALPHA_RETURN_IF_ERROR(ParseNpyColumns(bytes, source, 2, &values));
-  std::vector<Point2> points(values.size() / 2);
-  for (size_t i = 0; i < points.size(); ++i) points[i] = {values[2 * i], values[2 * i + 1]};
-  return points;
+  return PointsOfRows(values);
 }
 
 absl::StatusOr<GeoreferencedPoints> ParseWeightedPointsNpy(absl::string_view bytes, const std::string& source) {
   std::vector<double> values;
   GALPHA_RETURN_IF_ERROR(ParseNpyColumns(bytes, source, 3, &values));
-  GeoreferencedPoints out;
-  out.points.resize(values.size() / 3);
-  out.weights.resize(values.size() / 3);
-  for (size_t i = 0; i < out.points.size(); ++i) {
-    out.points[i] = {values[3 * i], values[3 * i + 1]};
-    out.weights[i] = values[3 * i + 2];
-  }
-  return out;
+  return WeightedPointsOfRows(values);
 }
 
 absl::StatusOr<GeoreferencedPoints> ParseWeightedGeoJson(absl::string_view text, const std::string& source,
