@@ -52,11 +52,6 @@ struct WriteRepresentative {
   GALPHA_HD void operator()(uint32_t k) const { representative[sorted[k]] = sorted[head[k]]; }
 };
 
-struct IsRunHead {
-  const uint32_t* head;
-  GALPHA_HD bool operator()(uint32_t k) const { return head[k] == k; }
-};
-
 /// Weighted input: the sort key of the weight of the input point a permutation entry names, heaviest
 /// first. Sorted stably by it before y and x, the points are ordered by (x, y, weight descending,
 /// index): at one position the heaviest point leads and hides the others.

@@ -24,6 +24,7 @@
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
+#include "tests/support/triangulation_sets.hpp"
 
 namespace galpha {
 
@@ -32,7 +33,9 @@ static void PrintTo(Backend backend, std::ostream* os) { *os << BackendName(back
 
 namespace {
 
+using testing::CanonicalTriangles;
 using testing::IsOk;
+using testing::SortedEdges;
 using testing::StatusIs;
 
 using Edge = std::array<uint32_t, 2>;
@@ -40,25 +43,6 @@ using Tri = std::array<uint32_t, 3>;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Triangles rotated to start at their smallest index (keeping the counter-clockwise order), sorted:
-// equal for two triangulations exactly when they have the same triangles.
-std::vector<Tri> CanonicalTriangles(const Triangulation& t) {
-  std::vector<Tri> out;
-  out.reserve(t.triangles.size());
-  for (Tri v : t.triangles) {
-    std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
-    out.push_back(v);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-std::vector<Edge> SortedEdges(const Triangulation& t) {
-  std::vector<Edge> edges = t.edges;
-  std::sort(edges.begin(), edges.end());
-  return edges;
-}
 
 // Empty when the sorted lists `a` and `b` are equal, else how many entries each alone has and the
 // first few (gtest would print both lists whole).

@@ -15,33 +15,20 @@
 #include "tests/support/backend_fixture.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
+#include "tests/support/triangulation_sets.hpp"
 #include "tests/support/weight_generators.hpp"
 
 namespace galpha {
 namespace {
 
+using testing::CanonicalTriangles;
 using ::testing::HasSubstr;
 using testing::IsOk;
+using testing::SortedEdges;
 using testing::StatusIs;
 
 using Edge = std::array<uint32_t, 2>;
 using Tri = std::array<uint32_t, 3>;
-
-std::vector<Tri> CanonicalTriangles(const Triangulation& t) {
-  std::vector<Tri> out;
-  for (Tri v : t.triangles) {
-    std::rotate(v.begin(), std::min_element(v.begin(), v.end()), v.end());
-    out.push_back(v);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-std::vector<Edge> SortedEdges(const Triangulation& t) {
-  std::vector<Edge> edges = t.edges;
-  std::sort(edges.begin(), edges.end());
-  return edges;
-}
 
 class RegularTest : public testing::BackendTest {
  protected:
