@@ -86,21 +86,15 @@ GALPHA_HD inline bool CanonicalExactTerms(const Point2* points, int n, ExactRadi
 
 }  // namespace radius_detail
 
-/// The refined key of the edge (n = 2) or triangle (n = 3) p[0..n).
-GALPHA_HD inline RefinedRadiusSq RefineRadiusSq(const Point2* p, int n) {
-  using namespace radius_detail;
+namespace radius_detail {
+
+/// The refined key of Num / (4 Den) * 2^(-2s) for exact terms with Num > 0 and Den > 0 (the
+/// derivation above); not ok when the quotient's range or the buffers do not suffice.
+GALPHA_HD inline RefinedRadiusSq RefineTerms(const ExactRadiusTerms& terms, int s) {
   RefinedRadiusSq out;
-  ExactRadiusTerms terms;
-  int s = 0;
-  if (!CanonicalExactTerms(p, n, &terms, &s) || terms.numn == 0) return out;
-  if (terms.denn == 0) {  // collinear triangle
-    out.ok = true;
-    out.infinite = true;
-    return out;
-  }
   const double num_top = terms.num[terms.numn - 1], den_top = terms.den[terms.denn - 1];
-  // Num and Den are positive (squares), so are their top components. Their quotient must stay
-  // well inside the double range, and q0 * Den must be splittable (below 2^996).
+  // Num and Den are positive, so are their top components. Their quotient must stay well inside
+  // the double range, and q0 * Den must be splittable (below 2^996).
   const int quotient_exponent = ExponentOf(num_top) - ExponentOf(den_top);
   if (quotient_exponent > 900 || quotient_exponent < -900) return out;
   const double q0 = num_top / den_top;
@@ -132,6 +126,23 @@ GALPHA_HD inline RefinedRadiusSq RefineRadiusSq(const Point2* p, int n) {
   return out;
 }
 
+}  // namespace radius_detail
+
+/// The refined key of the edge (n = 2) or triangle (n = 3) p[0..n).
+GALPHA_HD inline RefinedRadiusSq RefineRadiusSq(const Point2* p, int n) {
+  using namespace radius_detail;
+  RefinedRadiusSq out;
+  ExactRadiusTerms terms;
+  int s = 0;
+  if (!CanonicalExactTerms(p, n, &terms, &s) || terms.numn == 0) return out;
+  if (terms.denn == 0) {  // collinear triangle
+    out.ok = true;
+    out.infinite = true;
+    return out;
+  }
+  return RefineTerms(terms, s);
+}
+
 /// Whether b's exact value is certainly above a's, given refined keys with a before b in key
 /// order: at a common exponent (where both are below 4) the exact difference of the keys exceeds
 /// kRefinedSeparation = 2^-146, and their certified errors sum to under 6 * 2^-150 < 2^-147, so
@@ -139,14 +150,22 @@ GALPHA_HD inline RefinedRadiusSq RefineRadiusSq(const Point2* p, int n) {
 GALPHA_HD inline bool RefinedKeysSeparated(const RefinedRadiusSq& a, const RefinedRadiusSq& b) {
   using namespace exact;
   if (a.infinite || b.infinite) return !a.infinite && b.infinite;  // only an infinite b is above a finite a
-  const int64_t gap = static_cast<int64_t>(b.exponent) - a.exponent;
-  if (gap >= 2) return true;  // b >= 4 (1 - 2^-50) > 2 (1 + 2^-50) > a, errors included
+  // Signed keys (weighted radii, core/exact/weighted_radius.hpp): a key's sign is its value's (hi
+  // carries it, and |mid| + |lo| < |hi|). Two negative keys are mirrored positive ones: b is above
+  // a when |a| is above |b|, so the larger magnitude is a's and the common exponent b's.
+  const bool a_negative = a.hi < 0.0, b_negative = b.hi < 0.0;
+  if (a_negative != b_negative) return a_negative;
+  const RefinedRadiusSq& upper = a_negative ? a : b;  // the larger magnitude if separated
+  const RefinedRadiusSq& lower = a_negative ? b : a;
+  const int64_t gap = static_cast<int64_t>(upper.exponent) - lower.exponent;
+  if (gap >= 2) return true;  // |upper| >= 4 (1 - 2^-50) > 2 (1 + 2^-50) > |lower|, errors included
   if (gap < 0) return false;
   const double scale = gap == 1 ? 2.0 : 1.0;  // exact
+  const double sa = a_negative ? scale : 1.0, sb = a_negative ? 1.0 : scale;
   // b - a - 2^-146 by Grow-Expansion only, which keeps an expansion nonoverlapping (Shewchuk 1997,
   // Theorem 10) so that its most significant component carries the sign; every step is exact.
-  const double terms[7] = {Mul(b.lo, scale),   Mul(b.mid, scale), Mul(b.hi, scale), -a.lo, -a.mid, -a.hi,
-                           -kRefinedSeparation};
+  const double terms[7] = {Mul(b.lo, sb),   Mul(b.mid, sb), Mul(b.hi, sb),      -Mul(a.lo, sa),
+                           -Mul(a.mid, sa), -Mul(a.hi, sa), -kRefinedSeparation};
   double e[8];
   int en = 0;
   for (const double t : terms) en = GrowExpansionZeroElim(en, e, t, e);

@@ -79,12 +79,16 @@ GALPHA_HD inline RefinedSortWords RefinedSortWordsOf(uint32_t run_index, uint32_
     out.word[3] = (uint64_t{0xffffffffu} << 32) | id;
     return out;
   }
+  // A negative key (a weighted radius, core/exact/weighted_radius.hpp) is encoded from its
+  // magnitude, then mirrored below every nonnegative one (below).
+  const bool negative = key.hi < 0.0;
+  const double sign = negative ? -1.0 : 1.0;
   // m * 2^160 with m = hi + mid + lo in (1 - 2^-52, 2): hi is in [1, 2) and |mid| + |lo| is below
   // half an ulp of hi. The sum is positive and below 2^161, so the arithmetic modulo 2^192 is exact.
   uint64_t t[3] = {0, 0, 0};
-  refined_detail::AddFixedPoint160(key.hi, t);
-  refined_detail::AddFixedPoint160(key.mid, t);
-  refined_detail::AddFixedPoint160(key.lo, t);
+  refined_detail::AddFixedPoint160(sign * key.hi, t);
+  refined_detail::AddFixedPoint160(sign * key.mid, t);
+  refined_detail::AddFixedPoint160(sign * key.lo, t);
   int64_t exponent = key.exponent;
   if ((t[2] >> 32) == 0) {  // m < 1: one bit up (m > 1/2, so the doubled value is in [1, 2))
     t[2] = (t[2] << 1) | (t[1] >> 63);
@@ -93,10 +97,20 @@ GALPHA_HD inline RefinedSortWords RefinedSortWordsOf(uint32_t run_index, uint32_
     --exponent;
   }
   // Now t = 2^160 + f: bit 160 is bit 32 of t[2]; f's top 64 bits, next 64, last 32.
-  out.word[0] = run | static_cast<uint32_t>(exponent + (int64_t{1} << 31));
   out.word[1] = (t[2] << 32) | (t[1] >> 32);
   out.word[2] = (t[1] << 32) | (t[0] >> 32);
   out.word[3] = (t[0] << 32) | id;
+  if (!negative) {
+    out.word[0] = run | static_cast<uint32_t>(exponent + (int64_t{1} << 31));
+    return out;
+  }
+  // Exponents stay within +-2^12 of 0, so nonnegative keys' low halves lie near 2^31 and negative
+  // ones' near 2^30, larger magnitudes lower; the fraction bits are complemented likewise (the
+  // truncation is then toward zero for negative keys too, and the bounds above hold).
+  out.word[0] = run | static_cast<uint32_t>((int64_t{1} << 30) - exponent);
+  out.word[1] = ~out.word[1];
+  out.word[2] = ~out.word[2];
+  out.word[3] = (~out.word[3] & (~uint64_t{0} << 32)) | id;
   return out;
 }
 
