@@ -18,11 +18,8 @@ const char kUsage[] =
     "Exact 2D alpha shapes of the points in FILE, computed locally, or by a galpha server (--server).\n"
     "\n"
     "commands:\n"
-    "  triangulate FILE [--weights radius|squared [--weight-property NAME]]\n"
-    "                              the Delaunay triangulation's counts and stage times, one JSON line;\n"
-    "                              with --weights, the regular (weighted Delaunay) triangulation of\n"
-    "                              points with a radius (or squared radius) each: the third field of\n"
-    "                              text, the third column of .npy, weighted .bin, or a GeoJSON property\n"
+    "  triangulate FILE              the Delaunay triangulation's counts and stage times, one JSON line\n"
+    "                              (with --weights, the regular triangulation and its hidden points)\n"
     "  spectrum FILE               the spectrum: one alpha_sq per line, ascending (shortest round-trip decimals)\n"
     "  classify FILE THRESHOLD [--mode general|regularized] [--vertex-rule report|cgal]\n"
     "                              every simplex at THRESHOLD: 'v i CLASS' (one per distinct point),\n"
@@ -80,6 +77,12 @@ const char kUsage[] =
     "                              none: planar coordinates. A geographic CRS (x longitude, y latitude)\n"
     "                              is computed in metres (alpha, areas) in a local projection; GeoJSON\n"
     "                              is written in WGS84 longitude/latitude, other formats in FILE's CRS\n"
+    "  --weights radius|squared    weighted points (atoms, disks): every command but --group-by and\n"
+    "                              --server builds the weighted family (the regular triangulation's\n"
+    "                              alpha shapes; hidden points EXTERIOR). A point's third value is its\n"
+    "                              radius (squared here, the weight) or its squared radius, which may\n"
+    "                              be negative: the third field of text, the third column of .npy,\n"
+    "                              weighted .bin, or a GeoJSON property (--weight-property NAME)\n"
     "  -h, --help                  this text\n"
     "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
     "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
@@ -105,8 +108,8 @@ const char kUsage[] =
 static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && kDefaultMaxLineBytes == 65536,
               "update kUsage");
 
-const absl::string_view kGlobalOptions[9] = {"backend", "server", "tls-ca", "encoding", "max-points",
-                                             "layer",   "crs",    "plane",  "slab"};
+const absl::string_view kGlobalOptions[11] = {"backend", "server", "tls-ca", "encoding", "max-points",     "layer",
+                                              "crs",     "plane",  "slab",   "weights",  "weight-property"};
 
 namespace {
 

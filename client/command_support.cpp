@@ -96,6 +96,24 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
     if (crs->empty()) return absl::InvalidArgumentError("--crs needs a CRS (as EPSG:4326), or none");
     common.crs = *crs;
   }
+  if (const std::string* weights = line->Find("weights")) {
+    if (*weights == "radius") {
+      common.input.weights = InputOptions::Weights::kRadius;
+    } else if (*weights == "squared") {
+      common.input.weights = InputOptions::Weights::kSquared;
+    } else {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--weights is radius or squared (what the third value of a point is), not '", *weights, "'"));
+    }
+    if (!common.server.empty()) {
+      return absl::InvalidArgumentError(
+          "--weights builds weighted families locally: the Build stream does not carry weights (yet)");
+    }
+  }
+  if (const std::string* property = line->Find("weight-property")) {
+    if (property->empty()) return absl::InvalidArgumentError("--weight-property needs a property's name");
+    common.input.weight_property = *property;
+  }
   if (const std::string* encoding = line->Find("encoding")) {
     if (common.server.empty()) return absl::InvalidArgumentError("--encoding needs --server");
     if (*encoding != "auto" && *encoding != "raw") {
@@ -121,15 +139,19 @@ absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line) {
   return parsed;
 }
 
-absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common) {
+absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common, std::vector<double>* weights) {
   try {
-    return ReadInputPoints(common.file, common.input);
+    if (common.input.weights == InputOptions::Weights::kNone) return ReadInputPoints(common.file, common.input);
+    GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints read, ReadInputPointsAndCrs(common.file, common.input));
+    *weights = std::move(read.weights);
+    return std::move(read.points);
   } catch (const std::exception& e) {
     return absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
   }
 }
 
-absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points) {
+absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points,
+                                        const std::vector<double>& weights) {
   BuildOptions options;
   options.backend = common.backend;
   if (points.size() >= kProgressMinPoints) {
@@ -140,6 +162,7 @@ absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vec
                    fraction * 100.0, seconds);
     };
   }
+  if (!weights.empty()) return BuildWeightedAlphaFamily(points, weights, options);
   return BuildAlphaFamily(points, options);
 }
 
@@ -176,7 +199,16 @@ absl::StatusOr<FramedPoints> ReadFramedPoints(const CommonArgs& common) {
   } catch (const std::exception& e) {
     return absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
   }
-  return FramePoints(common, std::move(read.points), read.crs);
+  GALPHA_ASSIGN_OR_RETURN(FramedPoints frame, FramePoints(common, std::move(read.points), read.crs));
+  if (!read.weights.empty() && frame.crs && frame.crs->geographic) {
+    // A weight is a squared length in the units of the coordinates: degrees are none, and the
+    // local projection would change distances without changing the weights.
+    return absl::InvalidArgumentError(
+        absl::StrCat("points file '", common.file, "': --weights needs planar coordinates, and its CRS (",
+                     frame.crs->name, ") is geographic: project the points (and the radii) to a metric CRS first"));
+  }
+  frame.weights = std::move(read.weights);
+  return frame;
 }
 
 absl::StatusOr<std::vector<Point2>> OutputPoints(const FramedPoints& frame, bool geojson) {
@@ -197,7 +229,7 @@ std::string CrsLabel(const FramedPoints& frame) { return frame.crs ? Coordinates
 absl::StatusOr<AlphaFamily> LoadFamily(const CommonArgs& common, size_t* input_points, FramedPoints* frame) {
   GALPHA_ASSIGN_OR_RETURN(FramedPoints read, ReadFramedPoints(common));
   *input_points = read.input.size();
-  absl::StatusOr<AlphaFamily> family = BuildFamily(common, read.Computed());
+  absl::StatusOr<AlphaFamily> family = BuildFamily(common, read.Computed(), read.weights);
   if (frame != nullptr) *frame = std::move(read);
   return family;
 }

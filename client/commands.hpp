@@ -101,8 +101,9 @@ struct HolesArgs {
 absl::StatusOr<HolesArgs> ParseHolesArgs(const CommandLine& line);
 
 /// ReadInputPoints of the command's FILE (read once: it may be a pipe), with an exception thrown
-/// while reading (out of memory) reported as an error.
-absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common);
+/// while reading (out of memory) reported as an error. With --weights the weights (squared radii)
+/// go to *weights.
+absl::StatusOr<std::vector<Point2>> ReadPoints(const CommonArgs& common, std::vector<double>* weights);
 
 /// FILE's points and the frame the family is computed in (docs/design.md, "Coordinate reference
 /// systems"): with a geographic CRS, the local projection of the points, in metres; otherwise
@@ -116,6 +117,9 @@ struct FramedPoints {
   std::optional<CrsInfo> crs;
   /// The local projection as a PROJ string (geographic CRS only).
   std::string projection;
+  /// With --weights: each point's weight (squared radius, in the input's squared units); empty
+  /// otherwise.
+  std::vector<double> weights;
 
   /// What the family is built from, and what areas are measured in.
   const std::vector<Point2>& Computed() const { return crs && crs->geographic ? projected : input; }
@@ -136,9 +140,10 @@ nlohmann::ordered_json CrsJson(const FramedPoints& frame);
 /// "coordinates in CRS NAME (ID)", what an SVG's <desc> says; empty without a CRS.
 std::string CrsLabel(const FramedPoints& frame);
 
-/// Builds the family of `points` on the command's backend; for 100000 points or more, reports
-/// each build phase on stderr.
-absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points);
+/// Builds the family of `points` (weighted when `weights` is not empty) on the command's backend;
+/// for 100000 points or more, reports each build phase on stderr.
+absl::StatusOr<AlphaFamily> BuildFamily(const CommonArgs& common, const std::vector<Point2>& points,
+                                        const std::vector<double>& weights);
 
 /// ReadFramedPoints, then BuildFamily of the computed points. `input_points` receives the number of
 /// points read, `frame` (when given) the points and their CRS.

@@ -18,25 +18,11 @@
 namespace galpha::alphactl {
 
 int RunTriangulate(Args args) {
-  auto common = ParseCommon("triangulate", args, {"weights", "weight-property"});
+  auto common = ParseCommon("triangulate", args, {});
   if (!common.ok()) return UsageError(common.status());
   if (!common->server.empty()) {
     return UsageError(absl::InvalidArgumentError(
         "triangulate runs locally only: a server builds whole families (use summary or bench with --server)"));
-  }
-  if (const std::string* weights = common->line.Find("weights")) {
-    if (*weights == "radius") {
-      common->input.weights = InputOptions::Weights::kRadius;
-    } else if (*weights == "squared") {
-      common->input.weights = InputOptions::Weights::kSquared;
-    } else {
-      return UsageError(absl::InvalidArgumentError(
-          absl::StrCat("--weights is radius or squared (what the third value of a point is), not '", *weights, "'")));
-    }
-  }
-  if (const std::string* property = common->line.Find("weight-property")) {
-    if (property->empty()) return UsageError(absl::InvalidArgumentError("--weight-property needs a property's name"));
-    common->input.weight_property = *property;
   }
   TriangulateOptions options;
   options.backend = common->backend;
@@ -112,14 +98,15 @@ int RunBench(Args args) {
 
   // Read once: FILE may be a pipe. Best of `repeat` per stage, matched by name in the first
   // build's order; the total is the best build's sum (not the sum of the per-stage bests).
-  auto points = ReadPoints(*common);
+  std::vector<double> weights;
+  auto points = ReadPoints(*common, &weights);
   if (!points.ok()) return Failure(points.status());
   const size_t input_points = points->size();
   std::vector<std::pair<std::string, double>> best;
   double best_total = 0.0;
   std::optional<AlphaFamily> family;
   for (int64_t run = 0; run < repeat; ++run) {
-    auto built = BuildFamily(*common, *points);
+    auto built = BuildFamily(*common, *points, weights);
     if (!built.ok()) return Failure(built.status());
     double total = 0.0;
     for (const StageTime& s : built->report().stage_times) {

@@ -41,6 +41,10 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
     return UsageError(
         absl::InvalidArgumentError("--group-by builds each group here; it does not combine with --server"));
   }
+  if (common.input.weights != InputOptions::Weights::kNone) {
+    return UsageError(absl::InvalidArgumentError(
+        "--group-by reads groups without weights: build a weighted set's shape without --group-by"));
+  }
   if (format != "geojson" && format != "wkt") {
     return UsageError(absl::InvalidArgumentError("--group-by writes geojson or wkt (one shape per group), not svg"));
   }
@@ -62,7 +66,7 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
     auto frame = FramePoints(common, std::move(subset), read.crs);
     if (!frame.ok())
       return Failure(absl::Status(frame.status().code(), absl::StrCat(name, ": ", frame.status().message())));
-    auto family = BuildFamily(common, frame->Computed());
+    auto family = BuildFamily(common, frame->Computed(), /*weights=*/{});
     if (!family.ok())
       return Failure(absl::Status(family.status().code(), absl::StrCat(name, ": ", family.status().message())));
     auto level = ResolveThreshold(*family, threshold);

@@ -63,6 +63,16 @@ int RunClassify(Args args) {
   return FinishOutput(out);
 }
 
+namespace {
+
+/// A weighted family's hidden points (input indices, ascending); null for an unweighted one.
+nlohmann::ordered_json HiddenPointsJson(const AlphaFamily& family) {
+  if (!family.weighted()) return nullptr;
+  return family.HiddenPoints();
+}
+
+}  // namespace
+
 int RunSummary(Args args) {
   auto common = ParseCommon("summary", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "vertex-rule"});
   if (!common.ok()) return UsageError(common.status());
@@ -84,6 +94,7 @@ int RunSummary(Args args) {
                                        {"points", input_points},
                                        {"distinct_points", family->num_unique()},
                                        {"duplicates", family->num_duplicates()},
+                                       {"hidden_points", HiddenPointsJson(*family)},
                                        {"spectrum_size", family->spectrum().size()},
                                        {"level", level},
                                        {"alpha_sq", threshold->alpha_sq},

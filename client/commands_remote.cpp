@@ -233,6 +233,7 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
                                        {"points", remote->input_points},
                                        {"distinct_points", build.distinct_points()},
                                        {"duplicates", build.duplicates()},
+                                       {"hidden_points", nullptr},  // servers build unweighted families
                                        {"spectrum_size", build.spectrum_size()},
                                        {"level", summary.level()},
                                        {"alpha_sq", summary.alpha_sq()},
@@ -402,7 +403,8 @@ int RemoteBench(const CommonArgs& common, int64_t repeat) {
   double best_engine = 0.0, best_rpc = 0.0;
   v1::BuildSummary summary;
   // Read once: FILE may be a pipe.
-  auto points = ReadPoints(common);
+  std::vector<double> no_weights;  // --weights is refused with --server (ParseCommon)
+  auto points = ReadPoints(common, &no_weights);
   if (!points.ok()) return Failure(points.status());
   const size_t input_points = points->size();
   for (int64_t run = 0; run < repeat; ++run) {

@@ -135,8 +135,6 @@ GALPHA_HD inline bool LiftedLength(int xn, const double* x, int yn, const double
 GALPHA_HD inline bool WeightedExactTerms(const Point2* p, const double* w, int n, int s,
                                          radius_detail::ExactRadiusTerms* terms) {
   using namespace weighted_detail;
-  double w0[2];
-  const int w0n = TwoToExpansion(ScaleByPow2(w[0], 2 * s), 0.0, w0);  // exact (a one-component expansion)
   double num[kBoundedCapacity];
   int numn;
   if (n == 2) {
@@ -182,9 +180,9 @@ GALPHA_HD inline bool WeightedExactTerms(const Point2* p, const double* w, int n
     if (!BoundedProduct(cxn, cx, cxn, cx, xx, &xxn) || !BoundedProduct(cyn, cy, cyn, cy, yy, &yyn)) return false;
     if (!BoundedSum(xxn, xx, yyn, yy, false, num, &numn)) return false;
   }
-  // Num -= 4 Den w0 (times 4: exact).
-  double four_w0[2];
-  const int four_w0n = w0n == 0 ? 0 : TwoToExpansion(Mul(w0[w0n - 1], 4.0), 0.0, four_w0);
+  // Num -= 4 Den w0 (w0 * 2^(2s) and times 4: exact, as the scale check keeps it normal).
+  const double four_w0[1] = {Mul(ScaleByPow2(w[0], 2 * s), 4.0)};
+  const int four_w0n = four_w0[0] != 0.0 ? 1 : 0;
   double shift[kBoundedCapacity];
   int shiftn;
   if (!BoundedProduct(terms->denn, terms->den, four_w0n, four_w0, shift, &shiftn)) return false;

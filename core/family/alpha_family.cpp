@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/exact/radius_rational.hpp"
+#include "core/exact/weighted_radius_rational.hpp"
 
 namespace galpha {
 
@@ -28,14 +29,24 @@ const char* SimplexClassName(SimplexClass c) {
 AlphaFamily::AlphaFamily(AlphaFamilyParts parts) : parts_(std::move(parts)) {
   const AlphaRanks& r = parts_.ranks;
   const uint32_t num_tri = static_cast<uint32_t>(parts_.triangles.size());
-  // Every point on a triangle from the largest first-triangle rank over the distinct points.
+  // Every point on a triangle from the largest first-triangle rank over the distinct points
+  // (weighted: those that are vertices).
   if (num_tri > 0) {
     uint32_t worst = 0;
     for (uint32_t v = 0; v < parts_.points.size(); ++v) {
-      if (parts_.representative[v] == v) worst = std::max(worst, r.vertex_tri_low[v]);
+      if (parts_.representative[v] == v && !hidden(v)) worst = std::max(worst, r.vertex_tri_low[v]);
     }
     if (worst != kNeverRank) solid_level_ = worst;
   }
+  if (weighted()) min_alpha_sq_ = -*std::max_element(parts_.weights.begin(), parts_.weights.end());
+}
+
+std::vector<uint32_t> AlphaFamily::HiddenPoints() const {
+  std::vector<uint32_t> out;
+  for (uint32_t v = 0; v < parts_.hidden.size(); ++v) {
+    if (parts_.hidden[v] != 0) out.push_back(v);
+  }
+  return out;
 }
 
 namespace {
@@ -44,17 +55,24 @@ namespace {
 int CompareRankWith(const AlphaFamilyParts& p, int64_t rank, const mpq_class& value) {
   const uint32_t id = p.ranks.spectrum_simplex[static_cast<size_t>(rank - 1)];
   Point2 pts[3];
+  double ws[3];
   int n;
   const uint32_t num_tri = static_cast<uint32_t>(p.triangles.size());
+  const bool weighted = !p.weights.empty();
   if (id < num_tri) {
-    for (int k = 0; k < 3; ++k) pts[k] = p.points[p.triangles[id][k]];
     n = 3;
+    for (int k = 0; k < 3; ++k) {
+      pts[k] = p.points[p.triangles[id][k]];
+      ws[k] = weighted ? p.weights[p.triangles[id][k]] : 0.0;
+    }
   } else {
-    pts[0] = p.points[p.edges[id - num_tri][0]];
-    pts[1] = p.points[p.edges[id - num_tri][1]];
     n = 2;
+    for (int k = 0; k < 2; ++k) {
+      pts[k] = p.points[p.edges[id - num_tri][k]];
+      ws[k] = weighted ? p.weights[p.edges[id - num_tri][k]] : 0.0;
+    }
   }
-  const std::optional<mpq_class> threshold = RadiusSqRational(pts, n);
+  const std::optional<mpq_class> threshold = SimplexRadiusSqRational(pts, weighted ? ws : nullptr, n);
   if (!threshold) return 1;
   const int c = cmp(*threshold, value);
   return (c > 0) - (c < 0);
@@ -78,7 +96,7 @@ int64_t CountAtMost(const AlphaFamilyParts& p, const mpq_class& value) {
 
 absl::StatusOr<int64_t> AlphaFamily::LevelForAlphaSq(double alpha_sq) const {
   if (std::isnan(alpha_sq)) return absl::InvalidArgumentError("alpha_sq is NaN");
-  if (alpha_sq < 0) return -1;
+  if (alpha_sq < min_alpha_sq_) return -1;
   if (std::isinf(alpha_sq)) return max_level();
   return CountAtMost(parts_, mpq_class(alpha_sq));
 }
@@ -88,7 +106,9 @@ absl::StatusOr<int64_t> AlphaFamily::LevelForAlpha(double alpha) const {
   if (alpha < 0) return absl::InvalidArgumentError(absl::StrCat("alpha is a radius and must be >= 0, got ", alpha));
   if (std::isinf(alpha)) return max_level();
   const mpq_class radius(alpha);
-  return CountAtMost(parts_, radius * radius);
+  const mpq_class alpha_sq = radius * radius;
+  if (alpha_sq < mpq_class(min_alpha_sq_)) return -1;  // weighted, every weight negative
+  return CountAtMost(parts_, alpha_sq);
 }
 
 absl::StatusOr<int64_t> AlphaFamily::LevelForRank(int64_t rank) const {
@@ -100,8 +120,8 @@ absl::StatusOr<int64_t> AlphaFamily::LevelForRank(int64_t rank) const {
 }
 
 int64_t AlphaFamily::RankLowerBound(double alpha_sq) const {
-  if (std::isnan(alpha_sq) || alpha_sq <= 0) return 1;
-  if (std::isinf(alpha_sq)) return max_level() + 1;
+  if (std::isnan(alpha_sq) || (alpha_sq <= 0 && !weighted())) return 1;  // unweighted values are positive
+  if (std::isinf(alpha_sq)) return alpha_sq > 0 ? max_level() + 1 : 1;
   // Ranks below the answer are those with threshold < alpha_sq.
   const mpq_class value(alpha_sq);
   int64_t lo = 0, hi = max_level();
@@ -134,7 +154,7 @@ SimplexClass AlphaFamily::ClassifyEdge(uint32_t e, int64_t level, ClassifyMode m
 
 SimplexClass AlphaFamily::ClassifyVertex(uint32_t v, int64_t level, ClassifyMode mode, VertexRule rule) const {
   const AlphaRanks& r = parts_.ranks;
-  if (level < 0) return SimplexClass::kExterior;
+  if (level < 0 || hidden(v)) return SimplexClass::kExterior;
   const uint32_t tri_low = r.vertex_tri_low[v];
   const uint32_t high = r.vertex_mu_high[v];
   const bool has_triangle = tri_low != kNeverRank && level >= static_cast<int64_t>(tri_low);
@@ -254,14 +274,14 @@ size_t VectorBytes(const HostVector<T>& v) {
 
 size_t AlphaFamily::HostBytes() const {
   const AlphaRanks& r = parts_.ranks;
-  return sizeof(*this) + VectorBytes(parts_.points) + VectorBytes(parts_.representative) +
-         VectorBytes(parts_.triangles) + VectorBytes(parts_.edges) + VectorBytes(r.spectrum) +
-         VectorBytes(r.spectrum_simplex) + VectorBytes(r.tri_rank) + VectorBytes(r.edge_rho_rank) +
-         VectorBytes(r.edge_mu_low) + VectorBytes(r.edge_mu_high) + VectorBytes(r.edge_triangles) +
-         VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) + VectorBytes(r.vertex_tri_low) +
-         VectorBytes(r.master_begin) + VectorBytes(r.master) + VectorBytes(r.components) +
-         VectorBytes(r.solid_components) + VectorBytes(r.holes) + VectorBytes(r.regularized_components) +
-         VectorBytes(r.regularized_holes) + VectorBytes(r.area_units);
+  return sizeof(*this) + VectorBytes(parts_.points) + VectorBytes(parts_.representative) + VectorBytes(parts_.weights) +
+         VectorBytes(parts_.hidden) + VectorBytes(parts_.triangles) + VectorBytes(parts_.edges) +
+         VectorBytes(r.spectrum) + VectorBytes(r.spectrum_simplex) + VectorBytes(r.tri_rank) +
+         VectorBytes(r.edge_rho_rank) + VectorBytes(r.edge_mu_low) + VectorBytes(r.edge_mu_high) +
+         VectorBytes(r.edge_triangles) + VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) +
+         VectorBytes(r.vertex_tri_low) + VectorBytes(r.master_begin) + VectorBytes(r.master) +
+         VectorBytes(r.components) + VectorBytes(r.solid_components) + VectorBytes(r.holes) +
+         VectorBytes(r.regularized_components) + VectorBytes(r.regularized_holes) + VectorBytes(r.area_units);
 }
 
 }  // namespace galpha

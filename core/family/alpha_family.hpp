@@ -3,8 +3,10 @@
 // Built by BuildAlphaFamily (gpu/alpha/alpha_engine.hpp); semantics in docs/design.md, "Semantics".
 //
 // Thresholds are resolved to a *level*: the number of spectrum values <= the threshold, compared
-// exactly (level 0: alpha_sq in [0, spectrum[0]); level -1: a negative alpha_sq, where nothing is in).
-// The complex at level L is the complex at every alpha_sq in [spectrum[L-1], spectrum[L]).
+// exactly (level 0: alpha_sq in [min_alpha_sq, spectrum[0]); level -1: alpha_sq below
+// min_alpha_sq, where nothing is in). min_alpha_sq is 0 unweighted, minus the largest weight
+// weighted (below it every disk of squared radius alpha_sq + w is empty). The complex at level L is
+// the complex at every alpha_sq in [spectrum[L-1], spectrum[L]).
 #pragma once
 
 #include <array>
@@ -47,6 +49,11 @@ struct AlphaFamilyParts {
   uint32_t num_unique = 0;
   HostVector<std::array<uint32_t, 3>> triangles;  // counter-clockwise, input indices
   HostVector<std::array<uint32_t, 2>> edges;      // (smaller, larger) input index
+  /// Weighted families (issue 18): every input point's weight (the squared radius of its disk),
+  /// and 1 for every input index whose point is hidden (no vertex of the regular triangulation:
+  /// EXTERIOR at every level). Both empty for an unweighted family.
+  HostVector<double> weights;
+  HostVector<uint8_t> hidden;
   AlphaRanks ranks;
   BuildReport report;
 };
@@ -70,6 +77,15 @@ class AlphaFamily {
   const HostVector<std::array<uint32_t, 3>>& triangles() const { return parts_.triangles; }
   const HostVector<std::array<uint32_t, 2>>& edges() const { return parts_.edges; }
   const AlphaRanks& ranks() const { return parts_.ranks; }
+  /// Whether the family was built from weighted points; their weights and hidden flags (empty
+  /// when unweighted).
+  bool weighted() const { return !parts_.weights.empty(); }
+  const HostVector<double>& weights() const { return parts_.weights; }
+  bool hidden(uint32_t v) const { return !parts_.hidden.empty() && parts_.hidden[v] != 0; }
+  /// Input indices of the hidden points, ascending.
+  std::vector<uint32_t> HiddenPoints() const;
+  /// The lower end of level 0: 0 unweighted, minus the largest weight weighted.
+  double min_alpha_sq() const { return min_alpha_sq_; }
   const BuildReport& report() const { return parts_.report; }
 
   /// Host memory the family holds (its arrays' capacities), in bytes: what a cache charges for it.
@@ -83,7 +99,8 @@ class AlphaFamily {
   absl::StatusOr<int64_t> LevelForAlphaSq(double alpha_sq) const;
   /// Level of the radius `alpha` (alpha^2 compared exactly). InvalidArgument for NaN or alpha < 0.
   absl::StatusOr<int64_t> LevelForAlpha(double alpha) const;
-  /// Level of a rank (the complex at spectrum[rank - 1]; rank 0: alpha = 0). OutOfRange beyond K.
+  /// Level of a rank (the complex at spectrum[rank - 1]; rank 0: the points alone, level 0).
+  /// OutOfRange beyond K.
   absl::StatusOr<int64_t> LevelForRank(int64_t rank) const;
   /// CGAL's alpha_lower_bound: the first rank whose exact threshold is >= alpha_sq (K + 1 when
   /// none is).
@@ -129,6 +146,7 @@ class AlphaFamily {
  private:
   AlphaFamilyParts parts_;
   std::optional<int64_t> solid_level_;
+  double min_alpha_sq_ = 0.0;
 };
 
 }  // namespace galpha

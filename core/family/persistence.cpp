@@ -165,7 +165,9 @@ std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const Hos
   }
   // One essential class a component, created by its oldest vertex (its root).
   for (uint32_t v = 0; v < num_points; ++v) {
-    if (family.representative()[v] == v && forest.IsRoot(v)) pairs.push_back({0, 0, kNeverRank, v, kNoSimplex});
+    if (family.representative()[v] == v && !family.hidden(v) && forest.IsRoot(v)) {
+      pairs.push_back({0, 0, kNeverRank, v, kNoSimplex});
+    }
   }
   return pairs;
 }

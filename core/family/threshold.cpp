@@ -6,7 +6,7 @@
 namespace galpha {
 
 double PublishedAlphaSq(const AlphaFamily& family, int64_t level) {
-  return level <= 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
+  return level <= 0 ? family.min_alpha_sq() : family.spectrum()[static_cast<size_t>(level - 1)];
 }
 
 absl::StatusOr<ResolvedThreshold> ResolveThreshold(const AlphaFamily& family, const Threshold& threshold) {

@@ -19,13 +19,14 @@ struct Threshold {
 
 /// A threshold resolved to a level (the number of spectrum values <= it) and the squared radius
 /// it stands for: the given alpha_sq, alpha * alpha rounded, or for a rank and an area ratio the
-/// published spectrum value of the level (0 at level 0).
+/// published spectrum value of the level (PublishedAlphaSq).
 struct ResolvedThreshold {
   int64_t level = 0;
   double alpha_sq = 0.0;
 };
 
-/// The published squared radius of `level`: spectrum[level - 1], 0 for levels 0 and -1.
+/// The published squared radius of `level`: spectrum[level - 1]; for levels 0 and -1 the lower end
+/// of level 0 (0 unweighted, minus the largest weight weighted).
 double PublishedAlphaSq(const AlphaFamily& family, int64_t level);
 
 /// InvalidArgument for a NaN, a negative alpha, a rank outside 0..K ("rank R is outside 0..K

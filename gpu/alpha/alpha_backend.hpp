@@ -21,6 +21,8 @@ struct AlphaInput {
   const std::array<uint32_t, 3>* triangles = nullptr;
   uint32_t num_triangles = 0;  // simplex ids below this are triangles, the rest edges
   const std::array<uint32_t, 2>* edges = nullptr;
+  /// Weighted families: the weight of every input point; nullptr when unweighted.
+  const double* weights = nullptr;
 };
 
 /// What a backend's build hands back; BuildAlphaFamily() moves it into an AlphaFamily.
@@ -29,6 +31,8 @@ struct FamilyOutput {
   uint32_t num_unique = 0;
   HostVector<std::array<uint32_t, 3>> triangles;
   HostVector<std::array<uint32_t, 2>> edges;
+  /// Weighted: 1 for every input index whose point is hidden; empty when unweighted.
+  HostVector<uint8_t> hidden;
   AlphaRanks ranks;
   std::vector<StageTime> stage_times;
   size_t peak_memory_bytes = 0;
@@ -42,11 +46,14 @@ struct BuildHooks {
   uint64_t max_exact_comparisons = 0;
 };
 
-/// Builds the family of `n` finite points on the OpenMP backend. Throws EngineError (or a
-/// Thrust/std exception) on failure.
-void BuildFamilyOnCpu(const Point2* points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out);
+/// Builds the family of `n` finite points (with `weights`, one per point, or nullptr for the
+/// unweighted family) on the OpenMP backend. Throws EngineError (or a Thrust/std exception) on
+/// failure.
+void BuildFamilyOnCpu(const Point2* points, const double* weights, uint32_t n, const BuildHooks& hooks,
+                      FamilyOutput* out);
 
 /// The same on the CUDA backend, on `stream` (a cudaStream_t, or nullptr for one of its own).
-void BuildFamilyOnCuda(const Point2* points, uint32_t n, void* stream, const BuildHooks& hooks, FamilyOutput* out);
+void BuildFamilyOnCuda(const Point2* points, const double* weights, uint32_t n, void* stream, const BuildHooks& hooks,
+                       FamilyOutput* out);
 
 }  // namespace galpha::detail

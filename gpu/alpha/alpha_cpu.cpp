@@ -5,9 +5,10 @@
 
 namespace galpha::detail {
 
-void BuildFamilyOnCpu(const Point2* points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out) {
+void BuildFamilyOnCpu(const Point2* points, const double* weights, uint32_t n, const BuildHooks& hooks,
+                      FamilyOutput* out) {
   CpuSystem system;
-  RunFamilyBuild(system, points, n, hooks, out);
+  RunFamilyBuild(system, points, weights, n, hooks, out);
 }
 
 }  // namespace galpha::detail

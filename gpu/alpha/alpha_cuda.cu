@@ -7,15 +7,16 @@
 
 namespace galpha::detail {
 
-void BuildFamilyOnCuda(const Point2* points, uint32_t n, void* stream, const BuildHooks& hooks, FamilyOutput* out) {
+void BuildFamilyOnCuda(const Point2* points, const double* weights, uint32_t n, void* stream, const BuildHooks& hooks,
+                       FamilyOutput* out) {
   if (stream != nullptr) {
     CudaSystem system(static_cast<cudaStream_t>(stream));
-    RunFamilyBuild(system, points, n, hooks, out);
+    RunFamilyBuild(system, points, weights, n, hooks, out);
     return;
   }
   OwnedStream owned;
   CudaSystem system(owned.get());
-  RunFamilyBuild(system, points, n, hooks, out);
+  RunFamilyBuild(system, points, weights, n, hooks, out);
 }
 
 }  // namespace galpha::detail

@@ -19,9 +19,9 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-}  // namespace
-
-absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options) {
+/// The build of either family: `weights` empty for the unweighted one.
+absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                        const BuildOptions& options) {
   auto report = [&](std::string_view phase, double fraction) {
     if (options.progress) options.progress(phase, fraction);
   };
@@ -33,6 +33,9 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   // account for the whole call.
   const auto validate_start = std::chrono::steady_clock::now();
   GALPHA_RETURN_IF_ERROR(ValidatePoints(points));
+  const bool weighted = !weights.empty();
+  if (weighted) GALPHA_RETURN_IF_ERROR(ValidateWeights(points, weights));
+  const double* weight_data = weighted ? weights.data() : nullptr;
   const double validate_seconds = SecondsSince(validate_start);
   GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
   if (stop_requested()) return cancelled_error("0 phases");
@@ -52,9 +55,9 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   };
   GALPHA_RETURN_IF_ERROR(detail::RunEngine(absl::StrCat("building the alpha family of ", n, " points"), [&] {
     if (backend == Backend::kCuda) {
-      detail::BuildFamilyOnCuda(points.data(), n, options.cuda_stream, hooks, &built);
+      detail::BuildFamilyOnCuda(points.data(), weight_data, n, options.cuda_stream, hooks, &built);
     } else {
-      detail::BuildFamilyOnCpu(points.data(), n, hooks, &built);
+      detail::BuildFamilyOnCpu(points.data(), weight_data, n, hooks, &built);
     }
   }));
   report("alpha", 0.9);
@@ -74,12 +77,33 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
   parts.triangles = std::move(built.triangles);
   parts.edges = std::move(built.edges);
   parts.ranks = std::move(built.ranks);
+  if (weighted) {
+    parts.weights.resize(weights.size());
+    detail::ParallelCopy(parts.weights.data(), weights.data(), weights.size() * sizeof(double));
+    parts.hidden = std::move(built.hidden);
+  }
   // The stage list is complete before the family owns it; the constructor's own pass over the
   // points is the little it leaves out.
   parts.report.stage_times.push_back({"assemble", SecondsSince(assemble_start)});
   AlphaFamily family(std::move(parts));
   report("components", 1.0);
   return family;
+}
+
+}  // namespace
+
+absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options) {
+  return BuildFamily(points, {}, options);
+}
+
+absl::StatusOr<AlphaFamily> BuildWeightedAlphaFamily(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                                     const BuildOptions& options) {
+  if (weights.size() != points.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("weighted build: ", weights.size(), " weights for ", points.size(), " points"));
+  }
+  if (points.empty()) return BuildFamily(points, {}, options);  // nothing to weigh
+  return BuildFamily(points, weights, options);
 }
 
 bool IsExactComparisonLimit(const absl::Status& status) {

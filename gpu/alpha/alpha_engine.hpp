@@ -38,4 +38,12 @@ bool IsExactComparisonLimit(const absl::Status& status);
 /// Builds the family. Errors as Triangulate's (gpu/triangulation/delaunay.hpp), and Cancelled.
 absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, const BuildOptions& options = {});
 
+/// Builds the weighted family (issue 18; docs/design.md, "Weighted alpha shapes"): the
+/// subcomplexes of the regular triangulation of the points with `weights` (one per point, the
+/// squared radius of its disk; negative values are valid), thresholds the squared radii of the
+/// smallest orthogonal circles, hidden points EXTERIOR at every level. Errors as
+/// TriangulateWeighted's (a weight count that is not the point count among them), and Cancelled.
+absl::StatusOr<AlphaFamily> BuildWeightedAlphaFamily(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                                     const BuildOptions& options = {});
+
 }  // namespace galpha

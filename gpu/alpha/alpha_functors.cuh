@@ -13,6 +13,7 @@
 #include "core/exact/radius_key.hpp"
 #include "core/exact/radius_nearest.hpp"
 #include "core/exact/radius_refined.hpp"
+#include "core/exact/simplex_radius.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/system/atomic_increment.cuh"
 
@@ -68,12 +69,15 @@ struct WriteEdgeTriangles {
 };
 
 /// The points of simplex `id` (id < num_tri: a triangle; else the edge id - num_tri) into p;
-/// returns the number of points.
+/// returns the number of points. A weighted family's simplices have weights too (`weights`, per
+/// input index; nullptr for an unweighted family): the radius operations of
+/// core/exact/simplex_radius.hpp take `Weights(w)`, which is nullptr for an unweighted family.
 struct SimplexPoints {
   const Point2* points;
   const TriIdx* tri;
   const EdgeIdx* edges;
   uint32_t num_tri;
+  const double* weights = nullptr;
   GALPHA_HD int operator()(uint32_t id, Point2* p) const {
     if (id < num_tri) {
       for (int k = 0; k < 3; ++k) p[k] = points[tri[id].v[k]];
@@ -84,11 +88,30 @@ struct SimplexPoints {
     p[1] = points[e.v[1]];
     return 2;
   }
+  /// The points and, weighted, the weights (w is left alone for an unweighted family).
+  GALPHA_HD int operator()(uint32_t id, Point2* p, double* w) const {
+    const int n = (*this)(id, p);
+    if (weights != nullptr) {
+      if (id < num_tri) {
+        for (int k = 0; k < 3; ++k) w[k] = weights[tri[id].v[k]];
+      } else {
+        const EdgeIdx e = edges[id - num_tri];
+        w[0] = weights[e.v[0]];
+        w[1] = weights[e.v[1]];
+      }
+    }
+    return n;
+  }
+  /// What the radius operations take for a simplex's weights read into w.
+  GALPHA_HD const double* Weights(const double* w) const { return weights != nullptr ? w : nullptr; }
 };
 
 /// Radius key of every triangle (entries 0..T) and edge (entries T..T+E); an attached edge gets
-/// kAttachedKey (it has no spectrum value of its own). Flags uncertified keys.
+/// kAttachedKey (it has no spectrum value of its own). Flags uncertified keys (1), and weighted
+/// edges whose attachment the bounded arithmetic could not decide (kAttachmentUndecided, plus 1
+/// when the key is not certified either): the host decides those (ResolveAttachmentOnHost).
 constexpr uint64_t kAttachedKey = ~uint64_t{0} - 1;  // below kInfiniteRadiusKey, above every radius
+constexpr uint8_t kAttachmentUndecided = 2;
 struct ComputeRadiusKeys {
   SimplexPoints simplex;
   const EdgeTris* edge_tris;
@@ -96,7 +119,9 @@ struct ComputeRadiusKeys {
   uint8_t* uncertified;
   GALPHA_HD void operator()(uint32_t id) const {
     Point2 p[3];
-    const int n = simplex(id, p);
+    double w[3];
+    const int n = simplex(id, p, w);
+    uint8_t undecided = 0;
     if (n == 2) {
       const EdgeTris et = edge_tris[id - simplex.num_tri];
       for (int side = 0; side < 2; ++side) {
@@ -109,17 +134,40 @@ struct ComputeRadiusKeys {
           const Point2 q = simplex.points[v];
           if (!(q == p[0]) && !(q == p[1])) r = v;
         }
-        if (InDiametralCircleSign(p[0], p[1], simplex.points[r]) > 0) {
+        if (simplex.weights != nullptr) w[2] = simplex.weights[r];
+        const int sign = SimplexAttachedSign(p[0], p[1], simplex.points[r], simplex.Weights(w));
+        if (sign == 2) undecided = kAttachmentUndecided;
+        if (sign == 1) {
           keys[id] = kAttachedKey;
           uncertified[id] = 0;
           return;
         }
       }
     }
-    const RadiusSqApprox a = ApproxRadiusSq(p, n);
+    const RadiusSqApprox a = ApproxSimplexRadiusSq(p, simplex.Weights(w), n);
     keys[id] = a.key;
-    uncertified[id] = a.certified ? 0 : 1;
+    uncertified[id] = static_cast<uint8_t>((a.certified ? 0 : 1) | undecided);
   }
+};
+
+/// Whether a flag byte has `flag` set.
+struct HasFlag {
+  uint8_t flag;
+  GALPHA_HD bool operator()(uint8_t v) const { return (v & flag) != 0; }
+};
+
+/// Weighted: an input point's hidden flag, read through its representative.
+struct HiddenThroughRepresentative {
+  const uint32_t* representative;
+  const uint8_t* hidden;  // as the triangulation marks it: on representatives
+  GALPHA_HD uint8_t operator()(uint32_t i) const { return hidden[representative[i]]; }
+};
+
+/// Weighted: a distinct point (its own representative) that is hidden.
+struct HiddenRepresentative {
+  const uint32_t* representative;
+  const uint8_t* hidden;
+  GALPHA_HD bool operator()(uint32_t i) const { return representative[i] == i && hidden[i] != 0; }
 };
 
 /// Whether a spectrum entry (by key) takes part in the spectrum: born at a finite radius and not
@@ -160,8 +208,13 @@ constexpr uint32_t kMaxDeviceRun = 16;
 /// than the enclosures, take the bounded exact comparison, counted. Everything but that last step
 /// stays in registers: on the device a thread per comparison is bound by its local memory. Not
 /// inlined: OrderRunNeighbours and RepairRun's two loops call it.
-GALPHA_HD GALPHA_NOINLINE inline Order CompareRunEntries(const Point2* pa, int na, const Point2* pb, int nb,
-                                                         uint32_t* count) {
+GALPHA_HD GALPHA_NOINLINE inline Order CompareRunEntries(const Point2* pa, const double* wa, int na, const Point2* pb,
+                                                         const double* wb, int nb, uint32_t* count) {
+  if (wa != nullptr) {  // weighted: no enclosures (their bound is the unweighted formula's)
+    if (WeightedRadiusCongruent(pa, wa, na, pb, wb, nb)) return Order::kEqual;
+    ++*count;
+    return CompareSimplexRadiusSqBounded(pa, wa, na, pb, wb, nb);
+  }
   if (RadiusCongruent(pa, na, pb, nb)) return Order::kEqual;
   RadiusSqEnclosure ea, eb;
   if (EncloseRadiusSq(pa, na, &ea) && EncloseRadiusSq(pb, nb, &eb)) {
@@ -199,10 +252,11 @@ struct OrderRunNeighbours {
     const uint32_t b = run_begin[r], n = run_begin[r + 1] - b;
     if (n > kMaxDeviceRun || k + 1 >= n) return;
     Point2 pa[3], pb[3];
-    const int na = simplex(ids[b + k], pa);
-    const int nb = simplex(ids[b + k + 1], pb);
+    double wa[3], wb[3];
+    const int na = simplex(ids[b + k], pa, wa);
+    const int nb = simplex(ids[b + k + 1], pb, wb);
     uint32_t count = 0;
-    const Order order = CompareRunEntries(pa, na, pb, nb, &count);
+    const Order order = CompareRunEntries(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb, &count);
     verdict[b + k] = EncodeVerdict(order, count != 0);
   }
 };
@@ -252,14 +306,15 @@ struct RepairRun {
     for (uint32_t i = 0; i < n; ++i) local[i] = ids[b + i];
     equal_class[0] = 0;
     Point2 pa[3], pb[3];
+    double wa[3], wb[3];
     for (uint32_t i = 1; i < n; ++i) {
       const uint32_t x = local[i];
-      const int nx = simplex(x, pa);
+      const int nx = simplex(x, pa, wa);
       uint8_t x_class = static_cast<uint8_t>(i);
       uint32_t j = i;
       while (j > 0) {
-        const int ny = simplex(local[j - 1], pb);
-        const Order c = CompareRunEntries(pb, ny, pa, nx, &count);
+        const int ny = simplex(local[j - 1], pb, wb);
+        const Order c = CompareRunEntries(pb, simplex.Weights(wb), ny, pa, simplex.Weights(wa), nx, &count);
         if (c == Order::kUndecided) {
           needs_host[r] = 1;
           comparisons[r] = count;
@@ -280,9 +335,9 @@ struct RepairRun {
         new_value[b + i] = 0;
         continue;
       }
-      const int na = simplex(local[i - 1], pa);
-      const int nb = simplex(local[i], pb);
-      const Order c = CompareRunEntries(pa, na, pb, nb, &count);
+      const int na = simplex(local[i - 1], pa, wa);
+      const int nb = simplex(local[i], pb, wb);
+      const Order c = CompareRunEntries(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb, &count);
       if (c == Order::kUndecided) {
         needs_host[r] = 1;
         comparisons[r] = count;
@@ -326,9 +381,13 @@ struct CheckRunOfOneDouble {
     const uint32_t r = run_of[i] - 1;
     if (!settled[r]) return;
     Point2 p[3], q[3];
-    const int n = simplex(ids[i], p), m = simplex(ids[run_begin[r]], q);
+    double wp[3], wq[3];
+    const int n = simplex(ids[i], p, wp), m = simplex(ids[run_begin[r]], q, wq);
     double a, b;
-    if (!ExactDoubleRadiusSq(p, n, &a) || !ExactDoubleRadiusSq(q, m, &b) || a != b) settled[r] = 0;
+    if (!ExactDoubleSimplexRadiusSq(p, simplex.Weights(wp), n, &a) ||
+        !ExactDoubleSimplexRadiusSq(q, simplex.Weights(wq), m, &b) || a != b) {
+      settled[r] = 0;
+    }
   }
 };
 
@@ -389,8 +448,9 @@ struct NearestSpectrumValue {
   uint8_t* needs_host;
   GALPHA_HD void operator()(uint32_t r) const {
     Point2 p[3];
-    const int n = simplex(spectrum_simplex[r], p);
-    needs_host[r] = NearestRadiusSqFast(p, n, &spectrum[r]) || NearestRadiusSqBounded(p, n, &spectrum[r]) ? 0 : 1;
+    double w[3];
+    const int n = simplex(spectrum_simplex[r], p, w);
+    needs_host[r] = NearestSimplexRadiusSq(p, simplex.Weights(w), n, &spectrum[r]) ? 0 : 1;
   }
 };
 

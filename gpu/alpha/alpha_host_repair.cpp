@@ -8,6 +8,8 @@
 #include "core/exact/order.hpp"
 #include "core/exact/radius_compare.hpp"
 #include "core/exact/radius_rational.hpp"
+#include "core/exact/simplex_radius.hpp"
+#include "core/exact/weighted_radius_rational.hpp"
 
 namespace galpha::detail {
 namespace {
@@ -49,26 +51,35 @@ class ExactComparator {
     }
     if (budget_->exhausted()) return 0;
     Point2 pa[3], pb[3];
-    const int na = Points(a, pa), nb = Points(b, pb);
-    const Order c = CompareRadiusSqBounded(pa, na, pb, nb);
+    double wa[3], wb[3];
+    const int na = Points(a, pa, wa), nb = Points(b, pb, wb);
+    const Order c = CompareSimplexRadiusSqBounded(pa, Weights(wa), na, pb, Weights(wb), nb);
     if (c != Order::kUndecided) {
       ++counts_.bounded_exact;
       return SignOf(c);
     }
     ++counts_.cpu_fallback;
-    return CompareRadiusSqRational(pa, na, pb, nb);
+    return CompareSimplexRadiusSqRational(pa, Weights(wa), na, pb, Weights(wb), nb);
   }
 
-  int Points(uint32_t id, Point2* p) const {
+  /// The simplex's points, and its weights into w when the family is weighted.
+  int Points(uint32_t id, Point2* p, double* w) const {
     if (id < in_.num_triangles) {
-      for (int k = 0; k < 3; ++k) p[k] = in_.points[in_.triangles[id][k]];
+      for (int k = 0; k < 3; ++k) {
+        p[k] = in_.points[in_.triangles[id][k]];
+        if (in_.weights != nullptr) w[k] = in_.weights[in_.triangles[id][k]];
+      }
       return 3;
     }
     const std::array<uint32_t, 2>& e = in_.edges[id - in_.num_triangles];
-    p[0] = in_.points[e[0]];
-    p[1] = in_.points[e[1]];
+    for (int k = 0; k < 2; ++k) {
+      p[k] = in_.points[e[k]];
+      if (in_.weights != nullptr) w[k] = in_.weights[e[k]];
+    }
     return 2;
   }
+  /// w for a weighted family, else nullptr (what the radius operations take).
+  const double* Weights(const double* w) const { return in_.weights != nullptr ? w : nullptr; }
 
   const ComparisonCounts& counts() const { return counts_; }
 
@@ -132,8 +143,9 @@ bool RepairRunOfExactDoubles(ExactComparator& cmp, uint32_t* ids, uint32_t n, ui
   std::vector<std::pair<double, uint32_t>> values(n);
   for (uint32_t i = 0; i < n; ++i) {
     Point2 p[3];
-    const int k = cmp.Points(ids[i], p);
-    if (!ExactDoubleRadiusSq(p, k, &values[i].first)) return false;
+    double w[3];
+    const int k = cmp.Points(ids[i], p, w);
+    if (!ExactDoubleSimplexRadiusSq(p, cmp.Weights(w), k, &values[i].first)) return false;
     values[i].second = ids[i];
   }
   // Congruent simplices (a grid's triangles) are all equal: one pass proves it.
@@ -233,9 +245,29 @@ void NearestValuesOnHost(const AlphaInput& in, const std::vector<uint8_t>& needs
   for (size_t r = 0; r < needs.size(); ++r) {
     if (!needs[r]) continue;
     Point2 p[3];
-    const int n = points.Points(out->spectrum_simplex[r], p);
-    const std::optional<mpq_class> value = RadiusSqRational(p, n);
+    double w[3];
+    const int n = points.Points(out->spectrum_simplex[r], p, w);
+    const std::optional<mpq_class> value = SimplexRadiusSqRational(p, points.Weights(w), n);
     out->spectrum[r] = value ? NearestDouble(*value) : HUGE_VAL;
+  }
+}
+
+void ResolveAttachmentOnHost(const AlphaInput& in, const std::array<int32_t, 2>* edge_triangles,
+                             const std::vector<uint32_t>& edge_ids, std::vector<uint8_t>* attached) {
+  attached->assign(edge_ids.size(), 0);
+  for (size_t i = 0; i < edge_ids.size(); ++i) {
+    const std::array<uint32_t, 2>& e = in.edges[edge_ids[i]];
+    for (const int32_t t : edge_triangles[edge_ids[i]]) {
+      if (t < 0) continue;
+      uint32_t r = in.triangles[t][0];
+      for (const uint32_t v : in.triangles[t]) {
+        if (!(in.points[v] == in.points[e[0]]) && !(in.points[v] == in.points[e[1]])) r = v;
+      }
+      if (WeightedAttachedSignRational(in.points[e[0]], in.points[e[1]], in.points[r], in.weights[e[0]],
+                                       in.weights[e[1]], in.weights[r]) > 0) {
+        (*attached)[i] = 1;
+      }
+    }
   }
 }
 

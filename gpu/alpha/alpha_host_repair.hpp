@@ -33,4 +33,10 @@ inline constexpr uint64_t kNoComparisonLimit = ~uint64_t{0};
 /// out->spectrum[r] for every rank with needs[r], by GMP.
 void NearestValuesOnHost(const AlphaInput& in, const std::vector<uint8_t>& needs, AlphaRanks* out);
 
+/// Weighted: whether each edge of `edge_ids` (edge ids) is attached by the third vertex of one of
+/// its triangles (`edge_triangles`, per edge), by GMP: the edges whose attachment the bounded
+/// arithmetic left undecided. attached[i] is 1 or 0.
+void ResolveAttachmentOnHost(const AlphaInput& in, const std::array<int32_t, 2>* edge_triangles,
+                             const std::vector<uint32_t>& edge_ids, std::vector<uint8_t>* attached);
+
 }  // namespace galpha::detail

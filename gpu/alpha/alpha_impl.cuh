@@ -59,14 +59,17 @@ struct PipelineMesh {
   const TriIdx* tri;
   const EdgeIdx* edges;
   const uint32_t* representative;  // per input point, its first occurrence
+  const double* weights;           // per input point; nullptr for an unweighted family
+  const uint8_t* hidden;           // weighted: per input point as given by the triangulation; else nullptr
   uint32_t n;                      // input points, duplicates included
   uint32_t num_unique;
+  uint32_t num_vertices;  // distinct points that are vertices (weighted: not hidden)
   uint32_t num_tri;
   uint32_t num_edges;
 
   /// Spectrum entries are simplex ids: triangles first, then edges.
   uint32_t num_simplices() const { return num_tri + num_edges; }
-  SimplexPoints simplex() const { return SimplexPoints{points, tri, edges, num_tri}; }
+  SimplexPoints simplex() const { return SimplexPoints{points, tri, edges, num_tri, weights}; }
 };
 
 template <class System>
@@ -76,8 +79,11 @@ PipelineMesh PipelineMeshOf(SystemTriangulation<System>& t) {
   mesh.tri = reinterpret_cast<const TriIdx*>(t.tri.data());
   mesh.edges = reinterpret_cast<const EdgeIdx*>(t.edges.data());
   mesh.representative = t.representative.data();
+  mesh.weights = t.weights.size() > 0 ? t.weights.data() : nullptr;
+  mesh.hidden = t.weights.size() > 0 ? t.hidden.data() : nullptr;
   mesh.n = static_cast<uint32_t>(t.points.size());
   mesh.num_unique = t.num_unique;
+  mesh.num_vertices = t.num_unique;  // weighted: less the hidden ones (HiddenVertices)
   mesh.num_tri = static_cast<uint32_t>(t.tri.size());
   mesh.num_edges = static_cast<uint32_t>(t.edges.size());
   return mesh;
@@ -192,7 +198,7 @@ struct ComponentCounts {
 /// (the host arrays are sized at once: sizing a HostVector touches no memory).
 template <class System>
 HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, const PipelineMesh& mesh,
-                                   const Point2* host_points, FamilyOutput* family) {
+                                   const Point2* host_points, const double* host_weights, FamilyOutput* family) {
   family->triangles.resize(mesh.num_tri);
   family->edges.resize(mesh.num_edges);
   family->representative.resize(mesh.n);
@@ -203,10 +209,27 @@ HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, 
                          {family->representative.data(), t.representative.data(), size_t{mesh.n} * sizeof(uint32_t)}}),
       AlphaInput{}};
   host.input.points = host_points;
+  host.input.weights = host_weights;
   host.input.triangles = family->triangles.data();
   host.input.num_triangles = mesh.num_tri;
   host.input.edges = family->edges.data();
   return host;
+}
+
+/// Weighted: every input point's hidden flag through its representative (a duplicate of a hidden
+/// point is hidden) into the family, and the number of distinct points that are vertices.
+template <class System>
+void HiddenVertices(System& sys, PipelineMesh& mesh, FamilyOutput* family) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<uint8_t, System> hidden(sys, mesh.n);
+  thrust::transform(policy, zero, zero + mesh.n, hidden.data(),
+                    HiddenThroughRepresentative{mesh.representative, mesh.hidden});
+  mesh.num_vertices =
+      mesh.num_unique - static_cast<uint32_t>(thrust::count_if(
+                            policy, zero, zero + mesh.n, HiddenRepresentative{mesh.representative, hidden.data()}));
+  family->hidden.resize(mesh.n);
+  sys.Download({{family->hidden.data(), hidden.data(), size_t{mesh.n}}});
 }
 
 /// Edge topology: the incident triangles of every edge (none for a collinear chain). The
@@ -225,14 +248,44 @@ Buffer<EdgeTris, System> EdgeTriangles(System& sys, const PipelineMesh& mesh, Sy
   return edge_tris;
 }
 
+/// Weighted edges whose attachment bounded arithmetic left undecided (rare: weights far more
+/// precise than the edge is long): decided on the host by GMP, their keys and flags put right.
+template <class System>
+void ResolveUndecidedAttachment(System& sys, const PipelineMesh& mesh, const Buffer<EdgeTris, System>& edge_tris,
+                                HostMesh<System>& host_mesh, SimplexKeys<System>* keys) {
+  const uint32_t num_tri = mesh.num_tri;
+  const std::vector<uint8_t> flags = keys->uncertified.ToHostVector(mesh.num_simplices());
+  std::vector<uint32_t> edge_ids;
+  for (uint32_t e = 0; e < mesh.num_edges; ++e) {
+    if ((flags[num_tri + e] & kAttachmentUndecided) != 0) edge_ids.push_back(e);
+  }
+  std::vector<EdgeTris> host_edge_tris = edge_tris.ToHostVector(mesh.num_edges);
+  std::vector<std::array<int32_t, 2>> triangles_of(mesh.num_edges);
+  for (uint32_t e = 0; e < mesh.num_edges; ++e) triangles_of[e] = {host_edge_tris[e].t[0], host_edge_tris[e].t[1]};
+  std::vector<uint8_t> attached;
+  ResolveAttachmentOnHost(host_mesh.Get(), triangles_of.data(), edge_ids, &attached);
+  for (size_t i = 0; i < edge_ids.size(); ++i) {
+    const uint32_t id = num_tri + edge_ids[i];
+    const uint8_t flag = static_cast<uint8_t>(attached[i] ? 0 : (flags[id] & 1));
+    sys.FromHost(keys->uncertified.data() + id, &flag, 1);
+    if (attached[i]) sys.FromHost(keys->key.data() + id, &kAttachedKey, 1);
+  }
+}
+
 /// Radii and attachment: one certified key per simplex.
 template <class System>
-SimplexKeys<System> KeySimplices(System& sys, const PipelineMesh& mesh, const Buffer<EdgeTris, System>& edge_tris) {
+SimplexKeys<System> KeySimplices(System& sys, const PipelineMesh& mesh, const Buffer<EdgeTris, System>& edge_tris,
+                                 HostMesh<System>& host_mesh) {
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t num_simplices = mesh.num_simplices();
   SimplexKeys<System> keys{Buffer<uint64_t, System>(sys, num_simplices), Buffer<uint8_t, System>(sys, num_simplices)};
   thrust::for_each_n(sys.policy(), zero, num_simplices,
                      ComputeRadiusKeys{mesh.simplex(), edge_tris.data(), keys.key.data(), keys.uncertified.data()});
+  if (mesh.weights != nullptr &&
+      thrust::count_if(sys.policy(), keys.uncertified.data(), keys.uncertified.data() + num_simplices,
+                       HasFlag{kAttachmentUndecided}) > 0) {
+    ResolveUndecidedAttachment(sys, mesh, edge_tris, host_mesh, &keys);
+  }
   return keys;
 }
 
@@ -681,7 +734,7 @@ ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                                  AreaCurveScale{}};
   TopologyCurves(
       sys,
-      TopologyCurvesIn{mesh.n, mesh.num_unique, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
+      TopologyCurvesIn{mesh.n, mesh.num_vertices, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
                        edge_tris.data(), mesh.representative, ranks.tri_rank.data(), ranks.edge_rho_rank.data(),
                        iv.edge_mu_low.data(), iv.edge_mu_high.data(), iv.vertex_tri_low.data()},
       TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
@@ -732,14 +785,16 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
 /// is the same input in host memory (the host's exact repairs read it). One stage a call; the
 /// buffers a stage no longer needs are freed by the stage that reads them last.
 template <class System>
-void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points, StageTimer<System>& timer,
-                      uint64_t max_exact_comparisons, FamilyOutput* family) {
+void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points,
+                      const double* host_weights, StageTimer<System>& timer, uint64_t max_exact_comparisons,
+                      FamilyOutput* family) {
   AlphaRanks* out = &family->ranks;
-  const PipelineMesh mesh = PipelineMeshOf(t);
-  HostMesh<System> host_mesh = StartMeshDownload(sys, t, mesh, host_points, family);
+  PipelineMesh mesh = PipelineMeshOf(t);
+  HostMesh<System> host_mesh = StartMeshDownload(sys, t, mesh, host_points, host_weights, family);
+  if (mesh.weights != nullptr) HiddenVertices(sys, mesh, family);
   Buffer<EdgeTris, System> edge_tris = EdgeTriangles(sys, mesh, &t);
   timer.EndStage("edge_topology");
-  SimplexKeys<System> keys = KeySimplices(sys, mesh, edge_tris);
+  SimplexKeys<System> keys = KeySimplices(sys, mesh, edge_tris, host_mesh);
   timer.EndStage("radii_attachment");
   SortedSpectrum<System> sorted = SortSpectrum(sys, mesh, &keys);
   timer.EndStage("spectrum_sort");
@@ -764,12 +819,12 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
 /// The whole build on one system: triangulation, then the alpha pipeline on the triangulation
 /// where it lies; the family comes back to the host once (partly beside the last stages).
 template <class System>
-void RunFamilyBuild(System& sys, const Point2* host_points, uint32_t n, const BuildHooks& hooks, FamilyOutput* out) {
+void RunFamilyBuild(System& sys, const Point2* host_points, const double* host_weights, uint32_t n,
+                    const BuildHooks& hooks, FamilyOutput* out) {
   StageTimer<System> timer(sys, &out->stage_times);
-  SystemTriangulation<System> t =
-      TriangulateOnSystem(sys, host_points, /*host_weights=*/nullptr, n, /*keep_points=*/true, timer);
+  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, host_weights, n, /*keep_points=*/true, timer);
   if (hooks.after_triangulation) hooks.after_triangulation();
-  RunAlphaPipeline(sys, t, host_points, timer, hooks.max_exact_comparisons, out);
+  RunAlphaPipeline(sys, t, host_points, host_weights, timer, hooks.max_exact_comparisons, out);
   timer.Finish();
   out->peak_memory_bytes = sys.peak_bytes();
 }

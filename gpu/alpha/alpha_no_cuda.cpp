@@ -4,7 +4,7 @@
 
 namespace galpha::detail {
 
-void BuildFamilyOnCuda(const Point2*, uint32_t, void*, const BuildHooks&, FamilyOutput*) {
+void BuildFamilyOnCuda(const Point2*, const double*, uint32_t, void*, const BuildHooks&, FamilyOutput*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 

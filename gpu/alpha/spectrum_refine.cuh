@@ -122,8 +122,9 @@ struct ComputeRefinedEntry {
     entry.run = run_of[i] - 1;
     entry.id = ids[i];
     Point2 p[3];
-    const int n = simplex(entry.id, p);
-    entry.key = RefineRadiusSq(p, n);
+    double w[3];
+    const int n = simplex(entry.id, p, w);
+    entry.key = RefineSimplexRadiusSq(p, simplex.Weights(w), n);
     if (!entry.key.ok) run_unrefinable[entry.run] = 1;
     entries[k] = entry;
   }
@@ -162,13 +163,14 @@ struct JudgeRefinedPair {
       return;
     }
     Point2 pa[3], pb[3];
-    const int na = simplex(a.id, pa), nb = simplex(b.id, pb);
-    if (RadiusCongruent(pa, na, pb, nb)) {
+    double wa[3], wb[3];
+    const int na = simplex(a.id, pa, wa), nb = simplex(b.id, pb, wb);
+    if (SimplexRadiusCongruent(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb)) {
       verdict[k] = kPairEqual;
       return;
     }
     comparisons[k] = 1;
-    const Order order = CompareRadiusSqBounded(pa, na, pb, nb);
+    const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
     verdict[k] = order == Order::kLess ? kPairLess : order == Order::kEqual ? kPairEqual : kPairBad;
   }
 };
@@ -187,10 +189,11 @@ GALPHA_HD inline int ExactClusterEntrySign(const SimplexPoints& simplex, const R
   if (RefinedKeysSeparated(a.key, b.key)) return -1;
   if (RefinedKeysSeparated(b.key, a.key)) return 1;
   Point2 pa[3], pb[3];
-  const int na = simplex(a.id, pa), nb = simplex(b.id, pb);
-  if (RadiusCongruent(pa, na, pb, nb)) return 0;
+  double wa[3], wb[3];
+  const int na = simplex(a.id, pa, wa), nb = simplex(b.id, pb, wb);
+  if (SimplexRadiusCongruent(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb)) return 0;
   AtomicIncrement(comparisons);
-  const Order order = CompareRadiusSqBounded(pa, na, pb, nb);
+  const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
   if (order != Order::kUndecided) return SignOf(order);
   cluster_undecided[cluster] = 1;  // concurrent writes only ever write 1
   return 0;

@@ -86,14 +86,16 @@ template <class System>
 struct SystemTriangulation {
   explicit SystemTriangulation(System& sys)
       : points(sys, 0),
+        weights(sys, 0),
         representative(sys, 0),
         hidden(sys, 0),
         tri(sys, 0),
         nbr(sys, 0),
         edge_begin(sys, 0),
         edges(sys, 0) {}
-  /// The input as given (kept only when asked for).
+  /// The input as given (kept only when asked for), and its weights when weighted.
   Buffer<Point2, System> points;
+  Buffer<double, System> weights;
   /// For every input index, its first occurrence.
   Buffer<uint32_t, System> representative;
   uint32_t num_unique = 0;
@@ -507,7 +509,10 @@ SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_
     } else {
       WriteCollinearChain(sys, &distinct, &result);
     }
-    if (keep_points) result.points = std::move(input);
+    if (keep_points) {
+      result.points = std::move(input);
+      result.weights = std::move(input_weights);
+    }
     timer.EndStage("collinear_chain");
   };
   if (AllCollinear(sys, input, distinct)) {
@@ -552,7 +557,11 @@ SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_
     timer.EndStage("regular_check");
   }
   if (weights != nullptr) release_input();
-  input_weights.Reset();
+  if (keep_points) {
+    result.weights = std::move(input_weights);
+  } else {
+    input_weights.Reset();
+  }
   builder->ReleaseWorkspace();
   OutputTriangles(sys, *builder, &result);
   builder.reset();  // the mesh, as soon as the output holds its triangles

@@ -170,9 +170,36 @@ TEST(AlphactlTest, TriangulatesWeightedPointsWithRadiiOrSquaredRadii) {
   ExpectError(Alphactl("triangulate " + Quote(negative) + " --weights radius"), 1, "point 1 has a negative radius");
   // As squared radii, negative values are valid.
   EXPECT_EQ(Alphactl("triangulate " + Quote(negative) + " --backend=cpu --weights squared").exit_code, 0);
-  ExpectError(Alphactl("summary " + Quote(path) + " --rank 0 --weights radius"), 2, "unknown option '--weights'");
+  ExpectError(Alphactl("summary " + Quote(path) + " --rank 0 --weights radius --server localhost:1"), 2,
+              "the Build stream does not carry weights");
   std::filesystem::remove(path);
   std::filesystem::remove(negative);
+}
+
+TEST(AlphactlTest, BuildsWeightedFamilies) {
+  // Three unit disks at the corners of a triangle of side 2 and a disk of radius sqrt(0.5) inside
+  // it (as in weighted_family_cgal_test): the edges between overlapping disks are born below 0,
+  // and below -1 (minus the largest weight) nothing is in. (1,1) with radius 0.1 is hidden.
+  const std::string path = WriteFile("alphactl_weighted.csv", "x,y,w\n0,0,1\n2,0,1\n1,1.75,1\n1,0.6,0.5\n1,1,0.01\n");
+  const nlohmann::json summary =
+      nlohmann::json::parse(Succeeds("summary", path, "--rank 0 --backend=cpu --weights squared"));
+  EXPECT_EQ(summary["hidden_points"], nlohmann::json::array({4}));
+  EXPECT_EQ(summary["vertices"]["EXTERIOR"], 1);  // the hidden point
+  EXPECT_EQ(summary["vertices"]["SINGULAR"], 4);
+  EXPECT_EQ(summary["alpha_sq"], -1.0);  // level 0 starts at minus the largest weight
+  const std::vector<std::string> spectrum = SplitLines(Succeeds("spectrum", path, "--backend=cpu --weights squared"));
+  ASSERT_FALSE(spectrum.empty());
+  EXPECT_LT(std::stod(spectrum.front()), 0.0);
+  const nlohmann::json below =
+      nlohmann::json::parse(Succeeds("summary", path, "--alpha-sq -1.5 --backend=cpu --weights squared"));
+  EXPECT_EQ(below["level"], -1);
+  EXPECT_EQ(below["components"], 0);
+  // The hidden point is EXTERIOR at every threshold, and named in classify's output as such.
+  const std::string classes = Succeeds("classify", path, "--rank 3 --backend=cpu --weights squared");
+  EXPECT_NE(classes.find("v 4 EXTERIOR\n"), std::string::npos) << classes;
+  // Unweighted summaries say so.
+  EXPECT_TRUE(nlohmann::json::parse(Succeeds("summary", path, "--rank 0 --backend=cpu"))["hidden_points"].is_null());
+  std::filesystem::remove(path);
 }
 
 TEST(AlphactlTest, FileNamesAreEscapedInTheJson) {
@@ -331,14 +358,16 @@ TEST(AlphactlTest, SummaryIsOneJsonObjectWithItsKeysInOrder) {
   const nlohmann::ordered_json j = nlohmann::ordered_json::parse(run.out);
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys,
-            (std::vector<std::string>{"file", "points", "distinct_points", "duplicates", "spectrum_size", "level",
-                                      "alpha_sq", "mode", "vertex_rule", "vertices", "edges", "triangles", "components",
-                                      "solid_components", "holes", "interior_area", "hull_area", "crs", "backend"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{
+                      "file",          "points",        "distinct_points", "duplicates", "hidden_points",
+                      "spectrum_size", "level",         "alpha_sq",        "mode",       "vertex_rule",
+                      "vertices",      "edges",         "triangles",       "components", "solid_components",
+                      "holes",         "interior_area", "hull_area",       "crs",        "backend"}));
   const nlohmann::json expected = {{"file", SquareCsv()},
                                    {"points", 4},
                                    {"distinct_points", 4},
                                    {"duplicates", 0},
+                                   {"hidden_points", nullptr},
                                    {"spectrum_size", 2},
                                    {"level", 1},
                                    {"alpha_sq", 0.25},
