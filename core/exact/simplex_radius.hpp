@@ -28,7 +28,7 @@ GALPHA_HD GALPHA_NOINLINE inline Order CompareWeighted(const Point2* a, const do
   return CompareWeightedRadiusSqBounded(a, wa, na, b, wb, nb);
 }
 GALPHA_HD GALPHA_NOINLINE inline bool NearestWeighted(const Point2* p, const double* w, int n, double* out) {
-  return NearestWeightedRadiusSqBounded(p, w, n, out);
+  return NearestWeightedRadiusSqFast(p, w, n, out) || NearestWeightedRadiusSqBounded(p, w, n, out);
 }
 GALPHA_HD GALPHA_NOINLINE inline RefinedRadiusSq RefineWeighted(const Point2* p, const double* w, int n) {
   return RefineWeightedRadiusSq(p, w, n);

@@ -29,10 +29,12 @@
 // 0, E = d (r - p).(r - q): the diametral test of attachment.hpp.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "core/base/hd.hpp"
 #include "core/base/point.hpp"
+#include "core/exact/double_double.hpp"
 #include "core/exact/expansion.hpp"
 #include "core/exact/order.hpp"
 #include "core/exact/radius_key.hpp"
@@ -221,14 +223,129 @@ GALPHA_HD inline uint64_t SignedKeyOf(double m, int e, bool negative, bool* in_r
 
 }  // namespace weighted_detail
 
+namespace weighted_detail {
+
+/// A double with a bound on its distance to the exact value it stands for: the running error
+/// analysis of the weighted floating filter. Every operation adds its own rounding (u |v|, u =
+/// 2^-53, valid while results stay normal: the caller keeps magnitudes within 2^+-400) to the
+/// propagated bounds. The bounds are themselves rounded: a few ulps of relative error each, which
+/// the caller covers by a margin of 2^-40 on the final bound.
+struct Bounded {
+  double v;
+  double e;
+};
+
+constexpr double kUnitRoundoff = 0x1p-53;
+
+GALPHA_HD GALPHA_FORCEINLINE Bounded RoundedDiff(double a, double b) {
+  const double v = Sub(a, b);
+  return {v, Mul(Abs(v), kUnitRoundoff)};
+}
+GALPHA_HD GALPHA_FORCEINLINE Bounded Plus(Bounded a, Bounded b) {
+  const double v = Add(a.v, b.v);
+  return {v, Add(Add(a.e, b.e), Mul(Abs(v), kUnitRoundoff))};
+}
+GALPHA_HD GALPHA_FORCEINLINE Bounded Minus(Bounded a, Bounded b) {
+  const double v = Sub(a.v, b.v);
+  return {v, Add(Add(a.e, b.e), Mul(Abs(v), kUnitRoundoff))};
+}
+GALPHA_HD GALPHA_FORCEINLINE Bounded Times(Bounded a, Bounded b) {
+  const double v = Mul(a.v, b.v);
+  const double e = Add(Add(Mul(Abs(a.v), b.e), Mul(Abs(b.v), a.e)), Mul(a.e, b.e));
+  return {v, Add(e, Mul(Abs(v), kUnitRoundoff))};
+}
+/// a / b; the caller checks b.e < |b.v| first.
+GALPHA_HD GALPHA_FORCEINLINE Bounded Over(Bounded a, Bounded b) {
+  const double v = a.v / b.v;
+  const double e = Add(a.e, Mul(Abs(v), b.e)) / Sub(Abs(b.v), b.e);
+  return {v, Add(e, Mul(Abs(v), kUnitRoundoff))};
+}
+/// Whether a value stays where the bounds above hold: zero, or normal well inside the range.
+GALPHA_HD GALPHA_FORCEINLINE bool InFilterRange(double v) {
+  return v == 0.0 || (Abs(v) >= 0x1p-400 && Abs(v) <= 0x1p400);
+}
+
+/// The floating filter of ApproxWeightedRadiusSq: rho^2 scaled by 2^(2s) with a bound on its
+/// error, from the formulas of the module comment in doubles (differences scaled by 2^s so that
+/// the largest difference or square root of a weight is near 1). False where the bound is not
+/// valid (a value out of range) or the denominator's bound reaches its value (nearly collinear).
+GALPHA_HD inline bool FilteredWeightedRadiusSq(const Point2* p, const double* w, int n, Bounded* out, int* scale) {
+  double maxabs = 0.0;
+  for (int i = 1; i < n; ++i) {
+    const double dx = Abs(Sub(p[i].x, p[0].x)), dy = Abs(Sub(p[i].y, p[0].y));
+    maxabs = dx > maxabs ? dx : maxabs;
+    maxabs = dy > maxabs ? dy : maxabs;
+  }
+  double maxw = 0.0;
+  for (int i = 0; i < n; ++i) maxw = Abs(w[i]) > maxw ? Abs(w[i]) : maxw;
+  if (!(maxabs > 0.0 && maxabs <= 0x1p500) || !(maxw <= 0x1p900)) return false;  // also NaN
+  int e = ExponentOf(maxabs);
+  if (maxw > 0.0) {
+    const int ew = (ExponentOf(maxw) + 2) >> 1;
+    e = ew > e ? ew : e;
+  }
+  const int s = -e;
+  const Bounded w0 = {ScaleByPow2(w[0], 2 * s), 0.0};
+  if (!InFilterRange(w0.v)) return false;
+  Bounded d[2][2], lifted_weight[2];
+  for (int k = 0; k + 1 < n; ++k) {
+    d[k][0] = RoundedDiff(p[k + 1].x, p[0].x);
+    d[k][1] = RoundedDiff(p[k + 1].y, p[0].y);
+    lifted_weight[k] = RoundedDiff(w[k + 1], w[0]);
+    // Scaling by powers of two is exact in range: values and bounds alike.
+    d[k][0] = {ScaleByPow2(d[k][0].v, s), ScaleByPow2(d[k][0].e, s)};
+    d[k][1] = {ScaleByPow2(d[k][1].v, s), ScaleByPow2(d[k][1].e, s)};
+    lifted_weight[k] = {ScaleByPow2(lifted_weight[k].v, 2 * s), ScaleByPow2(lifted_weight[k].e, 2 * s)};
+    if (!InFilterRange(d[k][0].v) || !InFilterRange(d[k][1].v) || !InFilterRange(lifted_weight[k].v)) return false;
+  }
+  Bounded value;
+  if (n == 2) {
+    const Bounded len = Plus(Times(d[0][0], d[0][0]), Times(d[0][1], d[0][1]));
+    const Bounded t = Minus(len, lifted_weight[0]);
+    const Bounded four_len = {Mul(len.v, 4.0), Mul(len.e, 4.0)};
+    if (!(four_len.e < Abs(four_len.v))) return false;
+    value = Minus(Over(Times(t, t), four_len), w0);
+  } else {
+    const Bounded wb = Minus(Plus(Times(d[0][0], d[0][0]), Times(d[0][1], d[0][1])), lifted_weight[0]);
+    const Bounded wc = Minus(Plus(Times(d[1][0], d[1][0]), Times(d[1][1], d[1][1])), lifted_weight[1]);
+    const Bounded area = Minus(Times(d[0][0], d[1][1]), Times(d[0][1], d[1][0]));
+    const Bounded cx = Minus(Times(wb, d[1][1]), Times(wc, d[0][1]));
+    const Bounded cy = Minus(Times(wc, d[0][0]), Times(wb, d[1][0]));
+    const Bounded num = Plus(Times(cx, cx), Times(cy, cy));
+    const Bounded square = Times(area, area);
+    const Bounded den = {Mul(square.v, 4.0), Mul(square.e, 4.0)};
+    if (!InFilterRange(area.v) || !(den.e < Abs(den.v))) return false;
+    value = Minus(Over(num, den), w0);
+  }
+  if (!InFilterRange(value.v) || !(value.e < 0x1p400)) return false;
+  *out = value;
+  *scale = s;
+  return true;
+}
+
+}  // namespace weighted_detail
+
 /// Certified key of a weighted simplex's rho^2 (the key order and kRadiusKeyGap of radius_key.hpp,
-/// extended to signed values: module comment of SignedKeyOf). The approximation is the quotient of
-/// the exact terms' top components (each within 2^-51.99 of its compressed expansion, the quotient
+/// extended to signed values: module comment of SignedKeyOf). The approximation is the floating
+/// filter's (FilteredWeightedRadiusSq) when its bound certifies 2^-42, else the quotient of the
+/// exact terms' top components (each within 2^-51.99 of its compressed expansion, the quotient
 /// rounded once: within 2^-49 of rho^2, relatively, as kRadiusSqRelErr demands); a collinear
 /// triangle gets kInfiniteRadiusKey, and exact terms that do not fit give certified == false.
 GALPHA_HD inline RadiusSqApprox ApproxWeightedRadiusSq(const Point2* p, const double* w, int n) {
   using namespace weighted_detail;
   RadiusSqApprox out;
+  // The floating filter first: certified when its error bound (with a margin of 2^-40 for the
+  // rounding of the bound itself) is below 2^-42 of the value.
+  Bounded filtered;
+  int filter_scale = 0;
+  if (FilteredWeightedRadiusSq(p, w, n, &filtered, &filter_scale) && filtered.v != 0.0 &&
+      Mul(filtered.e, 1.0 + 0x1p-40) <= Mul(Abs(filtered.v), 0x1p-42)) {
+    bool in_range = true;
+    const double m = Abs(filtered.v);
+    const int m_exp = ExponentOf(m);
+    out.key = SignedKeyOf(ScaleByPow2(m, -m_exp), m_exp - 2 * filter_scale, filtered.v < 0.0, &in_range);
+    if (in_range) return out;
+  }
   radius_detail::ExactRadiusTerms terms;
   int s = 0;
   if (!OwnTerms(p, w, n, n == 2 ? 4 : 6, &terms, &s)) {
@@ -308,18 +425,25 @@ GALPHA_HD inline bool NearestWeightedRadiusSqBounded(const Point2* p, const doub
   const double num = t.num[t.numn - 1], den = t.den[t.denn - 1];
   const bool negative = num < 0.0;
   const int num_exp = ExponentOf(num), den_exp = ExponentOf(den);
-  // In scaled units |v| = |Num| / (4 Den) = c * 2^shift, c in [1/4, 4): m = c * 2^shift times Den
-  // must neither overflow nor underflow a Two-Product (|Num| < 2^930 and Den > 2^-960 keep shift
-  // inside these bounds for every value that is a normal double).
-  const int shift = num_exp - den_exp - 2;
-  if (shift > 700 || shift < -700) return false;
-  const double scale = Pow2(shift);
-  double c = ScaleByPow2(Abs(num), -num_exp) / ScaleByPow2(den, -den_exp);
   // Work on |v|: flip Num's sign for a negative value.
   radius_detail::ExactRadiusTerms magnitude = t;
   if (negative) {
     for (int i = 0; i < magnitude.numn; ++i) magnitude.num[i] = -magnitude.num[i];
   }
+  // In scaled units |v| = |Num| / (4 Den) = c * 2^shift: m = c * 2^shift times Den must neither
+  // overflow nor underflow a Two-Product (|Num| < 2^930 and Den > 2^-960 keep shift inside these
+  // bounds for every value that is a normal double). The first guess is the refined quotient
+  // (radius_refined.hpp, within 2^-150): almost always the answer, which the loop then only checks
+  // (two exact comparisons instead of a walk of several ulps from a 2^-49 guess).
+  int shift = num_exp - den_exp - 2;
+  double c = ScaleByPow2(Abs(num), -num_exp) / ScaleByPow2(den, -den_exp);
+  const RefinedRadiusSq refined = radius_detail::RefineTerms(magnitude, s);
+  if (refined.ok) {
+    c = Add(refined.hi, refined.mid);  // in [1, 2]
+    shift = refined.exponent + 2 * s;
+  }
+  if (shift > 700 || shift < -700) return false;
+  const double scale = Pow2(shift);
   for (int iteration = 0; iteration < 8; ++iteration) {
     const double up = Mul(Sub(radius_detail::NextUp(c), c), 0.5);
     const double down = Mul(Sub(c, radius_detail::NextDown(c)), 0.5);
@@ -335,12 +459,122 @@ GALPHA_HD inline bool NearestWeightedRadiusSqBounded(const Point2* p, const doub
       const int e = shift - 2 * s;
       // c * 2^e must be a normal double (rounding c is the whole rounding then).
       if (ExponentOf(c) + e < -1022 || ExponentOf(c) + e > 1023) return false;
-      const double v = ScaleByPow2(c, e);
+      const double v = ldexp(c, e);
       *out = negative ? -v : v;
       return true;
     }
   }
   return false;
+}
+
+namespace weighted_detail {
+
+/// The double-double twin of Bounded: a value hi + lo and a bound on its distance to the exact
+/// value, each operation adding its own error as double_double.hpp states it (AddDd 3.01 u^2 of
+/// the operands' his, MulDd 8.01 u^2 of their product, DivDd 2^-100 relative), rounded up, to the
+/// propagated bounds (|operand| <= |hi| (1 + 2^-52)); the bounds' own rounding is covered by the
+/// caller's margin.
+struct BoundedDd {
+  DoubleDouble v;
+  double e;
+};
+
+constexpr double kDdSlack = 1.0 + 0x1p-50;
+
+GALPHA_HD GALPHA_FORCEINLINE BoundedDd ExactDiffDd(double a, double b, int s) {
+  double hi, lo;
+  TwoDiff(a, b, hi, lo);
+  return {DoubleDouble{ScaleByPow2(hi, s), ScaleByPow2(lo, s)}, 0.0};
+}
+GALPHA_HD GALPHA_FORCEINLINE BoundedDd PlusDd(BoundedDd a, BoundedDd b, bool negate_b = false) {
+  const DoubleDouble v = AddDd(a.v, b.v, negate_b);
+  return {v, Add(Add(a.e, b.e), Mul(Add(Abs(a.v.hi), Abs(b.v.hi)), 4.0 * kUnitRoundoff * kUnitRoundoff))};
+}
+GALPHA_HD GALPHA_FORCEINLINE BoundedDd TimesDd(BoundedDd a, BoundedDd b) {
+  const DoubleDouble v = MulDd(a.v, b.v);
+  const double propagated = Add(Mul(Add(Mul(Abs(a.v.hi), b.e), Mul(Abs(b.v.hi), a.e)), kDdSlack), Mul(a.e, b.e));
+  return {v, Add(propagated, Mul(Abs(Mul(a.v.hi, b.v.hi)), 9.0 * kUnitRoundoff * kUnitRoundoff))};
+}
+/// a / b for b > 0 with b.e < b.v.hi / 2 (the caller checks).
+GALPHA_HD GALPHA_FORCEINLINE BoundedDd OverDd(BoundedDd a, BoundedDd b) {
+  const bool negative = a.v.hi < 0.0;
+  const DoubleDouble magnitude = negative ? DoubleDouble{-a.v.hi, -a.v.lo} : a.v;
+  DoubleDouble q = DivDd(magnitude, b.v);
+  const double propagated =
+      Mul(Add(a.e, Mul(Abs(q.hi), Mul(b.e, kDdSlack))), kDdSlack) / Sub(b.v.hi, Mul(b.e, kDdSlack));
+  if (negative) q = DoubleDouble{-q.hi, -q.lo};
+  return {q, Add(Mul(propagated, kDdSlack), Mul(Abs(q.hi), 0x1p-99))};
+}
+
+}  // namespace weighted_detail
+
+/// The double nearest to a weighted simplex's rho^2 from a double-double evaluation with a running
+/// error bound (about 2^-100 relative where nothing cancels): decides the rounding unless the
+/// value lies within the bound of a midpoint between doubles, cancels too much, or is not a normal
+/// double (false: NearestWeightedRadiusSqBounded decides). The fast path of a weighted spectrum.
+GALPHA_HD inline bool NearestWeightedRadiusSqFast(const Point2* p, const double* w, int n, double* out) {
+  using namespace weighted_detail;
+  double maxabs = 0.0, maxw = 0.0;
+  for (int i = 1; i < n; ++i) {
+    const double dx = Abs(Sub(p[i].x, p[0].x)), dy = Abs(Sub(p[i].y, p[0].y));
+    maxabs = dx > maxabs ? dx : maxabs;
+    maxabs = dy > maxabs ? dy : maxabs;
+  }
+  for (int i = 0; i < n; ++i) maxw = Abs(w[i]) > maxw ? Abs(w[i]) : maxw;
+  if (!(maxabs > 0.0 && maxabs <= 0x1p500) || !(maxw <= 0x1p900)) return false;
+  int e = ExponentOf(maxabs);
+  if (maxw > 0.0) {
+    const int ew = (ExponentOf(maxw) + 2) >> 1;
+    e = ew > e ? ew : e;
+  }
+  const int s = -e;
+  // Differences and weight differences exactly (Two-Diff), scaled; tiny ones beside large ones
+  // could underflow in products: the exact path takes them.
+  BoundedDd d[2][2], lifted_weight[2];
+  for (int k = 0; k + 1 < n; ++k) {
+    d[k][0] = ExactDiffDd(p[k + 1].x, p[0].x, s);
+    d[k][1] = ExactDiffDd(p[k + 1].y, p[0].y, s);
+    lifted_weight[k] = ExactDiffDd(w[k + 1], w[0], 2 * s);
+    if (!InFilterRange(d[k][0].v.hi) || !InFilterRange(d[k][1].v.hi) || !InFilterRange(lifted_weight[k].v.hi)) {
+      return false;
+    }
+  }
+  const BoundedDd w0 = {DoubleDouble{ScaleByPow2(w[0], 2 * s), 0.0}, 0.0};
+  if (!InFilterRange(w0.v.hi)) return false;
+  BoundedDd value;
+  if (n == 2) {
+    const BoundedDd len = PlusDd(TimesDd(d[0][0], d[0][0]), TimesDd(d[0][1], d[0][1]));
+    const BoundedDd t = PlusDd(len, lifted_weight[0], true);
+    const BoundedDd four_len = {DoubleDouble{Mul(len.v.hi, 4.0), Mul(len.v.lo, 4.0)}, Mul(len.e, 4.0)};
+    if (!(Mul(four_len.e, 2.0) < four_len.v.hi)) return false;
+    value = PlusDd(OverDd(TimesDd(t, t), four_len), w0, true);
+  } else {
+    const BoundedDd wb = PlusDd(PlusDd(TimesDd(d[0][0], d[0][0]), TimesDd(d[0][1], d[0][1])), lifted_weight[0], true);
+    const BoundedDd wc = PlusDd(PlusDd(TimesDd(d[1][0], d[1][0]), TimesDd(d[1][1], d[1][1])), lifted_weight[1], true);
+    const BoundedDd area = PlusDd(TimesDd(d[0][0], d[1][1]), TimesDd(d[0][1], d[1][0]), true);
+    const BoundedDd cx = PlusDd(TimesDd(wb, d[1][1]), TimesDd(wc, d[0][1]), true);
+    const BoundedDd cy = PlusDd(TimesDd(wc, d[0][0]), TimesDd(wb, d[1][0]), true);
+    const BoundedDd num = PlusDd(TimesDd(cx, cx), TimesDd(cy, cy));
+    const BoundedDd square = TimesDd(area, area);
+    const BoundedDd den = {DoubleDouble{Mul(square.v.hi, 4.0), Mul(square.v.lo, 4.0)}, Mul(square.e, 4.0)};
+    if (!InFilterRange(area.v.hi) || !(Mul(den.e, 2.0) < den.v.hi)) return false;
+    value = PlusDd(OverDd(num, den), w0, true);
+  }
+  if (!InFilterRange(value.v.hi) || value.v.hi == 0.0) return false;
+  // Unscale: exact for h, which must be normal; l and the bound may lose bits below 2^-1074, which
+  // the 2^-1060 added to the bound covers (half an ulp of h is at least 2^-953).
+  const int unscaled_exponent = ExponentOf(value.v.hi) - 2 * s;
+  if (unscaled_exponent < -900 || unscaled_exponent > 1000) return false;
+  const double h = ldexp(value.v.hi, -2 * s);
+  const double l = ldexp(value.v.lo, -2 * s);
+  const double err = Add(Mul(ldexp(value.e, -2 * s), 1.0 + 0x1p-40), 0x1p-1060);
+  // h is the nearest double when the enclosure stays strictly inside h's rounding interval.
+  const double up = Mul(Sub(radius_detail::NextUp(Abs(h)), Abs(h)), 0.5);
+  const double down = Mul(Sub(Abs(h), radius_detail::NextDown(Abs(h))), 0.5);
+  const double above = h > 0.0 ? up : down, below = h > 0.0 ? down : up;  // toward +inf and -inf
+  if (!(Add(l, err) < above && Sub(l, err) > -below)) return false;
+  *out = h;
+  return true;
 }
 
 /// The refined key (radius_refined.hpp, its certified error and its separation test extended to

@@ -43,7 +43,8 @@ std::string Show(const WeightedSimplex& s) {
 /// ties everywhere); "equal": grid cells with one weight; "nudged": grid with coordinates or
 /// weights moved by an ulp; "random": uniform coordinates and weights up to the squared spacing;
 /// "heavy": weights 1e6 times the squared spacing, nearly equal; "light": weights 1e-9 of it;
-/// "offset": coordinates near 1e9 with unit spacing; "negative": weights well below zero.
+/// "offset": coordinates near 1e9 with unit spacing; "negative": weights well below zero; "tiny":
+/// coordinates near 2^-900 (squared radii below the smallest double).
 std::vector<WeightedSimplex> Family(const std::string& name, int count, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<int> small(-4, 4), weight(-3, 3), coin(0, 1), ulps(-2, 2);
@@ -62,6 +63,9 @@ std::vector<WeightedSimplex> Family(const std::string& name, int count, uint64_t
           }
           if (s.w[i] != 0.0 && coin(rng)) s.w[i] = std::nextafter(s.w[i], 10.0);
         }
+      } else if (name == "tiny") {  // rho^2 far below the smallest double: it rounds to 0
+        s.p[i] = {std::ldexp(unit(rng), -900), std::ldexp(unit(rng), -900)};
+        s.w[i] = 0.0;
       } else if (name == "offset") {
         s.p[i] = {1e9 + static_cast<double>(small(rng)) + unit(rng), 1e9 + static_cast<double>(small(rng))};
         s.w[i] = unit(rng);
@@ -81,8 +85,8 @@ std::vector<WeightedSimplex> Family(const std::string& name, int count, uint64_t
 }
 
 const std::vector<std::string>& FamilyNames() {
-  static const std::vector<std::string> names = {"grid",  "equal", "nudged", "random",
-                                                 "heavy", "light", "offset", "negative"};
+  static const std::vector<std::string> names = {"grid",  "equal",  "nudged",   "random", "heavy",
+                                                 "light", "offset", "negative", "tiny"};
   return names;
 }
 
@@ -151,6 +155,34 @@ TEST(WeightedRadius, KeysOrderCertifiedValues) {
   }
 }
 
+TEST(WeightedRadius, FloatingFilterBoundsItsError) {
+  int filtered = 0, certified = 0;
+  for (const std::string& name : FamilyNames()) {
+    for (const WeightedSimplex& s : Family(name, 600, 17)) {
+      weighted_detail::Bounded value;
+      int scale = 0;
+      if (!weighted_detail::FilteredWeightedRadiusSq(s.p, s.w, s.n, &value, &scale)) continue;
+      ++filtered;
+      const std::optional<mpq_class> exact = Exact(s);
+      ASSERT_TRUE(exact.has_value()) << "a collinear triangle passed the filter: " << Show(s);
+      // |exact * 2^(2s) - v| <= e, in rationals.
+      mpq_class scaled = *exact;
+      mpz_class power = 1;
+      mpz_mul_2exp(power.get_mpz_t(), power.get_mpz_t(), static_cast<unsigned long>(std::abs(2 * scale)));
+      if (scale >= 0) {
+        scaled *= mpq_class(power);
+      } else {
+        scaled /= mpq_class(power);
+      }
+      const mpq_class error = abs(scaled - mpq_class(value.v));
+      ASSERT_LE(error, mpq_class(value.e) * mpq_class(1.0 + 0x1p-40)) << name << " " << Show(s);
+      certified += value.v != 0.0 && value.e <= std::abs(value.v) * 0x1p-42 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(filtered, 3000);
+  EXPECT_GT(certified, 2500);  // the filter decides most keys
+}
+
 TEST(WeightedRadius, BoundedComparisonIsExact) {
   int decided = 0, ties = 0;
   for (const std::string& name : FamilyNames()) {
@@ -196,6 +228,22 @@ TEST(WeightedRadius, NearestDoubleIsCorrectlyRounded) {
     }
   }
   EXPECT_GT(rounded, 3000);
+}
+
+TEST(WeightedRadius, FastNearestDoubleIsCorrectlyRoundedWhereItDecides) {
+  int decided = 0, total = 0;
+  for (const std::string& name : FamilyNames()) {
+    for (const WeightedSimplex& s : Family(name, 1500, 71)) {
+      ++total;
+      double got = 0.0;
+      if (!NearestWeightedRadiusSqFast(s.p, s.w, s.n, &got)) continue;
+      ++decided;
+      const std::optional<mpq_class> exact = Exact(s);
+      ASSERT_TRUE(exact.has_value()) << Show(s);
+      ASSERT_EQ(got, NearestDouble(*exact)) << name << " " << Show(s);
+    }
+  }
+  EXPECT_GT(decided, total * 3 / 4);  // most values: the exact loop is the exception
 }
 
 TEST(WeightedRadius, RefinedKeysAndSortWordsOrderSeparatedValues) {

@@ -1,7 +1,8 @@
 // The CUDA and CPU backends build identical families: the same spectrum (bit for bit), the same
 // ranks and intervals for every triangle and edge (named by their vertices, so that the test does
 // not depend on the order in which each backend emits them), the same vertex intervals, the same
-// master list rank by rank, the same component and hole curves, the same persistence pairs. Skipped without a GPU; run
+// master list rank by rank, the same component and hole curves, the same persistence pairs; for
+// unweighted and weighted families (the same hidden points too). Skipped without a GPU; run
 // on one by bench/gpu_run.sh test.
 #include <algorithm>
 #include <array>
@@ -19,6 +20,7 @@
 #include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
+#include "tests/support/weight_generators.hpp"
 
 namespace galpha {
 namespace {
@@ -77,17 +79,23 @@ std::vector<std::tuple<uint32_t, uint32_t, uint32_t, Simplex, Simplex>> Persiste
   return out;
 }
 
-void ExpectIdentical(const std::vector<Point2>& points, const std::string& where) {
+/// `weights` empty: the unweighted family; else the weighted one.
+void ExpectIdentical(const std::vector<Point2>& points, const std::string& where,
+                     const std::vector<double>& weights = {}) {
   BuildOptions cpu_options, cuda_options;
   cpu_options.backend = Backend::kCpu;
   cuda_options.backend = Backend::kCuda;
-  absl::StatusOr<AlphaFamily> cpu = BuildAlphaFamily(points, cpu_options);
-  absl::StatusOr<AlphaFamily> cuda = BuildAlphaFamily(points, cuda_options);
+  auto build = [&](const BuildOptions& options) {
+    return weights.empty() ? BuildAlphaFamily(points, options) : BuildWeightedAlphaFamily(points, weights, options);
+  };
+  absl::StatusOr<AlphaFamily> cpu = build(cpu_options);
+  absl::StatusOr<AlphaFamily> cuda = build(cuda_options);
   ASSERT_THAT(cpu, IsOk()) << where;
   ASSERT_THAT(cuda, IsOk()) << where;
   ASSERT_EQ(cuda->report().backend, "cuda");
   ASSERT_EQ(cpu->spectrum(), cuda->spectrum()) << where;
   ASSERT_EQ(cpu->representative(), cuda->representative()) << where;
+  ASSERT_EQ(cpu->HiddenPoints(), cuda->HiddenPoints()) << where;
   ASSERT_EQ(Intervals(*cpu), Intervals(*cuda)) << where;
   ASSERT_EQ(cpu->ranks().vertex_mu_low, cuda->ranks().vertex_mu_low) << where;
   ASSERT_EQ(cpu->ranks().vertex_mu_high, cuda->ranks().vertex_mu_high) << where;
@@ -124,6 +132,32 @@ TEST(AlphaBackendIdentityTest, EveryGenerator) {
       ExpectIdentical(generator->generate(n, 3), std::string(name) + " n=" + std::to_string(n));
       if (HasFatalFailure()) return;
     }
+  }
+}
+
+TEST(AlphaBackendIdentityTest, WeightedFamilies) {
+  if (!CudaBackendAvailable()) GTEST_SKIP() << "no GPU";
+  for (const char* name : {"uniform", "gaussian", "clustered", "grid", "circle", "two_lines", "parallel_lines",
+                           "with_duplicates", "huge_offset_1e9", "ulp_lattice", "lidar_cm"}) {
+    const gen::NamedGenerator* generator = gen::FindDistribution(name);
+    ASSERT_NE(generator, nullptr) << name;
+    for (const std::string& kind : gen::WeightKinds()) {
+      for (size_t n : {size_t{1000}, size_t{100000}}) {
+        const std::vector<Point2> points = generator->generate(n, 5);
+        ExpectIdentical(points, std::string(name) + " " + kind + " n=" + std::to_string(n),
+                        gen::Weights(kind, points, 6));
+        if (HasFatalFailure()) return;
+      }
+    }
+  }
+  // The molecule with its atoms' radii, and with a water probe's.
+  absl::StatusOr<GeoreferencedPoints> atoms = ReadWeightedPointsFile(testdata::DataDir() + "/pdb_2xhe_radii.txt");
+  ASSERT_THAT(atoms, IsOk());
+  for (const double probe : {0.0, 1.4}) {
+    std::vector<double> weights;
+    for (const double r : atoms->weights) weights.push_back((r + probe) * (r + probe));
+    ExpectIdentical(atoms->points, "2XHE probe " + std::to_string(probe), weights);
+    if (HasFatalFailure()) return;
   }
 }
 
