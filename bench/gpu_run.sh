@@ -78,6 +78,21 @@ for phase in "${phases[@]}"; do
         --gtest_filter='Backends/RegularTest.*/cuda'
       grep -E '^\| [a-z_]+ \| [0-9]+ \| cuda|weights |ERROR SUMMARY' "$out/regular.log"
       ;;
+    weighted)
+      # Weighted families (issue 18) against CGAL's weighted Alpha_shape_2, each beside the same
+      # points unweighted (the table's last column); then 10M, every weight kind, and memcheck.
+      run_step weighted 420 .carry/bin/alpha_bench --backend=cuda --sizes=1000000 \
+        --dists=uniform,gaussian,clustered,grid --repeat=3 --weights=uniform
+      for w in zero signed many_hidden one_huge integers; do
+        run_step weighted 200 .carry/bin/alpha_bench --backend=cuda --sizes=1000000 --dists=uniform --repeat=3 \
+          --cgal-max=0 --weights=$w
+      done
+      run_step weighted 200 .carry/bin/alpha_bench --backend=cuda --sizes=10000000 --dists=uniform --repeat=2 \
+        --cgal-max=0 --weights=uniform
+      run_step weighted 300 compute-sanitizer --tool memcheck --error-exitcode 9 .carry/bin/weighted_family_cgal_test \
+        --gtest_filter='*KnownShape/cuda:*ManySmall*/cuda'
+      grep -E '^\| [a-z_]+ \| [0-9]+ \| (cuda|[0-9.]+ \|)|weights |ERROR SUMMARY|x \(' "$out/weighted.log"
+      ;;
     sanitize)
       small=data/ourairports_medium_large.bin
       for tool in memcheck racecheck synccheck; do
@@ -89,8 +104,8 @@ for phase in "${phases[@]}"; do
       grep -E "ERROR SUMMARY|RACECHECK SUMMARY|Invalid|Race" "$out/sanitize.log" | sort | uniq -c | head -n 20
       ;;
     test)
-      for t in predicates_test predicates_device_test power_test radius_test triangulation_checks_test delaunay_test regular_test regular_cgal_test \
-               delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test persistence_gudhi_test alpha_backend_identity_test; do
+      for t in predicates_test predicates_device_test power_test radius_test weighted_radius_test triangulation_checks_test delaunay_test regular_test regular_cgal_test \
+               delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test weighted_family_cgal_test persistence_gudhi_test alpha_backend_identity_test; do
         [ -x ".carry/bin/$t" ] || continue
         # One process per test, so that a hang names its test and the rest still run.
         for name in $(".carry/bin/$t" --gtest_list_tests | awk '/^[^ ]/{suite=$1} /^  /{print suite $1}'); do

@@ -83,6 +83,8 @@ const char kUsage[] =
     "                              radius (squared here, the weight) or its squared radius, which may\n"
     "                              be negative: the third field of text, the third column of .npy,\n"
     "                              weighted .bin, or a GeoJSON property (--weight-property NAME)\n"
+    "  --probe R                   with --weights radius: every radius grows by R before squaring\n"
+    "                              (1.4 angstrom, a water probe: solvent-accessible disks)\n"
     "  -h, --help                  this text\n"
     "Options take their value as '--name VALUE' or '--name=VALUE'; '--' ends the options.\n"
     "--mode: general keeps singular simplices, regularized only what bounds or fills triangles.\n"
@@ -108,8 +110,8 @@ const char kUsage[] =
 static_assert(kDefaultMaxPoints == 100000000 && kMaxPoints == 1073741824 && kDefaultMaxLineBytes == 65536,
               "update kUsage");
 
-const absl::string_view kGlobalOptions[11] = {"backend", "server", "tls-ca", "encoding", "max-points",     "layer",
-                                              "crs",     "plane",  "slab",   "weights",  "weight-property"};
+const absl::string_view kGlobalOptions[12] = {"backend", "server", "tls-ca", "encoding", "max-points",      "layer",
+                                              "crs",     "plane",  "slab",   "weights",  "weight-property", "probe"};
 
 namespace {
 

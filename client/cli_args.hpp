@@ -26,7 +26,7 @@ extern const char kUsage[];
 
 /// The options that apply to every command, accepted before the command too (as git's and
 /// kubectl's are): --backend, --server, --tls-ca, --encoding, --max-points, --layer.
-extern const absl::string_view kGlobalOptions[11];
+extern const absl::string_view kGlobalOptions[12];
 
 /// The command line split at its command.
 struct Invocation {

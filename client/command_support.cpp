@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <iterator>
@@ -8,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
@@ -109,6 +111,17 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
       return absl::InvalidArgumentError(
           "--weights builds weighted families locally: the Build stream does not carry weights (yet)");
     }
+  }
+  if (const std::string* probe = line->Find("probe")) {
+    if (common.input.weights != InputOptions::Weights::kRadius) {
+      return absl::InvalidArgumentError("--probe grows radii: it needs --weights radius");
+    }
+    double value = 0.0;
+    if (!absl::SimpleAtod(*probe, &value) || !std::isfinite(value) || value < 0.0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--probe is a radius, a finite number >= 0 (1.4 for water), not '", *probe, "'"));
+    }
+    common.input.probe = value;
   }
   if (const std::string* property = line->Find("weight-property")) {
     if (property->empty()) return absl::InvalidArgumentError("--weight-property needs a property's name");

@@ -332,8 +332,10 @@ absl::StatusOr<GeoreferencedPoints> ReadInputPointsAndCrs(const std::string& fil
               "point ", i, " has a negative radius (", r,
               "); radii must be >= 0 (--weights squared reads the values as squared radii, which may be negative)"));
         }
-        // The weight is the double nearest r^2; a radius of 2^500 or more has no weight in the domain.
-        weighted.weights[i] = r * r;
+        // The weight is the double nearest (r + probe)^2, r + probe rounded first (--probe); a
+        // radius of 2^500 or more has no weight in the domain.
+        const double grown = r + options.probe;
+        weighted.weights[i] = grown * grown;
         if (std::isfinite(r) && !(weighted.weights[i] < 0x1p1000)) {
           return absl::InvalidArgumentError(
               absl::StrCat("point ", i, " has a radius of ", r, ": radii must be below 2^500 (~3.27e150)"));

@@ -58,6 +58,9 @@ struct InputOptions {
   Weights weights = Weights::kNone;
   /// The GeoJSON feature property that holds the weights (--weight-property; GeoJSON only).
   std::string weight_property;
+  /// With kRadius: added to every radius before squaring (--probe: a solvent probe's radius, 1.4
+  /// angstrom for water, turns van der Waals disks into solvent-accessible ones). >= 0.
+  double probe = 0.0;
 };
 
 /// Reads the points of `file`, or of standard input when `file` is "-", as the header comment

@@ -20,6 +20,7 @@ namespace {
 
 // Changes whenever the meaning of a handle changes, so that old handles stop matching.
 constexpr char kDomainTag[] = "galpha.v2.points";
+constexpr char kWeightedDomainTag[] = "galpha.v2.weighted-points";
 constexpr size_t kDigestBytes = 32;
 
 /// SHA-256 of the concatenation of `parts`. Allocation failure of the 200-byte context is the
@@ -38,11 +39,9 @@ void Sha256(std::initializer_list<std::pair<const void*, size_t>> parts, unsigne
   EVP_MD_CTX_free(context);
 }
 
-}  // namespace
-
-std::string PointSetHandle(absl::Span<const Point2> points) {
-  const auto* bytes = reinterpret_cast<const unsigned char*>(points.data());
-  const uint64_t total = points.size() * sizeof(Point2);
+/// The handle's tree over `total` bytes under `tag` (with its NUL).
+template <size_t kTagBytes>
+std::string TreeHandle(const unsigned char* bytes, uint64_t total, const char (&tag)[kTagBytes]) {
   const int64_t num_leaves = static_cast<int64_t>((total + kHandleLeafBytes - 1) / kHandleLeafBytes);
   std::vector<unsigned char> leaves(static_cast<size_t>(num_leaves) * kDigestBytes);
   const unsigned char leaf_prefix = 0;
@@ -54,7 +53,7 @@ std::string PointSetHandle(absl::Span<const Point2> points) {
     Sha256({{&leaf_prefix, 1}, {bytes + begin, size}}, &leaves[static_cast<size_t>(i) * kDigestBytes]);
   }
   unsigned char root[kDigestBytes];
-  Sha256({{kDomainTag, sizeof(kDomainTag)}, {&total, sizeof(total)}, {leaves.data(), leaves.size()}}, root);
+  Sha256({{tag, kTagBytes}, {&total, sizeof(total)}, {leaves.data(), leaves.size()}}, root);
   static constexpr char kHex[] = "0123456789abcdef";
   std::string handle = "sha256-";
   for (unsigned char b : root) {
@@ -62,6 +61,23 @@ std::string PointSetHandle(absl::Span<const Point2> points) {
     handle += kHex[b & 15];
   }
   return handle;
+}
+
+}  // namespace
+
+std::string PointSetHandle(absl::Span<const Point2> points) {
+  return TreeHandle(reinterpret_cast<const unsigned char*>(points.data()), points.size() * sizeof(Point2), kDomainTag);
+}
+
+std::string WeightedPointSetHandle(absl::Span<const Point2> points, absl::Span<const double> weights) {
+  std::vector<double> triples(3 * points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    triples[3 * i] = points[i].x;
+    triples[3 * i + 1] = points[i].y;
+    triples[3 * i + 2] = i < weights.size() ? weights[i] : 0.0;
+  }
+  return TreeHandle(reinterpret_cast<const unsigned char*>(triples.data()), triples.size() * sizeof(double),
+                    kWeightedDomainTag);
 }
 
 bool IsWellFormedHandle(const std::string& handle) {

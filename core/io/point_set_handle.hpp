@@ -28,6 +28,11 @@ inline constexpr size_t kHandleLeafBytes = size_t{1} << 20;
 /// The handle of a whole point set: "sha256-" and 64 lowercase hex digits.
 std::string PointSetHandle(absl::Span<const Point2> points);
 
+/// The handle of a weighted point set (a weighted family, issue 18): the same tree over the
+/// triples (x0, y0, w0, x1, y1, w1, ...) under the tag "galpha.v2.weighted-points", so that it
+/// covers the weights and never equals an unweighted handle. `weights` holds one per point.
+std::string WeightedPointSetHandle(absl::Span<const Point2> points, absl::Span<const double> weights);
+
 /// Whether `handle` has the form PointSetHandle produces ("sha256-" + 64 lowercase hex digits).
 bool IsWellFormedHandle(const std::string& handle);
 

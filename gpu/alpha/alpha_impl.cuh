@@ -203,11 +203,15 @@ HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, 
   family->edges.resize(mesh.num_edges);
   family->representative.resize(mesh.n);
   family->num_unique = t.num_unique;
-  HostMesh<System> host{
-      sys.DownloadAsync({{family->triangles.data(), t.tri.data(), size_t{mesh.num_tri} * sizeof(TriIdx)},
-                         {family->edges.data(), t.edges.data(), size_t{mesh.num_edges} * sizeof(EdgeIdx)},
-                         {family->representative.data(), t.representative.data(), size_t{mesh.n} * sizeof(uint32_t)}}),
-      AlphaInput{}};
+  std::vector<HostCopy> copies = {
+      {family->triangles.data(), t.tri.data(), size_t{mesh.num_tri} * sizeof(TriIdx)},
+      {family->edges.data(), t.edges.data(), size_t{mesh.num_edges} * sizeof(EdgeIdx)},
+      {family->representative.data(), t.representative.data(), size_t{mesh.n} * sizeof(uint32_t)}};
+  if (mesh.hidden != nullptr) {  // weighted: the flags HiddenVertices put through the representatives
+    family->hidden.resize(mesh.n);
+    copies.push_back({family->hidden.data(), mesh.hidden, size_t{mesh.n}});
+  }
+  HostMesh<System> host{sys.DownloadAsync(std::move(copies)), AlphaInput{}};
   host.input.points = host_points;
   host.input.weights = host_weights;
   host.input.triangles = family->triangles.data();
@@ -217,19 +221,18 @@ HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, 
 }
 
 /// Weighted: every input point's hidden flag through its representative (a duplicate of a hidden
-/// point is hidden) into the family, and the number of distinct points that are vertices.
+/// point is hidden), in place in the triangulation's flags (safe: a representative's own flag is
+/// never rewritten with another value), and the number of distinct points that are vertices. The
+/// flags then go to the family with the mesh (StartMeshDownload).
 template <class System>
-void HiddenVertices(System& sys, PipelineMesh& mesh, FamilyOutput* family) {
+void HiddenVertices(System& sys, SystemTriangulation<System>& t, PipelineMesh& mesh) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
-  Buffer<uint8_t, System> hidden(sys, mesh.n);
-  thrust::transform(policy, zero, zero + mesh.n, hidden.data(),
+  thrust::transform(policy, zero, zero + mesh.n, t.hidden.data(),
                     HiddenThroughRepresentative{mesh.representative, mesh.hidden});
   mesh.num_vertices =
-      mesh.num_unique - static_cast<uint32_t>(thrust::count_if(
-                            policy, zero, zero + mesh.n, HiddenRepresentative{mesh.representative, hidden.data()}));
-  family->hidden.resize(mesh.n);
-  sys.Download({{family->hidden.data(), hidden.data(), size_t{mesh.n}}});
+      mesh.num_unique - static_cast<uint32_t>(thrust::count_if(policy, zero, zero + mesh.n,
+                                                               HiddenRepresentative{mesh.representative, mesh.hidden}));
 }
 
 /// Edge topology: the incident triangles of every edge (none for a collinear chain). The
@@ -790,8 +793,8 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
                       FamilyOutput* family) {
   AlphaRanks* out = &family->ranks;
   PipelineMesh mesh = PipelineMeshOf(t);
+  if (mesh.weights != nullptr) HiddenVertices(sys, t, mesh);
   HostMesh<System> host_mesh = StartMeshDownload(sys, t, mesh, host_points, host_weights, family);
-  if (mesh.weights != nullptr) HiddenVertices(sys, mesh, family);
   Buffer<EdgeTris, System> edge_tris = EdgeTriangles(sys, mesh, &t);
   timer.EndStage("edge_topology");
   SimplexKeys<System> keys = KeySimplices(sys, mesh, edge_tris, host_mesh);

@@ -47,6 +47,26 @@ PointArray AsPointArray(const py::object& points) {
   return array;
 }
 
+using WeightArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// Weights as a 1-D float64 array of `n` values (forcecast, as the points).
+WeightArray AsWeightArray(const py::object& weights, size_t n) {
+  WeightArray array = WeightArray::ensure(weights);
+  if (!array) {
+    PyErr_Clear();
+    throw StatusError(absl::InvalidArgumentError(
+        absl::StrCat("weights must be an (N,) array of numbers, got ", std::string(py::str(py::type::of(weights))))));
+  }
+  if (array.ndim() != 1 || static_cast<size_t>(array.shape(0)) != n) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < array.ndim(); ++d) absl::StrAppend(&shape, d ? ", " : "", array.shape(d));
+    absl::StrAppend(&shape, array.ndim() == 1 ? ",)" : ")");
+    throw StatusError(
+        absl::InvalidArgumentError(absl::StrCat("weights must have shape (", n, ",): one per point, got ", shape)));
+  }
+  return array;
+}
+
 absl::Span<const Point2> PointsOf(const PointArray& array) {
   return {reinterpret_cast<const Point2*>(array.data()), static_cast<size_t>(array.shape(0))};
 }
@@ -93,10 +113,17 @@ py::array_t<double> PointsArray(const std::vector<Point2>& points) {
 
 }  // namespace
 
-std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const std::string& backend,
-                                               const py::object& progress, const std::string& name) {
+std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const py::object& weights,
+                                               const std::string& backend, const py::object& progress,
+                                               const std::string& name) {
   const PointArray array = AsPointArray(points);
   const absl::Span<const Point2> span = PointsOf(array);
+  WeightArray weight_array;
+  absl::Span<const double> weight_span;
+  if (!weights.is_none()) {
+    weight_array = AsWeightArray(weights, span.size());
+    weight_span = {weight_array.data(), static_cast<size_t>(weight_array.shape(0))};
+  }
   if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
     throw StatusError(absl::InvalidArgumentError("progress must be None or a callable (phase, fraction)"));
   }
@@ -126,7 +153,8 @@ std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const s
   std::optional<absl::StatusOr<AlphaFamily>> built;
   {
     py::gil_scoped_release release;
-    built.emplace(BuildAlphaFamily(span, options));
+    built.emplace(weights.is_none() ? BuildAlphaFamily(span, options)
+                                    : BuildWeightedAlphaFamily(span, weight_span, options));
   }
   if (callbacks.error) throw std::move(*callbacks.error);
   return std::make_shared<const FamilyState>(ValueOrThrow(*std::move(built)), name);

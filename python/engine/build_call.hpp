@@ -13,12 +13,14 @@
 namespace galpha::python {
 
 /// Builds the family of `points` (anything NumPy turns into an (N, 2) float64 array) on `backend`
-/// ("auto", "cpu" or "cuda"), labelled `name`. `progress`, when not None, is called as
+/// ("auto", "cpu" or "cuda"), labelled `name`; with `weights` (None, or N numbers: each point's
+/// squared radius) the weighted family. `progress`, when not None, is called as
 /// progress(phase, fraction) after each engine phase, with the GIL. Between phases the build
 /// checks for signals: Ctrl-C (or any exception from `progress`) stops it, frees what it held and
 /// raises that exception. Engine errors raise EngineError.
-std::shared_ptr<const FamilyState> BuildFamily(const pybind11::object& points, const std::string& backend,
-                                               const pybind11::object& progress, const std::string& name);
+std::shared_ptr<const FamilyState> BuildFamily(const pybind11::object& points, const pybind11::object& weights,
+                                               const std::string& backend, const pybind11::object& progress,
+                                               const std::string& name);
 
 /// The content handle of `points` (core/io/point_set_handle.hpp), hashed with the GIL released.
 std::string HandleOf(const pybind11::object& points);

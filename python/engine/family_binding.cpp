@@ -73,6 +73,8 @@ py::dict SummaryDict(const FamilyState& state) {
   summary["triangles"] = family.triangles().size();
   summary["edges"] = family.edges().size();
   summary["spectrum_size"] = family.spectrum().size();
+  summary["weighted"] = family.weighted();
+  summary["hidden_points"] = family.HiddenPoints().size();
   summary["backend"] = report.backend;
   summary["stage_times"] = stage_times;
   summary["comparisons"] = comparisons;
@@ -177,6 +179,15 @@ void RegisterFamily(py::module_& module) {
             return state->Handle();
           },
           "The content handle of the family's points: 'sha256-' and 64 hex digits.")
+      .def(
+          "hidden_points",
+          [](const FamilyObject& self) {
+            std::vector<uint32_t> hidden = self.state()->family().HiddenPoints();
+            const auto n = static_cast<py::ssize_t>(hidden.size());
+            return ArrayFromVector(std::move(hidden), {n});
+          },
+          "Input indices of the points a weighted family hides (no vertex of the regular triangulation), "
+          "ascending, as uint32; empty for an unweighted family.")
       .def(
           "summary", [](const FamilyObject& self) { return SummaryDict(*self.state()); },
           "What the build produced and measured: a dict with the fields of galpha.BuildSummary but 'cached'.")

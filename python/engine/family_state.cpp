@@ -13,7 +13,10 @@ FamilyState::FamilyState(AlphaFamily family, std::string name) : family_(std::mo
 }
 
 const std::string& FamilyState::Handle() const {
-  std::call_once(handle_once_, [this] { handle_ = PointSetHandle(family_.points()); });
+  std::call_once(handle_once_, [this] {
+    handle_ = family_.weighted() ? WeightedPointSetHandle(family_.points(), family_.weights())
+                                 : PointSetHandle(family_.points());
+  });
   return handle_;
 }
 

@@ -25,7 +25,8 @@ class FamilyState {
   /// not, as the service charges its cache, so that the figure never changes).
   size_t bytes() const { return bytes_; }
 
-  /// The content handle of the family's points (core/io/point_set_handle.hpp), computed once.
+  /// The content handle of the family's points (core/io/point_set_handle.hpp; of the points and
+  /// their weights for a weighted family), computed once.
   const std::string& Handle() const;
 
   /// Input indices of the distinct points (each first occurrence), ascending.

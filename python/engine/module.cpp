@@ -17,13 +17,16 @@ PYBIND11_MODULE(_engine, module) {
   galpha::python::RegisterFamily(module);
   module.def(
       "build",
-      [](const py::object& points, const std::string& backend, const py::object& progress, const std::string& name) {
-        return galpha::python::FamilyObject(galpha::python::BuildFamily(points, backend, progress, name));
+      [](const py::object& points, const std::string& backend, const py::object& progress, const std::string& name,
+         const py::object& weights) {
+        return galpha::python::FamilyObject(galpha::python::BuildFamily(points, weights, backend, progress, name));
       },
       py::arg("points"), py::arg("backend") = "auto", py::arg("progress") = py::none(), py::arg("name") = "",
+      py::arg("weights") = py::none(),
       "Builds the exact alpha family of an (N, 2) float64 array (used without a copy when C-contiguous) on "
-      "backend 'auto', 'cpu' or 'cuda', with the GIL released. progress(phase, fraction) is called after each "
-      "phase; Ctrl-C or an exception in progress stops the build between phases and is raised.");
+      "backend 'auto', 'cpu' or 'cuda', with the GIL released; with weights (N numbers, squared radii) the "
+      "weighted family. progress(phase, fraction) is called after each phase; Ctrl-C or an exception in "
+      "progress stops the build between phases and is raised.");
   module.def("handle", &galpha::python::HandleOf, py::arg("points"),
              "The content handle of an (N, 2) float64 array, as the server and the C++ client compute it.");
   module.def("frame", &galpha::python::FrameOf, py::arg("crs"), py::arg("points"),

@@ -197,6 +197,18 @@ TEST(AlphactlTest, BuildsWeightedFamilies) {
   // The hidden point is EXTERIOR at every threshold, and named in classify's output as such.
   const std::string classes = Succeeds("classify", path, "--rank 3 --backend=cpu --weights squared");
   EXPECT_NE(classes.find("v 4 EXTERIOR\n"), std::string::npos) << classes;
+  // --probe grows every radius before squaring: a water probe covers the hidden point too.
+  const std::string radii = WriteFile("alphactl_radii.csv", "x,y,r\n0,0,1\n2,0,1\n1,1.75,1\n1,0.6,0.7\n");
+  const nlohmann::json plain =
+      nlohmann::json::parse(Succeeds("summary", radii, "--rank 0 --backend=cpu --weights radius"));
+  const nlohmann::json grown =
+      nlohmann::json::parse(Succeeds("summary", radii, "--rank 0 --backend=cpu --weights radius --probe 1.4"));
+  EXPECT_EQ(plain["alpha_sq"], -1.0);  // minus the largest weight, 1^2
+  EXPECT_EQ(grown["alpha_sq"], -(2.4 * 2.4));
+  ExpectError(Alphactl("summary " + Quote(radii) + " --rank 0 --weights squared --probe 1.4"), 2,
+              "needs --weights radius");
+  ExpectError(Alphactl("summary " + Quote(radii) + " --rank 0 --weights radius --probe -1"), 2, "finite number >= 0");
+  std::filesystem::remove(radii);
   // Unweighted summaries say so.
   EXPECT_TRUE(nlohmann::json::parse(Succeeds("summary", path, "--rank 0 --backend=cpu"))["hidden_points"].is_null());
   std::filesystem::remove(path);
@@ -251,7 +263,8 @@ TEST(AlphactlTest, HelpListsEveryCommandAndOption) {
                            "--min-hole-area",
                            "text|csv|json|svg",
                            "--weights radius|squared",
-                           "--weight-property"}) {
+                           "--weight-property",
+                           "--probe"}) {
     EXPECT_NE(help.out.find(word), std::string::npos) << word;
   }
   const CommandResult none = Alphactl("");

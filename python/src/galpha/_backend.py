@@ -64,5 +64,8 @@ class FamilyBackend(Protocol):
     def persistence(self, dimensions: Tuple[int, ...], min_persistence: float) -> PersistenceDiagram:
         """The dimensions (a non-empty tuple of 0 and 1, checked by the caller); the others empty."""
 
+    def hidden_points(self) -> np.ndarray:
+        """Input indices (uint32, ascending) of the points a weighted family hides; empty otherwise."""
+
     def release(self) -> bool:
         """Frees the family (network: drops it from the server's cache); True when it was held."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Optional, Protocol, Union
 
+import numpy as np
 
 
 from ._encoding import check_encoding
@@ -23,7 +24,14 @@ PROGRESS_BAR_MIN_POINTS = 100_000
 
 class Client(Protocol):
     def build(
-        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+        self,
+        points: Any,
+        *,
+        name: str = "",
+        progress: Progress = None,
+        encoding: str = "auto",
+        crs: Any = None,
+        weights: Any = None,
     ) -> Family: ...
 
     def close(self) -> None: ...
@@ -86,9 +94,19 @@ class NetworkClient:
         return f"<galpha.NetworkClient {self.target}>"
 
     def build(
-        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+        self,
+        points: Any,
+        *,
+        name: str = "",
+        progress: Progress = None,
+        encoding: str = "auto",
+        crs: Any = None,
+        weights: Any = None,
     ) -> Family:
         """Uploads the points (unless the server already holds them) and returns their family.
+
+        ``weights``: must be None: the server builds unweighted families (its Build stream carries
+        no weights yet); weighted families are built by :func:`galpha.local`.
 
         ``crs``: the CRS of the coordinates ("EPSG:4326", an EPSG code, a pyproj CRS; "none" for
         planar ones), by default a GeoSeries' or GeoDataFrame's own. A geographic CRS is computed
@@ -102,6 +120,8 @@ class NetworkClient:
         points"). Either way the server builds the same family under the same handle.
         """
         encoding = check_encoding(encoding)
+        if weights is not None:
+            raise InvalidInput("weights: the server builds unweighted families; build weighted ones with galpha.local()")
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
         callback, close = progress_callback(progress, len(array))
@@ -157,17 +177,43 @@ class LocalClient:
         return f"<galpha.LocalClient backend={self.backend}>"
 
     def build(
-        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+        self,
+        points: Any,
+        *,
+        name: str = "",
+        progress: Progress = None,
+        encoding: str = "auto",
+        crs: Any = None,
+        weights: Any = None,
     ) -> Family:
         """Builds the family in this process (the GIL is released while the engine runs).
         ``encoding`` ("auto" or "raw") is checked and ignored: nothing is uploaded, and code can
-        switch between the clients unchanged. ``crs`` as :meth:`NetworkClient.build` takes it."""
+        switch between the clients unchanged. ``crs`` as :meth:`NetworkClient.build` takes it.
+
+        ``weights``: one squared radius per point (an atom of radius r weighs r**2; negative
+        values are valid) builds the weighted family: the alpha shapes of the disks, over their
+        regular triangulation; points it hides are EXTERIOR at every threshold
+        (:attr:`Family.hidden_points`). Weights are squared lengths in the coordinates' units, so
+        a geographic CRS is refused with them."""
         check_encoding(encoding)
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
+        weight_array = None
+        if weights is not None:
+            weight_array = np.ascontiguousarray(np.asarray(weights, dtype=np.float64))
+            if weight_array.shape != (len(array),):
+                raise InvalidInput(
+                    f"weights must have shape ({len(array)},): one per point, got {weight_array.shape}"
+                )
+            if frame.projection is not None:
+                raise InvalidInput(
+                    "weights need planar coordinates: the CRS is geographic (project the points and radii first)"
+                )
         callback, close = progress_callback(progress, len(array))
         try:
-            backend = self._local.build_local(frame.computed, self.backend, callback, name=name)
+            backend = self._local.build_local(
+                frame.computed, self.backend, callback, name=name, weights=weight_array
+            )
         finally:
             if close is not None:
                 close()

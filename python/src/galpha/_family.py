@@ -273,6 +273,12 @@ class Family:
         return self._backend.summary()
 
     @property
+    def hidden_points(self) -> np.ndarray:
+        """Input indices (uint32, ascending) of the points a weighted family hides: no vertex of
+        the regular triangulation, EXTERIOR at every threshold. Empty for an unweighted family."""
+        return self._backend.hidden_points()
+
+    @property
     def spectrum_size(self) -> int:
         """K: the number of distinct thresholds; ranks run 0..K."""
         return self._backend.summary().spectrum_size

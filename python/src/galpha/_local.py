@@ -179,16 +179,26 @@ class LocalFamilyBackend:
         h0, h1 = self._family.persistence([int(d) for d in dimensions], float(min_persistence))
         return PersistenceDiagram(h0=_pairs(0, h0), h1=_pairs(1, h1))
 
+    @_translated
+    def hidden_points(self) -> np.ndarray:
+        return self._family.hidden_points()
+
     def release(self) -> bool:
         return self._family.release()
 
 
 @_translated
 def build_local(
-    points: np.ndarray, backend: str, progress: Optional[Callable[[str, float], None]], *, name: str = ""
+    points: np.ndarray,
+    backend: str,
+    progress: Optional[Callable[[str, float], None]],
+    *,
+    name: str = "",
+    weights: Optional[np.ndarray] = None,
 ) -> LocalFamilyBackend:
     """Builds the family of ``points`` (an (N, 2) float64 C-contiguous array, used without a copy)
-    on ``backend`` ("auto", "cpu" or "cuda"). ``progress(phase, fraction)`` is called after each
-    engine phase. Ctrl-C stops the build between phases (KeyboardInterrupt), as does an exception
-    raised by ``progress`` (re-raised here)."""
-    return LocalFamilyBackend(_engine.build(points, backend, progress, name))
+    on ``backend`` ("auto", "cpu" or "cuda"); with ``weights`` (N squared radii) the weighted
+    family. ``progress(phase, fraction)`` is called after each engine phase. Ctrl-C stops the
+    build between phases (KeyboardInterrupt), as does an exception raised by ``progress``
+    (re-raised here)."""
+    return LocalFamilyBackend(_engine.build(points, backend, progress, name, weights))

@@ -523,6 +523,9 @@ class NetworkFamilyBackend:
         request = persistence_request(self._handle, dimensions, min_persistence)
         return persistence_from(self._stream(self._calls.persistence, request))
 
+    def hidden_points(self) -> np.ndarray:
+        return np.empty(0, dtype=np.uint32)  # servers build unweighted families
+
     def release(self) -> bool:
         return self._call(self._calls.release, pb.ReleaseRequest(handle=self._handle)).released
 

@@ -116,6 +116,11 @@ class BuildSummary:
     #: Bytes of the point messages this call uploaded (protobuf encoding, without gRPC's framing;
     #: raw doubles are 16 a point): 0 when nothing was uploaded (a family the server held, the local engine).
     upload_bytes: int = 0
+    #: A weighted family (built with ``weights=``: the regular triangulation's alpha shapes).
+    weighted: bool = False
+    #: Points a weighted family hides (no vertex of the regular triangulation; EXTERIOR at every
+    #: threshold): :attr:`Family.hidden_points` lists them. 0 when unweighted.
+    hidden_points: int = 0
 
 
 @dataclasses.dataclass(frozen=True)

@@ -286,13 +286,22 @@ class AsyncClient:
         await self._channel.close()
 
     async def build(
-        self, points: Any, *, name: str = "", progress: Progress = None, encoding: str = "auto", crs: Any = None
+        self,
+        points: Any,
+        *,
+        name: str = "",
+        progress: Progress = None,
+        encoding: str = "auto",
+        crs: Any = None,
+        weights: Any = None,
     ) -> AsyncFamily:
         """Uploads the points (unless the server holds them) and awaits the build. Cancelling the
         task cancels the upload; the server then drops what it had received. ``encoding``: "auto"
         or "raw", and ``crs``, as :meth:`galpha.NetworkClient.build` takes them (chunks are encoded
         off the event loop, in its default executor)."""
         encoding = check_encoding(encoding)
+        if weights is not None:
+            raise InvalidInput("weights: the server builds unweighted families; build weighted ones with galpha.local()")
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
         computed = frame.computed

@@ -25,18 +25,22 @@ std::vector<unsigned char> Digest(const std::vector<unsigned char>& bytes) {
   return digest;
 }
 
-std::string DocumentedHandle(const std::vector<Point2>& points) {
-  std::vector<unsigned char> coordinates(points.size() * 16);
+/// The documented tree; with `weights`, over (x, y, w) triples under the weighted tag.
+std::string DocumentedHandle(const std::vector<Point2>& points, const std::vector<double>* weights = nullptr) {
+  const size_t per_point = weights != nullptr ? 3 : 2;
+  std::vector<unsigned char> coordinates(points.size() * 8 * per_point);
   for (size_t i = 0; i < points.size(); ++i) {
-    // Little-endian IEEE doubles, x then y, written out byte by byte.
-    for (int axis = 0; axis < 2; ++axis) {
+    // Little-endian IEEE doubles, x then y (then w), written out byte by byte.
+    for (size_t axis = 0; axis < per_point; ++axis) {
       uint64_t bits;
-      const double value = axis == 0 ? points[i].x : points[i].y;
+      const double value = axis == 0 ? points[i].x : (axis == 1 ? points[i].y : (*weights)[i]);
       std::memcpy(&bits, &value, 8);
-      for (int b = 0; b < 8; ++b) coordinates[16 * i + 8 * axis + b] = static_cast<unsigned char>(bits >> (8 * b));
+      for (int b = 0; b < 8; ++b) {
+        coordinates[8 * per_point * i + 8 * axis + b] = static_cast<unsigned char>(bits >> (8 * b));
+      }
     }
   }
-  const std::string tag = "galpha.v2.points";
+  const std::string tag = weights != nullptr ? "galpha.v2.weighted-points" : "galpha.v2.points";
   std::vector<unsigned char> root(tag.begin(), tag.end());
   root.push_back(0);
   const uint64_t total = coordinates.size();
@@ -71,6 +75,21 @@ TEST(PointSetHandleTest, FollowsTheDocumentedHashTree) {
     const std::string handle = PointSetHandle(points);
     EXPECT_EQ(handle, DocumentedHandle(points)) << n << " points";
     EXPECT_TRUE(IsWellFormedHandle(handle));
+  }
+}
+
+TEST(PointSetHandleTest, WeightedHandlesCoverTheWeights) {
+  for (size_t n : {size_t{0}, size_t{5}, kHandleLeafBytes / 24 + 3}) {
+    const std::vector<Point2> points = Points(n);
+    std::vector<double> weights(n);
+    for (size_t i = 0; i < n; ++i) weights[i] = 0.25 * static_cast<double>(i % 13);
+    const std::string handle = WeightedPointSetHandle(points, weights);
+    EXPECT_EQ(handle, DocumentedHandle(points, &weights)) << n << " points";
+    EXPECT_NE(handle, PointSetHandle(points));  // never an unweighted family's
+    if (n == 0) continue;
+    std::vector<double> changed = weights;
+    changed.back() = std::nextafter(changed.back(), 10.0);
+    EXPECT_NE(WeightedPointSetHandle(points, changed), handle);
   }
 }
 

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -89,6 +90,26 @@ void CompareAtLevel(const AlphaFamily& f, const CgalWeightedAlphaOracle& oracle,
   const auto interior =
       static_cast<size_t>(std::count(got.triangles.begin(), got.triangles.end(), SimplexClass::kInterior));
   EXPECT_EQ(interior, expected.interior_triangles) << where << " level " << level;
+  // The component curve against a union-find over the complex CGAL classified (its vertices
+  // joined by its edges that are not EXTERIOR): hidden points are in no component.
+  std::map<uint32_t, uint32_t> parent;
+  for (const auto& [v, cls] : expected.vertices) {
+    if (cls != OracleClass::kExterior) parent[v] = v;
+  }
+  auto find = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  size_t components = parent.size();
+  for (const auto& [edge, cls] : expected.edges) {
+    if (cls == OracleClass::kExterior) continue;
+    const uint32_t a = find(edge.first), b = find(edge.second);
+    if (a != b) {
+      parent[a] = b;
+      --components;
+    }
+  }
+  EXPECT_EQ(f.Components(level), components) << where << " level " << level;
 }
 
 /// Returns whether the two triangulations were the same (full comparison made).
