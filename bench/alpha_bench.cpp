@@ -22,7 +22,9 @@
 // backend the engine's device peak is printed too.
 // GCC 12 flags a copy inside CGAL's Weighted_point_2 (a boost tuple, through Epeck's static
 // filters) as maybe-uninitialized at -O3; the warning is CGAL's, not this file's.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 #include <CGAL/Alpha_shape_2.h>
 #include <CGAL/Alpha_shape_face_base_2.h>

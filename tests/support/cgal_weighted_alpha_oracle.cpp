@@ -18,7 +18,9 @@
 
 // GCC 12 flags a copy inside CGAL's Weighted_point_2 (a boost tuple, through Epeck's static
 // filters) as maybe-uninitialized at -O3; the warning is CGAL's, not this file's.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 #include <CGAL/Alpha_shape_2.h>
 #include <CGAL/Alpha_shape_face_base_2.h>
@@ -92,6 +94,7 @@ struct CgalWeightedAlphaOracle::Impl {
   void Build(const std::vector<std::pair<Kernel::Weighted_point_2, uint32_t>>& input) {
     regular.clear();
     std::vector<std::pair<Kernel::Weighted_point_2, uint32_t>> shifted;
+    shifted.reserve(input.size());
     for (const auto& [wp, index] : input) {
       shifted.emplace_back(Kernel::Weighted_point_2(wp.point(), wp.weight() + shift), index);
     }

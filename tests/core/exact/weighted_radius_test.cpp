@@ -137,6 +137,7 @@ TEST(WeightedRadius, KeysOrderCertifiedValues) {
   for (const std::string& name : FamilyNames()) {
     const std::vector<WeightedSimplex> simplices = Family(name, 180, 11);
     std::vector<RadiusSqApprox> keys;
+    keys.reserve(simplices.size());
     for (const WeightedSimplex& s : simplices) keys.push_back(ApproxWeightedRadiusSq(s.p, s.w, s.n));
     for (size_t i = 0; i < simplices.size(); ++i) {
       if (!keys[i].certified) continue;
@@ -250,6 +251,7 @@ TEST(WeightedRadius, RefinedKeysAndSortWordsOrderSeparatedValues) {
   for (const std::string& name : FamilyNames()) {
     const std::vector<WeightedSimplex> simplices = Family(name, 140, 41);
     std::vector<RefinedRadiusSq> keys;
+    keys.reserve(simplices.size());
     for (const WeightedSimplex& s : simplices) keys.push_back(RefineWeightedRadiusSq(s.p, s.w, s.n));
     for (size_t i = 0; i < simplices.size(); ++i) {
       for (size_t j = 0; j < simplices.size(); ++j) {
