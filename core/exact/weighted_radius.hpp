@@ -97,7 +97,8 @@ GALPHA_HD inline bool WeightedScaleFor(const WeightedRange& range, int degree, i
     e = ew > e ? ew : e;
   }
   *s = kWeightedScaleTop - e;
-  return degree * (range.lowest_bit + *s) >= -960;
+  // ScaleByPow2 scales weights by 2^(2s) and needs 2s >= -1022 (in the input domain 2s >= -822).
+  return 2 * *s >= -1022 && degree * (range.lowest_bit + *s) >= -960;
 }
 
 /// w * 2^(2s) (exact: the scale check keeps it normal), or w1 - w0 scaled, as an expansion.
@@ -196,9 +197,12 @@ GALPHA_HD inline bool WeightedExactTerms(const Point2* p, const double* w, int n
 namespace weighted_detail {
 
 /// The exact terms of one weighted simplex at its own scale (degree: what the caller multiplies).
-GALPHA_HD inline bool OwnTerms(const Point2* p, const double* w, int n, int degree, ExactRadiusTerms* terms, int* s) {
+/// `lowest_bit` (optional) receives the range's lowest bit (see WeightedRange).
+GALPHA_HD inline bool OwnTerms(const Point2* p, const double* w, int n, int degree, ExactRadiusTerms* terms, int* s,
+                               int* lowest_bit = nullptr) {
   WeightedRange range;
   AddToRange(p, w, n, &range);
+  if (lowest_bit != nullptr) *lowest_bit = range.lowest_bit;
   return WeightedScaleFor(range, degree, s) && WeightedExactTerms(p, w, n, *s, terms);
 }
 
@@ -299,11 +303,13 @@ GALPHA_HD inline bool FilteredWeightedRadiusSq(const Point2* p, const double* w,
     if (!InFilterRange(d[k][0].v) || !InFilterRange(d[k][1].v) || !InFilterRange(lifted_weight[k].v)) return false;
   }
   Bounded value;
+  // Every intermediate must stay where the bounds hold (zero or normal, within 2^+-400): a value
+  // that cancelled into the subnormal range would have lost more than its u-relative bound.
   if (n == 2) {
     const Bounded len = Plus(Times(d[0][0], d[0][0]), Times(d[0][1], d[0][1]));
     const Bounded t = Minus(len, lifted_weight[0]);
     const Bounded four_len = {Mul(len.v, 4.0), Mul(len.e, 4.0)};
-    if (!(four_len.e < Abs(four_len.v))) return false;
+    if (!InFilterRange(len.v) || !InFilterRange(t.v) || !(four_len.e < Abs(four_len.v))) return false;
     value = Minus(Over(Times(t, t), four_len), w0);
   } else {
     const Bounded wb = Minus(Plus(Times(d[0][0], d[0][0]), Times(d[0][1], d[0][1])), lifted_weight[0]);
@@ -314,7 +320,11 @@ GALPHA_HD inline bool FilteredWeightedRadiusSq(const Point2* p, const double* w,
     const Bounded num = Plus(Times(cx, cx), Times(cy, cy));
     const Bounded square = Times(area, area);
     const Bounded den = {Mul(square.v, 4.0), Mul(square.e, 4.0)};
-    if (!InFilterRange(area.v) || !(den.e < Abs(den.v))) return false;
+    const double intermediates[7] = {wb.v, wc.v, area.v, cx.v, cy.v, num.v, square.v};
+    for (const double v : intermediates) {
+      if (!InFilterRange(v)) return false;
+    }
+    if (!(den.e < Abs(den.v))) return false;
     value = Minus(Over(num, den), w0);
   }
   if (!InFilterRange(value.v) || !(value.e < 0x1p400)) return false;
@@ -413,7 +423,8 @@ GALPHA_HD inline bool NearestWeightedRadiusSqBounded(const Point2* p, const doub
   radius_detail::ExactRadiusTerms t;
   int s = 0;
   // Degree of Num (6) plus the two of the candidate m (a value times 2^(2s)) in Num - 4 m Den.
-  if (!OwnTerms(p, w, n, 10, &t, &s)) return false;
+  int lowest_bit = 0;
+  if (!OwnTerms(p, w, n, 10, &t, &s, &lowest_bit)) return false;
   if (t.denn == 0) {
     *out = BitsToDouble(uint64_t{0x7ff} << 52);
     return true;
@@ -442,7 +453,9 @@ GALPHA_HD inline bool NearestWeightedRadiusSqBounded(const Point2* p, const doub
     c = Add(refined.hi, refined.mid);  // in [1, 2]
     shift = refined.exponent + 2 * s;
   }
-  if (shift > 700 || shift < -700) return false;
+  // The candidate m carries a 53-bit significand, not a lattice value: its products with Den's
+  // components (multiples of 2^(4 (lowest_bit + s))) are exact only above 2^-1074.
+  if (shift > 700 || shift < -700 || shift - 53 + 4 * (lowest_bit + s) < -1074) return false;
   const double scale = Pow2(shift);
   for (int iteration = 0; iteration < 8; ++iteration) {
     const double up = Mul(Sub(radius_detail::NextUp(c), c), 0.5);
@@ -542,11 +555,14 @@ GALPHA_HD inline bool NearestWeightedRadiusSqFast(const Point2* p, const double*
   const BoundedDd w0 = {DoubleDouble{ScaleByPow2(w[0], 2 * s), 0.0}, 0.0};
   if (!InFilterRange(w0.v.hi)) return false;
   BoundedDd value;
+  // Intermediates in range, as in FilteredWeightedRadiusSq (a tail below 2^-400 is not checked:
+  // DoubleDouble's bounds are relative to the his, and his in range keep the tails' errors inside
+  // them up to 2^-1074 absolute, which the 2^-1060 of the final bound covers).
   if (n == 2) {
     const BoundedDd len = PlusDd(TimesDd(d[0][0], d[0][0]), TimesDd(d[0][1], d[0][1]));
     const BoundedDd t = PlusDd(len, lifted_weight[0], true);
     const BoundedDd four_len = {DoubleDouble{Mul(len.v.hi, 4.0), Mul(len.v.lo, 4.0)}, Mul(len.e, 4.0)};
-    if (!(Mul(four_len.e, 2.0) < four_len.v.hi)) return false;
+    if (!InFilterRange(len.v.hi) || !InFilterRange(t.v.hi) || !(Mul(four_len.e, 2.0) < four_len.v.hi)) return false;
     value = PlusDd(OverDd(TimesDd(t, t), four_len), w0, true);
   } else {
     const BoundedDd wb = PlusDd(PlusDd(TimesDd(d[0][0], d[0][0]), TimesDd(d[0][1], d[0][1])), lifted_weight[0], true);
@@ -557,7 +573,11 @@ GALPHA_HD inline bool NearestWeightedRadiusSqFast(const Point2* p, const double*
     const BoundedDd num = PlusDd(TimesDd(cx, cx), TimesDd(cy, cy));
     const BoundedDd square = TimesDd(area, area);
     const BoundedDd den = {DoubleDouble{Mul(square.v.hi, 4.0), Mul(square.v.lo, 4.0)}, Mul(square.e, 4.0)};
-    if (!InFilterRange(area.v.hi) || !(Mul(den.e, 2.0) < den.v.hi)) return false;
+    const double intermediates[7] = {wb.v.hi, wc.v.hi, area.v.hi, cx.v.hi, cy.v.hi, num.v.hi, square.v.hi};
+    for (const double v : intermediates) {
+      if (!InFilterRange(v)) return false;
+    }
+    if (!(Mul(den.e, 2.0) < den.v.hi)) return false;
     value = PlusDd(OverDd(num, den), w0, true);
   }
   if (!InFilterRange(value.v.hi) || value.v.hi == 0.0) return false;
@@ -606,8 +626,8 @@ GALPHA_HD inline RefinedRadiusSq RefineWeightedRadiusSq(const Point2* p, const d
   return out;
 }
 
-/// E of the module comment for edge pq and the third vertex r, scaled, as an expansion (0 when
-/// the buffers do not suffice: the caller then cannot decide and must not use the result).
+/// E of the module comment for edge pq and the third vertex r, scaled, as an expansion into
+/// out[0..*outn); false when the scale's range or the buffers do not suffice (undecided).
 GALPHA_HD inline bool WeightedAttachmentExpansion(Point2 p, Point2 q, Point2 r, double wp, double wq, double wr,
                                                   double* out, int* outn) {
   using namespace weighted_detail;

@@ -38,7 +38,8 @@ AlphaFamily::AlphaFamily(AlphaFamilyParts parts) : parts_(std::move(parts)) {
     }
     if (worst != kNeverRank) solid_level_ = worst;
   }
-  if (weighted()) min_alpha_sq_ = -*std::max_element(parts_.weights.begin(), parts_.weights.end());
+  // 0.0 - w, not -w: with a largest weight of 0 the bound is +0, as unweighted (-w would be -0).
+  if (weighted()) min_alpha_sq_ = 0.0 - *std::max_element(parts_.weights.begin(), parts_.weights.end());
 }
 
 std::vector<uint32_t> AlphaFamily::HiddenPoints() const {

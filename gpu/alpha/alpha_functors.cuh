@@ -156,11 +156,15 @@ struct HasFlag {
   GALPHA_HD bool operator()(uint8_t v) const { return (v & flag) != 0; }
 };
 
-/// Weighted: an input point's hidden flag, read through its representative.
+/// Weighted: a duplicate takes its representative's hidden flag (the triangulation marks
+/// representatives only); representatives are left alone, so that no flag is both read and written.
 struct HiddenThroughRepresentative {
   const uint32_t* representative;
-  const uint8_t* hidden;  // as the triangulation marks it: on representatives
-  GALPHA_HD uint8_t operator()(uint32_t i) const { return hidden[representative[i]]; }
+  uint8_t* hidden;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const uint32_t r = representative[i];
+    if (r != i) hidden[i] = hidden[r];
+  }
 };
 
 /// Weighted: a distinct point (its own representative) that is hidden.

@@ -221,15 +221,14 @@ HostMesh<System> StartMeshDownload(System& sys, SystemTriangulation<System>& t, 
 }
 
 /// Weighted: every input point's hidden flag through its representative (a duplicate of a hidden
-/// point is hidden), in place in the triangulation's flags (safe: a representative's own flag is
-/// never rewritten with another value), and the number of distinct points that are vertices. The
-/// flags then go to the family with the mesh (StartMeshDownload).
+/// point is hidden), in place in the triangulation's flags (only duplicates are written, and they
+/// read representatives' flags, which nobody writes), and the number of distinct points that are
+/// vertices. The flags then go to the family with the mesh (StartMeshDownload).
 template <class System>
 void HiddenVertices(System& sys, SystemTriangulation<System>& t, PipelineMesh& mesh) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
-  thrust::transform(policy, zero, zero + mesh.n, t.hidden.data(),
-                    HiddenThroughRepresentative{mesh.representative, mesh.hidden});
+  thrust::for_each_n(policy, zero, mesh.n, HiddenThroughRepresentative{mesh.representative, t.hidden.data()});
   mesh.num_vertices =
       mesh.num_unique - static_cast<uint32_t>(thrust::count_if(policy, zero, zero + mesh.n,
                                                                HiddenRepresentative{mesh.representative, mesh.hidden}));
