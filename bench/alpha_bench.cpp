@@ -335,18 +335,9 @@ int Main(int argc, char** argv) {
   // --weights is this benchmark's own; the shared parser gets the rest.
   std::string weight_kind;
   std::vector<char*> args;
-  for (int i = 0; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg.rfind("--weights=", 0) == 0) {
-      weight_kind = arg.substr(10);
-      const std::vector<std::string> kinds = gen::WeightKinds();
-      if (std::find(kinds.begin(), kinds.end(), weight_kind) == kinds.end()) {
-        std::fprintf(stderr, "unknown --weights kind '%s'\n%s", weight_kind.c_str(), kUsage);
-        return 2;
-      }
-    } else {
-      args.push_back(argv[i]);
-    }
+  if (const absl::Status taken = TakeWeightsOption(argc, argv, &weight_kind, &args); !taken.ok()) {
+    std::fprintf(stderr, "%s\n%s", std::string(taken.message()).c_str(), kUsage);
+    return 2;
   }
   const absl::StatusOr<BenchOptions> options = ParseBenchArgs(static_cast<int>(args.size()), args.data(), "--cgal-max");
   if (!options.ok()) {

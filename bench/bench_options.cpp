@@ -1,10 +1,13 @@
 #include "bench/bench_options.hpp"
 
+#include <algorithm>
+
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "core/io/point_formats.hpp"
 #include "tests/support/point_generators.hpp"
+#include "tests/support/weight_generators.hpp"
 
 namespace galpha {
 
@@ -77,6 +80,23 @@ absl::Status ForEachBenchInput(
     if (!points.ok()) return points.status();
     const size_t slash = file.find_last_of('/');
     run(slash == std::string::npos ? file : file.substr(slash + 1), *points);
+  }
+  return absl::OkStatus();
+}
+
+absl::Status TakeWeightsOption(int argc, char** argv, std::string* kind, std::vector<char*>* rest) {
+  kind->clear();
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--weights=", 0) != 0) {
+      rest->push_back(argv[i]);
+      continue;
+    }
+    *kind = arg.substr(10);
+    const std::vector<std::string> kinds = gen::WeightKinds();
+    if (std::find(kinds.begin(), kinds.end(), *kind) == kinds.end()) {
+      return absl::InvalidArgumentError(absl::StrCat("unknown --weights kind '", *kind, "'"));
+    }
   }
   return absl::OkStatus();
 }

@@ -32,6 +32,11 @@ struct BenchOptions {
 /// --sizes/--dists, only the files run.
 absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, const char* competitor_max_flag);
 
+/// Takes --weights=KIND (a kind of tests/support/weight_generators.hpp) out of argv, for the
+/// benchmarks that build weighted inputs: the kind ("" without the flag) into *kind, every other
+/// argument into *rest (ParseBenchArgs parses them). InvalidArgument for an unknown kind.
+absl::Status TakeWeightsOption(int argc, char** argv, std::string* kind, std::vector<char*>* rest);
+
 /// Calls `run` with every input the options name: each distribution at each size (generated with
 /// the seed), then each data file (named by its file name). An error reading a file stops there.
 absl::Status ForEachBenchInput(

@@ -36,6 +36,8 @@
 #include <tuple>
 #include <type_traits>
 
+#include "tests/support/cgal_oracle_classes.hpp"
+
 namespace galpha::testing {
 namespace {
 
@@ -62,25 +64,9 @@ using FT = AlphaShape::FT;
 
 mpq_class ToMpq(const FT& value) { return ExactToMpq(CGAL::exact(value)); }
 
-OracleClass FromCgal(AlphaShape::Classification_type type) {
-  switch (type) {
-    case AlphaShape::EXTERIOR:
-      return OracleClass::kExterior;
-    case AlphaShape::SINGULAR:
-      return OracleClass::kSingular;
-    case AlphaShape::REGULAR:
-      return OracleClass::kRegular;
-    case AlphaShape::INTERIOR:
-      return OracleClass::kInterior;
-  }
-  return OracleClass::kExterior;
-}
+OracleClass FromCgal(AlphaShape::Classification_type type) { return OracleClassOf<AlphaShape>(type); }
 
-std::pair<uint32_t, uint32_t> EdgeKey(const AlphaShape::Edge& edge) {
-  const uint32_t a = edge.first->vertex(AlphaShape::cw(edge.second))->info();
-  const uint32_t b = edge.first->vertex(AlphaShape::ccw(edge.second))->info();
-  return {std::min(a, b), std::max(a, b)};
-}
+std::pair<uint32_t, uint32_t> EdgeKey(const AlphaShape::Edge& edge) { return EdgeKeyOf<AlphaShape>(edge); }
 
 }  // namespace
 
