@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/exact/order.hpp"
+#include "core/exact/radius_compare.hpp"
 #include "core/exact/radius_rational.hpp"
 #include "core/exact/refined_sort_words.hpp"
 #include "core/exact/simplex_radius.hpp"
@@ -100,8 +101,17 @@ TEST(WeightedRadius, ZeroWeightsGiveTheUnweightedValue) {
     ASSERT_EQ(weighted.has_value(), plain.has_value());
     if (weighted) {
       EXPECT_EQ(*weighted, *plain) << Show(s);
-      // The bounded comparison of the weighted terms agrees with the unweighted value.
-      EXPECT_EQ(CompareWeightedRadiusSqBounded(s.p, s.w, s.n, s.p, s.w, s.n), Order::kEqual);
+      // The weighted expansions and keys give the unweighted answers: the same nearest double,
+      // and the same order against an unweighted simplex's value (compared through its own
+      // zero-weight terms with a weight-free path: the unweighted bounded comparison).
+      double nearest = 0.0;
+      ASSERT_TRUE(NearestWeightedRadiusSqBounded(s.p, s.w, s.n, &nearest)) << Show(s);
+      EXPECT_EQ(nearest, NearestDouble(*plain)) << Show(s);
+      const Point2 unit_edge[2] = {{0.0, 0.0}, {0.5, 0.25}};
+      const double zero[2] = {0.0, 0.0};
+      EXPECT_EQ(CompareWeightedRadiusSqBounded(s.p, s.w, s.n, unit_edge, zero, 2),
+                CompareRadiusSqBounded(s.p, s.n, unit_edge, 2))
+          << Show(s);
     }
   }
 }
