@@ -107,10 +107,6 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
       return absl::InvalidArgumentError(
           absl::StrCat("--weights is radius or squared (what the third value of a point is), not '", *weights, "'"));
     }
-    if (!common.server.empty()) {
-      return absl::InvalidArgumentError(
-          "--weights builds weighted families locally: the Build stream does not carry weights (yet)");
-    }
   }
   if (const std::string* probe = line->Find("probe")) {
     if (common.input.weights != InputOptions::Weights::kRadius) {

@@ -11,6 +11,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -77,6 +78,7 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
   client::BuildCallOptions options;
   options.name = common.file;
   options.skip_upload_if_cached = skip_upload_if_cached;
+  options.weights = frame->weights;  // with --weights: the weighted family
   if (common.raw_upload) options.encoding = client::PointEncoding::kRaw;
   const bool verbose = points->size() >= kProgressMinPoints;
   const auto start = std::chrono::steady_clock::now();
@@ -161,6 +163,53 @@ std::array<uint64_t, 4> FromProto(const v1::ClassCounts& counts) {
   return {counts.exterior(), counts.singular(), counts.regular(), counts.interior()};
 }
 
+/// A weighted family's hidden points (input indices, ascending), as the local summary lists them;
+/// null for an unweighted family. The server counts them (BuildSummary.hidden_points) and
+/// Classify at rank 0 reports them as its EXTERIOR vertices, first occurrences only: their
+/// duplicates (equal coordinates) are found among FILE's points. Classify stops after the
+/// vertices.
+absl::StatusOr<nlohmann::ordered_json> RemoteHiddenPoints(const RemoteFamily& remote) {
+  const v1::BuildSummary& build = remote.build.summary;
+  if (!build.weighted()) return nullptr;
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  if (build.hidden_points() == 0) return list;
+  v1::ClassifyRequest request;
+  request.set_handle(remote.build.handle);
+  request.mutable_threshold()->set_rank(0);
+  const std::vector<Point2>& points = remote.frame.Computed();
+  // Compared as values (-0.0 equals 0.0), as the engine finds duplicates.
+  std::set<std::pair<double, double>> hidden_at;
+  bool past_vertices = false;
+  absl::Status status = remote.client->Classify(request, [&](const v1::ClassifyResponse& message) {
+    if (!message.has_chunk()) return absl::OkStatus();
+    const v1::SimplexChunk& chunk = message.chunk();
+    if (chunk.kind() != v1::SIMPLEX_KIND_VERTEX) {
+      past_vertices = true;
+      return absl::CancelledError("the vertices are all here");  // ends the stream
+    }
+    if (static_cast<size_t>(chunk.vertex_indices_size()) != chunk.classes().size()) {
+      return absl::DataLossError("a Classify chunk's indices and classes disagree in length");
+    }
+    for (size_t i = 0; i < chunk.classes().size(); ++i) {
+      if (static_cast<unsigned char>(chunk.classes()[i]) != v1::SIMPLEX_CLASS_EXTERIOR) continue;
+      const uint32_t v = chunk.vertex_indices(static_cast<int>(i));
+      if (v >= points.size())
+        return absl::DataLossError(absl::StrCat("Classify names vertex ", v, " of ", points.size()));
+      hidden_at.emplace(points[v].x, points[v].y);
+    }
+    return absl::OkStatus();
+  });
+  if (!status.ok() && !past_vertices) return status;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (hidden_at.count({points[i].x, points[i].y}) != 0) list.push_back(i);
+  }
+  if (list.size() != build.hidden_points()) {
+    return absl::DataLossError(absl::StrCat("the server counts ", build.hidden_points(),
+                                            " hidden points; Classify at rank 0 gives ", list.size()));
+  }
+  return list;
+}
+
 }  // namespace
 
 int RemoteSpectrum(const CommonArgs& common) {
@@ -228,12 +277,14 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
     return absl::OkStatus();
   });
   if (!status.ok()) return QueryError(common, status);
+  auto hidden = RemoteHiddenPoints(*remote);
+  if (!hidden.ok()) return QueryError(common, hidden.status());
   const v1::BuildSummary& build = remote->build.summary;
   const nlohmann::ordered_json json = {{"file", common.file},
                                        {"points", remote->input_points},
                                        {"distinct_points", build.distinct_points()},
                                        {"duplicates", build.duplicates()},
-                                       {"hidden_points", nullptr},  // servers build unweighted families
+                                       {"hidden_points", *std::move(hidden)},
                                        {"spectrum_size", build.spectrum_size()},
                                        {"level", summary.level()},
                                        {"alpha_sq", summary.alpha_sq()},
@@ -403,18 +454,20 @@ int RemoteBench(const CommonArgs& common, int64_t repeat) {
   double best_engine = 0.0, best_rpc = 0.0;
   v1::BuildSummary summary;
   // Read once: FILE may be a pipe.
-  std::vector<double> no_weights;  // --weights is refused with --server (ParseCommon)
-  auto points = ReadPoints(common, &no_weights);
+  std::vector<double> weights;  // with --weights: the weighted family is built
+  auto points = ReadPoints(common, &weights);
   if (!points.ok()) return Failure(points.status());
   const size_t input_points = points->size();
+  const std::string handle = weights.empty() ? PointSetHandle(*points) : WeightedPointSetHandle(*points, weights);
   for (int64_t run = 0; run < repeat; ++run) {
     auto connected = ConnectTo(common);
     if (!connected.ok()) return Failure(connected.status());
-    auto released = (*connected)->Release(PointSetHandle(*points));
+    auto released = (*connected)->Release(handle);
     if (!released.ok()) return Failure(ServerError(common, released.status()));
     client::BuildCallOptions options;
     options.name = common.file;
     options.skip_upload_if_cached = false;
+    options.weights = weights;
     if (common.raw_upload) options.encoding = client::PointEncoding::kRaw;
     const auto start = std::chrono::steady_clock::now();
     auto built = (*connected)->Build(*points, options);

@@ -51,42 +51,62 @@ void AlphaClient::PrepareContext(grpc::ClientContext* context, const std::string
 
 namespace {
 
-// One chunk of `points` as `encoding` says, into `message` (its points or encoded_points).
-absl::Status EncodeChunk(absl::Span<const Point2> points, PointEncoding encoding, wire::PointChunkEncoder* encoder,
-                         v1::BuildRequest* message) {
+// One chunk of `points` (and their `weights`, when weighted) as `encoding` says, into `message`
+// (its points or encoded_points).
+absl::Status EncodeChunk(absl::Span<const Point2> points, absl::Span<const double> weights, PointEncoding encoding,
+                         wire::PointChunkEncoder* encoder, v1::BuildRequest* message) {
   if (encoding == PointEncoding::kAuto) {
-    encoder->EncodeSmallest(points, message);
+    encoder->EncodeSmallest(points, weights, message);
     return absl::OkStatus();
   }
   if (encoding == PointEncoding::kRaw) {
-    message->mutable_points()->mutable_coordinates()->Assign(&points[0].x, &points[0].x + 2 * points.size());
+    auto* coordinates = message->mutable_points()->mutable_coordinates();
+    if (weights.empty()) {
+      coordinates->Assign(&points[0].x, &points[0].x + 2 * points.size());
+      return absl::OkStatus();
+    }
+    coordinates->Clear();
+    coordinates->Reserve(static_cast<int>(3 * points.size()));
+    for (size_t i = 0; i < points.size(); ++i) {
+      coordinates->AddAlreadyReserved(points[i].x);
+      coordinates->AddAlreadyReserved(points[i].y);
+      coordinates->AddAlreadyReserved(weights[i]);
+    }
     return absl::OkStatus();
   }
   wire::ChunkEncoding chunk;
   if (encoding != PointEncoding::kFloat64Compressed) {
-    std::optional<wire::ScaledAxes> scaled = wire::FindScaledIntegers(points);
+    std::optional<wire::ScaledAxes> scaled = wire::FindScaledIntegers(points, weights);
     if (!scaled) {
       return absl::InvalidArgumentError(
-          "the points are not exact scaled integers (offset + scale * X or X / 10^k on each axis) in every chunk");
+          absl::StrCat("the points are not exact scaled integers (offset + scale * X or X / 10^k on each axis",
+                       weights.empty() ? "" : ", the weights included", ") in every chunk"));
     }
     chunk.value_type = scaled->value_type;
     chunk.x_scale = scaled->x;
     chunk.y_scale = scaled->y;
+    chunk.w_scale = scaled->w;
   }
   if (encoding != PointEncoding::kScaledIntegers) {
     chunk.compression = v1::POINT_COMPRESSION_ZSTD;
-    chunk.transform = encoder->ChooseTransform(points, chunk);
+    chunk.transform = encoder->ChooseTransform(points, weights, chunk);
   }
-  return encoder->Encode(points, chunk, message->mutable_encoded_points());
+  return encoder->Encode(points, weights, chunk, message->mutable_encoded_points());
 }
 
 }  // namespace
 
 absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, const BuildCallOptions& options) {
   BuildResult result;
+  const absl::Span<const double> weights = options.weights;
+  const bool weighted = !weights.empty();
+  if (weighted && weights.size() != points.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(points.size(), " points need ", points.size(), " weights, not ", weights.size()));
+  }
   // The handle before the upload: to skip it when the server holds the family, and to route the
   // stream to the replica that would hold it.
-  const std::string handle = PointSetHandle(points);
+  const std::string handle = weighted ? WeightedPointSetHandle(points, weights) : PointSetHandle(points);
   // With a CRS the server hashes the projected points: the handle is not known here.
   if (options.skip_upload_if_cached && options.crs.empty()) {
     auto described = Describe(handle);
@@ -109,6 +129,7 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   message.mutable_header()->set_name(options.name);
   message.mutable_header()->set_expected_points(points.size());
   message.mutable_header()->set_crs(options.crs);
+  message.mutable_header()->set_weighted(weighted);
   bool open = writer->Write(message);
   // Chunks are encoded in batches, one thread a chunk (each with its own encoder), then written in
   // order: encoding costs 4-16 ms a 1 MiB chunk on one core, as much as sending it over 1 Gb/s.
@@ -125,7 +146,8 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
     const auto encode = [&](size_t i) {
       const size_t begin = first + i * kPointsPerChunk;
       const size_t count = std::min(kPointsPerChunk, points.size() - begin);
-      statuses[i] = EncodeChunk(points.subspan(begin, count), options.encoding, encoders[i].get(), &messages[i]);
+      statuses[i] = EncodeChunk(points.subspan(begin, count), weighted ? weights.subspan(begin, count) : weights,
+                                options.encoding, encoders[i].get(), &messages[i]);
     };
     std::vector<std::thread> threads;
     for (size_t i = 1; i < chunks; ++i) threads.emplace_back(encode, i);

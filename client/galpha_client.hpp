@@ -78,6 +78,11 @@ struct BuildCallOptions {
   /// BuildHeader.crs: the points' CRS, projected by the server when geographic (empty: planar).
   /// The Describe pre-check is skipped then (the handle is the projected points').
   std::string crs;
+  /// Weighted points (BuildHeader.weighted): one weight per point, the squared radius of its disk
+  /// (finite, possibly negative); empty: unweighted. Not owned: it must outlive the call. The
+  /// handle then covers the weights (WeightedPointSetHandle). InvalidArgument, before anything is
+  /// sent, for a count other than the points'.
+  absl::Span<const double> weights;
 };
 
 /// gRPC status to absl::Status (the codes are the same numbers).

@@ -119,7 +119,8 @@ void BuildReactor::EndOfStream() {
   // A compact entry of these points: they are here, so they are built as uploaded (the cache then
   // drops the entry: a promotion); the frame it kept stays attached, as on a resident hit.
   if (found.compact != nullptr && build_->frame == nullptr) build_->frame = found.compact->frame();
-  const size_t need = build_->points.size() * (kBuildBytesPerPoint + sizeof(Point2));
+  const size_t need =
+      build_->points.size() * (kBuildBytesPerPoint + sizeof(Point2)) + build_->weights.size() * kBuildBytesPerWeight;
   absl::Status submitted = service_->scheduler_->Submit(
       tenant_, need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
   if (!submitted.ok()) Respond(submitted);
@@ -149,7 +150,9 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   const auto deadline = start + std::chrono::duration_cast<Clock::duration>(limit);
   options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
   options.max_exact_comparisons = ExactComparisonLimit(points, service_->options_.exact_comparisons);
-  absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(build_->points, options);
+  absl::StatusOr<AlphaFamily> family = build_->header.weighted()
+                                           ? BuildWeightedAlphaFamily(build_->points, build_->weights, options)
+                                           : BuildAlphaFamily(build_->points, options);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   decoder_.ReleasePoints();
   if (!family.ok()) {

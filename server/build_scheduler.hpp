@@ -19,6 +19,13 @@
 
 namespace galpha::server {
 
+/// What a weighted build needs on top of an unweighted one's estimate, per point: the weight
+/// itself (8 bytes, uploaded and kept by the engine) and the weighted pipeline's larger peak (its
+/// device buffers peaked at up to 657 B/pt on an H100 against 466-537 unweighted, bench/results/
+/// h100_weighted_family_2026-11-27_ninth_final.log), with the same headroom as the unweighted
+/// estimate.
+inline constexpr size_t kBuildBytesPerWeight = 160;
+
 /// What a running job gets: its slot and the slot's CUDA stream (null on the CPU backend).
 struct BuildSlot {
   int index = 0;

@@ -88,6 +88,7 @@ BuildStreamDecoder::~BuildStreamDecoder() {
 
 void BuildStreamDecoder::ReleasePoints() {
   HostVector<Point2>().swap(decoded_.points);
+  HostVector<double>().swap(decoded_.weights);
   if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(tenant_, reserved_);
   reserved_ = 0;
 }
@@ -114,8 +115,12 @@ absl::Status BuildStreamDecoder::CheckPointCount(uint64_t after) const {
   return absl::OkStatus();
 }
 
+size_t BuildStreamDecoder::PointBytes() const {
+  return decoded_.header.weighted() ? sizeof(Point2) + sizeof(double) : sizeof(Point2);
+}
+
 absl::Status BuildStreamDecoder::Grow(uint64_t count) {
-  if (absl::Status s = Reserve(count * sizeof(Point2)); !s.ok()) return s;
+  if (absl::Status s = Reserve(count * PointBytes()); !s.ok()) return s;
   const size_t after = decoded_.points.size() + count;
   if (after > decoded_.points.capacity()) {
     // Capacity grows with the bytes that arrived (doubling, as a vector does, but never past an
@@ -125,8 +130,10 @@ absl::Status BuildStreamDecoder::Grow(uint64_t count) {
     size_t capacity = std::max<size_t>(after, 2 * decoded_.points.capacity());
     if (expected > 0) capacity = std::min<size_t>(capacity, expected);
     decoded_.points.reserve(capacity);
+    if (decoded_.header.weighted()) decoded_.weights.reserve(capacity);
   }
   decoded_.points.resize(after);
+  if (decoded_.header.weighted()) decoded_.weights.resize(after);
   return absl::OkStatus();
 }
 
@@ -153,24 +160,38 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       if (!decoded_.header.crs().empty()) {
         absl::StatusOr<CrsInfo> crs = DescribeCrs(decoded_.header.crs());
         if (!crs.ok()) return absl::InvalidArgumentError(absl::StrCat("the header's crs: ", crs.status().message()));
+        // A weight is a squared length in the units of the coordinates: degrees are none, and the
+        // local projection would change distances without changing the weights.
+        if (decoded_.header.weighted() && crs->geographic) {
+          return absl::InvalidArgumentError(
+              absl::StrCat("the header is weighted and its crs (", crs->name,
+                           ") is geographic: weights need planar coordinates (project the centres and radii first)"));
+        }
       }
       // Nothing is reserved for an announced size (a stream that only announces would hold the
       // budget for nothing): only a size that no limit could ever hold is refused now.
       if (in_flight_ == nullptr) return absl::OkStatus();
       const uint64_t most = std::numeric_limits<uint64_t>::max();
-      return in_flight_->CheckCanEverFit(tenant_, expected > most / sizeof(Point2) ? most : expected * sizeof(Point2));
+      return in_flight_->CheckCanEverFit(tenant_, expected > most / PointBytes() ? most : expected * PointBytes());
     }
     case galpha::v1::BuildRequest::kPoints: {
       if (!has_header_) return absl::InvalidArgumentError("the build stream must start with a header");
       const auto& coordinates = message.points().coordinates();
       const size_t count = static_cast<size_t>(coordinates.size());
       const uint64_t before = decoded_.points.size();
+      const bool weighted = decoded_.header.weighted();
+      const size_t axes = weighted ? 3 : 2;  // doubles a point
       ++chunks_;
-      if (count % 2 != 0) {
+      if (!weighted && count % 2 != 0) {
         return absl::InvalidArgumentError(absl::StrCat("a point chunk holds an odd number of doubles (", count,
                                                        ") after point ", before, ": send x, y pairs"));
       }
-      if (absl::Status s = CheckPointCount(before + count / 2); !s.ok()) return s;
+      if (weighted && count % 3 != 0) {
+        return absl::InvalidArgumentError(absl::StrCat("a point chunk holds ", count,
+                                                       " doubles, not a multiple of 3, after point ", before,
+                                                       ": the header is weighted, send x, y, w triples"));
+      }
+      if (absl::Status s = CheckPointCount(before + count / axes); !s.ok()) return s;
       // One branch-free pass over the chunk (it vectorises); the index only when one is bad.
       const double* values = coordinates.data();
       bool all_finite = true;
@@ -178,12 +199,22 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       if (!all_finite) {
         size_t i = 0;
         while (std::isfinite(values[i])) ++i;
-        return absl::InvalidArgumentError(absl::StrCat("point ", before + i / 2, " has a ",
-                                                       std::isnan(values[i]) ? "NaN" : "infinite", " ",
-                                                       i % 2 == 0 ? "x" : "y", " coordinate"));
+        const size_t axis = i % axes;
+        return absl::InvalidArgumentError(absl::StrCat("point ", before + i / axes, " has a ",
+                                                       std::isnan(values[i]) ? "NaN" : "infinite",
+                                                       axis == 2   ? " weight"
+                                                       : axis == 0 ? " x coordinate"
+                                                                   : " y coordinate"));
       }
-      if (absl::Status s = Grow(count / 2); !s.ok()) return s;
-      if (count > 0) std::memcpy(&decoded_.points[before], coordinates.data(), count * sizeof(double));
+      if (absl::Status s = Grow(count / axes); !s.ok()) return s;
+      if (!weighted) {
+        if (count > 0) std::memcpy(&decoded_.points[before], coordinates.data(), count * sizeof(double));
+        return absl::OkStatus();
+      }
+      for (size_t i = 0; i < count / 3; ++i) {
+        decoded_.points[before + i] = Point2{values[3 * i], values[3 * i + 1]};
+        decoded_.weights[before + i] = values[3 * i + 2];
+      }
       return absl::OkStatus();
     }
     case galpha::v1::BuildRequest::kEncodedPoints: {
@@ -194,17 +225,21 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       // Every limit applies to the decoded points, checked before anything is decompressed: the
       // stated count against the limits, its decoded bytes reserved, then the decoder writes at
       // most that many points.
-      if (absl::Status s = wire::CheckEncodedChunkShape(chunk, at); !s.ok()) return s;
+      const bool weighted = decoded_.header.weighted();
+      if (absl::Status s = wire::CheckEncodedChunkShape(chunk, at, weighted); !s.ok()) return s;
       const uint64_t count = chunk.point_count();
       if (absl::Status s = CheckPointCount(before + count); !s.ok()) return s;
       if (absl::Status s = Grow(count); !s.ok()) return s;
-      absl::Status decoded = chunk_decoder_.Decode(chunk, at, &decoded_.points[before]);
+      absl::Status decoded =
+          weighted ? chunk_decoder_.DecodeWeighted(chunk, at, &decoded_.points[before], &decoded_.weights[before])
+                   : chunk_decoder_.Decode(chunk, at, &decoded_.points[before]);
       if (!decoded.ok()) {
         // A refused chunk adds nothing and holds nothing.
         decoded_.points.resize(before);
+        if (weighted) decoded_.weights.resize(before);
         if (in_flight_ != nullptr) {
-          in_flight_->Release(tenant_, count * sizeof(Point2));
-          reserved_ -= count * sizeof(Point2);
+          in_flight_->Release(tenant_, count * PointBytes());
+          reserved_ -= count * PointBytes();
         }
       }
       return decoded;
@@ -232,7 +267,8 @@ absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
   }
   // Hashed once the points are all here: in parallel (point_set_handle.hpp), ~1 ms at 1M points
   // on 16 cores.
-  decoded_.handle = PointSetHandle(decoded_.points);
+  decoded_.handle = decoded_.header.weighted() ? WeightedPointSetHandle(decoded_.points, decoded_.weights)
+                                               : PointSetHandle(decoded_.points);
   return &decoded_;
 }
 

@@ -65,6 +65,8 @@ struct BuildStreamLimits {
 struct DecodedBuild {
   galpha::v1::BuildHeader header;
   HostVector<Point2> points;  // not zeroed as it grows: every byte is then copied in
+  /// A weighted stream's weights (header.weighted), one per point; empty otherwise.
+  HostVector<double> weights;
   std::string handle;
   /// With a header CRS: the CRS and, for a geographic one, the points as sent (`points` then
   /// holds their local projection, which the handle hashes).
@@ -88,12 +90,13 @@ class BuildStreamDecoder {
   BuildStreamDecoder& operator=(const BuildStreamDecoder&) = delete;
 
   /// One message. InvalidArgument: a chunk before the header, a second header, a name longer than
-  /// kMaxBuildNameBytes, an odd number of coordinates, NaN or infinity (naming the point's index in
-  /// the whole stream), more points than the header announced, a malformed EncodedPointChunk (naming
+  /// kMaxBuildNameBytes, a weighted header with a geographic crs, an odd number of coordinates
+  /// (weighted: not a multiple of 3), NaN or infinity in a coordinate or a weight (naming the
+  /// point's index in the whole stream), more points than the header announced, a malformed EncodedPointChunk (naming
   /// the chunk: wire::PointChunkDecoder::Decode). ResourceExhausted (tagged with its BuildRefusal):
   /// more points than the limit, more bytes in flight than the server's or the tenant's limit (a
   /// header announcing more than a limit could ever hold is refused at once). Every limit counts
-  /// decoded points, 16 bytes each: an encoded chunk's stated count is checked and its decoded bytes
+  /// decoded points, 16 bytes each (24 weighted): an encoded chunk's stated count is checked and its decoded bytes
   /// reserved before it is decompressed.
   absl::Status Add(const galpha::v1::BuildRequest& message);
 
@@ -109,6 +112,8 @@ class BuildStreamDecoder {
 
  private:
   absl::Status Reserve(size_t bytes);
+  // Bytes a decoded point holds: 16, or 24 with its weight.
+  size_t PointBytes() const;
   // The point limits for a stream of `after` points: ResourceExhausted or InvalidArgument.
   absl::Status CheckPointCount(uint64_t after) const;
   // `count` more points at the end of decoded_.points, their bytes reserved first.

@@ -55,7 +55,8 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> FamilyPromoter::Promote(
   if (rebuild->compact == nullptr) return result.get();  // another caller's rebuild
 
   // The rebuild's memory is admitted like an upload's build of the same points.
-  const size_t need = rebuild->compact->points().size() * (bytes_per_point_ + sizeof(Point2));
+  const size_t need = rebuild->compact->points().size() * (bytes_per_point_ + sizeof(Point2)) +
+                      rebuild->compact->weights().size() * kBuildBytesPerWeight;
   absl::Status submitted = scheduler_->Submit(tenant, need, [this, rebuild](const BuildSlot& slot, bool draining) {
     Run(rebuild, slot.cuda_stream, draining);
   });
@@ -84,7 +85,9 @@ void FamilyPromoter::Run(const std::shared_ptr<Rebuild>& rebuild, void* cuda_str
   // No time or comparison limit: these points were built within them once, and the engine is
   // deterministic.
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(compact.points(), options);
+  absl::StatusOr<AlphaFamily> family = compact.weights().empty()
+                                           ? BuildAlphaFamily(compact.points(), options)
+                                           : BuildWeightedAlphaFamily(compact.points(), compact.weights(), options);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!family.ok()) {
     ReturnFreedHeapMemory();

@@ -353,6 +353,8 @@ void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
   summary->set_peak_memory_bytes(report.peak_memory_bytes);
   summary->set_family_bytes(cached.bytes());
   if (const auto frame = cached.Frame()) summary->set_projection(frame->projection);
+  summary->set_weighted(family.weighted());
+  if (family.weighted()) summary->set_hidden_points(family.HiddenPoints().size());
 }
 
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifySource(

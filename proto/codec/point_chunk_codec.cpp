@@ -125,13 +125,14 @@ bool IsPlain(v1::PointTransform transform) {
   return transform == v1::POINT_TRANSFORM_NONE || transform == v1::POINT_TRANSFORM_UNSPECIFIED;
 }
 
-// Interleaved words (x0, y0, x1, y1, ...) to the transform's bytes (the proto's PointTransform).
-// Plane by plane, so that every pass reads and writes memory in order (it vectorises).
+// Interleaved words (x0, y0, x1, y1, ...; weighted x0, y0, w0, ...: `axes` a point) to the
+// transform's bytes (the proto's PointTransform). Plane by plane, so that every pass reads and
+// writes memory in order (it vectorises).
 template <typename Word>
-void TransformWords(const std::vector<Word>& words, v1::PointTransform transform, std::vector<Word>* scratch,
-                    std::string* bytes) {
+void TransformWords(const std::vector<Word>& words, size_t axes, v1::PointTransform transform,
+                    std::vector<Word>* scratch, std::string* bytes) {
   const size_t count = words.size();
-  const size_t n = count / 2;
+  const size_t n = count / axes;
   bytes->resize(count * sizeof(Word));
   auto* out = reinterpret_cast<unsigned char*>(bytes->data());
   if (IsPlain(transform)) {
@@ -140,12 +141,12 @@ void TransformWords(const std::vector<Word>& words, v1::PointTransform transform
   }
   std::vector<Word>& planar = *scratch;
   planar.resize(count);
-  for (size_t axis = 0; axis < 2; ++axis) {
+  for (size_t axis = 0; axis < axes; ++axis) {
     Word previous = 0;
     Word before_previous = 0;
     Word* stored = planar.data() + axis * n;
     for (size_t i = 0; i < n; ++i) {
-      const Word w = words[2 * i + axis];
+      const Word w = words[axes * i + axis];
       stored[i] = transform == v1::POINT_TRANSFORM_BYTE_SHUFFLE
                       ? w
                       : ZigZag<Word>(static_cast<Word>(w - Predict(transform, previous, before_previous)));
@@ -161,9 +162,9 @@ void TransformWords(const std::vector<Word>& words, v1::PointTransform transform
 
 // The inverse of TransformWords. `planar` is scratch.
 template <typename Word>
-void UntransformWords(const unsigned char* bytes, size_t n, v1::PointTransform transform, std::vector<Word>* planar,
-                      std::vector<Word>* words) {
-  const size_t count = 2 * n;
+void UntransformWords(const unsigned char* bytes, size_t n, size_t axes, v1::PointTransform transform,
+                      std::vector<Word>* planar, std::vector<Word>* words) {
+  const size_t count = axes * n;
   words->resize(count);
   if (IsPlain(transform)) {
     std::memcpy(words->data(), bytes, count * sizeof(Word));
@@ -177,17 +178,17 @@ void UntransformWords(const unsigned char* bytes, size_t n, v1::PointTransform t
     for (size_t j = 0; j < count; ++j) stored[j] |= static_cast<Word>(Word{plane[j]} << (8 * b));
   }
   Word* out = words->data();
-  for (size_t axis = 0; axis < 2; ++axis) {
+  for (size_t axis = 0; axis < axes; ++axis) {
     const Word* in = stored + axis * n;
     if (transform == v1::POINT_TRANSFORM_BYTE_SHUFFLE) {
-      for (size_t i = 0; i < n; ++i) out[2 * i + axis] = in[i];
+      for (size_t i = 0; i < n; ++i) out[axes * i + axis] = in[i];
       continue;
     }
     Word previous = 0;
     Word before_previous = 0;
     for (size_t i = 0; i < n; ++i) {
       const Word w = static_cast<Word>(UnZigZag(in[i]) + Predict(transform, previous, before_previous));
-      out[2 * i + axis] = w;
+      out[axes * i + axis] = w;
       before_previous = previous;
       previous = w;
     }
@@ -211,24 +212,31 @@ absl::Status CheckAxisScale(const v1::EncodedPointChunk& chunk, const v1::AxisSc
   return absl::OkStatus();
 }
 
-// The first of the chunk's decoded coordinates that is not finite, as a refusal naming its point;
-// OK when all are. `how`: how the values were decoded, for the message.
-absl::Status CheckFinite(const double* values, size_t count, const ChunkPosition& at, const char* how) {
+// The name of axis `axis` of a point with `axes` values, for messages.
+const char* AxisName(size_t axis) {
+  static constexpr const char* kNames[] = {"x", "y", "w"};
+  return kNames[axis];
+}
+
+// The first of the chunk's decoded values (`axes` a point) that is not finite, as a refusal naming
+// its point; OK when all are. `how`: how the values were decoded, for the message.
+absl::Status CheckFinite(const double* values, size_t count, size_t axes, const ChunkPosition& at, const char* how) {
   // One branch-free pass (it vectorises); the index only when one is bad.
   bool all_finite = true;
   for (size_t i = 0; i < count; ++i) all_finite &= std::isfinite(values[i]);
   if (all_finite) return absl::OkStatus();
   size_t i = 0;
   while (std::isfinite(values[i])) ++i;
-  return Refuse(at, "point ", at.first_point + i / 2, " has ", std::isnan(values[i]) ? "a NaN" : "an infinite", " ",
-                i % 2 == 0 ? "x" : "y", " coordinate", how);
+  const char* what = i % axes == 2 ? " weight" : i % axes == 0 ? " x coordinate" : " y coordinate";
+  return Refuse(at, "point ", at.first_point + i / axes, " has ", std::isnan(values[i]) ? "a NaN" : "an infinite", what,
+                how);
 }
 
 }  // namespace
 
 double ScaledValue(const v1::AxisScale& scale, int64_t x) { return AxisStep(scale)(x); }
 
-absl::Status CheckEncodedChunkShape(const v1::EncodedPointChunk& chunk, const ChunkPosition& at) {
+absl::Status CheckEncodedChunkShape(const v1::EncodedPointChunk& chunk, const ChunkPosition& at, bool weighted) {
   if (chunk.point_count() == 0) return Refuse(at, "it states no points (point_count 0)");
   if (chunk.point_count() > kMaxPointsPerEncodedChunk) {
     return Refuse(at, "it states ", chunk.point_count(), " points; an encoded chunk holds at most ",
@@ -246,12 +254,19 @@ absl::Status CheckEncodedChunkShape(const v1::EncodedPointChunk& chunk, const Ch
   if (!v1::PointCompression_IsValid(chunk.compression())) {
     return Refuse(at, "compression ", static_cast<int>(chunk.compression()), " is not a PointCompression");
   }
+  if (!weighted && chunk.has_w_scale()) {
+    return Refuse(at, "it has a w_scale, but the stream is not weighted (BuildHeader.weighted)");
+  }
   if (chunk.value_type() == v1::POINT_VALUE_TYPE_FLOAT64) {
-    if (chunk.has_x_scale() || chunk.has_y_scale()) return Refuse(at, "a FLOAT64 chunk takes no x_scale or y_scale");
+    if (chunk.has_x_scale() || chunk.has_y_scale() || chunk.has_w_scale()) {
+      return Refuse(at, "a FLOAT64 chunk takes no x_scale, y_scale or w_scale");
+    }
     return absl::OkStatus();
   }
   if (absl::Status s = CheckAxisScale(chunk, chunk.x_scale(), chunk.has_x_scale(), "x_scale", at); !s.ok()) return s;
-  return CheckAxisScale(chunk, chunk.y_scale(), chunk.has_y_scale(), "y_scale", at);
+  if (absl::Status s = CheckAxisScale(chunk, chunk.y_scale(), chunk.has_y_scale(), "y_scale", at); !s.ok()) return s;
+  if (!weighted) return absl::OkStatus();
+  return CheckAxisScale(chunk, chunk.w_scale(), chunk.has_w_scale(), "w_scale (the stream is weighted)", at);
 }
 
 PointChunkDecoder::PointChunkDecoder()
@@ -269,10 +284,28 @@ void PointChunkDecoder::ReleaseScratch() {
 }
 
 absl::Status PointChunkDecoder::Decode(const v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out) {
-  if (absl::Status s = CheckEncodedChunkShape(chunk, at); !s.ok()) return s;
+  return DecodeValues(chunk, at, 2, &out[0].x);
+}
+
+absl::Status PointChunkDecoder::DecodeWeighted(const v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out,
+                                               double* weights) {
+  if (absl::Status s = CheckEncodedChunkShape(chunk, at, /*weighted=*/true); !s.ok()) return s;
+  const size_t n = chunk.point_count();
+  triples_.resize(3 * n);
+  if (absl::Status s = DecodeValues(chunk, at, 3, triples_.data()); !s.ok()) return s;
+  for (size_t i = 0; i < n; ++i) {
+    out[i] = Point2{triples_[3 * i], triples_[3 * i + 1]};
+    weights[i] = triples_[3 * i + 2];
+  }
+  return absl::OkStatus();
+}
+
+absl::Status PointChunkDecoder::DecodeValues(const v1::EncodedPointChunk& chunk, const ChunkPosition& at, size_t axes,
+                                             double* values) {
+  if (absl::Status s = CheckEncodedChunkShape(chunk, at, axes == 3); !s.ok()) return s;
   const size_t n = chunk.point_count();
   const v1::PointValueType type = chunk.value_type();
-  const size_t expected = 2 * n * WordBytes(type);
+  const size_t expected = axes * n * WordBytes(type);
   const std::string& data = chunk.data();
   const unsigned char* bytes = reinterpret_cast<const unsigned char*>(data.data());
   if (chunk.compression() == v1::POINT_COMPRESSION_ZSTD) {
@@ -311,44 +344,56 @@ absl::Status PointChunkDecoder::Decode(const v1::EncodedPointChunk& chunk, const
                   expected, " bytes");
   }
 
-  double* values = &out[0].x;
+  const size_t count = axes * n;
   if (type == v1::POINT_VALUE_TYPE_FLOAT64) {
-    UntransformWords<uint64_t>(bytes, n, chunk.transform(), &planar64_, &words64_);
-    std::memcpy(values, words64_.data(), 2 * n * sizeof(double));
-    return CheckFinite(values, 2 * n, at, "");
+    UntransformWords<uint64_t>(bytes, n, axes, chunk.transform(), &planar64_, &words64_);
+    std::memcpy(values, words64_.data(), count * sizeof(double));
+    return CheckFinite(values, count, axes, at, "");
   }
-  const AxisStep steps[2] = {AxisStep(chunk.x_scale()), AxisStep(chunk.y_scale())};
+  const AxisStep steps[3] = {AxisStep(chunk.x_scale()), AxisStep(chunk.y_scale()), AxisStep(chunk.w_scale())};
   if (type == v1::POINT_VALUE_TYPE_INT32) {
-    UntransformWords<uint32_t>(bytes, n, chunk.transform(), &planar32_, &words32_);
-    for (size_t axis = 0; axis < 2; ++axis) {
+    UntransformWords<uint32_t>(bytes, n, axes, chunk.transform(), &planar32_, &words32_);
+    for (size_t axis = 0; axis < axes; ++axis) {
       const AxisStep step = steps[axis];
-      for (size_t i = axis; i < 2 * n; i += 2) values[i] = step(static_cast<int32_t>(words32_[i]));
+      for (size_t i = axis; i < count; i += axes) values[i] = step(static_cast<int32_t>(words32_[i]));
     }
   } else {
-    UntransformWords<uint64_t>(bytes, n, chunk.transform(), &planar64_, &words64_);
-    for (size_t i = 0; i < 2 * n; ++i) {
+    UntransformWords<uint64_t>(bytes, n, axes, chunk.transform(), &planar64_, &words64_);
+    for (size_t i = 0; i < count; ++i) {
       const auto x = static_cast<int64_t>(words64_[i]);
       if (x > kMaxExactInteger || x < -kMaxExactInteger) {
-        return Refuse(at, "point ", at.first_point + i / 2, "'s ", i % 2 == 0 ? "x" : "y", " integer is ", x,
+        return Refuse(at, "point ", at.first_point + i / axes, "'s ", AxisName(i % axes), " integer is ", x,
                       ", over 2^53 in magnitude: no double holds it exactly");
       }
-      values[i] = steps[i % 2](x);
+      values[i] = steps[i % axes](x);
     }
   }
-  return CheckFinite(values, 2 * n, at, " (decoded from its integer: offset + scale * X overflows)");
+  return CheckFinite(values, count, axes, at, " (decoded from its integer: offset + scale * X overflows)");
 }
 
 namespace {
 
-// X for every coordinate of one axis under `scale`, verified bit for bit; nullopt at the first
-// coordinate it does not reproduce.
-bool AxisIntegers(absl::Span<const Point2> points, size_t axis, const v1::AxisScale& scale, int64_t* smallest,
-                  int64_t* largest) {
+// One axis of a chunk's values: every `stride`-th double from `first` (x or y of packed points,
+// or a weight column with stride 1).
+struct Column {
+  const double* first = nullptr;
+  size_t stride = 1;
+  size_t size = 0;
+  double operator[](size_t i) const { return first[i * stride]; }
+};
+
+Column PointAxis(absl::Span<const Point2> points, size_t axis) {
+  return Column{points.empty() ? nullptr : &points[0].x + axis, 2, points.size()};
+}
+
+// X for every value of one axis under `scale`, verified bit for bit; false at the first value it
+// does not reproduce.
+bool AxisIntegers(const Column& column, const v1::AxisScale& scale, int64_t* smallest, int64_t* largest) {
   const AxisStep step(scale);
   int64_t low = 0;
   int64_t high = 0;
-  for (const Point2& p : points) {
-    const double v = axis == 0 ? p.x : p.y;
+  for (size_t i = 0; i < column.size; ++i) {
+    const double v = column[i];
     const std::optional<int64_t> x = step.Invert(v);
     if (!x || Bits(step(*x)) != Bits(v)) return false;
     low = std::min(low, *x);
@@ -359,12 +404,12 @@ bool AxisIntegers(absl::Span<const Point2> points, size_t axis, const v1::AxisSc
   return true;
 }
 
-// The smallest power-of-two step 2^-k under which every coordinate of the axis is an integer of
-// at most 53 bits; nullopt when none is.
-std::optional<v1::AxisScale> PowerOfTwoScale(absl::Span<const Point2> points, size_t axis) {
+// The smallest power-of-two step 2^-k under which every value of the axis is an integer of at
+// most 53 bits; nullopt when none is.
+std::optional<v1::AxisScale> PowerOfTwoScale(const Column& column) {
   int k = 0;
-  for (const Point2& p : points) {
-    const double v = axis == 0 ? p.x : p.y;
+  for (size_t i = 0; i < column.size; ++i) {
+    const double v = column[i];
     if (!std::isfinite(v)) return std::nullopt;
     if (v == 0) continue;
     int exponent = 0;
@@ -384,9 +429,9 @@ std::optional<v1::AxisScale> PowerOfTwoScale(absl::Span<const Point2> points, si
   return scale;
 }
 
-std::optional<std::pair<v1::AxisScale, bool>> FindAxisScale(absl::Span<const Point2> points, size_t axis) {
+std::optional<std::pair<v1::AxisScale, bool>> FindAxisScale(const Column& column) {
   double lowest = std::numeric_limits<double>::infinity();
-  for (const Point2& p : points) lowest = std::min(lowest, axis == 0 ? p.x : p.y);
+  for (size_t i = 0; i < column.size; ++i) lowest = std::min(lowest, column[i]);
   if (!std::isfinite(lowest)) return std::nullopt;
   std::vector<v1::AxisScale> candidates;
   for (size_t k = 0; k < std::size(kPowersOfTen); ++k) {
@@ -406,11 +451,11 @@ std::optional<std::pair<v1::AxisScale, bool>> FindAxisScale(absl::Span<const Poi
       if (scale.offset() != 0) candidates.push_back(scale);
     }
   }
-  if (std::optional<v1::AxisScale> scale = PowerOfTwoScale(points, axis)) candidates.push_back(*scale);
+  if (std::optional<v1::AxisScale> scale = PowerOfTwoScale(column)) candidates.push_back(*scale);
   for (const v1::AxisScale& scale : candidates) {
     int64_t smallest = 0;
     int64_t largest = 0;
-    if (AxisIntegers(points, axis, scale, &smallest, &largest)) {
+    if (AxisIntegers(column, scale, &smallest, &largest)) {
       const bool fits32 =
           smallest >= std::numeric_limits<int32_t>::min() && largest <= std::numeric_limits<int32_t>::max();
       return std::make_pair(scale, fits32);
@@ -421,16 +466,25 @@ std::optional<std::pair<v1::AxisScale, bool>> FindAxisScale(absl::Span<const Poi
 
 }  // namespace
 
-std::optional<ScaledAxes> FindScaledIntegers(absl::Span<const Point2> points) {
+std::optional<ScaledAxes> FindScaledIntegers(absl::Span<const Point2> points) { return FindScaledIntegers(points, {}); }
+
+std::optional<ScaledAxes> FindScaledIntegers(absl::Span<const Point2> points, absl::Span<const double> weights) {
   if (points.empty()) return std::nullopt;
-  auto x = FindAxisScale(points, 0);
+  auto x = FindAxisScale(PointAxis(points, 0));
   if (!x) return std::nullopt;
-  auto y = FindAxisScale(points, 1);
+  auto y = FindAxisScale(PointAxis(points, 1));
   if (!y) return std::nullopt;
   ScaledAxes axes;
   axes.x = x->first;
   axes.y = y->first;
-  axes.value_type = x->second && y->second ? v1::POINT_VALUE_TYPE_INT32 : v1::POINT_VALUE_TYPE_INT64;
+  bool fits32 = x->second && y->second;
+  if (!weights.empty()) {
+    auto w = FindAxisScale(Column{weights.data(), 1, weights.size()});
+    if (!w) return std::nullopt;
+    axes.w = w->first;
+    fits32 = fits32 && w->second;
+  }
+  axes.value_type = fits32 ? v1::POINT_VALUE_TYPE_INT32 : v1::POINT_VALUE_TYPE_INT64;
   return axes;
 }
 
@@ -453,10 +507,32 @@ absl::Status PointChunkEncoder::Compress(const std::string& input, std::string* 
 
 absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, const ChunkEncoding& encoding,
                                        v1::EncodedPointChunk* out) {
+  return Encode(points, {}, encoding, out);
+}
+
+absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                       const ChunkEncoding& encoding, v1::EncodedPointChunk* out) {
   const size_t n = points.size();
   if (n == 0 || n > kMaxPointsPerEncodedChunk) {
     return absl::InvalidArgumentError(
         absl::StrCat("an encoded chunk holds 1 to ", kMaxPointsPerEncodedChunk, " points, not ", n));
+  }
+  const bool weighted = !weights.empty();
+  if (weighted && weights.size() != n) {
+    return absl::InvalidArgumentError(absl::StrCat(n, " points need ", n, " weights, not ", weights.size()));
+  }
+  // The values interleaved as the words are: the points themselves, or x, y, w triples.
+  const size_t axes = weighted ? 3 : 2;
+  const size_t count = axes * n;
+  const double* values = &points[0].x;
+  if (weighted) {
+    triples_.resize(count);
+    for (size_t i = 0; i < n; ++i) {
+      triples_[3 * i] = points[i].x;
+      triples_[3 * i + 1] = points[i].y;
+      triples_[3 * i + 2] = weights[i];
+    }
+    values = triples_.data();
   }
   out->Clear();
   out->set_point_count(n);
@@ -464,31 +540,33 @@ absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, const Ch
   out->set_transform(encoding.transform);
   out->set_compression(encoding.compression);
   if (encoding.value_type == v1::POINT_VALUE_TYPE_FLOAT64) {
-    words64_.resize(2 * n);
-    std::memcpy(words64_.data(), &points[0].x, 2 * n * sizeof(double));
-    TransformWords(words64_, encoding.transform, &planar64_, &words_);
+    words64_.resize(count);
+    std::memcpy(words64_.data(), values, count * sizeof(double));
+    TransformWords(words64_, axes, encoding.transform, &planar64_, &words_);
   } else {
     *out->mutable_x_scale() = encoding.x_scale;
     *out->mutable_y_scale() = encoding.y_scale;
-    const AxisStep steps[2] = {AxisStep(encoding.x_scale), AxisStep(encoding.y_scale)};
+    if (weighted) *out->mutable_w_scale() = encoding.w_scale;
+    const AxisStep steps[3] = {AxisStep(encoding.x_scale), AxisStep(encoding.y_scale), AxisStep(encoding.w_scale)};
     const bool narrow = encoding.value_type == v1::POINT_VALUE_TYPE_INT32;
     std::vector<uint64_t>& words64 = words64_;
     std::vector<uint32_t>& words32 = words32_;
     if (narrow) {
-      words32.resize(2 * n);
+      words32.resize(count);
     } else {
-      words64.resize(2 * n);
+      words64.resize(count);
     }
-    for (size_t i = 0; i < 2 * n; ++i) {
-      const double v = i % 2 == 0 ? points[i / 2].x : points[i / 2].y;
-      const std::optional<int64_t> x = steps[i % 2].Invert(v);
-      if (!x || Bits(steps[i % 2](*x)) != Bits(v)) {
-        return absl::InvalidArgumentError(absl::StrCat("point ", i / 2, "'s ", i % 2 == 0 ? "x" : "y", " (", v,
+    for (size_t i = 0; i < count; ++i) {
+      const double v = values[i];
+      const AxisStep& step = steps[i % axes];
+      const std::optional<int64_t> x = step.Invert(v);
+      if (!x || Bits(step(*x)) != Bits(v)) {
+        return absl::InvalidArgumentError(absl::StrCat("point ", i / axes, "'s ", AxisName(i % axes), " (", v,
                                                        ") is not offset + scale * X for an integer X"));
       }
       if (narrow && (*x < std::numeric_limits<int32_t>::min() || *x > std::numeric_limits<int32_t>::max())) {
         return absl::InvalidArgumentError(
-            absl::StrCat("point ", i / 2, "'s ", i % 2 == 0 ? "x" : "y", " integer ", *x, " does not fit INT32"));
+            absl::StrCat("point ", i / axes, "'s ", AxisName(i % axes), " integer ", *x, " does not fit INT32"));
       }
       if (narrow) {
         words32[i] = static_cast<uint32_t>(static_cast<int32_t>(*x));
@@ -497,9 +575,9 @@ absl::Status PointChunkEncoder::Encode(absl::Span<const Point2> points, const Ch
       }
     }
     if (narrow) {
-      TransformWords(words32, encoding.transform, &planar32_, &words_);
+      TransformWords(words32, axes, encoding.transform, &planar32_, &words_);
     } else {
-      TransformWords(words64, encoding.transform, &planar64_, &words_);
+      TransformWords(words64, axes, encoding.transform, &planar64_, &words_);
     }
   }
   if (encoding.compression != v1::POINT_COMPRESSION_ZSTD) {
@@ -513,13 +591,17 @@ namespace {
 
 // The part of a chunk its encoding is chosen on: all of it up to 16,384 points (then the choice is
 // exact), else its first 8,192 points (eight trial compressions then cost one of the whole chunk).
-absl::Span<const Point2> Sample(absl::Span<const Point2> points) {
-  return points.size() <= 16384 ? points : points.subspan(0, 8192);
+size_t SampleSize(size_t n) { return n <= 16384 ? n : 8192; }
+
+template <typename T>
+absl::Span<const T> Sample(absl::Span<const T> values) {
+  return values.subspan(0, SampleSize(values.size()));
 }
 
 }  // namespace
 
-size_t PointChunkEncoder::BestTransform(absl::Span<const Point2> sample, ChunkEncoding* encoding) {
+size_t PointChunkEncoder::BestTransform(absl::Span<const Point2> sample, absl::Span<const double> weights,
+                                        ChunkEncoding* encoding) {
   size_t best_size = std::numeric_limits<size_t>::max();
   v1::PointTransform best = v1::POINT_TRANSFORM_NONE;
   for (v1::PointTransform transform : {v1::POINT_TRANSFORM_NONE, v1::POINT_TRANSFORM_BYTE_SHUFFLE,
@@ -528,7 +610,7 @@ size_t PointChunkEncoder::BestTransform(absl::Span<const Point2> sample, ChunkEn
     trial.transform = transform;
     trial.compression = v1::POINT_COMPRESSION_ZSTD;
     v1::EncodedPointChunk chunk;
-    if (!Encode(sample, trial, &chunk).ok()) continue;
+    if (!Encode(sample, weights, trial, &chunk).ok()) continue;
     if (chunk.data().size() < best_size) {
       best_size = chunk.data().size();
       best = transform;
@@ -539,42 +621,70 @@ size_t PointChunkEncoder::BestTransform(absl::Span<const Point2> sample, ChunkEn
 }
 
 v1::PointTransform PointChunkEncoder::ChooseTransform(absl::Span<const Point2> points, const ChunkEncoding& encoding) {
+  return ChooseTransform(points, {}, encoding);
+}
+
+v1::PointTransform PointChunkEncoder::ChooseTransform(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                                      const ChunkEncoding& encoding) {
   ChunkEncoding chosen = encoding;
-  BestTransform(Sample(points), &chosen);
+  const absl::Span<const Point2> sample = Sample(points);
+  BestTransform(sample, weights.subspan(0, weights.empty() ? 0 : sample.size()), &chosen);
   return chosen.transform;
 }
 
 void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, v1::BuildRequest* out) {
+  EncodeSmallest(points, {}, out);
+}
+
+void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                       v1::BuildRequest* out) {
+  const bool weighted = !weights.empty();
+  const size_t axes = weighted ? 3 : 2;
   const auto send_raw = [&] {
     auto* coordinates = out->mutable_points()->mutable_coordinates();
     coordinates->Clear();
-    if (!points.empty()) coordinates->Add(&points[0].x, &points[0].x + 2 * points.size());
+    if (points.empty()) return;
+    if (!weighted) {
+      coordinates->Add(&points[0].x, &points[0].x + 2 * points.size());
+      return;
+    }
+    coordinates->Reserve(static_cast<int>(3 * points.size()));
+    for (size_t i = 0; i < points.size(); ++i) {
+      coordinates->AddAlreadyReserved(points[i].x);
+      coordinates->AddAlreadyReserved(points[i].y);
+      coordinates->AddAlreadyReserved(weights[i]);
+    }
   };
-  if (points.empty() || points.size() > kMaxPointsPerEncodedChunk) return send_raw();
+  if (points.empty() || points.size() > kMaxPointsPerEncodedChunk || (weighted && weights.size() != points.size())) {
+    return send_raw();
+  }
   // Float64 and, where the data has them, scaled integers, each with its best transform on the
   // sample: integers usually win by far, but power-of-two steps of full-precision doubles (lon/lat
   // in one binade) are the same bits and can lose by a few bytes.
+  const absl::Span<const Point2> sample = Sample(points);
+  const absl::Span<const double> sample_weights = weights.subspan(0, weighted ? sample.size() : 0);
   ChunkEncoding encoding;
   encoding.compression = v1::POINT_COMPRESSION_ZSTD;
-  const size_t float_size = BestTransform(Sample(points), &encoding);
-  if (std::optional<ScaledAxes> scaled = FindScaledIntegers(points)) {
+  const size_t float_size = BestTransform(sample, sample_weights, &encoding);
+  if (std::optional<ScaledAxes> scaled = FindScaledIntegers(points, weights)) {
     ChunkEncoding integers = encoding;
     integers.value_type = scaled->value_type;
     integers.x_scale = scaled->x;
     integers.y_scale = scaled->y;
-    if (BestTransform(Sample(points), &integers) <= float_size) encoding = integers;
+    integers.w_scale = scaled->w;
+    if (BestTransform(sample, sample_weights, &integers) <= float_size) encoding = integers;
   }
   v1::EncodedPointChunk* chunk = out->mutable_encoded_points();
-  if (!Encode(points, encoding, chunk).ok()) return send_raw();
-  const size_t uncompressed = 2 * points.size() * WordBytes(encoding.value_type);
+  if (!Encode(points, weights, encoding, chunk).ok()) return send_raw();
+  const size_t uncompressed = axes * points.size() * WordBytes(encoding.value_type);
   if (chunk->data().size() >= uncompressed) {
     if (encoding.value_type == v1::POINT_VALUE_TYPE_FLOAT64) return send_raw();
     encoding.transform = v1::POINT_TRANSFORM_NONE;
     encoding.compression = v1::POINT_COMPRESSION_NONE;
-    if (!Encode(points, encoding, chunk).ok()) return send_raw();
+    if (!Encode(points, weights, encoding, chunk).ok()) return send_raw();
   }
-  // A raw chunk is 16 bytes a point plus a few of framing: the encoded one must beat that.
-  if (chunk->ByteSizeLong() >= 16 * points.size()) send_raw();
+  // A raw chunk is 8 bytes a value plus a few of framing: the encoded one must beat that.
+  if (chunk->ByteSizeLong() >= 8 * axes * points.size()) send_raw();
 }
 
 }  // namespace galpha::wire

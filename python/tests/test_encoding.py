@@ -7,6 +7,7 @@ points") with the answers of encoding="raw"."""
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import itertools
 import math
 
@@ -175,6 +176,26 @@ def test_encoding_is_checked(server) -> None:
 
     with pytest.raises(galpha.InvalidInput, match="unknown encoding None"):
         asyncio.run(run())
+
+
+@pytest.mark.parametrize("value_type", [E.FLOAT64, E.INT32, E.INT64])
+@pytest.mark.parametrize("transform,compression", FORMS)
+def test_weighted_points_round_trip_bit_for_bit_with_their_weights(value_type: int, transform: int, compression: int) -> None:
+    """(x, y, w) chunks of a weighted stream: the weight is a third axis with its own scale."""
+    points = las_like()
+    radii = np.random.default_rng(8).integers(120, 201, len(points))  # 1.20 to 2.00 A, squared: X / 10^4
+    weighted = np.column_stack((points, (radii * radii) / 1e4))
+    scaled = E.find_scaled_integers(weighted)
+    assert scaled is not None and scaled.w_scale is not None
+    encoding = E.ChunkEncoding(value_type, transform, compression) if value_type == E.FLOAT64 else dataclasses.replace(
+        scaled.encoding(transform, compression), value_type=value_type
+    )
+    message = E.encode_chunk(weighted, encoding)
+    np.testing.assert_array_equal(bits(E.decode_chunk(message, axes=3)), bits(weighted))
+    parsed = pb.EncodedPointChunk.FromString(message)
+    assert parsed.HasField("w_scale") == (value_type != E.FLOAT64)
+    with pytest.raises(ValueError):
+        E.decode_chunk(message)  # as two axes: the sizes disagree (or a w_scale in an unweighted stream)
 
 
 def test_the_server_decodes_every_form_to_the_same_points(client) -> None:

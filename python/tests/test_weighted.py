@@ -2,12 +2,13 @@
 GUDHI's weighted alpha complex in exact mode (an independent implementation over CGAL's regular
 triangulation): the same distinct thresholds of edges and triangles (GUDHI's filtration values of
 dimension 1 and 2 are their births, within an ulp of the exact values galpha rounds correctly), the
-same hidden points (vertices GUDHI leaves out); the handle covers the weights; the network client
-refuses weights with a message saying why. (The molecule's exact power ties are broken otherwise by
+same hidden points (vertices GUDHI leaves out); the handle covers the weights; the network clients
+build the same weighted family on the server. (The molecule's exact power ties are broken otherwise by
 GUDHI's d-dimensional triangulation: there only the hidden atoms are compared.)"""
 
 from __future__ import annotations
 
+import asyncio
 import math
 
 import numpy as np
@@ -15,6 +16,7 @@ import pytest
 from conftest import REPO
 
 import galpha
+import galpha.aio
 
 
 def _gudhi_births(points: np.ndarray, weights: np.ndarray):
@@ -98,7 +100,39 @@ def test_weights_change_the_handle_and_are_checked() -> None:
         local.build(points, weights=[1.0, 2.0, math.nan, 0.0])
 
 
-def test_network_clients_refuse_weights() -> None:
-    client = galpha.connect("localhost:1")
-    with pytest.raises(galpha.InvalidInput, match="unweighted families"):
-        client.build(np.zeros((3, 2)), weights=[0.0, 0.0, 0.0])
+def test_network_clients_build_the_weighted_family(client, server) -> None:
+    """The server builds what galpha.local() builds from (x, y, w) uploads, encoded or raw, under
+    the same handle; its hidden points come back from the count and Classify at rank 0, with
+    duplicates of hidden points (Classify lists first occurrences only)."""
+    rng = np.random.default_rng(9)
+    points = rng.random((2000, 2))
+    weights = rng.random(len(points)) / len(points)
+    points = np.vstack([points, points[:3]])  # duplicates (same weights)
+    weights = np.concatenate([weights, weights[:3]])
+    local = galpha.local("cpu").build(points, weights=weights)
+    remote = client.build(points, weights=weights)
+    assert remote.handle == local.handle
+    assert remote.summary.weighted and remote.summary.hidden_points == local.summary.hidden_points > 0
+    np.testing.assert_array_equal(remote.hidden_points, local.hidden_points)
+    np.testing.assert_array_equal(remote.spectrum(), local.spectrum())
+    for rank in (0, local.spectrum_size // 2):
+        ours, theirs = remote.classify(rank=rank), local.classify(rank=rank)
+        assert ours.vertex_counts == theirs.vertex_counts and ours.edge_counts == theirs.edge_counts
+        np.testing.assert_array_equal(ours.triangle_classes, theirs.triangle_classes)
+    assert remote.release()
+    raw = client.build(points, weights=weights, encoding="raw")
+    assert raw.handle == local.handle and not raw.summary.cached
+    np.testing.assert_array_equal(raw.hidden_points, local.hidden_points)
+    assert client.family(local.handle, points, weights=weights).summary.hidden_points == local.summary.hidden_points
+    unweighted = client.build(points)
+    assert unweighted.handle != local.handle and unweighted.hidden_points.size == 0
+
+    async def run() -> None:
+        async with galpha.aio.connect(server.address, timeout=60) as aio_client:
+            family = await aio_client.build(points, weights=weights)
+            assert family.handle == local.handle and family.summary.cached
+            np.testing.assert_array_equal(await family.hidden_points(), local.hidden_points)
+
+    asyncio.run(run())
+    with pytest.raises(galpha.InvalidInput, match="one per point"):
+        client.build(points, weights=weights[1:])

@@ -118,6 +118,57 @@ TEST(AlphactlRemoteTest, GeographicInputAnswersAsLocally) {
 }
 #endif
 
+// Weighted points go up as (x, y, w) (BuildHeader.weighted), encoded or raw, and every answer is
+// the local weighted family's: hidden points included, which the remote summary lists from the
+// server's count and Classify at rank 0, duplicates of hidden points with them.
+TEST(AlphactlRemoteTest, WeightedPointsAnswerAsLocally) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  // Disks of squared radius 0.6 to 0.79 on a perturbed unit grid, and in every third cell a point
+  // of weight 0 at its centre: the corners' plane lifts the centre to about |c|^2 + 0.5 - 0.7,
+  // under its own |c|^2, so it is hidden. The last lines repeat a hidden centre and a grid point,
+  // and add a light point next to a heavy one (hidden too).
+  const std::string file = std::filesystem::temp_directory_path() / "alphactl_remote_weighted.csv";
+  {
+    std::ofstream out(file);
+    for (int i = 0; i < 20; ++i) {
+      for (int j = 0; j < 20; ++j) {
+        out << i + (i * j % 7) / 100.0 << ' ' << j + ((i + 2 * j) % 5) / 100.0 << ' '
+            << 0.6 + ((i * 7 + j * 13) % 20) / 100.0 << '\n';
+      }
+    }
+    for (int i = 0; i < 19; i += 3) {
+      for (int j = 0; j < 19; j += 3) out << i + 0.5 << ' ' << j + 0.5 << " 0\n";
+    }
+    out << "3.5 6.5 0\n0 0 0.6\n5.05 5 0.5\n";
+  }
+  const CommandResult local = Alphactl("summary " + file + " --rank 0 --backend=cpu --weights squared");
+  ASSERT_EQ(local.exit_code, 0) << local.err;
+  EXPECT_NE(local.out.find("\"hidden_points\":[400,"), std::string::npos) << local.out;  // not null, not []
+  const char* commands[] = {
+      "summary --rank 0",
+      "summary --alpha-sq -0.5",
+      "summary --rank 40 --mode regularized",
+      "spectrum",
+      "classify --rank 7",
+      "shape --rank 30 --format wkt",
+      "masterlist --rank 12",
+      "optimal --components 1",
+      "persistence",
+  };
+  ExpectRemotePrintsAsLocal(server, file, commands, " --weights squared");
+  // Raw triples build the same family (the same handle: found, not rebuilt).
+  const CommandResult raw =
+      Alphactl("--encoding raw --server " + server.address() + " summary " + file + " --rank 0 --weights squared");
+  EXPECT_EQ(raw.exit_code, 0) << raw.err;
+  EXPECT_EQ(raw.out, local.out);
+  // The same coordinates unweighted are another family: no hidden points.
+  const CommandResult unweighted = Alphactl("--server " + server.address() + " summary " + file + " --rank 0");
+  EXPECT_EQ(unweighted.exit_code, 0) << unweighted.err;
+  EXPECT_NE(unweighted.out.find("\"hidden_points\":null"), std::string::npos) << unweighted.out;
+  std::filesystem::remove(file);
+}
+
 // --server, like every global option, may come before the command (as in git and kubectl), and
 // a pipe is read once and uploaded like a file.
 TEST(AlphactlRemoteTest, ServerMayComeBeforeTheCommand) {

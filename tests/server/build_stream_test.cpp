@@ -605,5 +605,126 @@ TEST(BuildStreamDecoderTest, EncodedChunkBeforeTheHeaderIsRefused) {
               StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("must start with a header")));
 }
 
+// ---- Weighted streams (BuildHeader.weighted) ------------------------------------------------
+
+v1::BuildRequest WeightedHeader(uint64_t expected_points) {
+  v1::BuildRequest message = Header(expected_points);
+  message.mutable_header()->set_weighted(true);
+  return message;
+}
+
+// Raw (x, y, w) triples.
+v1::BuildRequest WeightedChunk(absl::Span<const Point2> points, absl::Span<const double> weights) {
+  v1::BuildRequest message;
+  auto* coordinates = message.mutable_points()->mutable_coordinates();
+  for (size_t i = 0; i < points.size(); ++i) {
+    coordinates->Add(points[i].x);
+    coordinates->Add(points[i].y);
+    coordinates->Add(weights[i]);
+  }
+  return message;
+}
+
+// Weights with negative values, zeros and a subnormal: every bit pattern must survive.
+std::vector<double> AwkwardWeights(size_t n) {
+  std::vector<double> weights(n);
+  for (size_t i = 0; i < n; ++i) weights[i] = i % 5 == 0 ? -0.25 * static_cast<double>(i) : 1.0 / (1.0 + i);
+  weights[1] = 0.0;
+  weights[2] = std::numeric_limits<double>::denorm_min();
+  return weights;
+}
+
+TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirWeightsAndTheirHandle) {
+  const std::vector<Point2> points = gen::Uniform(300, 46);
+  const std::vector<double> weights = AwkwardWeights(points.size());
+  const auto all = absl::MakeConstSpan(points);
+  const auto all_weights = absl::MakeConstSpan(weights);
+  wire::PointChunkEncoder encoder;
+  v1::BuildRequest encoded;
+  encoder.EncodeSmallest(all.subspan(100, 200), all_weights.subspan(100, 200), &encoded);
+  ASSERT_TRUE(encoded.has_encoded_points()) << "200 points compress";
+  InFlightBytes in_flight(0);
+  BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight);
+  ASSERT_THAT(decoder.Add(WeightedHeader(300)), IsOk());
+  ASSERT_THAT(decoder.Add(WeightedChunk(all.subspan(0, 100), all_weights.subspan(0, 100))), IsOk());
+  ASSERT_THAT(decoder.Add(encoded), IsOk());
+  EXPECT_EQ(in_flight.held(), 300 * (sizeof(Point2) + sizeof(double))) << "24 bytes a weighted point";
+  absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  ASSERT_THAT(decoded, IsOk());
+  ASSERT_EQ((*decoded)->points.size(), points.size());
+  ASSERT_EQ((*decoded)->weights.size(), points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
+    ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
+    ASSERT_EQ(Bits((*decoded)->weights[i]), Bits(weights[i])) << i;
+  }
+  EXPECT_EQ((*decoded)->handle, WeightedPointSetHandle(points, weights));
+  EXPECT_NE((*decoded)->handle, PointSetHandle(points)) << "the handle covers the weights";
+}
+
+TEST(BuildStreamDecoderTest, WeightedStreamRefusalsNameThePointAndTheWeight) {
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
+    EXPECT_THAT(
+        decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1})),
+        StatusIs(absl::StatusCode::kInvalidArgument,
+                 ::testing::HasSubstr("4 doubles, not a multiple of 3, after point 0: the header is weighted")));
+  }
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
+    ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1, 0, 2})), IsOk());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{3, 3, 0.5, 4, 4, nan})),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("point 3 has a NaN weight")));
+    const std::vector<Point2> two = {{5, 5}, {6, 6}};
+    const std::vector<double> infinite = {1.0, -std::numeric_limits<double>::infinity()};
+    wire::PointChunkEncoder encoder;
+    wire::ChunkEncoding float64;
+    v1::BuildRequest encoded;
+    ASSERT_THAT(encoder.Encode(two, infinite, float64, encoded.mutable_encoded_points()), IsOk());
+    EXPECT_THAT(decoder.Add(encoded), StatusIs(absl::StatusCode::kInvalidArgument,
+                                               ::testing::HasSubstr("(from point 2): point 3 has an infinite weight")));
+    EXPECT_EQ(decoder.points_received(), 2u) << "refused chunks add nothing";
+  }
+  {
+    // An unweighted stream takes no weight scale, and a weighted integer chunk needs one.
+    const std::vector<Point2> two = {{1, 2}, {3, 4}};
+    const std::vector<double> weights = {0.5, 0.25};
+    wire::PointChunkEncoder encoder;
+    wire::ChunkEncoding integers;
+    integers.value_type = v1::POINT_VALUE_TYPE_INT32;
+    integers.x_scale.set_scale(1.0);
+    integers.y_scale.set_scale(1.0);
+    integers.w_scale.set_scale(0.25);
+    v1::BuildRequest weighted_chunk;
+    ASSERT_THAT(encoder.Encode(two, weights, integers, weighted_chunk.mutable_encoded_points()), IsOk());
+    BuildStreamDecoder unweighted(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(unweighted.Add(Header(0)), IsOk());
+    EXPECT_THAT(unweighted.Add(weighted_chunk),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the stream is not weighted")));
+    v1::BuildRequest no_scale = weighted_chunk;
+    no_scale.mutable_encoded_points()->clear_w_scale();
+    BuildStreamDecoder weighted(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(weighted.Add(WeightedHeader(0)), IsOk());
+    EXPECT_THAT(weighted.Add(no_scale), StatusIs(absl::StatusCode::kInvalidArgument,
+                                                 ::testing::HasSubstr("needs w_scale (the stream is weighted)")));
+    ASSERT_THAT(weighted.Add(weighted_chunk), IsOk());
+    absl::StatusOr<DecodedBuild*> decoded = weighted.Finish();
+    ASSERT_THAT(decoded, IsOk());
+    EXPECT_EQ((*decoded)->weights[1], 0.25);
+  }
+#ifdef GALPHA_WITH_PROJ
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    v1::BuildRequest header = WeightedHeader(0);
+    header.mutable_header()->set_crs("EPSG:4326");
+    EXPECT_THAT(decoder.Add(header),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("weights need planar coordinates")));
+  }
+#endif
+}
+
 }  // namespace
 }  // namespace galpha::server

@@ -137,7 +137,7 @@ TEST(PointChunkCodec, ScaledIntegersFoundFromTheDataRoundTripInEveryForm) {
       for (v1::PointTransform transform : kTransforms) {
         for (v1::PointCompression compression : kCompressions) {
           SCOPED_TRACE(absl::StrCat("type ", type, ", transform ", transform, ", compression ", compression));
-          ChunkEncoding encoding{type, scaled->x, scaled->y, transform, compression};
+          ChunkEncoding encoding{type, scaled->x, scaled->y, transform, compression, {}};
           v1::EncodedPointChunk chunk;
           ASSERT_THAT(encoder.Encode(c.points, encoding, &chunk), IsOk());
           std::vector<Point2> decoded(c.points.size());
@@ -248,16 +248,96 @@ TEST(PointChunkCodec, DecodesTheLayoutTheProtoDocuments) {
   ExpectBitIdentical(got, want);
 }
 
+// Weighted streams (BuildHeader.weighted): the weight is a third axis, written from the proto's
+// text by hand (x integers 10, 12 at scale 0.5; y -4, 100 at scale 0.25, offset 100; w 3, -7 at
+// divisor 4), then encoded and decoded in every form with atom-like weights (squared radii of
+// 0.01 A steps: X / 10^4) and awkward float64 ones.
+TEST(PointChunkCodec, WeightedChunksCarryTheWeightAsAThirdAxis) {
+  v1::EncodedPointChunk chunk;
+  chunk.set_point_count(2);
+  chunk.set_value_type(v1::POINT_VALUE_TYPE_INT64);
+  chunk.mutable_x_scale()->set_scale(0.5);
+  chunk.mutable_y_scale()->set_scale(0.25);
+  chunk.mutable_y_scale()->set_offset(100);
+  chunk.mutable_w_scale()->set_divisor(4);
+  chunk.set_transform(v1::POINT_TRANSFORM_BYTE_SHUFFLE);
+  // Planar: x 10, 12; y -4, 100; w 3, -7 (two's complement), in byte planes.
+  chunk.set_data(BytePlanes({10, 12, static_cast<uint64_t>(-4), 100, 3, static_cast<uint64_t>(-7)}));
+  PointChunkDecoder decoder;
+  std::vector<Point2> points(2);
+  std::vector<double> weights(2);
+  ASSERT_THAT(decoder.DecodeWeighted(chunk, ChunkPosition{}, points.data(), weights.data()), IsOk());
+  ExpectBitIdentical(points, {{5, 99}, {6, 125}});
+  EXPECT_EQ(weights, (std::vector<double>{0.75, -1.75}));
+  // Read as an unweighted chunk it is refused (a w_scale; and the data holds three words a point).
+  EXPECT_THAT(decoder.Decode(chunk, ChunkPosition{}, points.data()),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the stream is not weighted")));
+  chunk.clear_w_scale();
+  EXPECT_THAT(decoder.DecodeWeighted(chunk, ChunkPosition{}, points.data(), weights.data()),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("needs w_scale")));
+
+  std::vector<Point2> atoms;
+  std::vector<double> squared_radii;
+  for (int i = 0; i < 5000; ++i) {
+    atoms.push_back({static_cast<double>(i * 37 % 9973) / 1000, static_cast<double>(i * 91 % 9967) / 1000});
+    const int radius = 120 + i % 81;  // 1.20 to 2.00 A
+    squared_radii.push_back(static_cast<double>(radius * radius) / 10000);
+  }
+  const std::optional<ScaledAxes> scaled = FindScaledIntegers(atoms, squared_radii);
+  ASSERT_TRUE(scaled.has_value());
+  EXPECT_EQ(scaled->value_type, v1::POINT_VALUE_TYPE_INT32);
+  EXPECT_EQ(ScaledValue(scaled->w, 14400), 1.44);
+  std::vector<double> awkward(atoms.size());
+  for (size_t i = 0; i < awkward.size(); ++i) awkward[i] = (i % 3 == 0 ? -1.0 : 1.0) * std::ldexp(1.0 + i, -1070);
+  awkward[1] = -0.0;
+  PointChunkEncoder encoder;
+  for (v1::PointValueType type :
+       {v1::POINT_VALUE_TYPE_FLOAT64, v1::POINT_VALUE_TYPE_INT32, v1::POINT_VALUE_TYPE_INT64}) {
+    for (v1::PointTransform transform : kTransforms) {
+      for (v1::PointCompression compression : {v1::POINT_COMPRESSION_NONE, v1::POINT_COMPRESSION_ZSTD}) {
+        SCOPED_TRACE(absl::StrCat("type ", type, ", transform ", transform, ", compression ", compression));
+        const bool floats = type == v1::POINT_VALUE_TYPE_FLOAT64;
+        ChunkEncoding encoding{type, {}, {}, transform, compression, {}};
+        if (!floats) {
+          encoding.x_scale = scaled->x;
+          encoding.y_scale = scaled->y;
+          encoding.w_scale = scaled->w;
+        }
+        for (const std::vector<double>* w : {&squared_radii, &awkward}) {
+          if (!floats && w == &awkward) continue;
+          v1::EncodedPointChunk encoded;
+          ASSERT_THAT(encoder.Encode(atoms, *w, encoding, &encoded), IsOk());
+          EXPECT_EQ(encoded.has_w_scale(), !floats);
+          std::vector<Point2> got(atoms.size());
+          std::vector<double> got_weights(atoms.size());
+          ASSERT_THAT(decoder.DecodeWeighted(encoded, ChunkPosition{}, got.data(), got_weights.data()), IsOk());
+          ExpectBitIdentical(got, atoms);
+          for (size_t i = 0; i < atoms.size(); ++i) ASSERT_EQ(Bits(got_weights[i]), Bits((*w)[i])) << i;
+        }
+      }
+    }
+  }
+  // The smallest form of a weighted chunk is scaled integers here, well under raw triples.
+  v1::BuildRequest smallest;
+  encoder.EncodeSmallest(atoms, squared_radii, &smallest);
+  ASSERT_TRUE(smallest.has_encoded_points());
+  EXPECT_LT(smallest.ByteSizeLong(), 8 * atoms.size());
+}
+
 TEST(PointChunkCodec, EveryEncodingOfTheSamePointsHasTheSameHandleAsRaw) {
   const std::vector<Point2> points = ReadData("lidar_autzen");
   const std::string raw_handle = PointSetHandle(points);
   const std::optional<ScaledAxes> scaled = FindScaledIntegers(points);
   ASSERT_TRUE(scaled.has_value());
   std::vector<ChunkEncoding> encodings = {
-      {v1::POINT_VALUE_TYPE_FLOAT64, {}, {}, v1::POINT_TRANSFORM_DELTA_SHUFFLE, v1::POINT_COMPRESSION_ZSTD},
-      {v1::POINT_VALUE_TYPE_INT32, scaled->x, scaled->y, v1::POINT_TRANSFORM_NONE, v1::POINT_COMPRESSION_NONE},
-      {v1::POINT_VALUE_TYPE_INT64, scaled->x, scaled->y, v1::POINT_TRANSFORM_DELTA2_SHUFFLE,
-       v1::POINT_COMPRESSION_ZSTD}};
+      {v1::POINT_VALUE_TYPE_FLOAT64, {}, {}, v1::POINT_TRANSFORM_DELTA_SHUFFLE, v1::POINT_COMPRESSION_ZSTD, {}},
+      {v1::POINT_VALUE_TYPE_INT32, scaled->x, scaled->y, v1::POINT_TRANSFORM_NONE, v1::POINT_COMPRESSION_NONE, {}},
+      {v1::POINT_VALUE_TYPE_INT64,
+       scaled->x,
+       scaled->y,
+       v1::POINT_TRANSFORM_DELTA2_SHUFFLE,
+       v1::POINT_COMPRESSION_ZSTD,
+       {}}};
   PointChunkEncoder encoder;
   for (size_t e = 0; e < encodings.size(); ++e) {
     SCOPED_TRACE(e);

@@ -64,8 +64,10 @@ class FamilyBackend(Protocol):
     def persistence(self, dimensions: Tuple[int, ...], min_persistence: float) -> PersistenceDiagram:
         """The dimensions (a non-empty tuple of 0 and 1, checked by the caller); the others empty."""
 
-    def hidden_points(self) -> np.ndarray:
-        """Input indices (uint32, ascending) of the points a weighted family hides; empty otherwise."""
+    def hidden_points(self, points: np.ndarray) -> np.ndarray:
+        """Input indices (uint32, ascending) of the points a weighted family hides; empty otherwise.
+        `points`: the (N, 2) points the family was built from (a server lists first occurrences
+        only: their duplicates are found among them)."""
 
     def release(self) -> bool:
         """Frees the family (network: drops it from the server's cache); True when it was held."""

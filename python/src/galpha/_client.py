@@ -41,6 +41,25 @@ class Client(Protocol):
     def __exit__(self, *exc: Any) -> None: ...
 
 
+def checked_weights(weights: Any, array: np.ndarray, frame: Any) -> Optional[np.ndarray]:
+    """``weights`` as a (N,) float64 array, or None without weights. InvalidInput for another
+    shape, and with a geographic CRS (weights are squared lengths in the coordinates' units, which
+    the local projection would change). NaN and infinity are the engine's (or server's) to name."""
+    if weights is None:
+        return None
+    weight_array = np.ascontiguousarray(np.asarray(weights, dtype=np.float64))
+    if weight_array.shape != (len(array),):
+        raise InvalidInput(f"weights must have shape ({len(array)},): one per point, got {weight_array.shape}")
+    if frame.projection is not None:
+        raise InvalidInput("weights need planar coordinates: the CRS is geographic (project the points and radii first)")
+    return weight_array
+
+
+def upload_of(computed: np.ndarray, weights: Optional[np.ndarray]) -> np.ndarray:
+    """What a Build stream carries: (N, 2) points, or (N, 3) weighted points (x, y, w)."""
+    return computed if weights is None else np.column_stack((computed, weights))
+
+
 class _TqdmStages:
     """A tqdm bar per stage, fed fractions."""
 
@@ -105,8 +124,9 @@ class NetworkClient:
     ) -> Family:
         """Uploads the points (unless the server already holds them) and returns their family.
 
-        ``weights``: must be None: the server builds unweighted families (its Build stream carries
-        no weights yet); weighted families are built by :func:`galpha.local`.
+        ``weights``: one squared radius per point builds the weighted family, as
+        :meth:`LocalClient.build` does; the upload carries (x, y, w) and the handle covers the
+        weights.
 
         ``crs``: the CRS of the coordinates ("EPSG:4326", an EPSG code, a pyproj CRS; "none" for
         planar ones), by default a GeoSeries' or GeoDataFrame's own. A geographic CRS is computed
@@ -120,32 +140,32 @@ class NetworkClient:
         points"). Either way the server builds the same family under the same handle.
         """
         encoding = check_encoding(encoding)
-        if weights is not None:
-            raise InvalidInput("weights: the server builds unweighted families; build weighted ones with galpha.local()")
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
+        upload = upload_of(frame.computed, checked_weights(weights, array, frame))
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         try:
             sent = None if callback is None else (lambda n: callback("upload", n / total))
             # The server's build reports no progress: the bar shows the wait as stage "build".
             building = None if callback is None else (lambda done: callback("build", 1.0 if done else 0.0))
-            backend = self._network.build_on_server(self._calls, frame.computed, name, sent, encoding, building)
+            backend = self._network.build_on_server(self._calls, upload, name, sent, encoding, building)
         finally:
             if close is not None:
                 close()
         return Family(backend, array, frame)
 
-    def family(self, handle: str, points: Any, *, crs: Any = None) -> Family:
+    def family(self, handle: str, points: Any, *, crs: Any = None, weights: Any = None) -> Family:
         """The family the server holds under ``handle`` for these points (NotFound if it holds
         none); the points give the answers' coordinates and must be the ones the handle names
-        (with ``crs`` as :meth:`build` took it: the handle names the computed points)."""
+        (with ``crs`` and ``weights`` as :meth:`build` took them: the handle names the computed
+        points and their weights)."""
         from ._errors import NotFound
         from ._handle import point_set_handle
 
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
-        if point_set_handle(frame.computed) != handle:
+        if point_set_handle(upload_of(frame.computed, checked_weights(weights, array, frame))) != handle:
             raise InvalidInput(f"these points have another handle than {handle}")
         summary = self._network.find_cached(self._calls, handle)
         if summary is None:
@@ -198,17 +218,7 @@ class LocalClient:
         check_encoding(encoding)
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
-        weight_array = None
-        if weights is not None:
-            weight_array = np.ascontiguousarray(np.asarray(weights, dtype=np.float64))
-            if weight_array.shape != (len(array),):
-                raise InvalidInput(
-                    f"weights must have shape ({len(array)},): one per point, got {weight_array.shape}"
-                )
-            if frame.projection is not None:
-                raise InvalidInput(
-                    "weights need planar coordinates: the CRS is geographic (project the points and radii first)"
-                )
+        weight_array = checked_weights(weights, array, frame)
         callback, close = progress_callback(progress, len(array))
         try:
             backend = self._local.build_local(

@@ -8,6 +8,9 @@ fl(10^-k) * X``, ``2^-k * X``), each verified bit for bit with the server's arit
 transform tried on a sample as float64 and as integers, zstd level 3; the smallest kept, and a raw
 PointChunk when nothing beats 16 bytes a point. Messages are encoded by hand like ``_wire.py``'s
 (the fields are few and small; the data is one bytes field), so a chunk's bytes are copied once.
+
+Points are (n, 2) float64 arrays; the points of a weighted stream (BuildHeader.weighted) are (n, 3)
+arrays of x, y and the weight w, which is a third axis throughout (its own scale, w_scale).
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ _MAX_EXACT_INTEGER = float(1 << 53)
 _POWERS_OF_TEN = [float(10**k) for k in range(23)]
 _TENTH_POWERS = [float(f"1e-{k}") for k in range(23)]
 _WORD = {FLOAT64: ("<u8", "<i8", 8), INT32: ("<u4", "<i4", 4), INT64: ("<u8", "<i8", 8)}
+_AXIS_NAMES = ("x", "y", "w")
 
 
 class _Scratch(threading.local):
@@ -92,23 +96,32 @@ class AxisScale:
 
 @dataclasses.dataclass(frozen=True)
 class ChunkEncoding:
-    """How to encode one chunk; x_scale and y_scale for the integer value types only."""
+    """How to encode one chunk; x_scale and y_scale (and w_scale, weighted) for the integer value
+    types only."""
 
     value_type: int = FLOAT64
     transform: int = NONE
     compression: int = UNCOMPRESSED
     x_scale: Optional[AxisScale] = None
     y_scale: Optional[AxisScale] = None
+    w_scale: Optional[AxisScale] = None
+
+    def scales(self, axes: int) -> Tuple[Optional[AxisScale], ...]:
+        return (self.x_scale, self.y_scale, self.w_scale)[:axes]
 
 
 @dataclasses.dataclass
 class ScaledIntegers:
-    """Per-axis scales under which every coordinate is an integer, and the integers ((n, 2) int64)."""
+    """Per-axis scales under which every value is an integer, and the integers ((n, axes) int64)."""
 
     value_type: int  # INT32 when every integer fits, else INT64
     x_scale: AxisScale
     y_scale: AxisScale
     integers: np.ndarray
+    w_scale: Optional[AxisScale] = None  # weighted points only
+
+    def encoding(self, transform: int = NONE, compression: int = UNCOMPRESSED) -> ChunkEncoding:
+        return ChunkEncoding(self.value_type, transform, compression, self.x_scale, self.y_scale, self.w_scale)
 
 
 # ---- Scaled integers ---------------------------------------------------------------------------
@@ -251,42 +264,43 @@ def find_axis_scale(values: np.ndarray, out: Optional[np.ndarray] = None) -> Opt
 
 
 def find_scaled_integers(points: np.ndarray, scratch: bool = False) -> Optional[ScaledIntegers]:
-    """Per-axis scales under which every coordinate of (n, 2) `points` is an integer, exactly.
-    `scratch`: the integers live in this thread's scratch (valid until its next call)."""
-    n = len(points)
+    """Per-axis scales under which every value of (n, 2) `points` (or weighted (n, 3) ones) is an
+    integer, exactly. `scratch`: the integers live in this thread's scratch (valid until its next
+    call)."""
+    n, axes = points.shape
     if n == 0:
         return None
     column = _scratch.get("column", (n,), np.float64)
     found = []
-    integers = _scratch.get("integers_f", (2, n), np.float64) if scratch else np.empty((2, n))
-    for axis in range(2):
+    integers = _scratch.get("integers_f", (axes, n), np.float64) if scratch else np.empty((axes, n))
+    for axis in range(axes):
         np.copyto(column, points[:, axis])
         axis_scale = find_axis_scale(column, integers[axis])
         if axis_scale is None:
             return None
         found.append(axis_scale[0])
     fits32 = bool(integers.min() >= -(2.0**31) and integers.max() < 2.0**31)
-    words = _scratch.get("integers", (n, 2), np.int64) if scratch else np.empty((n, 2), np.int64)
+    words = _scratch.get("integers", (n, axes), np.int64) if scratch else np.empty((n, axes), np.int64)
     np.copyto(words, integers.T, casting="unsafe")
-    return ScaledIntegers(INT32 if fits32 else INT64, found[0], found[1], words)
+    return ScaledIntegers(INT32 if fits32 else INT64, found[0], found[1], words, found[2] if axes == 3 else None)
 
 
 # ---- Transforms ----------------------------------------------------------------------------------
 
 
 def _transformed(words: np.ndarray, transform: int) -> np.ndarray:
-    """Interleaved (n, 2) unsigned words as the transform's bytes (the proto's PointTransform), a
-    uint8 array in this thread's scratch."""
+    """Interleaved (n, axes) unsigned words as the transform's bytes (the proto's PointTransform),
+    a uint8 array in this thread's scratch."""
     if transform in (0, NONE):
         return np.ascontiguousarray(words).reshape(-1).view(np.uint8)
-    n = len(words)
+    n, axes = words.shape
     dtype = words.dtype
     width = dtype.itemsize
-    planar = _scratch.get("planar", (2, n), dtype)
-    np.copyto(planar, words.T)  # all x words, then all y words
+    planar = _scratch.get("planar", (axes, n), dtype)
+    np.copyto(planar, words.T)  # all x words, then all y words (then all w words)
     if transform != BYTE_SHUFFLE:
         # Residuals modulo 2^W of the prediction (the previous word, or 2 w[i-1] - w[i-2]).
-        residual = _scratch.get("residual", (2, n), dtype)
+        residual = _scratch.get("residual", (axes, n), dtype)
         residual[:, :1] = planar[:, :1]
         np.subtract(planar[:, 1:], planar[:, :-1], out=residual[:, 1:])
         if transform == DELTA2_SHUFFLE:
@@ -300,23 +314,25 @@ def _transformed(words: np.ndarray, transform: int) -> np.ndarray:
         np.left_shift(residual, dtype.type(1), out=residual)
         np.bitwise_xor(residual, planar, out=planar)
     # Byte planes: byte 0 of every word, then byte 1, ...
-    planes = _scratch.get("planes", (width, 2 * n), np.uint8)
+    planes = _scratch.get("planes", (width, axes * n), np.uint8)
     np.copyto(planes, planar.reshape(-1).view(np.uint8).reshape(-1, width).T)
     return planes.reshape(-1)
 
 
 def transform_words(words: np.ndarray, transform: int) -> bytes:
-    """Interleaved (n, 2) unsigned words to the transform's bytes (the proto's PointTransform)."""
+    """Interleaved (n, axes) unsigned words to the transform's bytes (the proto's PointTransform)."""
     return _transformed(words, transform).tobytes()
 
 
-def untransform_words(data: bytes, n: int, transform: int, word: str) -> np.ndarray:
-    """The inverse of transform_words: (n, 2) words of dtype `word`."""
+def untransform_words(data: bytes, n: int, transform: int, word: str, axes: int = 2) -> np.ndarray:
+    """The inverse of transform_words: (n, axes) words of dtype `word`."""
     dtype = np.dtype(word)
     if transform in (0, NONE):
-        return np.frombuffer(data, dtype=dtype).reshape(n, 2)
+        return np.frombuffer(data, dtype=dtype).reshape(n, axes)
     width = dtype.itemsize
-    planar = np.ascontiguousarray(np.frombuffer(data, dtype=np.uint8).reshape(width, 2 * n).T).view(dtype).reshape(2, n)
+    planar = (
+        np.ascontiguousarray(np.frombuffer(data, dtype=np.uint8).reshape(width, axes * n).T).view(dtype).reshape(axes, n)
+    )
     if transform != BYTE_SHUFFLE:
         one = dtype.type(1)
         residual = (planar >> one) ^ (dtype.type(0) - (planar & one))
@@ -381,11 +397,12 @@ def _chunk_data(points: np.ndarray, encoding: ChunkEncoding, integers: Optional[
 
 
 def scaled_integers(points: np.ndarray, encoding: ChunkEncoding) -> np.ndarray:
-    """The (n, 2) int64 integers of `points` under the encoding's scales; InvalidInput naming the
-    first coordinate they do not reproduce bit for bit or that does not fit the value type."""
-    assert encoding.x_scale is not None and encoding.y_scale is not None
+    """The (n, axes) int64 integers of `points` under the encoding's scales; InvalidInput naming
+    the first value they do not reproduce bit for bit or that does not fit the value type."""
     out = np.empty(points.shape, dtype=np.int64)
-    for axis, scale in enumerate((encoding.x_scale, encoding.y_scale)):
+    for axis, scale in enumerate(encoding.scales(points.shape[1])):
+        if scale is None:
+            raise InvalidInput(f"an integer encoding needs a {_AXIS_NAMES[axis]}_scale")
         values = np.ascontiguousarray(points[:, axis], dtype=np.float64)
         x = _estimate(values, np.float64(scale.step), np.bool_(scale.divide), np.float64(scale.offset))
         with np.errstate(all="ignore"):
@@ -394,13 +411,14 @@ def scaled_integers(points: np.ndarray, encoding: ChunkEncoding) -> np.ndarray:
                 good &= (x >= -(2.0**31)) & (x < 2.0**31)
         if not np.all(good):
             i = int(np.argmin(good))
-            raise InvalidInput(f"point {i}'s {'xy'[axis]} ({values[i]!r}) is not an integer under {scale}")
+            raise InvalidInput(f"point {i}'s {_AXIS_NAMES[axis]} ({values[i]!r}) is not an integer under {scale}")
         out[:, axis] = x.astype(np.int64)
     return out
 
 
 def encode_chunk(points: np.ndarray, encoding: ChunkEncoding, integers: Optional[np.ndarray] = None) -> bytes:
-    """The EncodedPointChunk message of (n, 2) float64 `points` (1 to 262,144) as `encoding` says.
+    """The EncodedPointChunk message of (n, 2) float64 `points` (weighted: (n, 3)), 1 to 262,144
+    of them, as `encoding` says.
     `integers`: the points' integers under the encoding's scales, when the caller has them (else
     computed and verified here)."""
     n = len(points)
@@ -408,17 +426,21 @@ def encode_chunk(points: np.ndarray, encoding: ChunkEncoding, integers: Optional
         raise InvalidInput(f"an encoded chunk holds 1 to {MAX_POINTS_PER_ENCODED_CHUNK} points, not {n}")
     if encoding.value_type != FLOAT64 and integers is None:
         integers = scaled_integers(points, encoding)
-    return _chunk_message(n, encoding, _chunk_data(points, encoding, integers))
+    return _chunk_message(n, encoding, _chunk_data(points, encoding, integers), points.shape[1])
 
 
-def _chunk_message(n: int, encoding: ChunkEncoding, data: bytes) -> bytes:
+def _chunk_message(n: int, encoding: ChunkEncoding, data: bytes, axes: int = 2) -> bytes:
     head = _varint_field(1, n) + _varint_field(2, encoding.value_type)
     if encoding.value_type != FLOAT64:
         assert encoding.x_scale is not None and encoding.y_scale is not None
         head += _wire._len_field(3, _axis_scale_message(encoding.x_scale))
         head += _wire._len_field(4, _axis_scale_message(encoding.y_scale))
     head += _varint_field(5, encoding.transform) + _varint_field(6, encoding.compression)
-    return head + _wire._varint((7 << 3) | _wire._LEN) + _wire._varint(len(data)) + data
+    head += _wire._varint((7 << 3) | _wire._LEN) + _wire._varint(len(data)) + data
+    if encoding.value_type != FLOAT64 and axes == 3:
+        assert encoding.w_scale is not None
+        head += _wire._len_field(8, _axis_scale_message(encoding.w_scale))
+    return head
 
 
 def encoded_request(chunk_message: bytes) -> bytes:
@@ -451,13 +473,12 @@ def choose_encoding(points: np.ndarray) -> Tuple[Optional[ChunkEncoding], Option
     if _zstd() is None:
         if scaled is None:
             return None, None
-        encoding = ChunkEncoding(scaled.value_type, NONE, UNCOMPRESSED, scaled.x_scale, scaled.y_scale)
-        return encoding, scaled.integers
+        return scaled.encoding(), scaled.integers
     chosen, size = _best_transform(points[:m], ChunkEncoding(FLOAT64), None)
     if scaled is not None:
         # Integers usually win by far; power-of-two steps of full-precision doubles (lon/lat in one
         # binade) are the same bits and can lose by a few bytes.
-        as_integers = ChunkEncoding(scaled.value_type, x_scale=scaled.x_scale, y_scale=scaled.y_scale)
+        as_integers = scaled.encoding()
         trial, trial_size = _best_transform(points[:m], as_integers, scaled.integers[:m])
         if trial_size <= size:
             return trial, scaled.integers
@@ -465,9 +486,9 @@ def choose_encoding(points: np.ndarray) -> Tuple[Optional[ChunkEncoding], Option
 
 
 def encode_smallest(points: np.ndarray) -> bytes:
-    """The BuildRequest of one chunk of (n, 2) float64 `points` in its smallest form: an
-    EncodedPointChunk, or a raw PointChunk when no encoding beats 16 bytes a point."""
-    n = len(points)
+    """The BuildRequest of one chunk of (n, 2) float64 `points` (weighted: (n, 3)) in its smallest
+    form: an EncodedPointChunk, or a raw PointChunk when no encoding beats 8 bytes a value."""
+    n, axes = points.shape
     if n == 0 or n > MAX_POINTS_PER_ENCODED_CHUNK:
         return _wire.encode_point_chunk_request(points)
     encoding, integers = choose_encoding(points)
@@ -475,14 +496,14 @@ def encode_smallest(points: np.ndarray) -> bytes:
         return _wire.encode_point_chunk_request(points)
     data = _chunk_data(points, encoding, integers)
     width = _WORD[encoding.value_type][2]
-    if len(data) >= 2 * n * width and encoding.compression == ZSTD:
+    if len(data) >= axes * n * width and encoding.compression == ZSTD:
         if encoding.value_type == FLOAT64:
             return _wire.encode_point_chunk_request(points)
         encoding = dataclasses.replace(encoding, transform=NONE, compression=UNCOMPRESSED)
         data = _chunk_data(points, encoding, integers)
-    message = _chunk_message(n, encoding, data)
-    # A raw chunk is 16 bytes a point plus a few of framing: the encoded one must beat that.
-    if len(message) >= 16 * n:
+    message = _chunk_message(n, encoding, data, axes)
+    # A raw chunk is 8 bytes a value plus a few of framing: the encoded one must beat that.
+    if len(message) >= 8 * axes * n:
         return _wire.encode_point_chunk_request(points)
     return encoded_request(message)
 
@@ -501,11 +522,12 @@ def _decode_axis_scale(payload: memoryview) -> AxisScale:
     return AxisScale(step, divide, offset)
 
 
-def decode_chunk(message: bytes) -> np.ndarray:
-    """The (n, 2) float64 points of an EncodedPointChunk message; ValueError for what the server
-    refuses (a malformed chunk, a size mismatch, an INT64 integer over 2^53)."""
+def decode_chunk(message: bytes, axes: int = 2) -> np.ndarray:
+    """The (n, 2) float64 points of an EncodedPointChunk message (a weighted stream's: (n, 3), with
+    `axes` 3); ValueError for what the server refuses (a malformed chunk, a size mismatch, an INT64
+    integer over 2^53)."""
     n = value_type = transform = compression = 0
-    scales: List[Optional[AxisScale]] = [None, None]
+    scales: List[Optional[AxisScale]] = [None, None, None]
     data = b""
     for number, _, value in _wire.fields(message):
         if number == 1:
@@ -520,40 +542,45 @@ def decode_chunk(message: bytes) -> np.ndarray:
             compression = int(value)  # type: ignore[arg-type]
         elif number == 7:
             data = bytes(value)  # type: ignore[arg-type]
+        elif number == 8:
+            if axes != 3:
+                raise ValueError("a w_scale in an unweighted stream")
+            scales[2] = _decode_axis_scale(value)  # type: ignore[arg-type]
     if not 1 <= n <= MAX_POINTS_PER_ENCODED_CHUNK or value_type not in _WORD:
         raise ValueError(f"bad point_count {n} or value_type {value_type}")
     word, signed, width = _WORD[value_type]
-    expected = 2 * n * width
+    expected = axes * n * width
     if compression == ZSTD:
         import zstandard
 
         data = zstandard.ZstdDecompressor().decompress(data, max_output_size=expected)
     if len(data) != expected:
         raise ValueError(f"the data is {len(data)} bytes; {n} points of {width}-byte words are {expected}")
-    words = untransform_words(data, n, transform, word)
+    words = untransform_words(data, n, transform, word, axes)
     if value_type == FLOAT64:
         return words.view("<f8").astype(np.float64)
     integers = words.view(signed).astype(np.int64)
     if np.any(np.abs(integers) > (1 << 53)):
         raise ValueError("an INT64 value is over 2^53 in magnitude")
-    out = np.empty((n, 2), dtype=np.float64)
-    for axis in range(2):
+    out = np.empty((n, axes), dtype=np.float64)
+    for axis in range(axes):
         scale = scales[axis]
         if scale is None:
-            raise ValueError(f"an integer chunk needs {'xy'[axis]}_scale")
+            raise ValueError(f"an integer chunk needs {_AXIS_NAMES[axis]}_scale")
         with np.errstate(all="ignore"):
             out[:, axis] = scale.values(integers[:, axis])
     return out
 
 
-def decode_request(request: bytes) -> np.ndarray:
-    """The points of one BuildRequest carrying points (raw or encoded)."""
+def decode_request(request: bytes, axes: int = 2) -> np.ndarray:
+    """The points of one BuildRequest carrying points (raw or encoded); `axes` 3 for a weighted
+    stream's (x, y, w)."""
     number, payload = _wire.split_oneof(request)
     if number == 2:
         for field, wire, value in _wire.fields(bytes(payload)):
             if field == 1:
-                return _wire._packed(value, wire, "<f8").reshape(-1, 2).astype(np.float64)
-        return np.empty((0, 2))
+                return _wire._packed(value, wire, "<f8").reshape(-1, axes).astype(np.float64)
+        return np.empty((0, axes))
     if number == 3:
-        return decode_chunk(bytes(payload))
+        return decode_chunk(bytes(payload), axes)
     raise ValueError(f"BuildRequest field {number} carries no points")

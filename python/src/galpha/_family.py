@@ -276,7 +276,7 @@ class Family:
     def hidden_points(self) -> np.ndarray:
         """Input indices (uint32, ascending) of the points a weighted family hides: no vertex of
         the regular triangulation, EXTERIOR at every threshold. Empty for an unweighted family."""
-        return self._backend.hidden_points()
+        return self._backend.hidden_points(self._frame.computed)
 
     @property
     def spectrum_size(self) -> int:

@@ -4,7 +4,9 @@ A SHA-256 tree over the coordinates as sent (little-endian doubles x0, y0, x1, .
 1 MiB leaves; each leaf's digest is SHA-256 of a zero byte and the leaf; the handle is SHA-256 of
 the tag "galpha.v2.points" with its NUL, the byte count (little-endian uint64) and the leaf
 digests, written "sha256-" + 64 hex digits (proto/galpha/v1/alpha_shapes.proto, BuildResponse).
-Knowing the handle before uploading lets the client skip the upload of a set the server holds.
+Weighted points hash their triples (x0, y0, w0, x1, ...) under the tag "galpha.v2.weighted-points"
+(core/io/point_set_handle.hpp, WeightedPointSetHandle). Knowing the handle before uploading lets
+the client skip the upload of a set the server holds.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 
 LEAF_BYTES = 1 << 20
 _TAG = b"galpha.v2.points\x00"
+_WEIGHTED_TAG = b"galpha.v2.weighted-points\x00"
 
 
 def _leaf_digest(view: memoryview) -> bytes:
@@ -27,8 +30,11 @@ def _leaf_digest(view: memoryview) -> bytes:
 
 
 def point_set_handle(points: np.ndarray) -> str:
-    """The handle of an (N, 2) float64 C-contiguous array (little-endian on every supported host)."""
-    data = memoryview(np.ascontiguousarray(points, dtype="<f8")).cast("B")
+    """The handle of an (N, 2) float64 array of points, or of an (N, 3) array of weighted points
+    (x, y, w), as the server computes it."""
+    array = np.ascontiguousarray(points, dtype="<f8")
+    tag = _WEIGHTED_TAG if array.ndim == 2 and array.shape[1] == 3 else _TAG
+    data = memoryview(array).cast("B")
     total = len(data)
     leaves = [data[i : i + LEAF_BYTES] for i in range(0, total, LEAF_BYTES)]
     if len(leaves) > 1:
@@ -37,5 +43,5 @@ def point_set_handle(points: np.ndarray) -> str:
             digests = list(pool.map(_leaf_digest, leaves))
     else:
         digests = [_leaf_digest(leaf) for leaf in leaves]
-    root = hashlib.sha256(_TAG + struct.pack("<Q", total) + b"".join(digests))
+    root = hashlib.sha256(tag + struct.pack("<Q", total) + b"".join(digests))
     return "sha256-" + root.hexdigest()

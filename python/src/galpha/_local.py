@@ -180,7 +180,7 @@ class LocalFamilyBackend:
         return PersistenceDiagram(h0=_pairs(0, h0), h1=_pairs(1, h1))
 
     @_translated
-    def hidden_points(self) -> np.ndarray:
+    def hidden_points(self, points: np.ndarray) -> np.ndarray:
         return self._family.hidden_points()
 
     def release(self) -> bool:

@@ -103,6 +103,8 @@ def summary_from(message: pb.BuildSummary, cached: bool) -> BuildSummary:
         peak_memory_bytes=message.peak_memory_bytes,
         family_bytes=message.family_bytes,
         cached=cached,
+        weighted=message.weighted,
+        hidden_points=message.hidden_points,
     )
 
 
@@ -291,7 +293,10 @@ class UploadCounter:
 
 
 def header_message(name: str, points: np.ndarray) -> bytes:
-    return pb.BuildRequest(header=pb.BuildHeader(name=name, expected_points=len(points))).SerializeToString()
+    """The Build header of (n, 2) points, or of (n, 3) weighted ones (x, y, w: BuildHeader.weighted)."""
+    weighted = points.ndim == 2 and points.shape[1] == 3
+    header = pb.BuildHeader(name=name, expected_points=len(points), weighted=weighted)
+    return pb.BuildRequest(header=header).SerializeToString()
 
 
 def chunk_message(chunk: np.ndarray, encoding: str) -> bytes:
@@ -523,11 +528,68 @@ class NetworkFamilyBackend:
         request = persistence_request(self._handle, dimensions, min_persistence)
         return persistence_from(self._stream(self._calls.persistence, request))
 
-    def hidden_points(self) -> np.ndarray:
-        return np.empty(0, dtype=np.uint32)  # servers build unweighted families
+    def hidden_points(self, points: np.ndarray) -> np.ndarray:
+        if self._summary.hidden_points == 0:
+            return np.empty(0, dtype=np.uint32)
+        # The server counts them; Classify at rank 0 reports them as its EXTERIOR vertices (every
+        # other vertex is in from rank 0), first occurrences only, vertices first: the stream is
+        # cancelled at the first edge chunk.
+        firsts: List[np.ndarray] = []
+        stream = self._calls.classify(
+            hidden_points_request(self._handle), timeout=self._calls.timeout, metadata=self._calls.metadata(self._handle)
+        )
+        try:
+            for raw in stream:
+                exterior = exterior_vertices(raw)
+                if exterior is None:
+                    break
+                firsts.append(exterior)
+        except grpc.RpcError as e:
+            raise raise_from_rpc(e) from None
+        finally:
+            stream.cancel()
+        return hidden_with_duplicates(points, firsts, self._summary.hidden_points)
 
     def release(self) -> bool:
         return self._call(self._calls.release, pb.ReleaseRequest(handle=self._handle)).released
+
+
+def hidden_points_request(handle: str) -> pb.ClassifyRequest:
+    """The Classify call whose EXTERIOR vertices are a weighted family's hidden points (first
+    occurrences): rank 0, where every other vertex is in (proto: BuildSummary.hidden_points)."""
+    return pb.ClassifyRequest(handle=handle, threshold=pb.Threshold(rank=0))
+
+
+def exterior_vertices(raw: bytes) -> Optional[np.ndarray]:
+    """The EXTERIOR vertices of one ClassifyResponse (empty for the summary); None once the stream
+    is past the vertices (an edge or triangle chunk), where a caller that wants vertices stops."""
+    number, payload = _wire.split_oneof(raw)
+    if number != 2:
+        return np.empty(0, dtype=np.uint32)
+    kind, indices, classes = _wire.decode_simplex_chunk(payload)
+    if kind != pb.SIMPLEX_KIND_VERTEX:
+        return None
+    return indices[classes == pb.SIMPLEX_CLASS_EXTERIOR]
+
+
+def hidden_with_duplicates(points: np.ndarray, parts: List[np.ndarray], count: int) -> np.ndarray:
+    """Every input index whose point equals one of the points `parts` name (hidden points and
+    their duplicates, as the engine finds duplicates: by value, -0.0 equal to 0.0), ascending;
+    DATA_LOSS unless they are the `count` the server reported."""
+    firsts = np.concatenate(parts) if parts else np.empty(0, dtype=np.uint32)
+    if len(firsts) and int(firsts.max()) >= len(points):
+        raise GalphaError(f"the server names point {int(firsts.max())} of {len(points)}", code="DATA_LOSS", code_number=15)
+    as_complex = np.empty(len(points), dtype=np.complex128)  # (x, y) as one sortable value, exactly
+    as_complex.real = points[:, 0] + 0.0  # -0.0 + 0.0 is 0.0
+    as_complex.imag = points[:, 1] + 0.0
+    hidden = np.flatnonzero(np.isin(as_complex, as_complex[firsts])).astype(np.uint32)
+    if len(hidden) != count:
+        raise GalphaError(
+            f"the server counts {count} hidden points; Classify at rank 0 gives {len(hidden)}",
+            code="DATA_LOSS",
+            code_number=15,
+        )
+    return hidden
 
 
 def find_cached(calls: Calls, handle: str) -> Optional[BuildSummary]:

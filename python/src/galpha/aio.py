@@ -15,7 +15,7 @@ import grpc
 import numpy as np
 
 from . import _network, _wire
-from ._client import Progress, progress_callback
+from ._client import Progress, checked_weights, progress_callback, upload_of
 from ._crs import Frame, frame_of
 from ._encoding import check_encoding
 from ._errors import InvalidInput
@@ -111,6 +111,27 @@ class AsyncFamily:
                 break
             rank = next_rank
         return np.concatenate(pages)
+
+    async def hidden_points(self) -> np.ndarray:
+        """As :attr:`galpha.Family.hidden_points`: the input indices (uint32, ascending) of the
+        points a weighted family hides; empty for an unweighted one."""
+        if self.summary.hidden_points == 0:
+            return np.empty(0, dtype=np.uint32)
+        firsts: List[np.ndarray] = []
+        call = self._calls.classify(
+            _network.hidden_points_request(self.handle), timeout=self._calls.timeout, metadata=self._metadata()
+        )
+        try:
+            async for raw in call:
+                exterior = _network.exterior_vertices(raw)
+                if exterior is None:
+                    break
+                firsts.append(exterior)
+        except grpc.RpcError as e:
+            raise _network.raise_from_rpc(e) from None
+        finally:
+            call.cancel()
+        return _network.hidden_with_duplicates(self._frame.computed, firsts, self.summary.hidden_points)
 
     async def classify(
         self,
@@ -298,19 +319,18 @@ class AsyncClient:
         """Uploads the points (unless the server holds them) and awaits the build. Cancelling the
         task cancels the upload; the server then drops what it had received. ``encoding``: "auto"
         or "raw", and ``crs``, as :meth:`galpha.NetworkClient.build` takes them (chunks are encoded
-        off the event loop, in its default executor)."""
+        off the event loop, in its default executor), and ``weights`` as
+        :meth:`galpha.NetworkClient.build` takes it."""
         encoding = check_encoding(encoding)
-        if weights is not None:
-            raise InvalidInput("weights: the server builds unweighted families; build weighted ones with galpha.local()")
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
-        computed = frame.computed
+        upload = upload_of(frame.computed, checked_weights(weights, array, frame))
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         sent: Optional[Callable[[int], None]] = None if callback is None else (lambda n: callback("upload", n / total))
         try:
             # Hashing 1M points takes ~10 ms; off the event loop for larger sets.
-            handle = await asyncio.get_running_loop().run_in_executor(None, point_set_handle, computed)
+            handle = await asyncio.get_running_loop().run_in_executor(None, point_set_handle, upload)
             metadata = self._calls.metadata(handle)
             try:
                 answer = await self._calls.describe(
@@ -323,7 +343,7 @@ class AsyncClient:
             counter = _network.UploadCounter()
             try:
                 answer = await self._calls.build(
-                    _upload_messages(name, computed, sent, encoding, counter), timeout=self._calls.timeout, metadata=metadata
+                    _upload_messages(name, upload, sent, encoding, counter), timeout=self._calls.timeout, metadata=metadata
                 )
             except grpc.RpcError as e:
                 raise _network.raise_from_rpc(e) from None
