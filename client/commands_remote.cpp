@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -166,8 +167,9 @@ std::array<uint64_t, 4> FromProto(const v1::ClassCounts& counts) {
 /// A weighted family's hidden points (input indices, ascending), as the local summary lists them;
 /// null for an unweighted family. The server counts them (BuildSummary.hidden_points) and
 /// Classify at rank 0 reports them as its EXTERIOR vertices, first occurrences only: their
-/// duplicates (equal coordinates) are found among FILE's points. Classify stops after the
-/// vertices.
+/// duplicates (the same position and the same weight: a lighter point at a heavier one's
+/// position is a point of its own, hidden, and listed) are found among FILE's weighted points.
+/// Classify stops after the vertices.
 absl::StatusOr<nlohmann::ordered_json> RemoteHiddenPoints(const RemoteFamily& remote) {
   const v1::BuildSummary& build = remote.build.summary;
   if (!build.weighted()) return nullptr;
@@ -177,8 +179,12 @@ absl::StatusOr<nlohmann::ordered_json> RemoteHiddenPoints(const RemoteFamily& re
   request.set_handle(remote.build.handle);
   request.mutable_threshold()->set_rank(0);
   const std::vector<Point2>& points = remote.frame.Computed();
+  const std::vector<double>& weights = remote.frame.weights;
+  if (weights.size() != points.size()) {
+    return absl::InternalError("the server holds a weighted family of points sent without weights");
+  }
   // Compared as values (-0.0 equals 0.0), as the engine finds duplicates.
-  std::set<std::pair<double, double>> hidden_at;
+  std::set<std::tuple<double, double, double>> hidden_at;
   bool past_vertices = false;
   absl::Status status = remote.client->Classify(request, [&](const v1::ClassifyResponse& message) {
     if (!message.has_chunk()) return absl::OkStatus();
@@ -195,13 +201,13 @@ absl::StatusOr<nlohmann::ordered_json> RemoteHiddenPoints(const RemoteFamily& re
       const uint32_t v = chunk.vertex_indices(static_cast<int>(i));
       if (v >= points.size())
         return absl::DataLossError(absl::StrCat("Classify names vertex ", v, " of ", points.size()));
-      hidden_at.emplace(points[v].x, points[v].y);
+      hidden_at.emplace(points[v].x, points[v].y, weights[v]);
     }
     return absl::OkStatus();
   });
   if (!status.ok() && !past_vertices) return status;
   for (size_t i = 0; i < points.size(); ++i) {
-    if (hidden_at.count({points[i].x, points[i].y}) != 0) list.push_back(i);
+    if (hidden_at.count({points[i].x, points[i].y, weights[i]}) != 0) list.push_back(i);
   }
   if (list.size() != build.hidden_points()) {
     return absl::DataLossError(absl::StrCat("the server counts ", build.hidden_points(),

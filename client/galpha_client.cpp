@@ -55,10 +55,7 @@ namespace {
 // (its points or encoded_points).
 absl::Status EncodeChunk(absl::Span<const Point2> points, absl::Span<const double> weights, PointEncoding encoding,
                          wire::PointChunkEncoder* encoder, v1::BuildRequest* message) {
-  if (encoding == PointEncoding::kAuto) {
-    encoder->EncodeSmallest(points, weights, message);
-    return absl::OkStatus();
-  }
+  if (encoding == PointEncoding::kAuto) return encoder->EncodeSmallest(points, weights, message);
   if (encoding == PointEncoding::kRaw) {
     auto* coordinates = message->mutable_points()->mutable_coordinates();
     if (weights.empty()) {

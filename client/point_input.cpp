@@ -253,11 +253,33 @@ absl::StatusOr<GeoreferencedPoints> ReadWeightedInput(const std::string& file, c
     return ReadTextInput(STDIN_FILENO, "standard input", options, /*weighted=*/true);
   }
   const std::string named = absl::StrCat("points file '", file, "'");
-  if (molecule || las || IsVectorPointsExtension(extension)) {
+  if (molecule) {
+    // Atoms carry their elements' van der Waals radii (ReadMoleculePoints): radii, not weights.
+    if (options.weights != InputOptions::Weights::kRadius) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "structure file '", file,
+          "': its atoms carry radii (their elements' van der Waals radii): read them with --weights radius"));
+    }
+    std::vector<double> radii;
+    GALPHA_ASSIGN_OR_RETURN(GeoreferencedPoints atoms,
+                            WithMaxPointsHint(ReadMoleculePoints(file, options.section, options.max_points, &radii)));
+    atoms.weights = std::move(radii);  // radii: the caller adds --probe and squares them
+    for (size_t i = 0; i < atoms.weights.size(); ++i) {
+      if (std::isnan(atoms.weights[i])) {
+        return absl::InvalidArgumentError(
+            absl::StrCat("structure file '", file, "': atom ", i,
+                         " (in file order, of those kept) has an element gemmi does not know: its van der Waals "
+                         "radius is unknown"));
+      }
+    }
+    return atoms;
+  }
+  if (las || IsVectorPointsExtension(extension)) {
     return absl::InvalidArgumentError(
         absl::StrCat(named,
                      " carries no weights that --weights reads: weighted points come as delimited text (x, y, weight), "
-                     ".npy (N, 3), weighted .bin or GeoJSON with --weight-property"));
+                     ".npy (N, 3), weighted .bin, GeoJSON with --weight-property, or PDB and mmCIF structures "
+                     "(their atoms' element radii, with --weights radius)"));
   }
   GALPHA_RETURN_IF_ERROR(CheckNamedInput(file, named, &info));
   const bool text = extension != ".bin" && extension != ".npy" && extension != ".geojson" && extension != ".json";

@@ -267,8 +267,11 @@ absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
   }
   // Hashed once the points are all here: in parallel (point_set_handle.hpp), ~1 ms at 1M points
   // on 16 cores.
-  decoded_.handle = decoded_.header.weighted() ? WeightedPointSetHandle(decoded_.points, decoded_.weights)
-                                               : PointSetHandle(decoded_.points);
+  // A weighted stream of no points is the empty set, unweighted (as BuildWeightedAlphaFamily
+  // builds it): one family and one handle for every empty set.
+  decoded_.handle = decoded_.header.weighted() && !decoded_.points.empty()
+                        ? WeightedPointSetHandle(decoded_.points, decoded_.weights)
+                        : PointSetHandle(decoded_.points);
   return &decoded_;
 }
 

@@ -9,6 +9,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
@@ -39,13 +40,17 @@ absl::StatusOr<MoleculeSection> ParseMoleculeSection(const std::string* plane, c
 /// The atoms of the first model of the structure at `path` (format by content: PDB or mmCIF;
 /// gzip-compressed files too), alternative conformations reduced to the first, as points of
 /// `section`, in file order. Coordinates are the file's (ångström), each the double that gemmi
-/// parses from the file's decimal text. No CRS (the points are not georeferenced).
+/// parses from the file's decimal text. No CRS (the points are not georeferenced). `radii`, when
+/// given, gets each kept atom's radius: its element's van der Waals radius in gemmi's table
+/// (Bondi's for the common elements: C 1.70, N 1.55, O 1.52, S 1.80 Å), as the double nearest
+/// the table's decimal; NaN for an atom whose element gemmi does not know.
 ///
 /// Errors name the file: InvalidArgument when this build has no gemmi, when gemmi cannot read
 /// the file (its message attached), or when its first model has no atoms (a slab may keep none:
 /// that is no error); ResourceExhausted when more than
 /// `max_points` atoms are kept.
 absl::StatusOr<GeoreferencedPoints> ReadMoleculePoints(const std::string& path, const MoleculeSection& section,
-                                                       uint64_t max_points = std::numeric_limits<uint64_t>::max());
+                                                       uint64_t max_points = std::numeric_limits<uint64_t>::max(),
+                                                       std::vector<double>* radii = nullptr);
 
 }  // namespace galpha

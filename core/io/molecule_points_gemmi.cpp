@@ -2,8 +2,11 @@
 #include <gemmi/mmread.hpp>
 #include <gemmi/modify.hpp>
 
+#include <charconv>
 #include <exception>
+#include <limits>
 #include <string>
+#include <system_error>
 
 #include "absl/strings/str_cat.h"
 #include "core/io/molecule_points.hpp"
@@ -11,8 +14,24 @@
 
 namespace galpha {
 
+namespace {
+
+/// The van der Waals radius of `element` as the double nearest the decimal in gemmi's table
+/// (which stores floats: 1.7f widened would be 1.7000000476837158, not 1.7); NaN for an element
+/// gemmi does not know (X), whose table entry is a placeholder.
+double VanDerWaalsRadius(gemmi::Element element) {
+  if (element.elem == gemmi::El::X) return std::numeric_limits<double>::quiet_NaN();
+  char text[32];
+  const auto written = std::to_chars(text, text + sizeof text, element.vdw_r());  // shortest round trip
+  double radius = std::numeric_limits<double>::quiet_NaN();
+  if (written.ec == std::errc()) std::from_chars(text, written.ptr, radius);
+  return radius;
+}
+
+}  // namespace
+
 absl::StatusOr<GeoreferencedPoints> ReadMoleculePoints(const std::string& path, const MoleculeSection& section,
-                                                       uint64_t max_points) {
+                                                       uint64_t max_points, std::vector<double>* radii) {
   const std::string named = absl::StrCat("structure file '", path, "'");
   gemmi::Structure structure;
   try {
@@ -31,6 +50,7 @@ absl::StatusOr<GeoreferencedPoints> ReadMoleculePoints(const std::string& path, 
   if (atoms == 0) return absl::InvalidArgumentError(absl::StrCat(named, " has no atoms in its first model"));
   const SectionAxes axes = AxesOf(section);
   GeoreferencedPoints out;
+  if (radii != nullptr) radii->clear();
   for (const gemmi::Chain& chain : structure.models.front().chains) {
     for (const gemmi::Residue& residue : chain.residues) {
       for (const gemmi::Atom& atom : residue.atoms) {
@@ -41,6 +61,7 @@ absl::StatusOr<GeoreferencedPoints> ReadMoleculePoints(const std::string& path, 
               absl::StrCat(named, " has more than ", max_points, " atoms in the section: more than the limit"));
         }
         out.points.push_back({xyz[axes.u], xyz[axes.v]});
+        if (radii != nullptr) radii->push_back(VanDerWaalsRadius(atom.element));
       }
     }
   }

@@ -281,6 +281,7 @@ void PointChunkDecoder::ReleaseScratch() {
   std::vector<uint64_t>().swap(planar64_);
   std::vector<uint32_t>().swap(words32_);
   std::vector<uint32_t>().swap(planar32_);
+  std::vector<double>().swap(triples_);
 }
 
 absl::Status PointChunkDecoder::Decode(const v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out) {
@@ -633,12 +634,16 @@ v1::PointTransform PointChunkEncoder::ChooseTransform(absl::Span<const Point2> p
 }
 
 void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, v1::BuildRequest* out) {
-  EncodeSmallest(points, {}, out);
+  EncodeSmallest(points, {}, out).IgnoreError();  // unweighted: nothing to refuse
 }
 
-void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, absl::Span<const double> weights,
-                                       v1::BuildRequest* out) {
+absl::Status PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                               v1::BuildRequest* out) {
   const bool weighted = !weights.empty();
+  if (weighted && weights.size() != points.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(points.size(), " points need ", points.size(), " weights, not ", weights.size()));
+  }
   const size_t axes = weighted ? 3 : 2;
   const auto send_raw = [&] {
     auto* coordinates = out->mutable_points()->mutable_coordinates();
@@ -655,8 +660,9 @@ void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, absl::Sp
       coordinates->AddAlreadyReserved(weights[i]);
     }
   };
-  if (points.empty() || points.size() > kMaxPointsPerEncodedChunk || (weighted && weights.size() != points.size())) {
-    return send_raw();
+  if (points.empty() || points.size() > kMaxPointsPerEncodedChunk) {
+    send_raw();
+    return absl::OkStatus();
   }
   // Float64 and, where the data has them, scaled integers, each with its best transform on the
   // sample: integers usually win by far, but power-of-two steps of full-precision doubles (lon/lat
@@ -675,16 +681,21 @@ void PointChunkEncoder::EncodeSmallest(absl::Span<const Point2> points, absl::Sp
     if (BestTransform(sample, sample_weights, &integers) <= float_size) encoding = integers;
   }
   v1::EncodedPointChunk* chunk = out->mutable_encoded_points();
-  if (!Encode(points, weights, encoding, chunk).ok()) return send_raw();
+  const auto raw = [&] {
+    send_raw();
+    return absl::OkStatus();
+  };
+  if (!Encode(points, weights, encoding, chunk).ok()) return raw();
   const size_t uncompressed = axes * points.size() * WordBytes(encoding.value_type);
   if (chunk->data().size() >= uncompressed) {
-    if (encoding.value_type == v1::POINT_VALUE_TYPE_FLOAT64) return send_raw();
+    if (encoding.value_type == v1::POINT_VALUE_TYPE_FLOAT64) return raw();
     encoding.transform = v1::POINT_TRANSFORM_NONE;
     encoding.compression = v1::POINT_COMPRESSION_NONE;
-    if (!Encode(points, weights, encoding, chunk).ok()) return send_raw();
+    if (!Encode(points, weights, encoding, chunk).ok()) return raw();
   }
   // A raw chunk is 8 bytes a value plus a few of framing: the encoded one must beat that.
   if (chunk->ByteSizeLong() >= 8 * axes * points.size()) send_raw();
+  return absl::OkStatus();
 }
 
 }  // namespace galpha::wire

@@ -134,8 +134,10 @@ class PointChunkEncoder {
   /// 8,192 points (then it can miss the smallest by a little).
   void EncodeSmallest(absl::Span<const Point2> points, galpha::v1::BuildRequest* out);
   /// Weighted points (empty `weights`: as above): the smallest chunk of a weighted stream, or raw
-  /// (x, y, w) triples when nothing beats their 24 bytes a point.
-  void EncodeSmallest(absl::Span<const Point2> points, absl::Span<const double> weights, galpha::v1::BuildRequest* out);
+  /// (x, y, w) triples when nothing beats their 24 bytes a point. InvalidArgument (and nothing
+  /// written) for a weight count other than the points'.
+  absl::Status EncodeSmallest(absl::Span<const Point2> points, absl::Span<const double> weights,
+                              galpha::v1::BuildRequest* out);
 
   /// The best transform for `points` under `value_type` and scales, chosen as EncodeSmallest
   /// chooses it, with zstd compression.

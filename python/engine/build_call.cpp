@@ -1,9 +1,11 @@
 #include "python/engine/build_call.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <optional>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include <pybind11/numpy.h>
 
@@ -203,8 +205,9 @@ py::dict ReadPointFile(const std::string& path, const std::string& layer, const 
   }
   const MoleculeSection section =
       ValueOrThrow(ParseMoleculeSection(plane_text ? &*plane_text : nullptr, slab_text ? &*slab_text : nullptr));
+  std::vector<double> radii;
   GeoreferencedPoints read = WithoutGil<GeoreferencedPoints>([&]() -> absl::StatusOr<GeoreferencedPoints> {
-    absl::StatusOr<GeoreferencedPoints> result = molecule ? ReadMoleculePoints(path, section, max_points)
+    absl::StatusOr<GeoreferencedPoints> result = molecule ? ReadMoleculePoints(path, section, max_points, &radii)
                                                  : vector ? ReadVectorPoints(path, layer, max_points)
                                                           : ReadGeoreferencedPointsFile(path);
     if (result.ok() && result->points.size() > max_points) {
@@ -216,6 +219,13 @@ py::dict ReadPointFile(const std::string& path, const std::string& layer, const 
   py::dict out;
   out["points"] = PointsArray(read.points);
   out["crs"] = read.crs ? py::object(py::str(*read.crs)) : py::object(py::none());
+  if (molecule) {
+    py::array_t<double> radius_array(static_cast<py::ssize_t>(radii.size()));
+    std::copy(radii.begin(), radii.end(), radius_array.mutable_data());
+    out["radii"] = std::move(radius_array);
+  } else {
+    out["radii"] = py::none();
+  }
   return out;
 }
 

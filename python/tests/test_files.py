@@ -64,11 +64,14 @@ def test_structures_and_text(tmp_path: pathlib.Path) -> None:
     np.testing.assert_array_equal(galpha.read_points(pdb, plane="zx").points, [[0, 0], [1, 4], [2, 4], [3, 0]])
     assert len(galpha.read_points(pdb, slab="0:1").points) == 2
     assert galpha.read_points(pdb).crs is None
+    # Each atom's element radius (N 1.55, C 1.70, O 1.52: the decimals, not gemmi's floats widened).
+    np.testing.assert_array_equal(galpha.read_points(pdb).radii, [1.55, 1.70, 1.70, 1.52])
+    np.testing.assert_array_equal(galpha.read_points(pdb, slab="0:1").radii, [1.55, 1.70])
     csv = tmp_path / "points.csv"
     csv.write_text("x,y\n0.1,0.2\n1e-3,5\n")
     text = galpha.read_points(csv)
     np.testing.assert_array_equal(text.points, [[0.1, 0.2], [1e-3, 5.0]])
-    assert text.crs is None
+    assert text.crs is None and text.radii is None
     with pytest.raises(InvalidInput, match="plane and slab apply to PDB"):
         galpha.read_points(csv, plane="xy")
     with pytest.raises(InvalidInput, match="layer applies to"):

@@ -103,16 +103,22 @@ def test_weights_change_the_handle_and_are_checked() -> None:
 def test_network_clients_build_the_weighted_family(client, server) -> None:
     """The server builds what galpha.local() builds from (x, y, w) uploads, encoded or raw, under
     the same handle; its hidden points come back from the count and Classify at rank 0, with
-    duplicates of hidden points (Classify lists first occurrences only)."""
+    duplicates of hidden points (Classify lists first occurrences only). Decimal coordinates and
+    weights go up as scaled integers, the weights with their own scale."""
     rng = np.random.default_rng(9)
-    points = rng.random((2000, 2))
-    weights = rng.random(len(points)) / len(points)
-    points = np.vstack([points, points[:3]])  # duplicates (same weights)
-    weights = np.concatenate([weights, weights[:3]])
+    points = rng.integers(0, 10**6, (2000, 2)) / 1e6  # X / 10^6, as decimal text parses
+    weight_integers = rng.integers(-50, 500, len(points))
+    weights = weight_integers / 1e6
+    # Duplicates (same positions and weights), and a lighter point at a point's position: a point
+    # of its own, hidden, whose heavier twin is not its duplicate.
+    points = np.vstack([points, points[:3], points[3:4]])
+    weights = np.concatenate([weights, weights[:3], (weight_integers[3:4] - 100) / 1e6])
     local = galpha.local("cpu").build(points, weights=weights)
     remote = client.build(points, weights=weights)
     assert remote.handle == local.handle
+    assert remote.summary.upload_bytes < 12 * len(points)  # scaled integers, not 24-byte triples
     assert remote.summary.weighted and remote.summary.hidden_points == local.summary.hidden_points > 0
+    assert len(points) - 1 in set(local.hidden_points.tolist())
     np.testing.assert_array_equal(remote.hidden_points, local.hidden_points)
     np.testing.assert_array_equal(remote.spectrum(), local.spectrum())
     for rank in (0, local.spectrum_size // 2):

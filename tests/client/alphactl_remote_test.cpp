@@ -127,7 +127,8 @@ TEST(AlphactlRemoteTest, WeightedPointsAnswerAsLocally) {
   // Disks of squared radius 0.6 to 0.79 on a perturbed unit grid, and in every third cell a point
   // of weight 0 at its centre: the corners' plane lifts the centre to about |c|^2 + 0.5 - 0.7,
   // under its own |c|^2, so it is hidden. The last lines repeat a hidden centre and a grid point,
-  // and add a light point next to a heavy one (hidden too).
+  // add a light point next to a heavy one and a lighter point at a grid point's position (a
+  // point of its own, not a duplicate: both hidden).
   const std::string file = std::filesystem::temp_directory_path() / "alphactl_remote_weighted.csv";
   {
     std::ofstream out(file);
@@ -140,7 +141,7 @@ TEST(AlphactlRemoteTest, WeightedPointsAnswerAsLocally) {
     for (int i = 0; i < 19; i += 3) {
       for (int j = 0; j < 19; j += 3) out << i + 0.5 << ' ' << j + 0.5 << " 0\n";
     }
-    out << "3.5 6.5 0\n0 0 0.6\n5.05 5 0.5\n";
+    out << "3.5 6.5 0\n0 0 0.6\n5.05 5 0.5\n0 0 0.3\n";
   }
   const CommandResult local = Alphactl("summary " + file + " --rank 0 --backend=cpu --weights squared");
   ASSERT_EQ(local.exit_code, 0) << local.err;

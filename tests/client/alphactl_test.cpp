@@ -498,8 +498,24 @@ TEST(AlphactlTest, StructuresGiveTheirAtomsInThePlaneAndSlabChosen) {
   EXPECT_EQ(nlohmann::json::parse(Succeeds("summary", pdb, "--slab 0:1 --rank 0"))["points"], 2);
   ExpectError(Alphactl("summary " + Quote(csv) + " --rank 0 --plane yz"), 1, "--plane and --slab apply to PDB");
   ExpectError(Alphactl("summary " + Quote(pdb) + " --rank 0 --slab 2:1"), 2, "--slab '2:1'");
+  // --weights radius gives each atom its element's van der Waals radius (N 1.55, C 1.70, O 1.52):
+  // the weighted family of the same disks written as text.
+  const std::string disks = WriteFile("alphactl_atom_disks.csv", "0 0 1.55\n4 0 1.70\n4 3 1.70\n0 3 1.52\n");
+  for (const char* options : {"--weights radius", "--weights radius --probe 1.4"}) {
+    SCOPED_TRACE(options);
+    EXPECT_EQ(Succeeds("spectrum", pdb, options), Succeeds("spectrum", disks, options));
+    nlohmann::json from_atoms = nlohmann::json::parse(Succeeds("summary", pdb, std::string(options) + " --rank 2"));
+    nlohmann::json from_text = nlohmann::json::parse(Succeeds("summary", disks, std::string(options) + " --rank 2"));
+    from_atoms.erase("file");
+    from_text.erase("file");
+    EXPECT_EQ(from_atoms, from_text);
+  }
+  EXPECT_LT(std::stod(SplitLines(Succeeds("spectrum", pdb, "--weights radius")).front()), 0.0) << "the disks overlap";
+  ExpectError(Alphactl("summary " + Quote(pdb) + " --rank 0 --weights squared"), 1,
+              "its atoms carry radii (their elements' van der Waals radii): read them with --weights radius");
   std::filesystem::remove(pdb);
   std::filesystem::remove(csv);
+  std::filesystem::remove(disks);
 }
 #endif  // GALPHA_WITH_GEMMI
 

@@ -641,7 +641,7 @@ TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirW
   const auto all_weights = absl::MakeConstSpan(weights);
   wire::PointChunkEncoder encoder;
   v1::BuildRequest encoded;
-  encoder.EncodeSmallest(all.subspan(100, 200), all_weights.subspan(100, 200), &encoded);
+  ASSERT_THAT(encoder.EncodeSmallest(all.subspan(100, 200), all_weights.subspan(100, 200), &encoded), IsOk());
   ASSERT_TRUE(encoded.has_encoded_points()) << "200 points compress";
   InFlightBytes in_flight(0);
   BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight);
@@ -660,6 +660,12 @@ TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirW
   }
   EXPECT_EQ((*decoded)->handle, WeightedPointSetHandle(points, weights));
   EXPECT_NE((*decoded)->handle, PointSetHandle(points)) << "the handle covers the weights";
+  // A weighted stream of no points is the empty set, unweighted: one handle for every empty set.
+  BuildStreamDecoder empty(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(empty.Add(WeightedHeader(0)), IsOk());
+  absl::StatusOr<DecodedBuild*> none = empty.Finish();
+  ASSERT_THAT(none, IsOk());
+  EXPECT_EQ((*none)->handle, PointSetHandle(std::vector<Point2>{}));
 }
 
 TEST(BuildStreamDecoderTest, WeightedStreamRefusalsNameThePointAndTheWeight) {

@@ -319,7 +319,9 @@ TEST(PointChunkCodec, WeightedChunksCarryTheWeightAsAThirdAxis) {
   }
   // The smallest form of a weighted chunk is scaled integers here, well under raw triples.
   v1::BuildRequest smallest;
-  encoder.EncodeSmallest(atoms, squared_radii, &smallest);
+  ASSERT_THAT(encoder.EncodeSmallest(atoms, squared_radii, &smallest), IsOk());
+  EXPECT_THAT(encoder.EncodeSmallest(atoms, absl::MakeConstSpan(squared_radii).subspan(1), &smallest),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("5000 points need 5000 weights")));
   ASSERT_TRUE(smallest.has_encoded_points());
   EXPECT_LT(smallest.ByteSizeLong(), 8 * atoms.size());
 }

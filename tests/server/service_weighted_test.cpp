@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <set>
@@ -83,12 +84,19 @@ RemoteClasses ClassifyRemote(client::AlphaClient& client, const std::string& han
   return out;
 }
 
+// Decimal coordinates (X / 10^6) and weights (X / 10^9), as files of atoms and sites hold them:
+// the client sends them as scaled integers, the weights with their own w_scale. The last point is
+// a lighter copy of the first's position: a point of its own, hidden.
 TEST(ServiceTest, WeightedBuildAnswersAsTheLocalWeightedFamily) {
   auto server = StartServer(TestServerOptions());
   ASSERT_NE(server, nullptr);
   auto client = ClientOf(*server);
-  const std::vector<Point2> points = gen::Uniform(3000, 31);
-  const std::vector<double> weights = Weights(points.size(), 32);
+  std::vector<Point2> points = gen::Uniform(3000, 31);
+  for (Point2& p : points) p = {std::round(p.x * 1e6) / 1e6, std::round(p.y * 1e6) / 1e6};
+  std::vector<double> weights = Weights(points.size(), 32);
+  for (double& w : weights) w = std::round(w * 1e9) / 1e9;
+  points.push_back(points.front());
+  weights.push_back((std::round(weights.front() * 1e9) - 1000) / 1e9);
   const AlphaFamily local = LocalWeightedFamily(points, weights);
   const std::vector<uint32_t> hidden = local.HiddenPoints();
   ASSERT_FALSE(hidden.empty()) << "the weights must hide points for this test to mean anything";
@@ -98,6 +106,7 @@ TEST(ServiceTest, WeightedBuildAnswersAsTheLocalWeightedFamily) {
   auto built = client->Build(points, options);
   ASSERT_THAT(built, IsOk());
   EXPECT_EQ(built->handle, WeightedPointSetHandle(points, weights));
+  EXPECT_LT(built->upload_bytes, 12 * points.size()) << "scaled integers, not raw triples (24 bytes a point)";
   EXPECT_TRUE(built->summary.weighted());
   EXPECT_EQ(built->summary.hidden_points(), hidden.size());
   EXPECT_EQ(built->summary.spectrum_size(), local.spectrum().size());
@@ -132,6 +141,7 @@ TEST(ServiceTest, WeightedBuildAnswersAsTheLocalWeightedFamily) {
   std::set<uint32_t> hidden_firsts;  // Classify lists first occurrences (uniform points have no duplicates)
   for (const uint32_t v : hidden) hidden_firsts.insert(local.representative()[v]);
   EXPECT_EQ(rank0.exterior_vertices, hidden_firsts);
+  EXPECT_EQ(hidden.back(), points.size() - 1) << "the lighter point at the first one's position";
 
   // The client's check before an upload finds the weighted handle: no upload.
   auto again = client->Build(points, options);
@@ -148,7 +158,7 @@ TEST(ServiceTest, WeightedBuildAnswersAsTheLocalWeightedFamily) {
   options.weights = absl::MakeConstSpan(weights).subspan(1);
   EXPECT_THAT(client->Build(points, options).status(),
               galpha::testing::StatusIs(absl::StatusCode::kInvalidArgument,
-                                        ::testing::HasSubstr("3000 points need 3000 weights, not 2999")));
+                                        ::testing::HasSubstr("3001 points need 3001 weights, not 3000")));
 }
 
 TEST(ServiceTest, DemotedWeightedFamilyIsRebuiltWithItsWeights) {

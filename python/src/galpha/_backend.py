@@ -66,8 +66,8 @@ class FamilyBackend(Protocol):
 
     def hidden_points(self, points: np.ndarray) -> np.ndarray:
         """Input indices (uint32, ascending) of the points a weighted family hides; empty otherwise.
-        `points`: the (N, 2) points the family was built from (a server lists first occurrences
-        only: their duplicates are found among them)."""
+        `points`: the rows the family was built from, (N, 2) or weighted (N, 3) with the weights (a
+        server lists first occurrences only: their duplicates, equal rows, are found among them)."""
 
     def release(self) -> bool:
         """Frees the family (network: drops it from the server's cache); True when it was held."""

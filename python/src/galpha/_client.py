@@ -56,8 +56,9 @@ def checked_weights(weights: Any, array: np.ndarray, frame: Any) -> Optional[np.
 
 
 def upload_of(computed: np.ndarray, weights: Optional[np.ndarray]) -> np.ndarray:
-    """What a Build stream carries: (N, 2) points, or (N, 3) weighted points (x, y, w)."""
-    return computed if weights is None else np.column_stack((computed, weights))
+    """What a Build stream carries: (N, 2) points, or (N, 3) weighted points (x, y, w). A weighted
+    set of no points is the empty set, unweighted (one family and handle for every empty set)."""
+    return computed if weights is None or len(weights) == 0 else np.column_stack((computed, weights))
 
 
 class _TqdmStages:
@@ -142,7 +143,8 @@ class NetworkClient:
         encoding = check_encoding(encoding)
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
-        upload = upload_of(frame.computed, checked_weights(weights, array, frame))
+        weight_array = checked_weights(weights, array, frame)
+        upload = upload_of(frame.computed, weight_array)
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         try:
@@ -153,7 +155,7 @@ class NetworkClient:
         finally:
             if close is not None:
                 close()
-        return Family(backend, array, frame)
+        return Family(backend, array, frame, weight_array)
 
     def family(self, handle: str, points: Any, *, crs: Any = None, weights: Any = None) -> Family:
         """The family the server holds under ``handle`` for these points (NotFound if it holds
@@ -165,12 +167,13 @@ class NetworkClient:
 
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
-        if point_set_handle(upload_of(frame.computed, checked_weights(weights, array, frame))) != handle:
+        weight_array = checked_weights(weights, array, frame)
+        if point_set_handle(upload_of(frame.computed, weight_array)) != handle:
             raise InvalidInput(f"these points have another handle than {handle}")
         summary = self._network.find_cached(self._calls, handle)
         if summary is None:
             raise NotFound(f"the server holds no family under {handle}")
-        return Family(self._network.NetworkFamilyBackend(self._calls, handle, summary), array, frame)
+        return Family(self._network.NetworkFamilyBackend(self._calls, handle, summary), array, frame, weight_array)
 
     def close(self) -> None:
         self._channel.close()

@@ -6,7 +6,7 @@ The format is docs/design.md, "Wire encodings of points"; the C++ codec
 scaled integers found from the data (``X / 10^k``, ``fl(10^-k) * X``, LAS-style ``offset +
 fl(10^-k) * X``, ``2^-k * X``), each verified bit for bit with the server's arithmetic; every
 transform tried on a sample as float64 and as integers, zstd level 3; the smallest kept, and a raw
-PointChunk when nothing beats 16 bytes a point. Messages are encoded by hand like ``_wire.py``'s
+PointChunk when nothing beats 8 bytes a value (16 a point, 24 weighted). Messages are encoded by hand like ``_wire.py``'s
 (the fields are few and small; the data is one bytes field), so a chunk's bytes are copied once.
 
 Points are (n, 2) float64 arrays; the points of a weighted stream (BuildHeader.weighted) are (n, 3)

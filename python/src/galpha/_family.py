@@ -227,6 +227,12 @@ def rings_to_shapely(rings: ShapeRings, points: np.ndarray, mode: Mode) -> Any:
     return _wkb.load(_wkb.collection_wkb(parts))
 
 
+def weighted_rows(computed: np.ndarray, weights: Optional[np.ndarray]) -> np.ndarray:
+    """(N, 2) points, or (N, 3) rows (x, y, w) with their weights: what identifies a point of a
+    weighted family (the engine's duplicates share position and weight)."""
+    return computed if weights is None or len(weights) == 0 else np.column_stack((computed, weights))
+
+
 class Family:
     """The exact family of alpha shapes of one point set (every alpha at once).
 
@@ -234,10 +240,16 @@ class Family:
     this process). Use it as a context manager to release it when done.
     """
 
-    def __init__(self, backend: FamilyBackend, points: np.ndarray, frame: Optional[Frame] = None) -> None:
+    def __init__(
+        self, backend: FamilyBackend, points: np.ndarray, frame: Optional[Frame] = None, weights: Optional[np.ndarray] = None
+    ) -> None:
         self._backend = backend
         self._points = points
         self._frame = frame if frame is not None else Frame(None, points)
+        # The weights the family was built with (None unweighted): with the computed points, what
+        # a server's hidden points are matched against (weighted_rows).
+        self._weights = weights
+        self._hidden: Optional[np.ndarray] = None
         #: The CRS of the coordinates: the ``crs=`` of the build, else the GeoSeries' or
         #: GeoDataFrame's it was built from; None for planar coordinates.
         self.crs = self._frame.crs
@@ -276,7 +288,9 @@ class Family:
     def hidden_points(self) -> np.ndarray:
         """Input indices (uint32, ascending) of the points a weighted family hides: no vertex of
         the regular triangulation, EXTERIOR at every threshold. Empty for an unweighted family."""
-        return self._backend.hidden_points(self._frame.computed)
+        if self._hidden is None:  # a server answers it with a Classify call: once
+            self._hidden = self._backend.hidden_points(weighted_rows(self._frame.computed, self._weights))
+        return self._hidden
 
     @property
     def spectrum_size(self) -> int:

@@ -18,6 +18,11 @@ class PointFile:
 
     points: np.ndarray  #: (N, 2) float64, in file order
     crs: Optional[str]  #: the file's CRS (GeoJSON: "OGC:CRS84", LAS, GDAL layers), or None
+    #: Structures (PDB, mmCIF): each atom's radius, its element's van der Waals radius in gemmi's
+    #: table in ångström (NaN where gemmi does not know the element); None for other formats.
+    #: ``client.build(f.points, weights=(f.radii + 1.4) ** 2)`` builds the solvent-accessible
+    #: weighted family (a 1.4 Å water probe).
+    radii: Optional[np.ndarray] = None
 
 
 def read_points(
@@ -41,4 +46,4 @@ def read_points(
         read = _engine.read_points(os.fspath(path), layer or "", plane, slab, int(max_points))
     except _engine.EngineError as e:
         raise error_for_code(e.code, e.message) from None
-    return PointFile(read["points"], read["crs"])
+    return PointFile(read["points"], read["crs"], read["radii"])

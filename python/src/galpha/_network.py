@@ -569,20 +569,23 @@ def exterior_vertices(raw: bytes) -> Optional[np.ndarray]:
     kind, indices, classes = _wire.decode_simplex_chunk(payload)
     if kind != pb.SIMPLEX_KIND_VERTEX:
         return None
+    if len(indices) != len(classes):
+        raise GalphaError("a Classify chunk's indices and classes disagree in length", code="DATA_LOSS", code_number=15)
     return indices[classes == pb.SIMPLEX_CLASS_EXTERIOR]
 
 
-def hidden_with_duplicates(points: np.ndarray, parts: List[np.ndarray], count: int) -> np.ndarray:
-    """Every input index whose point equals one of the points `parts` name (hidden points and
-    their duplicates, as the engine finds duplicates: by value, -0.0 equal to 0.0), ascending;
-    DATA_LOSS unless they are the `count` the server reported."""
+def hidden_with_duplicates(rows: np.ndarray, parts: List[np.ndarray], count: int) -> np.ndarray:
+    """Every input index whose row (x, y, w) equals one of the rows `parts` name (hidden points and
+    their duplicates, as the engine finds duplicates: the same position and weight, compared by
+    value, -0.0 equal to 0.0), ascending; DATA_LOSS unless they are the `count` the server
+    reported."""
     firsts = np.concatenate(parts) if parts else np.empty(0, dtype=np.uint32)
-    if len(firsts) and int(firsts.max()) >= len(points):
-        raise GalphaError(f"the server names point {int(firsts.max())} of {len(points)}", code="DATA_LOSS", code_number=15)
-    as_complex = np.empty(len(points), dtype=np.complex128)  # (x, y) as one sortable value, exactly
-    as_complex.real = points[:, 0] + 0.0  # -0.0 + 0.0 is 0.0
-    as_complex.imag = points[:, 1] + 0.0
-    hidden = np.flatnonzero(np.isin(as_complex, as_complex[firsts])).astype(np.uint32)
+    if len(firsts) and int(firsts.max()) >= len(rows):
+        raise GalphaError(f"the server names point {int(firsts.max())} of {len(rows)}", code="DATA_LOSS", code_number=15)
+    # Each distinct row's number (-0.0 + 0.0 is 0.0: equal values, equal bytes).
+    _, row_id = np.unique(np.ascontiguousarray(rows, dtype=np.float64) + 0.0, axis=0, return_inverse=True)
+    row_id = row_id.reshape(-1)
+    hidden = np.flatnonzero(np.isin(row_id, row_id[firsts])).astype(np.uint32)
     if len(hidden) != count:
         raise GalphaError(
             f"the server counts {count} hidden points; Classify at rank 0 gives {len(hidden)}",

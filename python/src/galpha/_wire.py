@@ -31,7 +31,8 @@ def _len_field(number: int, payload: bytes) -> bytes:
 
 
 def encode_point_chunk_request(chunk: np.ndarray) -> bytes:
-    """BuildRequest{points: PointChunk{coordinates: packed doubles}} for an (n, 2) float64 array."""
+    """BuildRequest{points: PointChunk{coordinates: packed doubles}} for an (n, 2) float64 array, or
+    a weighted stream's (n, 3) (x, y, w)."""
     packed = np.ascontiguousarray(chunk, dtype="<f8").tobytes()
     return _len_field(2, _len_field(1, packed))
 

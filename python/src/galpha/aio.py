@@ -62,8 +62,18 @@ def _aio_channel(target: str, tls_ca: Optional[str]) -> grpc.aio.Channel:
 class AsyncFamily:
     """A family on a galpha server, queried with coroutines (see :class:`galpha.Family`)."""
 
-    def __init__(self, calls: _network.Calls, handle: str, summary: BuildSummary, points: np.ndarray, frame: Frame) -> None:
+    def __init__(
+        self,
+        calls: _network.Calls,
+        handle: str,
+        summary: BuildSummary,
+        points: np.ndarray,
+        frame: Frame,
+        rows: Optional[np.ndarray] = None,
+    ) -> None:
         self._calls = calls
+        # What the family was built from: the computed points, with their weights when weighted.
+        self._rows = rows if rows is not None else frame.computed
         self.handle = handle
         self.summary = summary
         self.points = points
@@ -131,7 +141,7 @@ class AsyncFamily:
             raise _network.raise_from_rpc(e) from None
         finally:
             call.cancel()
-        return _network.hidden_with_duplicates(self._frame.computed, firsts, self.summary.hidden_points)
+        return _network.hidden_with_duplicates(self._rows, firsts, self.summary.hidden_points)
 
     async def classify(
         self,
@@ -336,7 +346,7 @@ class AsyncClient:
                 answer = await self._calls.describe(
                     pb.DescribeRequest(handle=handle), timeout=self._calls.timeout, metadata=metadata
                 )
-                return AsyncFamily(self._calls, handle, _network.summary_from(answer.summary, True), array, frame)
+                return AsyncFamily(self._calls, handle, _network.summary_from(answer.summary, True), array, frame, upload)
             except grpc.RpcError as e:
                 if e.code() != grpc.StatusCode.NOT_FOUND:
                     raise _network.raise_from_rpc(e) from None
@@ -351,7 +361,7 @@ class AsyncClient:
             if close is not None:
                 close()
         summary = dataclasses.replace(_network.summary_from(answer.summary, answer.cached), upload_bytes=counter.bytes)
-        return AsyncFamily(self._calls, answer.handle, summary, array, frame)
+        return AsyncFamily(self._calls, answer.handle, summary, array, frame, upload)
 
 
 def connect(

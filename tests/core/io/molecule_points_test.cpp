@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -116,6 +117,32 @@ TEST(MoleculePointsTest, SlabsKeepTheAtomsBetweenTheirBounds) {
   EXPECT_EQ(read->points[1].x, 13.149);
   EXPECT_THAT(ReadMoleculePoints(path, MoleculeSection{}, 3),
               StatusIs(absl::StatusCode::kResourceExhausted, HasSubstr("more than 3 atoms")));
+  std::filesystem::remove(path);
+}
+
+// Each kept atom's radius is its element's van der Waals radius in gemmi's table, as the double of
+// the table's decimal (not the float widened), and NaN for an element gemmi does not know.
+TEST(MoleculePointsTest, RadiiAreTheElementsVanDerWaalsRadii) {
+  const std::string path = Write("radii.pdb",
+                                 "ATOM      1  N   MET A   1       0.000   0.000   0.000  1.00  0.00           N\n"
+                                 "ATOM      2  CA  MET A   1       1.000   0.000   0.000  1.00  0.00           C\n"
+                                 "ATOM      3  SD  MET A   1       2.000   0.000   0.000  1.00  0.00           S\n"
+                                 "HETATM    4  O   HOH A 101       3.000   0.000   0.000  1.00  0.00           O\n"
+                                 "HETATM    5  X1  UNK A 102       4.000   0.000   0.000  1.00  0.00           X\n"
+                                 "END\n");
+  std::vector<double> radii;
+  absl::StatusOr<GeoreferencedPoints> read = ReadMoleculePoints(path, MoleculeSection{}, 100, &radii);
+  ASSERT_THAT(read, IsOk());
+  ASSERT_EQ(radii.size(), 5u);
+  EXPECT_EQ(radii[0], 1.55);
+  EXPECT_EQ(radii[1], 1.70);
+  EXPECT_EQ(radii[2], 1.80);
+  EXPECT_EQ(radii[3], 1.52);
+  EXPECT_TRUE(std::isnan(radii[4]));
+  EXPECT_TRUE(read->weights.empty()) << "radii are not weights: the caller makes weights of them";
+  // A section keeps the radii of the atoms it keeps.
+  ASSERT_THAT(ReadMoleculePoints(path, MoleculeSection{"yz", std::make_pair(1.5, 3.5)}, 100, &radii), IsOk());
+  EXPECT_EQ(radii, (std::vector<double>{1.80, 1.52}));
   std::filesystem::remove(path);
 }
 
