@@ -578,6 +578,24 @@ struct FillMasterEntries {
   }
 };
 
+/// Bits of a packed master entry (MasterEntry: kind 2, id 32, end point 2): with ranks below
+/// 2^(64 - kMasterEntryBits), (rank, entry) packs into one 64-bit sort key.
+constexpr int kMasterEntryBits = 36;
+
+/// The 64-bit key (rank, entry) of the master-list entry at `position`.
+struct RankedMasterKey {
+  const uint32_t* rank_of;
+  const uint64_t* entries;
+  GALPHA_HD uint64_t operator()(uint32_t position) const {
+    return (uint64_t{rank_of[position]} << kMasterEntryBits) | entries[position];
+  }
+};
+
+/// The entry of a RankedMasterKey.
+struct EntryOfRankedKey {
+  GALPHA_HD uint64_t operator()(uint64_t key) const { return key & ((uint64_t{1} << kMasterEntryBits) - 1); }
+};
+
 /// Largest rank segment sorted by one thread; longer ones (exact ties: a grid's congruent
 /// triangles) are sorted by a Thrust call each.
 constexpr uint32_t kMaxThreadSegment = 64;

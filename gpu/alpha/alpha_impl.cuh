@@ -670,9 +670,11 @@ void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t 
     // Many long segments (lattices: thousands of ranks of exact ties; centimetre LiDAR: 4,786
     // holding a quarter of the list at 1M): one sort per segment would cost a launch and a wait
     // each. The entries of the long segments are gathered (their positions ascend, a segment's
-    // contiguous), sorted by two stable radix sorts, by entry and then by rank, and put back at
-    // the same positions: every long segment gets its own entries sorted, the order one sort per
-    // segment gives, and the short segments' entries (most of the list) are not sorted again.
+    // contiguous), sorted by (rank, entry), and put back at the same positions: every long segment
+    // gets its own entries sorted, the order one sort per segment gives, and the short segments'
+    // entries (most of the list) are not sorted again. Below 2^28 ranks (rank, entry) is one
+    // 64-bit key, sorted once (entries are unique: a plain sort); beyond, two stable radix sorts,
+    // by entry and then by rank (parallel lines at 1M: 3,168 ranks hold the whole list).
     Buffer<uint32_t, System> rank_of(sys, num_master);
     thrust::upper_bound(policy, master_begin.data() + 1, master_begin.data() + (num_ranks + 2), zero, zero + num_master,
                         rank_of.data());
@@ -681,6 +683,16 @@ void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t 
         static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_master, position.data(),
                                               InLongSegment{rank_of.data(), long_segment.data()}) -
                               position.data());
+    if (num_ranks < (uint32_t{1} << (64 - kMasterEntryBits))) {
+      Buffer<uint64_t, System> key(sys, num_gathered);
+      thrust::transform(policy, position.data(), position.data() + num_gathered, key.data(),
+                        RankedMasterKey{rank_of.data(), master_entries->data()});
+      rank_of.Reset();
+      thrust::sort(policy, key.data(), key.data() + num_gathered);
+      const auto sorted_entries = thrust::make_transform_iterator(key.data(), EntryOfRankedKey{});
+      thrust::scatter(policy, sorted_entries, sorted_entries + num_gathered, position.data(), master_entries->data());
+      return;
+    }
     Buffer<uint64_t, System> entry(sys, num_gathered);
     Buffer<uint32_t, System> rank(sys, num_gathered);
     thrust::gather(policy, position.data(), position.data() + num_gathered, master_entries->data(), entry.data());
