@@ -68,16 +68,16 @@ struct RefinedEntry {
   RefinedRadiusSq key;
 };
 
-/// Every entry's four sort words, word-major (words[w * num_entries + k]): computed once, then each
-/// pass of the least-significant-word-first sort gathers its word by the permutation so far.
-struct WriteSortWords {
+/// Word `w` of entry perm[k]'s sort words (one pass of the least-significant-word-first sort).
+/// Computed again each pass rather than kept: four words of every entry would be the stage's
+/// largest buffer (a lattice nudged by ulps peaked 19 B/pt higher with them, on the H100).
+struct SortWordOf {
   const RefinedEntry* entries;
-  uint32_t num_entries;
-  uint64_t* words;
-  GALPHA_HD void operator()(uint32_t k) const {
-    const RefinedEntry& entry = entries[k];
-    const RefinedSortWords sort_words = RefinedSortWordsOf(entry.run, entry.id, entry.key);
-    for (int w = 0; w < 4; ++w) words[static_cast<size_t>(w) * num_entries + k] = sort_words.word[w];
+  const uint32_t* perm;
+  int w;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const RefinedEntry& entry = entries[perm[k]];
+    return RefinedSortWordsOf(entry.run, entry.id, entry.key).word[w];
   }
 };
 
@@ -346,25 +346,21 @@ struct ApplyRefinedVerdicts {
 /// Sorts refined entries by their sort words (RefinedSortWords): least significant word first, each
 /// pass a stable radix sort of one 64-bit word carrying a permutation, then one gather. A word
 /// that is the same in every entry (one run at one exponent: a lattice's long run) orders nothing,
-/// and its pass is skipped: a stable sort by a constant key leaves the permutation as it is.
+/// and its sort is skipped: a stable sort by a constant key leaves the permutation as it is.
 template <class System>
 void SortRefinedEntries(System& sys, Buffer<RefinedEntry, System>* entries, uint32_t num_refined) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
-  Buffer<uint64_t, System> words(sys, static_cast<size_t>(4) * num_refined);
-  thrust::for_each_n(policy, zero, num_refined, WriteSortWords{entries->data(), num_refined, words.data()});
   Buffer<uint32_t, System> perm(sys, num_refined);
   thrust::sequence(policy, perm.data(), perm.data() + num_refined);
   Buffer<uint64_t, System> word(sys, num_refined);
   for (int w = 3; w >= 0; --w) {
-    const uint64_t* column = words.data() + static_cast<size_t>(w) * num_refined;
-    const auto extremes = thrust::minmax_element(policy, column, column + num_refined);
+    thrust::transform(policy, zero, zero + num_refined, word.data(), SortWordOf{entries->data(), perm.data(), w});
+    const auto extremes = thrust::minmax_element(policy, word.data(), word.data() + num_refined);
     if (sys.Read(extremes.first) == sys.Read(extremes.second)) continue;
-    thrust::gather(policy, perm.data(), perm.data() + num_refined, column, word.data());
     thrust::stable_sort_by_key(policy, word.data(), word.data() + num_refined, perm.data());
   }
   word.Reset();
-  words.Reset();
   Buffer<RefinedEntry, System> sorted(sys, num_refined);
   thrust::gather(policy, perm.data(), perm.data() + num_refined, entries->data(), sorted.data());
   *entries = std::move(sorted);

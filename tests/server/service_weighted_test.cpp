@@ -18,6 +18,7 @@
 #include "core/family/classification_summary.hpp"
 #include "core/family/threshold.hpp"
 #include "core/io/point_set_handle.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
