@@ -18,7 +18,7 @@ namespace {
 
 /// The van der Waals radius of `element` as the double nearest the decimal in gemmi's table
 /// (which stores floats: 1.7f widened would be 1.7000000476837158, not 1.7); NaN for an element
-/// gemmi does not know (X), whose table entry is a placeholder.
+/// gemmi does not know (El::X), for which its table holds 1.0 in place of a radius.
 double VanDerWaalsRadius(gemmi::Element element) {
   if (element.elem == gemmi::El::X) return std::numeric_limits<double>::quiet_NaN();
   char text[32];
