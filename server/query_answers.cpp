@@ -354,7 +354,12 @@ void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
   summary->set_family_bytes(cached.bytes());
   if (const auto frame = cached.Frame()) summary->set_projection(frame->projection);
   summary->set_weighted(family.weighted());
-  if (family.weighted()) summary->set_hidden_points(family.HiddenPoints().size());
+  if (family.weighted()) {
+    // Counted from the flags: HiddenPoints() would build the whole list for its length.
+    uint64_t hidden = 0;
+    for (uint32_t v = 0; v < family.points().size(); ++v) hidden += family.hidden(v) ? 1 : 0;
+    summary->set_hidden_points(hidden);
+  }
 }
 
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifySource(
