@@ -11,7 +11,7 @@ import numpy as np
 from ._encoding import check_encoding
 from ._crs import frame_of
 from ._errors import InvalidInput
-from ._family import Family
+from ._family import Family, weighted_rows
 from ._points import as_points
 
 #: ``progress``: None (quiet), True (a tqdm bar on standard error), or a callable receiving
@@ -53,12 +53,6 @@ def checked_weights(weights: Any, array: np.ndarray, frame: Any) -> Optional[np.
     if frame.projection is not None:
         raise InvalidInput("weights need planar coordinates: the CRS is geographic (project the points and radii first)")
     return weight_array
-
-
-def upload_of(computed: np.ndarray, weights: Optional[np.ndarray]) -> np.ndarray:
-    """What a Build stream carries: (N, 2) points, or (N, 3) weighted points (x, y, w). A weighted
-    set of no points is the empty set, unweighted (one family and handle for every empty set)."""
-    return computed if weights is None or len(weights) == 0 else np.column_stack((computed, weights))
 
 
 class _TqdmStages:
@@ -144,7 +138,7 @@ class NetworkClient:
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
         weight_array = checked_weights(weights, array, frame)
-        upload = upload_of(frame.computed, weight_array)
+        upload = weighted_rows(frame.computed, weight_array)
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         try:
@@ -168,7 +162,7 @@ class NetworkClient:
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
         weight_array = checked_weights(weights, array, frame)
-        if point_set_handle(upload_of(frame.computed, weight_array)) != handle:
+        if point_set_handle(weighted_rows(frame.computed, weight_array)) != handle:
             raise InvalidInput(f"these points have another handle than {handle}")
         summary = self._network.find_cached(self._calls, handle)
         if summary is None:

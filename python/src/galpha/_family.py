@@ -228,8 +228,10 @@ def rings_to_shapely(rings: ShapeRings, points: np.ndarray, mode: Mode) -> Any:
 
 
 def weighted_rows(computed: np.ndarray, weights: Optional[np.ndarray]) -> np.ndarray:
-    """(N, 2) points, or (N, 3) rows (x, y, w) with their weights: what identifies a point of a
-    weighted family (the engine's duplicates share position and weight)."""
+    """(N, 2) points, or (N, 3) rows (x, y, w) with their weights: what a Build stream carries, and
+    what identifies a point of a weighted family (the engine's duplicates share position and
+    weight). A weighted set of no points is the empty set, unweighted (one family and handle for
+    every empty set)."""
     return computed if weights is None or len(weights) == 0 else np.column_stack((computed, weights))
 
 

@@ -15,7 +15,7 @@ import grpc
 import numpy as np
 
 from . import _network, _wire
-from ._client import Progress, checked_weights, progress_callback, upload_of
+from ._client import Progress, checked_weights, progress_callback
 from ._crs import Frame, frame_of
 from ._encoding import check_encoding
 from ._errors import InvalidInput
@@ -30,6 +30,7 @@ from ._family import (
     persistence_arguments,
     rings_to_shapely,
     threshold_from,
+    weighted_rows,
 )
 from ._handle import point_set_handle
 from ._points import as_points
@@ -334,7 +335,7 @@ class AsyncClient:
         encoding = check_encoding(encoding)
         array, data_crs = as_points(points)
         frame = frame_of(array, crs, data_crs)
-        upload = upload_of(frame.computed, checked_weights(weights, array, frame))
+        upload = weighted_rows(frame.computed, checked_weights(weights, array, frame))
         callback, close = progress_callback(progress, len(array))
         total = max(len(array), 1)
         sent: Optional[Callable[[int], None]] = None if callback is None else (lambda n: callback("upload", n / total))
