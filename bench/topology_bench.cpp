@@ -5,8 +5,10 @@
 //                  [--data FILE.bin]...
 // Per input: the family build (the engine's stages, the Betti curves among them: the "components"
 // stage computes the component and hole curves of both complexes in one pass), the persistence
-// diagram from the built family (host: the canonical orders, which the service computes once per
-// cached family, then the diagram: radix sorts by rank and two union-finds), and GUDHI's
+// diagram from the built family by the engine on the build's backend (gpu/alpha/
+// persistence_engine.hpp: upload, canonical orders, the two forests' elder rule, the sorted pairs;
+// checked pair for pair against the host's), the host's diagram (the canonical orders, which the
+// service computes once per cached family, then radix sorts by rank and two union-finds), and GUDHI's
 // AlphaComplex (exact) + persistent cohomology over Z/2Z on the same points, with both diagrams'
 // numbers of intervals of positive length (they may differ by a few where GUDHI's doubles reorder
 // near-ties: tests/gpu/alpha/persistence_gudhi_test.cpp compares the diagrams themselves).
@@ -23,6 +25,7 @@
 #include "core/family/canonical_order.hpp"
 #include "core/family/persistence.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
+#include "gpu/alpha/persistence_engine.hpp"
 #include "tests/support/gudhi_persistence_oracle.hpp"
 
 namespace galpha {
@@ -44,6 +47,9 @@ struct TopologyResult {
   double curves_ms = 0;                                             // its "components" stage
   double orders_ms = std::numeric_limits<double>::infinity();       // the canonical orders (cached by the service)
   double persistence_ms = std::numeric_limits<double>::infinity();  // the diagram from them
+  double engine_ms = std::numeric_limits<double>::infinity();       // the engine's diagram, whole call
+  PersistenceReport engine_report;                                  // of its fastest run
+  bool engine_same = true;                                          // pair for pair the host's
   size_t intervals[2] = {0, 0};                                     // of positive length (as doubles), both dimensions
   double gudhi_ms = -1;                                             // not run above --gudhi-max
   size_t gudhi_intervals[2] = {0, 0};
@@ -82,6 +88,27 @@ TopologyResult RunOne(const std::string& name, const std::vector<Point2>& points
       return result;
     }
     result.persistence_ms = std::min(result.persistence_ms, persistence_ms);
+    PersistenceOptions engine_options;
+    engine_options.backend = options.backend;
+    PersistenceReport report;
+    start = std::chrono::steady_clock::now();
+    absl::StatusOr<PersistenceDiagram> engine = ComputePersistenceOnBackend(*family, engine_options, &report);
+    const double engine_ms = MillisecondsSince(start);
+    if (!engine.ok()) {
+      result.error = engine.status().ToString();
+      return result;
+    }
+    if (engine_ms < result.engine_ms) {
+      result.engine_ms = engine_ms;
+      result.engine_report = std::move(report);
+    }
+    result.engine_same &= engine->pairs.size() == diagram->pairs.size() &&
+                          std::equal(engine->pairs.begin(), engine->pairs.end(), diagram->pairs.begin(),
+                                     [](const PersistencePair& a, const PersistencePair& b) {
+                                       return a.dimension == b.dimension && a.birth_rank == b.birth_rank &&
+                                              a.death_rank == b.death_rank && a.creator == b.creator &&
+                                              a.killer == b.killer;
+                                     });
     for (int d = 0; d < 2; ++d) {
       result.intervals[d] = 0;
       for (size_t i = diagram->dimension_begin[d]; i < diagram->dimension_begin[d + 1]; ++i) {
@@ -110,14 +137,27 @@ void PrintRow(const TopologyResult& r) {
   if (r.gudhi_ms >= 0) {
     std::snprintf(text, sizeof text, "%.1f", r.gudhi_ms);
     gudhi = text;
-    std::snprintf(text, sizeof text, "%.0fx", r.gudhi_ms / (r.curves_ms + r.orders_ms + r.persistence_ms));
+    std::snprintf(text, sizeof text, "%.0fx", r.gudhi_ms / (r.curves_ms + r.engine_ms));
     ratio = text;
     std::snprintf(text, sizeof text, "%zu / %zu", r.gudhi_intervals[0], r.gudhi_intervals[1]);
     gudhi_counts = text;
   }
-  std::printf("| %s | %zu | %s | %.1f | %.2f | %.1f | %.1f | %zu / %zu | %s | %s | %s |\n", r.name.c_str(), r.n,
-              r.backend.c_str(), r.build_ms, r.curves_ms, r.orders_ms, r.persistence_ms, r.intervals[0], r.intervals[1],
-              gudhi_counts.c_str(), gudhi.c_str(), ratio.c_str());
+  std::string stages;
+  for (const StageTime& stage : r.engine_report.stage_times) {
+    std::snprintf(text, sizeof text, "%s%s %.2f", stages.empty() ? "" : ", ", stage.stage.c_str(), stage.seconds * 1e3);
+    stages += text;
+  }
+  for (int d = 0; d < 2; ++d) {
+    const ForestPairing& f = r.engine_report.forests[d];
+    std::snprintf(text, sizeof text, "; H%d: %u rounds, %u of %u edges on the host", d, f.rounds, f.host_finished_edges,
+                  f.forest_edges);
+    stages += text;
+  }
+  std::printf("| %s | %zu | %s | %.1f | %.2f | %.2f (%s)%s | %.1f | %.1f | %.2fx | %zu / %zu | %s | %s | %s |\n",
+              r.name.c_str(), r.n, r.backend.c_str(), r.build_ms, r.curves_ms, r.engine_ms, stages.c_str(),
+              r.engine_same ? "" : " DIFFERENT from the host's", r.orders_ms, r.persistence_ms,
+              (r.orders_ms + r.persistence_ms) / r.engine_ms, r.intervals[0], r.intervals[1], gudhi_counts.c_str(),
+              gudhi.c_str(), ratio.c_str());
   std::fflush(stdout);
 }
 
@@ -131,15 +171,15 @@ int Main(int argc, char** argv) {
               BackendName(options->backend), CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
               std::thread::hardware_concurrency());
   std::printf(
-      "| input | n | backend | family build ms | Betti curves ms (components stage) | canonical orders ms (host) | "
-      "persistence ms (host) | H0 / H1 intervals | GUDHI's H0 / H1 intervals | GUDHI exact ms | "
-      "GUDHI / (curves + orders + persistence) |\n"
-      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+      "| input | n | backend | family build ms | Betti curves ms (components stage) | engine diagram ms (stages) | "
+      "host: canonical orders ms | host: diagram ms | host / engine | H0 / H1 intervals | GUDHI's H0 / H1 intervals | "
+      "GUDHI exact ms | GUDHI / (curves + engine diagram) |\n"
+      "|---|---:|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n");
   bool failed = false;
   auto run = [&](const std::string& name, const std::vector<Point2>& points) {
     std::fprintf(stderr, "running %s n=%zu\n", name.c_str(), points.size());
     const TopologyResult r = RunOne(name, points, *options);
-    failed |= !r.error.empty();
+    failed |= !r.error.empty() || !r.engine_same;
     PrintRow(r);
   };
   if (const absl::Status read = ForEachBenchInput(*options, run); !read.ok()) {

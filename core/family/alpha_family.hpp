@@ -82,6 +82,8 @@ class AlphaFamily {
   bool weighted() const { return !parts_.weights.empty(); }
   const HostVector<double>& weights() const { return parts_.weights; }
   bool hidden(uint32_t v) const { return !parts_.hidden.empty() && parts_.hidden[v] != 0; }
+  /// Per input index, 1 for a hidden point (empty when unweighted).
+  const HostVector<uint8_t>& hidden_flags() const { return parts_.hidden; }
   /// Input indices of the hidden points, ascending.
   std::vector<uint32_t> HiddenPoints() const;
   /// The lower end of level 0: 0 unweighted, minus the largest weight weighted.

@@ -76,22 +76,35 @@ struct RecordHookTarget {
   }
 };
 
+/// What a spanning forest reports of its edges (either may be null).
+struct ForestOutputs {
+  /// Forest edges counted at their rank (a weight's high word).
+  uint32_t* merges_at_rank = nullptr;
+  /// Forest edges marked with 1 at their index: (low word of the weight ^ mark_xor) - 1, for
+  /// weights that carry one (the persistence pairing's keys, persistence_pairs.cuh).
+  uint8_t* forest_mark = nullptr;
+  uint32_t mark_xor = 0;
+  /// Whether edges of rank kNeverRank are graph edges (the curves leave them out).
+  bool keep_never = false;
+};
+
 /// A component hooks to the other end of its lightest edge, except the smaller of two components
 /// that chose the same edge (the only cycles Borůvka can form with unique weights); each hooked
-/// edge is a forest edge, counted at its rank.
+/// edge is a forest edge, reported as `out` asks.
 struct HookComponent {
   const uint32_t* labels;
   const unsigned long long* best;
   const uint32_t* target;
   uint32_t* parent;
-  uint32_t* merges_at_rank;
+  ForestOutputs out;
   GALPHA_HD void operator()(uint32_t i) const {
     const uint32_t c = labels[i];
     if (best[c] == ~0ull) return;  // no edge leaves this component any more
     const uint32_t other = target[c];
     if (best[other] == best[c] && c < other) return;  // the other side hooks to us
     parent[c] = other;
-    AtomicIncrement(&merges_at_rank[static_cast<uint32_t>(best[c] >> 32)]);
+    if (out.merges_at_rank != nullptr) AtomicIncrement(&out.merges_at_rank[static_cast<uint32_t>(best[c] >> 32)]);
+    if (out.forest_mark != nullptr) out.forest_mark[(static_cast<uint32_t>(best[c]) ^ out.mark_xor) - 1u] = 1;
   }
 };
 
@@ -164,25 +177,30 @@ struct ClearFlag {
   GALPHA_HD void operator()(uint32_t) const { *flag = 0; }
 };
 
-struct HasRank {
-  GALPHA_HD bool operator()(const WeightedEdge& e) const { return static_cast<uint32_t>(e.weight >> 32) != kNeverRank; }
+/// Whether an edge is one of the graph's: not a loop (the dual graph's edges with the outer face
+/// on both sides), and with a rank unless kNeverRank edges are kept.
+struct IsGraphEdge {
+  bool keep_never;
+  GALPHA_HD bool operator()(const WeightedEdge& e) const {
+    return e.a != e.b && (keep_never || static_cast<uint32_t>(e.weight >> 32) != kNeverRank);
+  }
 };
 
-/// Adds to merges_at_rank[r] the number of spanning-forest edges of rank r. `edges` holds one
-/// entry per edge (weights unique; rank kNeverRank for an edge that never appears) and is used as
-/// working space (clobbered); nodes are 0..num_nodes.
+/// Finds the minimum spanning forest of the graph whose edges are `edges` (one entry per edge,
+/// weights unique; rank kNeverRank for an edge that never appears) over nodes 0..num_nodes and
+/// reports its edges as `out` asks. `edges` is used as working space (clobbered).
 ///
 /// A round's kernels are recorded once and replayed (the host's launch cost bounded the rounds,
 /// as in the triangulation's flip loop): the live edge and label counts stay on the device, and
 /// the host waits once a round, for whether edges were left and whether the pointer jumps
 /// converged.
 template <class System>
-void CountForestEdgesByRank(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes,
-                            uint32_t* merges_at_rank) {
+void SpanningForest(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes,
+                    const ForestOutputs& out) {
   auto policy = sys.policy();
   Buffer<WeightedEdge, System> active(sys, num_edges);
   const uint32_t num_ranked = static_cast<uint32_t>(
-      thrust::copy_if(policy, edges, edges + num_edges, active.data(), HasRank{}) - active.data());
+      thrust::copy_if(policy, edges, edges + num_edges, active.data(), IsGraphEdge{out.keep_never}) - active.data());
   WeightedEdge* kept = edges;  // the compactions' target from here on
   Buffer<uint32_t, System> labels(sys, num_nodes), kept_labels(sys, num_nodes), parent(sys, num_nodes),
       target(sys, num_nodes);
@@ -215,7 +233,7 @@ void CountForestEdgesByRank(System& sys, WeightedEdge* edges, uint32_t num_edges
       sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active.data(), best.data()});
       sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active.data(), best.data(), target.data()});
       sys.ForEachBelow(count + kLiveLabels,
-                       HookComponent{labels.data(), best.data(), target.data(), parent.data(), merges_at_rank});
+                       HookComponent{labels.data(), best.data(), target.data(), parent.data(), out});
       jump_group();
     });
     // The round's wait: whether edges were left for it (none: it changed nothing, and the forest
@@ -379,14 +397,14 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   thrust::transform(policy, zero, zero + in.num_edges, graph.data(),
                     GeneralGraphEdge{in.edges, in.edge_rho, in.edge_mu_low});
   thrust::fill_n(policy, merges.data(), levels, 0u);
-  CountForestEdgesByRank(sys, graph.data(), in.num_edges, in.num_points, merges.data());
+  SpanningForest(sys, graph.data(), in.num_edges, in.num_points, ForestOutputs{merges.data()});
   prefix(merges.data());
   thrust::transform(policy, zero, zero + levels, out.components, CurveAt{nullptr, merges.data(), in.num_unique});
   thrust::transform(policy, zero, zero + levels, out.holes, HolesAt{edge_births.data(), births.data(), merges.data()});
   // Regularized: the forest of edges taken with their first triangle.
   thrust::transform(policy, zero, zero + in.num_edges, graph.data(), RegularizedGraphEdge{in.edges, in.edge_mu_low});
   thrust::fill_n(policy, merges.data(), levels, 0u);
-  CountForestEdgesByRank(sys, graph.data(), in.num_edges, in.num_points, merges.data());
+  SpanningForest(sys, graph.data(), in.num_edges, in.num_points, ForestOutputs{merges.data()});
   prefix(merges.data());
   thrust::transform(policy, zero, zero + levels, out.regularized_components,
                     CurveAt{regularized_vertices.data(), merges.data(), 0u});
@@ -395,7 +413,7 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   // Solid.
   thrust::transform(policy, zero, zero + in.num_edges, graph.data(), SolidGraphEdge{in.edge_tris, in.edge_mu_high});
   thrust::fill_n(policy, merges.data(), levels, 0u);
-  CountForestEdgesByRank(sys, graph.data(), in.num_edges, in.num_tri, merges.data());
+  SpanningForest(sys, graph.data(), in.num_edges, in.num_tri, ForestOutputs{merges.data()});
   prefix(merges.data());
   thrust::transform(policy, zero, zero + levels, out.solid_components, CurveAt{births.data(), merges.data(), 0u});
 }

@@ -1,0 +1,21 @@
+// The CUDA instantiation of the engine's persistence diagram: one stream, stream-ordered memory.
+#include <cuda_runtime.h>
+
+#include "gpu/alpha/persistence_backend.hpp"
+#include "gpu/alpha/persistence_pairs.cuh"
+#include "gpu/system/cuda_system.cuh"
+
+namespace galpha::detail {
+
+void PersistenceOnCuda(const PersistenceIn& host, bool host_finish, void* stream, PersistenceOut* out) {
+  if (stream != nullptr) {
+    CudaSystem system(static_cast<cudaStream_t>(stream));
+    PersistenceDiagramFromHost(system, host, host_finish, out);
+    return;
+  }
+  OwnedStream owned;
+  CudaSystem system(owned.get());
+  PersistenceDiagramFromHost(system, host, host_finish, out);
+}
+
+}  // namespace galpha::detail

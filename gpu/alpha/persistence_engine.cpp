@@ -1,0 +1,51 @@
+#include "gpu/alpha/persistence_engine.hpp"
+
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/status_macros.hpp"
+#include "gpu/alpha/persistence_backend.hpp"
+#include "gpu/alpha/persistence_pairs.cuh"
+#include "gpu/system/engine_status.hpp"
+
+namespace galpha {
+
+absl::StatusOr<PersistenceDiagram> ComputePersistenceOnBackend(const AlphaFamily& family,
+                                                               const PersistenceOptions& options,
+                                                               PersistenceReport* report) {
+  GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
+  const AlphaRanks& r = family.ranks();
+  // The family's host arrays as the engine's types (the same layouts: two or three 32-bit words).
+  static_assert(sizeof(detail::EdgeIdx) == sizeof(family.edges()[0]));
+  static_assert(sizeof(detail::EdgeTris) == sizeof(r.edge_triangles[0]));
+  static_assert(sizeof(detail::TriIdx) == sizeof(family.triangles()[0]));
+  const detail::PersistenceIn in{static_cast<uint32_t>(family.points().size()),
+                                 static_cast<uint32_t>(family.edges().size()),
+                                 static_cast<uint32_t>(family.triangles().size()),
+                                 reinterpret_cast<const detail::EdgeIdx*>(family.edges().data()),
+                                 reinterpret_cast<const detail::EdgeTris*>(r.edge_triangles.data()),
+                                 reinterpret_cast<const detail::TriIdx*>(family.triangles().data()),
+                                 r.edge_rho_rank.data(),
+                                 r.edge_mu_low.data(),
+                                 r.tri_rank.data(),
+                                 family.representative().data(),
+                                 family.hidden_flags().empty() ? nullptr : family.hidden_flags().data()};
+  detail::PersistenceOut out;
+  GALPHA_RETURN_IF_ERROR(
+      detail::RunEngine(absl::StrCat("computing the persistence diagram of ", family.points().size(), " points"), [&] {
+        if (backend == Backend::kCuda) {
+          detail::PersistenceOnCuda(in, options.host_finish, options.cuda_stream, &out);
+        } else {
+          detail::PersistenceOnCpu(in, options.host_finish, &out);
+        }
+      }));
+  PersistenceDiagram diagram;
+  diagram.pairs = std::move(out.pairs);
+  diagram.dimension_begin[0] = 0;
+  diagram.dimension_begin[1] = out.num_h0;
+  diagram.dimension_begin[2] = diagram.pairs.size();
+  if (report != nullptr) *report = std::move(out.report);
+  return diagram;
+}
+
+}  // namespace galpha

@@ -1,0 +1,31 @@
+// The persistence diagram of a built family (core/family/persistence.hpp defines it) computed by
+// the engine's backend: the canonical orders, both spanning forests and the elder rule in parallel
+// on CUDA or OpenMP (persistence_pairs.cuh), the same diagram, pair for pair, as the host's
+// union-finds. docs/topology.md, "How the diagram is computed".
+#pragma once
+
+#include "absl/status/statusor.h"
+#include "core/family/alpha_family.hpp"
+#include "core/family/persistence.hpp"
+#include "gpu/alpha/persistence_report.hpp"
+#include "gpu/system/backend.hpp"
+
+namespace galpha {
+
+struct PersistenceOptions {
+  Backend backend = Backend::kAuto;
+  /// CUDA stream (a cudaStream_t) to run on; nullptr: one of the engine's own.
+  void* cuda_stream = nullptr;
+  /// Pair the forests' slow tails on the host (what is left once a parallel round contracts less
+  /// than an eighth of the live edges, or fewer than 1024 are left). False runs every round on the
+  /// backend, however many (tests use it to exercise the rounds on small inputs).
+  bool host_finish = true;
+};
+
+/// The diagram, with the stages' times and the forests' rounds in `report` when not null. Internal
+/// error if the family contradicts planar duality; Unavailable for CUDA in a build without it.
+absl::StatusOr<PersistenceDiagram> ComputePersistenceOnBackend(const AlphaFamily& family,
+                                                               const PersistenceOptions& options = {},
+                                                               PersistenceReport* report = nullptr);
+
+}  // namespace galpha

@@ -1,0 +1,140 @@
+// The engine's persistence diagram (gpu/alpha/persistence_engine.hpp: spanning forests and the
+// elder rule by parallel rounds) against the host's union-finds in filtration order
+// (core/family/persistence.cpp, itself checked against GUDHI by persistence_gudhi_test), pair for
+// pair: every generator, degenerate sets (ties, collinear, duplicates, tiny sets), weighted
+// families; with the forests' slow tails paired on the host (the default) and with every round on
+// the backend, on both backends. Families are built on the CPU, so the CUDA instance compares the
+// CUDA diagram with the host's on the very same family.
+#include <cstdint>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/family/alpha_family.hpp"
+#include "core/family/persistence.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "gpu/alpha/persistence_engine.hpp"
+#include "gtest/gtest.h"
+#include "tests/support/backend_fixture.hpp"
+#include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
+
+namespace galpha {
+namespace {
+
+using testing::IsOk;
+
+BuildOptions OnCpu() {
+  BuildOptions options;
+  options.backend = Backend::kCpu;
+  return options;
+}
+
+std::string Show(const PersistencePair& p) {
+  std::ostringstream out;
+  out << "{dim " << p.dimension << ", birth " << p.birth_rank << ", death " << p.death_rank << ", creator " << p.creator
+      << ", killer " << p.killer << "}";
+  return out.str();
+}
+
+class PersistenceEngineTest : public testing::BackendTest {
+ protected:
+  void ExpectSameAsHost(const AlphaFamily& family, const std::string& where) {
+    SCOPED_TRACE(where);
+    const absl::StatusOr<PersistenceDiagram> host = ComputePersistence(family);
+    ASSERT_THAT(host, IsOk());
+    for (const bool host_finish : {true, false}) {
+      SCOPED_TRACE(host_finish ? "tails on the host" : "every round on the backend");
+      PersistenceOptions options;
+      options.backend = GetParam();
+      options.host_finish = host_finish;
+      PersistenceReport report;
+      const absl::StatusOr<PersistenceDiagram> engine = ComputePersistenceOnBackend(family, options, &report);
+      ASSERT_THAT(engine, IsOk());
+      EXPECT_FALSE(report.stage_times.empty());
+      if (!host_finish) {
+        EXPECT_EQ(report.forests[0].host_finished_edges, 0u);
+        EXPECT_EQ(report.forests[1].host_finished_edges, 0u);
+      }
+      for (int d = 0; d < 3; ++d) EXPECT_EQ(engine->dimension_begin[d], host->dimension_begin[d]) << "dimension " << d;
+      ASSERT_EQ(engine->pairs.size(), host->pairs.size());
+      size_t mismatches = 0;
+      for (size_t i = 0; i < host->pairs.size() && mismatches < 5; ++i) {
+        const PersistencePair &a = engine->pairs[i], &b = host->pairs[i];
+        if (a.dimension != b.dimension || a.birth_rank != b.birth_rank || a.death_rank != b.death_rank ||
+            a.creator != b.creator || a.killer != b.killer) {
+          ADD_FAILURE() << "pair " << i << ": engine " << Show(a) << ", host " << Show(b);
+          ++mismatches;
+        }
+      }
+    }
+  }
+
+  void ExpectSameAsHost(const std::vector<Point2>& points, const std::string& where) {
+    absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(points, OnCpu());
+    ASSERT_THAT(family, IsOk()) << where;
+    ExpectSameAsHost(*family, where);
+  }
+};
+
+TEST_P(PersistenceEngineTest, EveryGenerator) {
+  for (const gen::NamedGenerator& generator : gen::AllDistributions()) {
+    for (const size_t n : {size_t{200}, size_t{5000}}) {
+      for (const uint64_t seed : {1u, 2u}) {
+        ExpectSameAsHost(generator.generate(n, seed),
+                         generator.name + " n " + std::to_string(n) + " seed " + std::to_string(seed));
+        if (HasFatalFailure()) return;
+      }
+    }
+  }
+}
+
+TEST_P(PersistenceEngineTest, DegenerateSets) {
+  // A grid: births tie everywhere, and ties are broken by canonical position, which makes the
+  // forests' weights increase along rows and columns: the rounds' slowest case.
+  std::vector<Point2> grid;
+  for (int i = 0; i < 60; ++i) {
+    for (int j = 0; j < 45; ++j) grid.push_back({static_cast<double>(i), static_cast<double>(j)});
+  }
+  ExpectSameAsHost(grid, "60 x 45 grid");
+  std::vector<Point2> holed;
+  for (size_t i = 0; i < grid.size(); ++i) {
+    if (i % 3 != 1) holed.push_back(grid[i]);
+  }
+  ExpectSameAsHost(holed, "grid with every third point removed");
+  std::vector<Point2> line;
+  for (int i = 0; i < 3000; ++i) line.push_back({0.5 * i, 0.25 * i});
+  ExpectSameAsHost(line, "collinear, evenly spaced");
+  std::vector<Point2> spread_line;
+  for (int i = 0; i < 2000; ++i) spread_line.push_back({1.0 * i * i, 0.0});
+  ExpectSameAsHost(spread_line, "collinear, gaps growing along the line");
+  std::vector<Point2> repeated = gen::Uniform(1500, 9);
+  const size_t distinct = repeated.size();
+  for (int copy = 0; copy < 2; ++copy) repeated.insert(repeated.end(), repeated.begin(), repeated.begin() + distinct);
+  ExpectSameAsHost(repeated, "every point three times");
+  ExpectSameAsHost(std::vector<Point2>{}, "no points");
+  ExpectSameAsHost(std::vector<Point2>{{1, 2}}, "one point");
+  ExpectSameAsHost(std::vector<Point2>{{1, 2}, {1, 2}}, "one point twice");
+  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}}, "two points");
+  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {0, 1}}, "a triangle");
+  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, "a square (co-circular)");
+}
+
+TEST_P(PersistenceEngineTest, WeightedFamilies) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> weight(-0.0004, 0.0004);
+  for (const size_t n : {size_t{300}, size_t{6000}}) {
+    const std::vector<Point2> points = gen::Uniform(n, 3);
+    std::vector<double> weights(points.size());
+    for (double& w : weights) w = weight(rng);
+    absl::StatusOr<AlphaFamily> family = BuildWeightedAlphaFamily(points, weights, OnCpu());
+    ASSERT_THAT(family, IsOk());
+    ExpectSameAsHost(*family, "weighted uniform n " + std::to_string(n));
+  }
+}
+
+GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(PersistenceEngineTest);
+
+}  // namespace
+}  // namespace galpha
