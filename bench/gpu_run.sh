@@ -105,7 +105,7 @@ for phase in "${phases[@]}"; do
       ;;
     test)
       for t in predicates_test predicates_device_test power_test radius_test weighted_radius_test triangulation_checks_test delaunay_test regular_test regular_cgal_test \
-               delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test weighted_family_cgal_test persistence_gudhi_test alpha_backend_identity_test; do
+               delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test weighted_family_cgal_test persistence_gudhi_test persistence_engine_test alpha_backend_identity_test; do
         [ -x ".carry/bin/$t" ] || continue
         # One process per test, so that a hang names its test and the rest still run.
         for name in $(".carry/bin/$t" --gtest_list_tests | awk '/^[^ ]/{suite=$1} /^  /{print suite $1}'); do

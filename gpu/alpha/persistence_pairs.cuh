@@ -488,6 +488,15 @@ void PairBySplicing(System& sys, WeightedEdge* forest, uint32_t num_forest, uint
   thrust::for_each_n(policy, zero, live, ScatterKilled{index_buffer.data(), killed_buffer.data(), killed_age});
 }
 
+/// Whether a graph edge is one of the forest's (by its mark).
+struct InForest {
+  const uint8_t* mark;
+  uint32_t mark_xor;
+  GALPHA_HD bool operator()(const WeightedEdge& e) const {
+    return mark[(static_cast<uint32_t>(e.weight) ^ mark_xor) - 1u] != 0;
+  }
+};
+
 /// The forest of a graph (edges one per family edge, clobbered), marked by canonical position,
 /// and its elder-rule kills.
 template <class System>
@@ -504,13 +513,6 @@ void ElderRuleForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint3
   out.keep_never = true;
   SpanningForest(sys, graph, num_edges, num_nodes, out);
   // The forest's edges, as the graph gave them (SpanningForest relabelled its copy).
-  struct InForest {
-    const uint8_t* mark;
-    uint32_t mark_xor;
-    GALPHA_HD bool operator()(const WeightedEdge& e) const {
-      return mark[(static_cast<uint32_t>(e.weight) ^ mark_xor) - 1u] != 0;
-    }
-  };
   const auto num_forest = static_cast<uint32_t>(
       thrust::copy_if(policy, forest.data(), forest.data() + num_edges, graph, InForest{forest_mark, mark_xor}) -
       graph);
