@@ -13,6 +13,7 @@
 #include "core/family/persistence.hpp"
 #include "core/geometry/shape.hpp"
 #include "core/geometry/shape_holes.hpp"
+#include "gpu/alpha/persistence_engine.hpp"
 
 namespace galpha::alphactl {
 
@@ -50,7 +51,8 @@ int RunPersistence(Args args) {
   size_t input_points = 0;
   auto family = LoadFamily(*common, &input_points);
   if (!family.ok()) return Failure(family.status());
-  auto diagram = ComputePersistence(*family);
+  // On the GPU when the family was built there (gpu/alpha/persistence_engine.hpp).
+  auto diagram = PersistenceDiagramOf(*family);
   if (!diagram.ok()) return Failure(diagram.status());
 
   std::vector<PersistenceRow> rows;

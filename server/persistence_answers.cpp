@@ -8,6 +8,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/family/persistence.hpp"
+#include "gpu/alpha/persistence_engine.hpp"
 
 namespace galpha::server {
 namespace {
@@ -82,8 +83,9 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::PersistenceResponse>>> MakePersis
     return absl::InvalidArgumentError(
         absl::StrCat("min_persistence ", min_persistence, " is not a length: give 0 or more"));
   }
+  // On the GPU when the family was built there (gpu/alpha/persistence_engine.hpp).
   absl::StatusOr<PersistenceDiagram> diagram =
-      ComputePersistence(cached->family(), cached->EdgeOrder(), cached->TriangleOrder());
+      PersistenceDiagramOf(cached->family(), cached->EdgeOrder(), cached->TriangleOrder());
   if (!diagram.ok()) return diagram.status();
   return std::make_unique<PersistenceSource>(std::move(cached), *std::move(diagram), dimensions, min_persistence);
 }

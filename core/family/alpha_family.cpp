@@ -282,7 +282,8 @@ size_t AlphaFamily::HostBytes() const {
          VectorBytes(r.edge_triangles) + VectorBytes(r.vertex_mu_low) + VectorBytes(r.vertex_mu_high) +
          VectorBytes(r.vertex_tri_low) + VectorBytes(r.master_begin) + VectorBytes(r.master) +
          VectorBytes(r.components) + VectorBytes(r.solid_components) + VectorBytes(r.holes) +
-         VectorBytes(r.regularized_components) + VectorBytes(r.regularized_holes) + VectorBytes(r.area_units);
+         VectorBytes(r.regularized_components) + VectorBytes(r.regularized_holes) + VectorBytes(r.area_units) +
+         (parts_.persistence ? VectorBytes(parts_.persistence->pairs) : 0);
 }
 
 }  // namespace galpha

@@ -20,6 +20,7 @@
 #include "core/base/point.hpp"
 #include "core/base/stage_time.hpp"
 #include "core/family/alpha_ranks.hpp"
+#include "core/family/persistence_pair.hpp"
 #include "core/geometry/shape.hpp"
 
 namespace galpha {
@@ -56,6 +57,8 @@ struct AlphaFamilyParts {
   HostVector<uint8_t> hidden;
   AlphaRanks ranks;
   BuildReport report;
+  /// The persistence diagram, when the build computed it (BuildOptions::persistence).
+  std::optional<PersistenceDiagram> persistence;
 };
 
 /// Classes of every simplex at one level: vertices by input index, edges and triangles by id.
@@ -82,6 +85,8 @@ class AlphaFamily {
   bool weighted() const { return !parts_.weights.empty(); }
   const HostVector<double>& weights() const { return parts_.weights; }
   bool hidden(uint32_t v) const { return !parts_.hidden.empty() && parts_.hidden[v] != 0; }
+  /// The persistence diagram the build computed (BuildOptions::persistence), or null.
+  const PersistenceDiagram* persistence() const { return parts_.persistence ? &*parts_.persistence : nullptr; }
   /// Per input index, 1 for a hidden point (empty when unweighted).
   const HostVector<uint8_t>& hidden_flags() const { return parts_.hidden; }
   /// Input indices of the hidden points, ascending.

@@ -74,8 +74,8 @@ HostVector<uint64_t> SortedFiltrationKeys(absl::Span<const uint32_t> order, size
 /// Sorts each run of consecutive items that `same_run` puts together by `less`: the lists below
 /// come out of the union-finds already ordered but for ties, so sorting the runs is linear.
 template <class SameRun, class Less>
-void SortRuns(std::vector<PersistencePair>::iterator begin, std::vector<PersistencePair>::iterator end,
-              SameRun same_run, Less less) {
+void SortRuns(HostVector<PersistencePair>::iterator begin, HostVector<PersistencePair>::iterator end, SameRun same_run,
+              Less less) {
   while (begin != end) {
     auto run_end = begin + 1;
     while (run_end != end && same_run(*begin, *run_end)) ++run_end;
@@ -142,10 +142,10 @@ struct EdgeStep {
 /// oldest vertex (lowest index: vertices of one rank are ordered by index) comes later. An edge
 /// inside one component closes a loop (it creates an H1 class): marked in `closes_loop` (by step).
 /// Pairs in Kruskal's order (death ascending), then the essential classes (ordered by the caller).
-std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const HostVector<EdgeStep>& steps,
-                                            std::vector<uint8_t>* closes_loop) {
+HostVector<PersistencePair> PairComponents(const AlphaFamily& family, const HostVector<EdgeStep>& steps,
+                                           std::vector<uint8_t>* closes_loop) {
   const auto num_points = static_cast<uint32_t>(family.points().size());
-  std::vector<PersistencePair> pairs;
+  HostVector<PersistencePair> pairs;
   pairs.reserve(family.num_unique());
   AgeOrderedForest forest(num_points);  // roots: their component's lowest index
   for (size_t i = 0; i < steps.size(); ++i) {
@@ -182,10 +182,10 @@ std::vector<PersistencePair> PairComponents(const AlphaFamily& family, const Hos
 /// reverse filtration order of their creators. Here an H1 pair's `creator` is the edge's canonical
 /// position and its `killer` the triangle's filtration position: the caller orders the pairs by
 /// the first, then maps both to ids.
-std::vector<PersistencePair> PairHoles(const HostVector<EdgeStep>& steps, const HostVector<uint64_t>& triangle_keys,
-                                       std::vector<uint8_t>* joins_dual) {
+HostVector<PersistencePair> PairHoles(const HostVector<EdgeStep>& steps, const HostVector<uint64_t>& triangle_keys,
+                                      std::vector<uint8_t>* joins_dual) {
   const auto num_tri = static_cast<uint32_t>(triangle_keys.size());
-  std::vector<PersistencePair> pairs;
+  HostVector<PersistencePair> pairs;
   pairs.reserve(num_tri);
   AgeOrderedForest forest(size_t{num_tri} + 1);  // roots: their component's latest position
   for (size_t i = steps.size(); i-- > 0;) {
@@ -242,10 +242,10 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
   // The two passes are independent (the dual decides for itself which edges close loops): the
   // holes on a second thread, the components here.
   std::vector<uint8_t> closes_loop(steps.size(), 0), joins_dual(steps.size(), 0);
-  std::future<std::vector<PersistencePair>> holes =
+  std::future<HostVector<PersistencePair>> holes =
       std::async(std::launch::async, [&] { return PairHoles(steps, triangle_keys, &joins_dual); });
-  std::vector<PersistencePair> components = PairComponents(family, steps, &closes_loop);
-  std::vector<PersistencePair> h1 = holes.get();
+  HostVector<PersistencePair> components = PairComponents(family, steps, &closes_loop);
+  HostVector<PersistencePair> h1 = holes.get();
   // Alexander duality, checked: an edge closes a loop exactly when it joins two components of the
   // complement.
   if (closes_loop != joins_dual) {
@@ -260,7 +260,7 @@ absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family,
   // in reverse filtration order of their creators (birth descending): reversed, only runs of equal
   // ranks remain to be ordered.
   PersistenceDiagram diagram;
-  std::vector<PersistencePair>& pairs = diagram.pairs;
+  HostVector<PersistencePair>& pairs = diagram.pairs;
   pairs = std::move(components);
   const size_t num_h0 = pairs.size();
   pairs.insert(pairs.end(), h1.rbegin(), h1.rend());

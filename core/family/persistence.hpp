@@ -23,15 +23,6 @@
 
 namespace galpha {
 
-/// Every class of positive persistence (death rank > birth rank; classes born and killed at the
-/// same threshold are not listed, as in GUDHI's default), ordered by dimension, birth rank, death
-/// rank (essential last), then the creator's canonical position.
-struct PersistenceDiagram {
-  std::vector<PersistencePair> pairs;
-  /// pairs of dimension 0 are pairs[0, dimension_begin[1]), of dimension 1 the rest.
-  size_t dimension_begin[3] = {0, 0, 0};
-};
-
 /// Two parallel sorts of (rank, canonical position) keys, then two union-finds (path halving:
 /// amortized logarithmic a find, one or two hops in practice);
 /// `edge_order` and `triangle_order` are the canonical orders (CanonicalOrders' fields). Internal

@@ -12,6 +12,7 @@
 #include "core/base/point.hpp"
 #include "core/base/stage_time.hpp"
 #include "core/family/alpha_ranks.hpp"
+#include "core/family/persistence_pair.hpp"
 
 namespace galpha::detail {
 
@@ -36,6 +37,9 @@ struct FamilyOutput {
   AlphaRanks ranks;
   std::vector<StageTime> stage_times;
   size_t peak_memory_bytes = 0;
+  /// The persistence diagram, when BuildHooks::persistence asked for it.
+  bool has_persistence = false;
+  PersistenceDiagram persistence;
 };
 
 /// Called between the build's phases: after the triangulation, `after_triangulation` runs (it
@@ -44,6 +48,8 @@ struct FamilyOutput {
 struct BuildHooks {
   std::function<void()> after_triangulation;
   uint64_t max_exact_comparisons = 0;
+  /// Compute the persistence diagram after the component curves.
+  bool persistence = false;
 };
 
 /// Builds the family of `n` finite points (with `weights`, one per point, or nullptr for the

@@ -46,6 +46,7 @@ absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::S
   detail::FamilyOutput built;
   detail::BuildHooks hooks;
   hooks.max_exact_comparisons = options.max_exact_comparisons;
+  hooks.persistence = options.persistence;
   hooks.after_triangulation = [&] {
     report("triangulation", 0.5);
     if (stop_requested()) {
@@ -77,6 +78,7 @@ absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::S
   parts.triangles = std::move(built.triangles);
   parts.edges = std::move(built.edges);
   parts.ranks = std::move(built.ranks);
+  if (built.has_persistence) parts.persistence = std::move(built.persistence);
   if (weighted) {
     parts.weights.resize(weights.size());
     detail::ParallelCopy(parts.weights.data(), weights.data(), weights.size() * sizeof(double));

@@ -30,6 +30,10 @@ struct BuildOptions {
   /// host's sequential repair, the only part whose work has no bound in the input's size, stops
   /// within 255 comparisons a host thread of the limit.
   uint64_t max_exact_comparisons = 0;
+  /// Also compute the persistence diagram (H0 and H1) in the build, on its backend, from the
+  /// family's arrays where they lie (gpu/alpha/persistence_pairs.cuh; stages persistence_*), and
+  /// keep it with the family (AlphaFamily::persistence()).
+  bool persistence = false;
 };
 
 /// Whether `status` is a build stopped by BuildOptions::max_exact_comparisons.

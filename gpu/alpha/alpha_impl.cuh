@@ -35,6 +35,7 @@
 #include "gpu/alpha/alpha_host_repair.hpp"
 #include "gpu/alpha/area_curve.cuh"
 #include "gpu/alpha/component_curve.cuh"
+#include "gpu/alpha/persistence_pairs.cuh"
 #include "gpu/alpha/spectrum_refine.cuh"
 #include "gpu/system/backend.hpp"
 #include "gpu/system/engine_system.cuh"
@@ -801,7 +802,7 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
 template <class System>
 void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points,
                       const double* host_weights, StageTimer<System>& timer, uint64_t max_exact_comparisons,
-                      FamilyOutput* family) {
+                      bool persistence, FamilyOutput* family) {
   AlphaRanks* out = &family->ranks;
   PipelineMesh mesh = PipelineMeshOf(t);
   if (mesh.weights != nullptr) HiddenVertices(sys, t, mesh);
@@ -826,6 +827,19 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   timer.EndStage("master_list");
   ComponentCounts<System> components = CountComponents(sys, mesh, edge_tris, ranks, intervals);
   timer.EndStage("components");
+  if (persistence) {
+    // While the tables download: the arrays it reads are the family's, where they lie.
+    PersistenceOut diagram;
+    PersistenceDiagramOnSystem(sys,
+                               PersistenceIn{mesh.n, mesh.num_edges, mesh.num_tri, mesh.edges, edge_tris.data(),
+                                             mesh.tri, ranks.edge_rho_rank.data(), intervals.edge_mu_low.data(),
+                                             ranks.tri_rank.data(), mesh.representative, mesh.hidden},
+                               /*host_finish=*/true, timer, &diagram);
+    family->persistence.pairs = std::move(diagram.pairs);
+    family->persistence.dimension_begin[1] = diagram.num_h0;
+    family->persistence.dimension_begin[2] = family->persistence.pairs.size();
+    family->has_persistence = true;
+  }
   FinishDownload(sys, ranks, values, master, components, &tables_download, &host_mesh, out);
   timer.EndStage("download");
 }
@@ -838,7 +852,7 @@ void RunFamilyBuild(System& sys, const Point2* host_points, const double* host_w
   StageTimer<System> timer(sys, &out->stage_times);
   SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, host_weights, n, /*keep_points=*/true, timer);
   if (hooks.after_triangulation) hooks.after_triangulation();
-  RunAlphaPipeline(sys, t, host_points, host_weights, timer, hooks.max_exact_comparisons, out);
+  RunAlphaPipeline(sys, t, host_points, host_weights, timer, hooks.max_exact_comparisons, hooks.persistence, out);
   timer.Finish();
   out->peak_memory_bytes = sys.peak_bytes();
 }

@@ -48,4 +48,17 @@ absl::StatusOr<PersistenceDiagram> ComputePersistenceOnBackend(const AlphaFamily
   return diagram;
 }
 
+absl::StatusOr<PersistenceDiagram> PersistenceDiagramOf(const AlphaFamily& family,
+                                                        absl::Span<const uint32_t> edge_order,
+                                                        absl::Span<const uint32_t> triangle_order) {
+  if (const PersistenceDiagram* built = family.persistence(); built != nullptr) return *built;
+  if (family.report().backend == BackendName(Backend::kCuda) && CudaBackendAvailable()) {
+    PersistenceOptions options;
+    options.backend = Backend::kCuda;
+    return ComputePersistenceOnBackend(family, options);
+  }
+  if (edge_order.empty() && !family.edges().empty()) return ComputePersistence(family);
+  return ComputePersistence(family, edge_order, triangle_order);
+}
+
 }  // namespace galpha

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/family/alpha_family.hpp"
 #include "core/family/persistence.hpp"
 #include "gpu/alpha/persistence_report.hpp"
@@ -27,5 +28,13 @@ struct PersistenceOptions {
 absl::StatusOr<PersistenceDiagram> ComputePersistenceOnBackend(const AlphaFamily& family,
                                                                const PersistenceOptions& options = {},
                                                                PersistenceReport* report = nullptr);
+
+/// The diagram front ends answer with: the family's own when its build computed it
+/// (BuildOptions::persistence); else the engine's on CUDA when the family was built there and
+/// CUDA is here; else the host's (ComputePersistence), with the canonical orders when the caller
+/// keeps them (empty spans: computed here). The same diagram whichever way.
+absl::StatusOr<PersistenceDiagram> PersistenceDiagramOf(const AlphaFamily& family,
+                                                        absl::Span<const uint32_t> edge_order = {},
+                                                        absl::Span<const uint32_t> triangle_order = {});
 
 }  // namespace galpha

@@ -60,7 +60,7 @@ struct PersistenceIn {
 
 /// The diagram as core/family/persistence.hpp defines it: H0 pairs first (num_h0 of them).
 struct PersistenceOut {
-  std::vector<PersistencePair> pairs;
+  HostVector<PersistencePair> pairs;
   size_t num_h0 = 0;
   PersistenceReport report;
 };
@@ -613,21 +613,19 @@ struct BirthDeathKey {
 };
 
 /// The listed pairs of `candidates` (made in the order of their last sort field: H0 by vertex,
-/// H1 by the creator's canonical position), stably sorted by `key`; appended to `out`.
+/// H1 by the creator's canonical position), stably sorted by `key`, into `*listed`; their number.
 template <class System, class Key, class KeyOf>
-void SortedPairs(System& sys, Buffer<PersistencePair, System>& candidates, uint32_t num_candidates, KeyOf key_of,
-                 std::vector<PersistencePair>* out) {
+uint32_t SortedPairs(System& sys, Buffer<PersistencePair, System>& candidates, uint32_t num_candidates, KeyOf key_of,
+                     Buffer<PersistencePair, System>* listed) {
   auto policy = sys.policy();
-  Buffer<PersistencePair, System> listed(sys, num_candidates);
+  *listed = Buffer<PersistencePair, System>(sys, num_candidates);
   const auto num_listed = static_cast<uint32_t>(
-      thrust::copy_if(policy, candidates.data(), candidates.data() + num_candidates, listed.data(), IsListed{}) -
-      listed.data());
+      thrust::copy_if(policy, candidates.data(), candidates.data() + num_candidates, listed->data(), IsListed{}) -
+      listed->data());
   Buffer<Key, System> keys(sys, num_listed);
-  thrust::transform(policy, listed.data(), listed.data() + num_listed, keys.data(), key_of);
-  thrust::stable_sort_by_key(policy, keys.data(), keys.data() + num_listed, listed.data());
-  const size_t begin = out->size();
-  out->resize(begin + num_listed);
-  sys.ToHost(out->data() + begin, listed.data(), num_listed);
+  thrust::transform(policy, listed->data(), listed->data() + num_listed, keys.data(), key_of);
+  thrust::stable_sort_by_key(policy, keys.data(), keys.data() + num_listed, listed->data());
+  return num_listed;
 }
 
 /// The diagram of core/family/persistence.hpp, pair for pair. `host_finish`: pair the forests'
@@ -643,7 +641,7 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
   Buffer<uint32_t, System> triangle_order(sys, num_tri), triangle_position(sys, num_tri);
   CanonicalEdgeOrder(sys, in, &edge_order, &edge_position);
   CanonicalTriangleOrder(sys, in, &triangle_order, &triangle_position);
-  timer.EndStage("canonical_orders");
+  timer.EndStage("persistence_orders");
   const EdgeFiltrationKey key{in.edge_rho_rank, in.edge_mu_low, edge_position.data()};
 
   Buffer<WeightedEdge, System> graph(sys, num_edges);
@@ -656,7 +654,7 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     ElderRuleForest(sys, graph.data(), num_edges, in.num_points, age.data(), 0u, host_finish, primal_forest.data(),
                     primal_killed.data(), &out->report.forests[0]);
   }
-  timer.EndStage("components_pairing");
+  timer.EndStage("persistence_h0");
   {
     Buffer<uint64_t, System> age(sys, size_t{num_tri} + 1);
     thrust::transform(policy, zero, zero + (num_tri + 1), age.data(),
@@ -665,7 +663,7 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     ElderRuleForest(sys, graph.data(), num_edges, num_tri + 1, age.data(), 0xFFFFFFFFu, host_finish, dual_forest.data(),
                     dual_killed.data(), &out->report.forests[1]);
   }
-  timer.EndStage("holes_pairing");
+  timer.EndStage("persistence_h1");
   graph.Reset();
   const auto violations = static_cast<uint32_t>(
       thrust::count_if(policy, zero, zero + num_edges, ViolatesDuality{primal_forest.data(), dual_forest.data()}));
@@ -675,7 +673,8 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
                           " edges close a loop exactly when they do not join two components of the complement");
   }
 
-  out->pairs.clear();
+  Buffer<PersistencePair, System> components(sys, 0), holes(sys, 0);
+  uint32_t num_components = 0, num_holes = 0;
   {
     Buffer<uint32_t, System> killer_position(sys, in.num_points);
     thrust::fill_n(policy, killer_position.data(), in.num_points, kNoPosition);
@@ -685,19 +684,26 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     thrust::transform(policy, zero, zero + in.num_points, candidates.data(),
                       ComponentPair{in.representative, in.hidden, killer_position.data(), edge_order.data(),
                                     in.edge_rho_rank, in.edge_mu_low});
-    SortedPairs<System, uint32_t>(sys, candidates, in.num_points, DeathKey{}, &out->pairs);
+    num_components = SortedPairs<System, uint32_t>(sys, candidates, in.num_points, DeathKey{}, &components);
   }
-  out->num_h0 = out->pairs.size();
-  Buffer<PersistencePair, System> candidates(sys, num_edges);
-  thrust::transform(policy, zero, zero + num_edges, candidates.data(),
-                    HolePair{dual_forest.data(), dual_killed.data(), edge_order.data(), triangle_order.data(),
-                             in.edge_rho_rank, in.edge_mu_low});
-  SortedPairs<System, uint64_t>(sys, candidates, num_edges, BirthDeathKey{}, &out->pairs);
-  timer.EndStage("pairs");
+  {
+    Buffer<PersistencePair, System> candidates(sys, num_edges);
+    thrust::transform(policy, zero, zero + num_edges, candidates.data(),
+                      HolePair{dual_forest.data(), dual_killed.data(), edge_order.data(), triangle_order.data(),
+                               in.edge_rho_rank, in.edge_mu_low});
+    num_holes = SortedPairs<System, uint64_t>(sys, candidates, num_edges, BirthDeathKey{}, &holes);
+  }
+  timer.EndStage("persistence_pairs");
+  // Not zeroed first (PersistencePair is trivial): the copy is the first touch, on every core.
+  out->pairs = HostVector<PersistencePair>(size_t{num_components} + num_holes);
+  out->num_h0 = num_components;
+  sys.Download({{out->pairs.data(), components.data(), num_components * sizeof(PersistencePair)},
+                {out->pairs.data() + num_components, holes.data(), num_holes * sizeof(PersistencePair)}});
+  timer.EndStage("persistence_download");
 }
 
 /// The diagram from a family's arrays in host memory (`host`): the CUDA system uploads them first
-/// (stage "upload"), the OpenMP system reads them where they are.
+/// (stage "persistence_upload"), the OpenMP system reads them where they are.
 template <class System>
 void PersistenceDiagramFromHost(System& sys, const PersistenceIn& host, bool host_finish, PersistenceOut* out) {
   StageTimer<System> timer(sys, &out->report.stage_times);
@@ -722,7 +728,7 @@ void PersistenceDiagramFromHost(System& sys, const PersistenceIn& host, bool hos
       copies.push_back({const_cast<uint8_t*>(host.hidden), hidden.data(), host.num_points * sizeof(uint8_t)});
     }
     sys.Upload(copies);
-    timer.EndStage("upload");
+    timer.EndStage("persistence_upload");
     const PersistenceIn in{host.num_points,
                            host.num_edges,
                            host.num_tri,

@@ -10,6 +10,7 @@
 #include "core/family/area_ratio.hpp"
 #include "core/family/canonical_order.hpp"
 #include "core/family/persistence.hpp"
+#include "gpu/alpha/persistence_engine.hpp"
 
 namespace galpha::python {
 namespace {
@@ -279,7 +280,8 @@ absl::StatusOr<std::array<PersistencePairs, 2>> AnswerPersistence(const FamilySt
         absl::StrCat("min_persistence ", min_persistence, " is not a length: give 0 or more"));
   }
   const AlphaFamily& family = state.family();
-  absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(family, state.EdgeOrder(), state.TriangleOrder());
+  // On the GPU when the family was built there (gpu/alpha/persistence_engine.hpp).
+  absl::StatusOr<PersistenceDiagram> diagram = PersistenceDiagramOf(family, state.EdgeOrder(), state.TriangleOrder());
   if (!diagram.ok()) return diagram.status();
   std::array<PersistencePairs, 2> answer;
   for (size_t d = 0; d < 2; ++d) {

@@ -40,6 +40,20 @@ std::string Show(const PersistencePair& p) {
 
 class PersistenceEngineTest : public testing::BackendTest {
  protected:
+  static void ExpectSame(const PersistenceDiagram& engine, const PersistenceDiagram& host) {
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(engine.dimension_begin[d], host.dimension_begin[d]) << "dimension " << d;
+    ASSERT_EQ(engine.pairs.size(), host.pairs.size());
+    size_t mismatches = 0;
+    for (size_t i = 0; i < host.pairs.size() && mismatches < 5; ++i) {
+      const PersistencePair &a = engine.pairs[i], &b = host.pairs[i];
+      if (a.dimension != b.dimension || a.birth_rank != b.birth_rank || a.death_rank != b.death_rank ||
+          a.creator != b.creator || a.killer != b.killer) {
+        ADD_FAILURE() << "pair " << i << ": engine " << Show(a) << ", host " << Show(b);
+        ++mismatches;
+      }
+    }
+  }
+
   void ExpectSameAsHost(const AlphaFamily& family, const std::string& where) {
     SCOPED_TRACE(where);
     const absl::StatusOr<PersistenceDiagram> host = ComputePersistence(family);
@@ -57,17 +71,7 @@ class PersistenceEngineTest : public testing::BackendTest {
         EXPECT_EQ(report.forests[0].host_finished_edges, 0u);
         EXPECT_EQ(report.forests[1].host_finished_edges, 0u);
       }
-      for (int d = 0; d < 3; ++d) EXPECT_EQ(engine->dimension_begin[d], host->dimension_begin[d]) << "dimension " << d;
-      ASSERT_EQ(engine->pairs.size(), host->pairs.size());
-      size_t mismatches = 0;
-      for (size_t i = 0; i < host->pairs.size() && mismatches < 5; ++i) {
-        const PersistencePair &a = engine->pairs[i], &b = host->pairs[i];
-        if (a.dimension != b.dimension || a.birth_rank != b.birth_rank || a.death_rank != b.death_rank ||
-            a.creator != b.creator || a.killer != b.killer) {
-          ADD_FAILURE() << "pair " << i << ": engine " << Show(a) << ", host " << Show(b);
-          ++mismatches;
-        }
-      }
+      ExpectSame(*engine, *host);
     }
   }
 
@@ -119,6 +123,45 @@ TEST_P(PersistenceEngineTest, DegenerateSets) {
   ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}}, "two points");
   ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {0, 1}}, "a triangle");
   ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, "a square (co-circular)");
+}
+
+// BuildOptions::persistence: the diagram computed in the build, from the family's arrays where they
+// lie (device memory on CUDA), is the host's; and PersistenceDiagramOf answers with it.
+TEST_P(PersistenceEngineTest, ComputedInTheBuild) {
+  for (const gen::NamedGenerator& generator : gen::AllDistributions()) {
+    SCOPED_TRACE(generator.name);
+    BuildOptions options;
+    options.backend = GetParam();
+    options.persistence = true;
+    absl::StatusOr<AlphaFamily> family = BuildAlphaFamily(generator.generate(4000, 5), options);
+    ASSERT_THAT(family, IsOk());
+    ASSERT_NE(family->persistence(), nullptr);
+    bool timed = false;
+    for (const StageTime& stage : family->report().stage_times) timed |= stage.stage == "persistence_h1";
+    EXPECT_TRUE(timed) << "the build's stages name the diagram's";
+    const absl::StatusOr<PersistenceDiagram> host = ComputePersistence(*family);
+    ASSERT_THAT(host, IsOk());
+    ExpectSame(*family->persistence(), *host);
+    const absl::StatusOr<PersistenceDiagram> answered = PersistenceDiagramOf(*family);
+    ASSERT_THAT(answered, IsOk());
+    ExpectSame(*answered, *host);
+  }
+  std::vector<Point2> points = gen::Uniform(3000, 4);
+  std::vector<double> weights(points.size());
+  for (size_t i = 0; i < weights.size(); ++i) weights[i] = 1e-4 * static_cast<double>(i % 7);
+  BuildOptions options;
+  options.backend = GetParam();
+  options.persistence = true;
+  absl::StatusOr<AlphaFamily> weighted = BuildWeightedAlphaFamily(points, weights, options);
+  ASSERT_THAT(weighted, IsOk());
+  ASSERT_NE(weighted->persistence(), nullptr);
+  const absl::StatusOr<PersistenceDiagram> host = ComputePersistence(*weighted);
+  ASSERT_THAT(host, IsOk());
+  ExpectSame(*weighted->persistence(), *host);
+  // Without the option the family has none.
+  absl::StatusOr<AlphaFamily> plain = BuildAlphaFamily(points, OnCpu());
+  ASSERT_THAT(plain, IsOk());
+  EXPECT_EQ(plain->persistence(), nullptr);
 }
 
 TEST_P(PersistenceEngineTest, WeightedFamilies) {
