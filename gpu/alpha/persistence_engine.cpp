@@ -55,7 +55,10 @@ absl::StatusOr<PersistenceDiagram> PersistenceDiagramOf(const AlphaFamily& famil
   if (family.report().backend == BackendName(Backend::kCuda) && CudaBackendAvailable()) {
     PersistenceOptions options;
     options.backend = Backend::kCuda;
-    return ComputePersistenceOnBackend(family, options);
+    absl::StatusOr<PersistenceDiagram> on_device = ComputePersistenceOnBackend(family, options);
+    // A device short of memory (a server's builds hold it) leaves the diagram to the host, which
+    // computes the same one.
+    if (on_device.ok() || !absl::IsResourceExhausted(on_device.status())) return on_device;
   }
   if (edge_order.empty() && !family.edges().empty()) return ComputePersistence(family);
   return ComputePersistence(family, edge_order, triangle_order);

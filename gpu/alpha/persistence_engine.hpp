@@ -31,8 +31,9 @@ absl::StatusOr<PersistenceDiagram> ComputePersistenceOnBackend(const AlphaFamily
 
 /// The diagram front ends answer with: the family's own when its build computed it
 /// (BuildOptions::persistence); else the engine's on CUDA when the family was built there and
-/// CUDA is here; else the host's (ComputePersistence), with the canonical orders when the caller
-/// keeps them (empty spans: computed here). The same diagram whichever way.
+/// CUDA is here (unless the device is out of memory); else the host's (ComputePersistence), with
+/// the canonical orders when the caller keeps them (empty spans: computed here). The same diagram
+/// whichever way.
 absl::StatusOr<PersistenceDiagram> PersistenceDiagramOf(const AlphaFamily& family,
                                                         absl::Span<const uint32_t> edge_order = {},
                                                         absl::Span<const uint32_t> triangle_order = {});
