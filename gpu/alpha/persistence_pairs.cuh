@@ -210,16 +210,6 @@ struct IdentityAge {
 
 // ---- The elder rule over a spanning forest ---------------------------------------------------------
 
-/// Clears the lightest-edge slots of a live edge's two nodes before the edges offer theirs.
-struct ResetBestAtEnds {
-  const WeightedEdge* edges;
-  unsigned long long* best;
-  GALPHA_HD void operator()(uint32_t i) const {
-    best[edges[i].a] = ~0ull;
-    best[edges[i].b] = ~0ull;
-  }
-};
-
 /// No node: the path minimum of a hook root (nothing above it).
 constexpr uint32_t kNoNode = 0xFFFFFFFFu;
 
@@ -432,19 +422,31 @@ void PairBySplicing(System& sys, WeightedEdge* forest, uint32_t num_forest, uint
   // Declared after the buffers: destroyed (after the stream's last replay) before them.
   typename System::Recording hook_round, more_jumps, splice_round;
   uint32_t live = num_forest;
-  for (uint32_t round = 0; live > 0; ++round) {
-    if (host_finish && live < kHostFinishBelow) break;
-    if (round > num_forest) throw EngineError(EngineError::Kind::kInternal, "persistence: forest rounds did not end");
-    report->rounds = round + 1;
+  // One wait a round (more only while the jumps have not converged): the counts of the previous
+  // round's splices are read with the hooks' convergence flag.
+  for (uint32_t round = 0;; ++round) {
+    if (round > num_forest + 1)
+      throw EngineError(EngineError::Kind::kInternal, "persistence: forest rounds did not end");
     sys.Replay(hook_round, [&] {
-      sys.ForEachBelow(count + kLiveEdges, ResetBestAtEnds{forest, best.data()});
+      // Every live node's slot, so that a node whose edges are all gone hooks nowhere and leaves.
+      sys.ForEachBelow(count + kLiveNodes, ResetBest{nodes.data(), best.data()});
       sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{forest, best.data()});
       sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{forest, best.data(), target.data()});
       sys.ForEachBelow(count + kLiveNodes,
                        StartHookPath{nodes.data(), best.data(), target.data(), eldest, path.data()});
       jump_group();
     });
-    uint32_t jumped = sys.Read(count + kJumped);
+    uint32_t now[kNumCounts] = {};
+    sys.Download({{now, count, sizeof(now)}});
+    live = now[kLiveEdges];
+    if (round > 0) {
+      const uint32_t spliced = now[kSplicedLast];
+      if (spliced == 0) throw EngineError(EngineError::Kind::kInternal, "persistence: a forest round spliced nothing");
+      if (host_finish && static_cast<uint64_t>(spliced) * 8 < static_cast<uint64_t>(live) + spliced) break;
+    }
+    if (live == 0 || (host_finish && live < kHostFinishBelow)) break;
+    report->rounds = round + 1;
+    uint32_t jumped = now[kJumped];
     for (int group = 0; jumped != 0; ++group) {
       if (group > 32) throw EngineError(EngineError::Kind::kInternal, "persistence: pointer jumping did not converge");
       sys.Replay(more_jumps, jump_group);
@@ -462,12 +464,6 @@ void PairBySplicing(System& sys, WeightedEdge* forest, uint32_t num_forest, uint
       sys.RunSingle(TakeKeptItems{count + kLiveEdges, count + kKeptEdges, count + kLiveNodes, count + kKeptNodes,
                                   count + kSpliced, count + kSplicedLast});
     });
-    uint32_t now[kNumCounts] = {};
-    sys.Download({{now, count, sizeof(now)}});
-    const uint32_t spliced = now[kSplicedLast];
-    if (spliced == 0) throw EngineError(EngineError::Kind::kInternal, "persistence: a forest round spliced nothing");
-    live = now[kLiveEdges];
-    if (host_finish && static_cast<uint64_t>(spliced) * 8 < static_cast<uint64_t>(live) + spliced) break;
   }
   report->forest_edges = num_forest;
   report->host_finished_edges = live;
