@@ -283,7 +283,9 @@ size_t AlphaFamily::HostBytes() const {
          VectorBytes(r.vertex_tri_low) + VectorBytes(r.master_begin) + VectorBytes(r.master) +
          VectorBytes(r.components) + VectorBytes(r.solid_components) + VectorBytes(r.holes) +
          VectorBytes(r.regularized_components) + VectorBytes(r.regularized_holes) + VectorBytes(r.area_units) +
-         (parts_.persistence ? VectorBytes(parts_.persistence->pairs) : 0);
+         // The diagram's array is reserved for the most pairs there could be and never touched
+         // beyond those there are (core/family/persistence_pair.hpp): only those are resident.
+         (parts_.persistence ? parts_.persistence->pairs.size() * sizeof(PersistencePair) : 0);
 }
 
 }  // namespace galpha

@@ -650,6 +650,27 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     ElderRuleForest(sys, graph.data(), num_edges, in.num_points, age.data(), 0u, host_finish, primal_forest.data(),
                     primal_killed.data(), &out->report.forests[0]);
   }
+  // H0's pairs go to the host while the dual forest is computed. The host array has room for
+  // every H1 pair too (at most one a dual forest edge: num_tri); it is not zeroed first
+  // (PersistencePair is trivial), so the copies are the first touch of what is used.
+  Buffer<PersistencePair, System> components(sys, 0);
+  uint32_t num_components = 0;
+  {
+    Buffer<uint32_t, System> killer_position(sys, in.num_points);
+    thrust::fill_n(policy, killer_position.data(), in.num_points, kNoPosition);
+    thrust::for_each_n(policy, zero, num_edges,
+                       RecordVertexKiller{primal_forest.data(), primal_killed.data(), killer_position.data()});
+    Buffer<PersistencePair, System> candidates(sys, in.num_points);
+    thrust::transform(policy, zero, zero + in.num_points, candidates.data(),
+                      ComponentPair{in.representative, in.hidden, killer_position.data(), edge_order.data(),
+                                    in.edge_rho_rank, in.edge_mu_low});
+    num_components = SortedPairs<System, uint32_t>(sys, candidates, in.num_points, DeathKey{}, &components);
+  }
+  out->pairs = HostVector<PersistencePair>(size_t{num_components} + num_tri);
+  out->num_h0 = num_components;
+  // Declared after `components`, which it reads: destroyed (waiting for the copy) before it.
+  auto components_download =
+      sys.DownloadAsync({{out->pairs.data(), components.data(), num_components * sizeof(PersistencePair)}});
   timer.EndStage("persistence_h0");
   {
     Buffer<uint64_t, System> age(sys, size_t{num_tri} + 1);
@@ -668,20 +689,8 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
                       "persistence: " + std::to_string(violations) +
                           " edges close a loop exactly when they do not join two components of the complement");
   }
-
-  Buffer<PersistencePair, System> components(sys, 0), holes(sys, 0);
-  uint32_t num_components = 0, num_holes = 0;
-  {
-    Buffer<uint32_t, System> killer_position(sys, in.num_points);
-    thrust::fill_n(policy, killer_position.data(), in.num_points, kNoPosition);
-    thrust::for_each_n(policy, zero, num_edges,
-                       RecordVertexKiller{primal_forest.data(), primal_killed.data(), killer_position.data()});
-    Buffer<PersistencePair, System> candidates(sys, in.num_points);
-    thrust::transform(policy, zero, zero + in.num_points, candidates.data(),
-                      ComponentPair{in.representative, in.hidden, killer_position.data(), edge_order.data(),
-                                    in.edge_rho_rank, in.edge_mu_low});
-    num_components = SortedPairs<System, uint32_t>(sys, candidates, in.num_points, DeathKey{}, &components);
-  }
+  Buffer<PersistencePair, System> holes(sys, 0);
+  uint32_t num_holes = 0;
   {
     Buffer<PersistencePair, System> candidates(sys, num_edges);
     thrust::transform(policy, zero, zero + num_edges, candidates.data(),
@@ -689,12 +698,11 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
                                in.edge_rho_rank, in.edge_mu_low});
     num_holes = SortedPairs<System, uint64_t>(sys, candidates, num_edges, BirthDeathKey{}, &holes);
   }
+  if (num_holes > num_tri) throw EngineError(EngineError::Kind::kInternal, "persistence: more holes than triangles");
   timer.EndStage("persistence_pairs");
-  // Not zeroed first (PersistencePair is trivial): the copy is the first touch, on every core.
-  out->pairs = HostVector<PersistencePair>(size_t{num_components} + num_holes);
-  out->num_h0 = num_components;
-  sys.Download({{out->pairs.data(), components.data(), num_components * sizeof(PersistencePair)},
-                {out->pairs.data() + num_components, holes.data(), num_holes * sizeof(PersistencePair)}});
+  sys.Download({{out->pairs.data() + num_components, holes.data(), num_holes * sizeof(PersistencePair)}});
+  components_download.Wait();
+  out->pairs.resize(size_t{num_components} + num_holes);  // smaller: no copy, no fill
   timer.EndStage("persistence_download");
 }
 
