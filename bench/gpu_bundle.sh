@@ -16,6 +16,11 @@ cd "$(dirname "$0")/.."
 # its database (the GPU machine reads .bin files only, without a CRS).
 scripts/drop-stale-build-dir.sh cuda
 cmake --preset cuda -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_PROJ=OFF -DGALPHA_WITH_GEMMI=OFF >/dev/null
+# An object whose compile was interrupted (two builds at once in this tree, a killed build) can be
+# left with no header dependencies recorded, and ninja then never rebuilds it when a header
+# changes: the bundle carried a stale engine once. Such objects are rebuilt.
+ninja -C build/cuda -t deps 2>/dev/null | awk '/: #deps 0,/{sub(/:$/, "", $1); print $1}' | grep -E '\.(cu|cpp)\.o$' |
+  while read -r object; do rm -f "build/cuda/$object"; done
 cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
