@@ -19,8 +19,8 @@ cmake --preset cuda -DGALPHA_WITH_GDAL=OFF -DGALPHA_WITH_PROJ=OFF -DGALPHA_WITH_
 # An object whose compile was interrupted (two builds at once in this tree, a killed build) can be
 # left with no header dependencies recorded, and ninja then never rebuilds it when a header
 # changes: the bundle carried a stale engine once. Such objects are rebuilt.
-ninja -C build/cuda -t deps 2>/dev/null | awk '/: #deps 0,/{sub(/:$/, "", $1); print $1}' | grep -E '\.(cu|cpp)\.o$' |
-  while read -r object; do rm -f "build/cuda/$object"; done
+stale=$(ninja -C build/cuda -t deps 2>/dev/null | awk '/: #deps 0,/ && $1 ~ /\.(cu|cpp)\.o:$/ {sub(/:$/, "", $1); print $1}' || true)
+for object in $stale; do rm -f "build/cuda/$object"; done
 cmake --build --preset cuda -j"$(nproc)"
 rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
