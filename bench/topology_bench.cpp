@@ -59,14 +59,7 @@ struct TopologyResult {
   std::string error;
 };
 
-bool SameDiagram(const PersistenceDiagram& a, const PersistenceDiagram& b) {
-  return a.pairs.size() == b.pairs.size() &&
-         std::equal(a.pairs.begin(), a.pairs.end(), b.pairs.begin(),
-                    [](const PersistencePair& x, const PersistencePair& y) {
-                      return x.dimension == y.dimension && x.birth_rank == y.birth_rank &&
-                             x.death_rank == y.death_rank && x.creator == y.creator && x.killer == y.killer;
-                    });
-}
+bool SameDiagram(const PersistenceDiagram& a, const PersistenceDiagram& b) { return a.pairs == b.pairs; }
 
 TopologyResult RunOne(const std::string& name, const std::vector<Point2>& points, const BenchOptions& options) {
   TopologyResult result;

@@ -27,6 +27,11 @@ struct PersistencePair {
   uint32_t killer;
 
   bool essential() const { return death_rank == kNeverRank; }
+  friend bool operator==(const PersistencePair& a, const PersistencePair& b) {
+    return a.dimension == b.dimension && a.birth_rank == b.birth_rank && a.death_rank == b.death_rank &&
+           a.creator == b.creator && a.killer == b.killer;
+  }
+  friend bool operator!=(const PersistencePair& a, const PersistencePair& b) { return !(a == b); }
 };
 
 /// Every class of positive persistence (death rank > birth rank; classes born and killed at the

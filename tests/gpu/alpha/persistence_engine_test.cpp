@@ -45,10 +45,8 @@ class PersistenceEngineTest : public testing::BackendTest {
     ASSERT_EQ(engine.pairs.size(), host.pairs.size());
     size_t mismatches = 0;
     for (size_t i = 0; i < host.pairs.size() && mismatches < 5; ++i) {
-      const PersistencePair &a = engine.pairs[i], &b = host.pairs[i];
-      if (a.dimension != b.dimension || a.birth_rank != b.birth_rank || a.death_rank != b.death_rank ||
-          a.creator != b.creator || a.killer != b.killer) {
-        ADD_FAILURE() << "pair " << i << ": engine " << Show(a) << ", host " << Show(b);
+      if (engine.pairs[i] != host.pairs[i]) {
+        ADD_FAILURE() << "pair " << i << ": engine " << Show(engine.pairs[i]) << ", host " << Show(host.pairs[i]);
         ++mismatches;
       }
     }
