@@ -100,9 +100,13 @@ struct AlphaRanks {
   ComparisonCounts comparisons;
 };
 
-/// Birth rank of an edge: rho when unattached, else mu-low (its first incident triangle).
+/// Birth rank of an edge: rho when unattached (rank > 0), else mu-low (its first incident
+/// triangle). One rule for the host and the engine's functors.
+GALPHA_HD inline uint32_t EdgeBirthRank(uint32_t rho_rank, uint32_t mu_low) {
+  return rho_rank != 0 ? rho_rank : mu_low;
+}
 inline uint32_t EdgeBirthRank(const AlphaRanks& r, uint32_t e) {
-  return r.edge_rho_rank[e] != 0 ? r.edge_rho_rank[e] : r.edge_mu_low[e];
+  return EdgeBirthRank(r.edge_rho_rank[e], r.edge_mu_low[e]);
 }
 
 }  // namespace galpha

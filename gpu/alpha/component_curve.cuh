@@ -265,7 +265,7 @@ struct GeneralGraphEdge {
   const uint32_t* rho;
   const uint32_t* mu_low;
   GALPHA_HD WeightedEdge operator()(uint32_t e) const {
-    const uint32_t birth = rho[e] != 0 ? rho[e] : mu_low[e];
+    const uint32_t birth = EdgeBirthRank(rho[e], mu_low[e]);
     return WeightedEdge{edges[e].v[0], edges[e].v[1], (static_cast<uint64_t>(birth) << 32) | e};
   }
 };
@@ -307,7 +307,7 @@ struct CountEdgeBirths {
   uint32_t* general_at_rank;
   uint32_t* regularized_at_rank;
   GALPHA_HD void operator()(uint32_t e) const {
-    const uint32_t birth = rho[e] != 0 ? rho[e] : mu_low[e];
+    const uint32_t birth = EdgeBirthRank(rho[e], mu_low[e]);
     if (birth != kNeverRank) AtomicIncrement(&general_at_rank[birth]);
     if (mu_low[e] != kNeverRank) AtomicIncrement(&regularized_at_rank[mu_low[e]]);
   }

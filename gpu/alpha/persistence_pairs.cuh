@@ -65,10 +65,6 @@ struct PersistenceOut {
   PersistenceReport report;
 };
 
-GALPHA_HD inline uint32_t EdgeBirthOf(const uint32_t* rho, const uint32_t* mu_low, uint32_t e) {
-  return rho[e] != 0 ? rho[e] : mu_low[e];
-}
-
 // ---- Canonical positions -------------------------------------------------------------------------
 
 struct EdgeVertexKey {
@@ -168,7 +164,7 @@ struct EdgeFiltrationKey {
   const uint32_t* mu_low;
   const uint32_t* edge_position;
   GALPHA_HD uint64_t operator()(uint32_t e) const {
-    return (static_cast<uint64_t>(EdgeBirthOf(rho, mu_low, e)) << 32) | (edge_position[e] + 1u);
+    return (static_cast<uint64_t>(EdgeBirthRank(rho[e], mu_low[e])) << 32) | (edge_position[e] + 1u);
   }
 };
 
@@ -559,7 +555,7 @@ struct ComponentPair {
       return pair;
     }
     const uint32_t e = edge_order[p];
-    const uint32_t death = EdgeBirthOf(rho, mu_low, e);
+    const uint32_t death = EdgeBirthRank(rho[e], mu_low[e]);
     if (death == 0) return pair;
     pair.dimension = 0;
     pair.death_rank = death;
@@ -583,7 +579,7 @@ struct HolePair {
     if (dual_forest[p] == 0) return pair;
     const uint64_t key = ~killed_age[p];  // the killing triangle's (rank, position); never the outer face's
     const uint32_t e = edge_order[p];
-    const uint32_t birth = EdgeBirthOf(rho, mu_low, e), death = static_cast<uint32_t>(key >> 32);
+    const uint32_t birth = EdgeBirthRank(rho[e], mu_low[e]), death = static_cast<uint32_t>(key >> 32);
     if (death <= birth) return pair;
     pair.dimension = 1;
     pair.birth_rank = birth;
