@@ -7,8 +7,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "core/exact/radius_rational.hpp"
-#include "core/exact/weighted_radius_rational.hpp"
+#include "core/family/simplex_threshold.hpp"
 
 namespace galpha {
 
@@ -54,29 +53,8 @@ namespace {
 
 /// sign(exact threshold of `rank` - value), exactly.
 int CompareRankWith(const AlphaFamilyParts& p, int64_t rank, const mpq_class& value) {
-  const uint32_t id = p.ranks.spectrum_simplex[static_cast<size_t>(rank - 1)];
-  Point2 pts[3];
-  double ws[3];
-  int n;
-  const uint32_t num_tri = static_cast<uint32_t>(p.triangles.size());
-  const bool weighted = !p.weights.empty();
-  if (id < num_tri) {
-    n = 3;
-    for (int k = 0; k < 3; ++k) {
-      pts[k] = p.points[p.triangles[id][k]];
-      ws[k] = weighted ? p.weights[p.triangles[id][k]] : 0.0;
-    }
-  } else {
-    n = 2;
-    for (int k = 0; k < 2; ++k) {
-      pts[k] = p.points[p.edges[id - num_tri][k]];
-      ws[k] = weighted ? p.weights[p.edges[id - num_tri][k]] : 0.0;
-    }
-  }
-  const std::optional<mpq_class> threshold = SimplexRadiusSqRational(pts, weighted ? ws : nullptr, n);
-  if (!threshold) return 1;
-  const int c = cmp(*threshold, value);
-  return (c > 0) - (c < 0);
+  return CompareSimplexThreshold(SimplexGeometry{p.points, p.weights, p.triangles, p.edges},
+                                 p.ranks.spectrum_simplex[static_cast<size_t>(rank - 1)], value);
 }
 
 /// Number of ranks whose exact threshold is <= value (binary search; thresholds increase).
@@ -138,36 +116,17 @@ int64_t AlphaFamily::RankLowerBound(double alpha_sq) const {
 }
 
 SimplexClass AlphaFamily::ClassifyTriangle(uint32_t t, int64_t level) const {
-  const uint32_t rank = parts_.ranks.tri_rank[t];
-  return rank != kNeverRank && level >= static_cast<int64_t>(rank) ? SimplexClass::kInterior : SimplexClass::kExterior;
+  return TriangleClassAt(parts_.ranks.tri_rank[t], level);
 }
 
 SimplexClass AlphaFamily::ClassifyEdge(uint32_t e, int64_t level, ClassifyMode mode) const {
   const AlphaRanks& r = parts_.ranks;
-  const uint32_t birth = EdgeBirthRank(r, e);
-  if (birth == kNeverRank || level < static_cast<int64_t>(birth)) return SimplexClass::kExterior;
-  if (r.edge_mu_low[e] == kNeverRank || level < static_cast<int64_t>(r.edge_mu_low[e])) {
-    return mode == ClassifyMode::kGeneral ? SimplexClass::kSingular : SimplexClass::kExterior;
-  }
-  if (r.edge_mu_high[e] == kNeverRank || level < static_cast<int64_t>(r.edge_mu_high[e])) return SimplexClass::kRegular;
-  return SimplexClass::kInterior;
+  return EdgeClassAt(r.edge_rho_rank[e], r.edge_mu_low[e], r.edge_mu_high[e], level, mode);
 }
 
 SimplexClass AlphaFamily::ClassifyVertex(uint32_t v, int64_t level, ClassifyMode mode, VertexRule rule) const {
   const AlphaRanks& r = parts_.ranks;
-  if (level < 0 || hidden(v)) return SimplexClass::kExterior;
-  const uint32_t tri_low = r.vertex_tri_low[v];
-  const uint32_t high = r.vertex_mu_high[v];
-  const bool has_triangle = tri_low != kNeverRank && level >= static_cast<int64_t>(tri_low);
-  const bool all_interior = high != kNeverRank && level >= static_cast<int64_t>(high);
-  if (mode == ClassifyMode::kRegularized && !has_triangle) return SimplexClass::kExterior;
-  if (rule == VertexRule::kReport) {
-    const uint32_t low = r.vertex_mu_low[v];
-    if (low == kNeverRank || level < static_cast<int64_t>(low)) return SimplexClass::kSingular;
-  } else if (!has_triangle) {
-    return SimplexClass::kSingular;
-  }
-  return all_interior ? SimplexClass::kInterior : SimplexClass::kRegular;
+  return VertexClassAt(hidden(v), r.vertex_mu_low[v], r.vertex_mu_high[v], r.vertex_tri_low[v], level, mode, rule);
 }
 
 Classification AlphaFamily::ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const {

@@ -21,19 +21,10 @@
 #include "core/base/stage_time.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "core/family/persistence_pair.hpp"
+#include "core/family/simplex_class.hpp"
 #include "core/geometry/shape.hpp"
 
 namespace galpha {
-
-enum class SimplexClass : uint8_t { kExterior = 0, kSingular = 1, kRegular = 2, kInterior = 3 };
-/// "EXTERIOR", "SINGULAR", "REGULAR", "INTERIOR".
-const char* SimplexClassName(SimplexClass c);
-
-/// GENERAL keeps singular simplices; REGULARIZED keeps only what bounds or fills triangles.
-enum class ClassifyMode { kGeneral, kRegularized };
-/// Vertex classes from incident edges (the rule of the report "Computing 2D Alpha Shapes Using GPU") or
-/// from incident triangles (CGAL's).
-enum class VertexRule { kReport, kCgal };
 
 /// What a build measured.
 struct BuildReport {

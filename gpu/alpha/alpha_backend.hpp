@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "core/base/host_vector.hpp"
@@ -13,6 +14,7 @@
 #include "core/base/stage_time.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "core/family/persistence_pair.hpp"
+#include "gpu/alpha/resident_backend.hpp"
 
 namespace galpha::detail {
 
@@ -40,6 +42,10 @@ struct FamilyOutput {
   /// The persistence diagram, when BuildHooks::persistence asked for it.
   bool has_persistence = false;
   PersistenceDiagram persistence;
+  /// When BuildHooks::resident asked for it: the rank tables where the build computed them (then
+  /// `ranks` holds only the comparison counts and the area scale); the mesh arrays above are on
+  /// the host either way.
+  std::unique_ptr<ResidentTables> resident;
 };
 
 /// Called between the build's phases: after the triangulation, `after_triangulation` runs (it
@@ -50,6 +56,10 @@ struct BuildHooks {
   uint64_t max_exact_comparisons = 0;
   /// Compute the persistence diagram after the component curves.
   bool persistence = false;
+  /// Keep the rank tables where they were computed (FamilyOutput::resident) instead of
+  /// downloading them; on CUDA the build then runs on a stream the tables own (the `stream`
+  /// argument must be null).
+  bool resident = false;
 };
 
 /// Builds the family of `n` finite points (with `weights`, one per point, or nullptr for the

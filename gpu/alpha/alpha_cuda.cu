@@ -1,6 +1,8 @@
 // The CUDA instantiation of the family build: one stream, stream-ordered memory.
 #include <cuda_runtime.h>
 
+#include <memory>
+
 #include "gpu/alpha/alpha_backend.hpp"
 #include "gpu/alpha/alpha_impl.cuh"
 #include "gpu/system/cuda_system.cuh"
@@ -9,6 +11,14 @@ namespace galpha::detail {
 
 void BuildFamilyOnCuda(const Point2* points, const double* weights, uint32_t n, void* stream, const BuildHooks& hooks,
                        FamilyOutput* out) {
+  if (hooks.resident) {
+    // The tables own the stream they were built on; later queries run on it too.
+    auto owned = std::make_shared<OwnedStream>();
+    auto resident = std::make_unique<ResidentTablesOn<CudaSystem>>(owned, std::make_unique<CudaSystem>(owned->get()));
+    RunFamilyBuild(resident->system(), points, weights, n, hooks, out, resident.get());
+    out->resident = std::move(resident);
+    return;
+  }
   if (stream != nullptr) {
     CudaSystem system(static_cast<cudaStream_t>(stream));
     RunFamilyBuild(system, points, weights, n, hooks, out);

@@ -8,6 +8,7 @@
 #include "core/base/status_macros.hpp"
 #include "core/io/input_validation.hpp"
 #include "gpu/alpha/alpha_backend.hpp"
+#include "gpu/alpha/alpha_build_parts.hpp"
 #include "gpu/system/engine_status.hpp"
 #include "gpu/system/host_copy.hpp"
 #include "gpu/triangulation/delaunay_backend.hpp"
@@ -19,9 +20,13 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// The build of either family: `weights` empty for the unweighted one.
-absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::Span<const double> weights,
-                                        const BuildOptions& options) {
+}  // namespace
+
+namespace detail {
+
+absl::Status BuildFamilyParts(absl::Span<const Point2> points, absl::Span<const double> weights,
+                              const BuildOptions& options, bool resident, AlphaFamilyParts* parts_out,
+                              std::unique_ptr<ResidentTables>* tables) {
   auto report = [&](std::string_view phase, double fraction) {
     if (options.progress) options.progress(phase, fraction);
   };
@@ -38,6 +43,10 @@ absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::S
   const double* weight_data = weighted ? weights.data() : nullptr;
   const double validate_seconds = SecondsSince(validate_start);
   GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
+  if (resident && backend == Backend::kCuda && options.cuda_stream != nullptr) {
+    return absl::InvalidArgumentError(
+        "a resident family runs on a CUDA stream of its own: leave BuildOptions::cuda_stream unset");
+  }
   if (stop_requested()) return cancelled_error("0 phases");
   const auto n = static_cast<uint32_t>(points.size());
 
@@ -47,6 +56,7 @@ absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::S
   detail::BuildHooks hooks;
   hooks.max_exact_comparisons = options.max_exact_comparisons;
   hooks.persistence = options.persistence;
+  hooks.resident = resident;
   hooks.after_triangulation = [&] {
     report("triangulation", 0.5);
     if (stop_requested()) {
@@ -65,7 +75,7 @@ absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::S
   if (stop_requested()) return cancelled_error("the alpha pipeline");
 
   const auto assemble_start = std::chrono::steady_clock::now();
-  AlphaFamilyParts parts;
+  AlphaFamilyParts& parts = *parts_out;
   parts.report.backend = BackendName(backend);
   parts.report.stage_times.push_back({"validate", validate_seconds});
   for (StageTime& stage : built.stage_times) parts.report.stage_times.push_back(std::move(stage));
@@ -87,9 +97,21 @@ absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::S
   // The stage list is complete before the family owns it; the constructor's own pass over the
   // points is the little it leaves out.
   parts.report.stage_times.push_back({"assemble", SecondsSince(assemble_start)});
-  AlphaFamily family(std::move(parts));
+  if (resident) *tables = std::move(built.resident);
   report("components", 1.0);
-  return family;
+  return absl::OkStatus();
+}
+
+}  // namespace detail
+
+namespace {
+
+/// The build of either family in host memory: `weights` empty for the unweighted one.
+absl::StatusOr<AlphaFamily> BuildFamily(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                        const BuildOptions& options) {
+  AlphaFamilyParts parts;
+  GALPHA_RETURN_IF_ERROR(detail::BuildFamilyParts(points, weights, options, /*resident=*/false, &parts, nullptr));
+  return AlphaFamily(std::move(parts));
 }
 
 }  // namespace

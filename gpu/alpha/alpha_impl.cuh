@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,6 +37,7 @@
 #include "gpu/alpha/area_curve.cuh"
 #include "gpu/alpha/component_curve.cuh"
 #include "gpu/alpha/persistence_pairs.cuh"
+#include "gpu/alpha/resident_arrays.cuh"
 #include "gpu/alpha/spectrum_refine.cuh"
 #include "gpu/system/backend.hpp"
 #include "gpu/system/engine_system.cuh"
@@ -793,16 +795,74 @@ void FinishDownload(System& sys, const SpectrumRanks<System>& ranks, const Spect
   if (values.any_needs_host) NearestValuesOnHost(host_input, values.needs_host.ToHostVector(num_ranks), out);
 }
 
+/// The resident path's end instead of the download (BuildHooks::resident): the final tables move
+/// into `resident` where they lie, with the few values the system could not round put right from
+/// the host, and the solid level computed there; the mesh's download (which the family keeps on
+/// the host) is waited for.
+template <class System>
+void KeepResidentTables(System& sys, const PipelineMesh& mesh, SystemTriangulation<System>& t,
+                        Buffer<EdgeTris, System>& edge_tris, SpectrumRanks<System>& ranks,
+                        SpectrumValues<System>& values, IntervalRanks<System>& iv, MasterListCsr<System>& master,
+                        ComponentCounts<System>& counts, HostMesh<System>* host_mesh,
+                        ResidentTablesOn<System>* resident, AlphaRanks* out) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t num_ranks = ranks.num_ranks;
+  const AlphaInput& host_input = host_mesh->Get();
+  if (values.any_needs_host) {
+    AlphaRanks rounded;
+    rounded.spectrum.resize(num_ranks);
+    rounded.spectrum_simplex.resize(num_ranks);
+    sys.Download(
+        {{rounded.spectrum.data(), values.spectrum.data(), size_t{num_ranks} * sizeof(double)},
+         {rounded.spectrum_simplex.data(), ranks.spectrum_simplex.data(), size_t{num_ranks} * sizeof(uint32_t)}});
+    NearestValuesOnHost(host_input, values.needs_host.ToHostVector(num_ranks), &rounded);
+    sys.Upload({{rounded.spectrum.data(), values.spectrum.data(), size_t{num_ranks} * sizeof(double)}});
+  }
+  // AlphaFamily's rule: the largest first-triangle rank over the distinct points that are vertices.
+  ResidentSizes sizes{mesh.n, mesh.num_tri, mesh.num_edges, num_ranks, master.num_master, std::nullopt};
+  if (mesh.num_tri > 0) {
+    const uint32_t worst = thrust::transform_reduce(
+        policy, zero, zero + mesh.n, DistinctVertexTriLow{mesh.representative, mesh.hidden, iv.vertex_tri_low.data()},
+        0u, thrust::maximum<uint32_t>());
+    if (worst != kNeverRank) sizes.solid_level = worst;
+  }
+  ResidentTableBuffers<System>& kept = resident->tables();
+  kept.spectrum = std::move(values.spectrum);
+  kept.spectrum_simplex = std::move(ranks.spectrum_simplex);
+  kept.tri_rank = std::move(ranks.tri_rank);
+  kept.edge_rho_rank = std::move(ranks.edge_rho_rank);
+  kept.edge_mu_low = std::move(iv.edge_mu_low);
+  kept.edge_mu_high = std::move(iv.edge_mu_high);
+  kept.edge_triangles = std::move(edge_tris);
+  kept.vertex_mu_low = std::move(iv.vertex_mu_low);
+  kept.vertex_mu_high = std::move(iv.vertex_mu_high);
+  kept.vertex_tri_low = std::move(iv.vertex_tri_low);
+  if (mesh.hidden != nullptr) kept.hidden = std::move(t.hidden);
+  kept.master_begin = std::move(master.begin);
+  kept.master = std::move(master.entries);
+  kept.components = std::move(counts.components);
+  kept.solid_components = std::move(counts.solid_components);
+  kept.holes = std::move(counts.holes);
+  kept.regularized_components = std::move(counts.regularized_components);
+  kept.regularized_holes = std::move(counts.regularized_holes);
+  kept.area_units = std::move(counts.area_units);
+  resident->set_sizes(sizes);
+  out->area_scale = counts.area_scale;
+  sys.Synchronize();
+}
+
 // ---- The pipeline -------------------------------------------------------------------------------------------
 
 /// Runs the alpha pipeline on the triangulation `t` (in `sys`'s memory, with its points kept) and
-/// downloads the family into `out`: triangles, edges, duplicate map and rank tables. `host_points`
-/// is the same input in host memory (the host's exact repairs read it). One stage a call; the
-/// buffers a stage no longer needs are freed by the stage that reads them last.
+/// downloads the family into `out`: triangles, edges, duplicate map and rank tables (or, with
+/// `resident`, downloads the mesh and keeps the rank tables there). `host_points` is the same input
+/// in host memory (the host's exact repairs read it). One stage a call; the buffers a stage no
+/// longer needs are freed by the stage that reads them last.
 template <class System>
 void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points,
                       const double* host_weights, StageTimer<System>& timer, uint64_t max_exact_comparisons,
-                      bool persistence, FamilyOutput* family) {
+                      bool persistence, ResidentTablesOn<System>* resident, FamilyOutput* family) {
   AlphaRanks* out = &family->ranks;
   PipelineMesh mesh = PipelineMeshOf(t);
   if (mesh.weights != nullptr) HiddenVertices(sys, t, mesh);
@@ -822,7 +882,9 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   IntervalRanks<System> intervals = ComputeIntervals(sys, mesh, edge_tris, &ranks, &keys);
   timer.EndStage("intervals");
   // Declared after the buffers it reads: on an early exit it waits for its copies before they go.
-  PendingDownloadOf<System> tables_download = StartTablesDownload(sys, mesh, edge_tris, ranks, values, intervals, out);
+  std::optional<PendingDownloadOf<System>> tables_download;
+  if (resident == nullptr)
+    tables_download.emplace(StartTablesDownload(sys, mesh, edge_tris, ranks, values, intervals, out));
   MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
   timer.EndStage("master_list");
   ComponentCounts<System> components = CountComponents(sys, mesh, edge_tris, ranks, intervals);
@@ -840,19 +902,27 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
     family->persistence.dimension_begin[2] = family->persistence.pairs.size();
     family->has_persistence = true;
   }
-  FinishDownload(sys, ranks, values, master, components, &tables_download, &host_mesh, out);
+  if (resident != nullptr) {
+    KeepResidentTables(sys, mesh, t, edge_tris, ranks, values, intervals, master, components, &host_mesh, resident,
+                       out);
+    timer.EndStage("keep_resident");
+    return;
+  }
+  FinishDownload(sys, ranks, values, master, components, &*tables_download, &host_mesh, out);
   timer.EndStage("download");
 }
 
 /// The whole build on one system: triangulation, then the alpha pipeline on the triangulation
-/// where it lies; the family comes back to the host once (partly beside the last stages).
+/// where it lies; the family comes back to the host once (partly beside the last stages), or, with
+/// `resident` (which owns `sys`), its rank tables stay there.
 template <class System>
 void RunFamilyBuild(System& sys, const Point2* host_points, const double* host_weights, uint32_t n,
-                    const BuildHooks& hooks, FamilyOutput* out) {
+                    const BuildHooks& hooks, FamilyOutput* out, ResidentTablesOn<System>* resident = nullptr) {
   StageTimer<System> timer(sys, &out->stage_times);
   SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, host_weights, n, /*keep_points=*/true, timer);
   if (hooks.after_triangulation) hooks.after_triangulation();
-  RunAlphaPipeline(sys, t, host_points, host_weights, timer, hooks.max_exact_comparisons, hooks.persistence, out);
+  RunAlphaPipeline(sys, t, host_points, host_weights, timer, hooks.max_exact_comparisons, hooks.persistence, resident,
+                   out);
   timer.Finish();
   out->peak_memory_bytes = sys.peak_bytes();
 }

@@ -1,0 +1,28 @@
+// Exact comparison of a user's threshold with a simplex's threshold (the squared radius of its
+// smallest circle, weighted: of its smallest orthogonal circle), the step every resolution of an
+// alpha or alpha_sq to a level takes, for families in host memory and resident ones alike.
+#pragma once
+
+#include <gmpxx.h>
+
+#include <array>
+#include <cstdint>
+
+#include "core/base/host_vector.hpp"
+#include "core/base/point.hpp"
+
+namespace galpha {
+
+/// The host arrays a simplex's threshold is computed from (weights empty when unweighted).
+struct SimplexGeometry {
+  const HostVector<Point2>& points;
+  const HostVector<double>& weights;
+  const HostVector<std::array<uint32_t, 3>>& triangles;
+  const HostVector<std::array<uint32_t, 2>>& edges;
+};
+
+/// sign(exact threshold of simplex `id` - value): `id` below the triangle count is a triangle,
+/// else the edge id plus the triangle count (AlphaRanks::spectrum_simplex's naming).
+int CompareSimplexThreshold(const SimplexGeometry& geometry, uint32_t id, const mpq_class& value);
+
+}  // namespace galpha

@@ -1,0 +1,282 @@
+// ResidentTablesOn<System>: a family's rank tables kept in its build's system memory after the
+// build (resident_backend.hpp), and the queries that run there: classification of every simplex,
+// the curves at a level and their searches, master-list and spectrum slices. Written once over
+// the execution system (CpuSystem or CudaSystem) like the pipeline that fills it (alpha_impl.cuh).
+#pragma once
+
+#include <thrust/binary_search.h>
+#include <thrust/find.h>
+#include <thrust/for_each.h>
+#include <thrust/functional.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "core/family/simplex_class.hpp"
+#include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/alpha/resident_backend.hpp"
+#include "gpu/system/engine_system.cuh"
+
+namespace galpha::detail {
+
+/// Classes at one level of every simplex: ids 0..n-1 are input points, then edges, then triangles
+/// (the rules of core/family/simplex_class.hpp, as AlphaFamily applies them).
+struct ClassifyEverySimplex {
+  const uint32_t* vertex_mu_low;
+  const uint32_t* vertex_mu_high;
+  const uint32_t* vertex_tri_low;
+  const uint8_t* hidden;  // per input point; null when unweighted
+  const uint32_t* edge_rho_rank;
+  const uint32_t* edge_mu_low;
+  const uint32_t* edge_mu_high;
+  const uint32_t* tri_rank;
+  uint32_t n, num_edges;
+  int64_t level;
+  ClassifyMode mode;
+  VertexRule rule;
+  SimplexClass* out;
+  GALPHA_HD void operator()(uint32_t i) const {
+    if (i < n) {
+      out[i] = VertexClassAt(hidden != nullptr && hidden[i] != 0, vertex_mu_low[i], vertex_mu_high[i],
+                             vertex_tri_low[i], level, mode, rule);
+    } else if (i - n < num_edges) {
+      const uint32_t e = i - n;
+      out[i] = EdgeClassAt(edge_rho_rank[e], edge_mu_low[e], edge_mu_high[e], level, mode);
+    } else {
+      out[i] = TriangleClassAt(tri_rank[i - n - num_edges], level);
+    }
+  }
+};
+
+/// Whether a level's curve values are within the limits (b null: only a's).
+struct CurvesWithin {
+  const uint32_t* a;
+  uint32_t max_a;
+  const uint32_t* b;
+  uint32_t max_b;
+  GALPHA_HD bool operator()(uint32_t level) const { return a[level] <= max_a && (b == nullptr || b[level] <= max_b); }
+};
+
+/// A distinct point's first-triangle rank (0 for duplicates and hidden points: they do not count).
+struct DistinctVertexTriLow {
+  const uint32_t* representative;
+  const uint8_t* hidden;  // null when unweighted
+  const uint32_t* vertex_tri_low;
+  GALPHA_HD uint32_t operator()(uint32_t v) const {
+    if (representative[v] != v || (hidden != nullptr && hidden[v] != 0)) return 0;
+    return vertex_tri_low[v];
+  }
+};
+
+/// The tables the pipeline leaves behind, moved in by KeepResidentTables (alpha_impl.cuh).
+template <class System>
+struct ResidentTableBuffers {
+  Buffer<double, System> spectrum;
+  Buffer<uint32_t, System> spectrum_simplex, tri_rank, edge_rho_rank, edge_mu_low, edge_mu_high;
+  Buffer<EdgeTris, System> edge_triangles;
+  Buffer<uint32_t, System> vertex_mu_low, vertex_mu_high, vertex_tri_low;
+  Buffer<uint8_t, System> hidden;  // weighted only
+  Buffer<uint32_t, System> master_begin;
+  Buffer<uint64_t, System> master;
+  Buffer<uint32_t, System> components, solid_components, holes, regularized_components, regularized_holes;
+  Buffer<unsigned long long, System> area_units;
+
+  explicit ResidentTableBuffers(System& sys)
+      : spectrum(sys, 0),
+        spectrum_simplex(sys, 0),
+        tri_rank(sys, 0),
+        edge_rho_rank(sys, 0),
+        edge_mu_low(sys, 0),
+        edge_mu_high(sys, 0),
+        edge_triangles(sys, 0),
+        vertex_mu_low(sys, 0),
+        vertex_mu_high(sys, 0),
+        vertex_tri_low(sys, 0),
+        hidden(sys, 0),
+        master_begin(sys, 0),
+        master(sys, 0),
+        components(sys, 0),
+        solid_components(sys, 0),
+        holes(sys, 0),
+        regularized_components(sys, 0),
+        regularized_holes(sys, 0),
+        area_units(sys, 0) {}
+};
+
+/// Sizes of the kept tables.
+struct ResidentSizes {
+  uint32_t n = 0, num_tri = 0, num_edges = 0, num_ranks = 0, num_master = 0;
+  std::optional<int64_t> solid_level;
+};
+
+template <class System>
+class ResidentTablesOn final : public ResidentTables {
+ public:
+  /// `owner` keeps what the system runs on alive (the CUDA stream; null on the CPU): it is
+  /// released after the system and the tables.
+  ResidentTablesOn(std::shared_ptr<void> owner, std::unique_ptr<System> system)
+      : owner_(std::move(owner)), system_(std::move(system)), tables_(*system_) {}
+
+  System& system() { return *system_; }
+  ResidentTableBuffers<System>& tables() { return tables_; }
+  void set_sizes(const ResidentSizes& sizes) { sizes_ = sizes; }
+
+  size_t Bytes() const override {
+    const ResidentTableBuffers<System>& t = tables_;
+    return t.spectrum.size() * sizeof(double) +
+           (t.spectrum_simplex.size() + t.tri_rank.size() + t.edge_rho_rank.size() + t.edge_mu_low.size() +
+            t.edge_mu_high.size() + t.vertex_mu_low.size() + t.vertex_mu_high.size() + t.vertex_tri_low.size() +
+            t.master_begin.size() + t.components.size() + t.solid_components.size() + t.holes.size() +
+            t.regularized_components.size() + t.regularized_holes.size()) *
+               sizeof(uint32_t) +
+           t.edge_triangles.size() * sizeof(EdgeTris) + t.hidden.size() + t.master.size() * sizeof(uint64_t) +
+           t.area_units.size() * sizeof(unsigned long long);
+  }
+  uint32_t num_ranks() const override { return sizes_.num_ranks; }
+  std::optional<int64_t> solid_level() const override { return sizes_.solid_level; }
+
+  void Classify(int64_t level, ClassifyMode mode, VertexRule rule, SimplexClass* vertices, SimplexClass* edges,
+                SimplexClass* triangles) override {
+    System& sys = *system_;
+    const ResidentTableBuffers<System>& t = tables_;
+    const size_t total = size_t{sizes_.n} + sizes_.num_edges + sizes_.num_tri;
+    Buffer<SimplexClass, System> classes(sys, total);
+    thrust::for_each_n(sys.policy(), thrust::counting_iterator<uint32_t>(0), total,
+                       ClassifyEverySimplex{t.vertex_mu_low.data(), t.vertex_mu_high.data(), t.vertex_tri_low.data(),
+                                            t.hidden.size() > 0 ? t.hidden.data() : nullptr, t.edge_rho_rank.data(),
+                                            t.edge_mu_low.data(), t.edge_mu_high.data(), t.tri_rank.data(), sizes_.n,
+                                            sizes_.num_edges, level, mode, rule, classes.data()});
+    sys.Download({{vertices, classes.data(), size_t{sizes_.n}},
+                  {edges, classes.data() + sizes_.n, size_t{sizes_.num_edges}},
+                  {triangles, classes.data() + sizes_.n + sizes_.num_edges, size_t{sizes_.num_tri}}});
+  }
+
+  CurveValues CurvesAt(int64_t level) override {
+    System& sys = *system_;
+    const auto at = static_cast<size_t>(level);
+    CurveValues v;
+    sys.Download({{&v.components, tables_.components.data() + at, sizeof(uint32_t)},
+                  {&v.solid_components, tables_.solid_components.data() + at, sizeof(uint32_t)},
+                  {&v.holes, tables_.holes.data() + at, sizeof(uint32_t)},
+                  {&v.regularized_components, tables_.regularized_components.data() + at, sizeof(uint32_t)},
+                  {&v.regularized_holes, tables_.regularized_holes.data() + at, sizeof(uint32_t)},
+                  {&v.area_units, tables_.area_units.data() + at, sizeof(uint64_t)}});
+    return v;
+  }
+
+  std::optional<int64_t> FirstLevelWhere(int64_t from, FamilyCurve a, uint32_t max_a,
+                                         std::optional<std::pair<FamilyCurve, uint32_t>> b) override {
+    System& sys = *system_;
+    const int64_t levels = int64_t{sizes_.num_ranks} + 1;
+    if (from >= levels) return std::nullopt;
+    const thrust::counting_iterator<uint32_t> first(static_cast<uint32_t>(from)), last(static_cast<uint32_t>(levels));
+    const auto found = thrust::find_if(
+        sys.policy(), first, last, CurvesWithin{Curve(a), max_a, b ? Curve(b->first) : nullptr, b ? b->second : 0u});
+    if (found == last) return std::nullopt;
+    return static_cast<int64_t>(*found);
+  }
+
+  std::vector<MasterEntry> MasterList(int64_t rank) override {
+    System& sys = *system_;
+    uint32_t bounds[2];
+    sys.Download({{bounds, tables_.master_begin.data() + rank, 2 * sizeof(uint32_t)}});
+    std::vector<MasterEntry> entries(bounds[1] - bounds[0]);
+    static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
+    if (!entries.empty()) {
+      sys.Download({{entries.data(), tables_.master.data() + bounds[0], entries.size() * sizeof(uint64_t)}});
+    }
+    return entries;
+  }
+
+  std::vector<double> Spectrum(int64_t first, int64_t count) override {
+    std::vector<double> values(static_cast<size_t>(count));
+    if (count > 0) {
+      system_->Download({{values.data(), tables_.spectrum.data() + first, values.size() * sizeof(double)}});
+    }
+    return values;
+  }
+
+  uint32_t SpectrumSimplex(int64_t index) override { return system_->Read(tables_.spectrum_simplex.data() + index); }
+
+  std::pair<int64_t, int64_t> SpectrumIndicesBetween(double lo, double hi) override {
+    System& sys = *system_;
+    const double* begin = tables_.spectrum.data();
+    const double* end = begin + sizes_.num_ranks;
+    const int64_t first = thrust::lower_bound(sys.policy(), begin, end, lo) - begin;
+    const int64_t last = thrust::upper_bound(sys.policy(), begin, end, hi) - begin;
+    return {first, std::max(first, last)};
+  }
+
+  void DownloadInto(AlphaRanks* out) override {
+    const ResidentTableBuffers<System>& t = tables_;
+    const size_t n = sizes_.n, num_tri = sizes_.num_tri, num_edges = sizes_.num_edges, levels = sizes_.num_ranks + 1;
+    out->spectrum.resize(sizes_.num_ranks);
+    out->spectrum_simplex.resize(sizes_.num_ranks);
+    out->tri_rank.resize(num_tri);
+    out->edge_rho_rank.resize(num_edges);
+    out->edge_mu_low.resize(num_edges);
+    out->edge_mu_high.resize(num_edges);
+    out->edge_triangles.resize(num_edges);
+    out->vertex_mu_low.resize(n);
+    out->vertex_mu_high.resize(n);
+    out->vertex_tri_low.resize(n);
+    out->master_begin.resize(levels + 1);
+    out->master.resize(sizes_.num_master);
+    out->components.resize(levels);
+    out->solid_components.resize(levels);
+    out->holes.resize(levels);
+    out->regularized_components.resize(levels);
+    out->regularized_holes.resize(levels);
+    out->area_units.resize(levels);
+    system_->Download({{out->spectrum.data(), t.spectrum.data(), sizes_.num_ranks * sizeof(double)},
+                       {out->spectrum_simplex.data(), t.spectrum_simplex.data(), sizes_.num_ranks * sizeof(uint32_t)},
+                       {out->tri_rank.data(), t.tri_rank.data(), num_tri * sizeof(uint32_t)},
+                       {out->edge_rho_rank.data(), t.edge_rho_rank.data(), num_edges * sizeof(uint32_t)},
+                       {out->edge_mu_low.data(), t.edge_mu_low.data(), num_edges * sizeof(uint32_t)},
+                       {out->edge_mu_high.data(), t.edge_mu_high.data(), num_edges * sizeof(uint32_t)},
+                       {out->edge_triangles.data(), t.edge_triangles.data(), num_edges * sizeof(EdgeTris)},
+                       {out->vertex_mu_low.data(), t.vertex_mu_low.data(), n * sizeof(uint32_t)},
+                       {out->vertex_mu_high.data(), t.vertex_mu_high.data(), n * sizeof(uint32_t)},
+                       {out->vertex_tri_low.data(), t.vertex_tri_low.data(), n * sizeof(uint32_t)},
+                       {out->master_begin.data(), t.master_begin.data(), (levels + 1) * sizeof(uint32_t)},
+                       {out->master.data(), t.master.data(), size_t{sizes_.num_master} * sizeof(uint64_t)},
+                       {out->components.data(), t.components.data(), levels * sizeof(uint32_t)},
+                       {out->solid_components.data(), t.solid_components.data(), levels * sizeof(uint32_t)},
+                       {out->holes.data(), t.holes.data(), levels * sizeof(uint32_t)},
+                       {out->regularized_components.data(), t.regularized_components.data(), levels * sizeof(uint32_t)},
+                       {out->regularized_holes.data(), t.regularized_holes.data(), levels * sizeof(uint32_t)},
+                       {out->area_units.data(), t.area_units.data(), levels * sizeof(uint64_t)}});
+  }
+
+ private:
+  const uint32_t* Curve(FamilyCurve c) const {
+    switch (c) {
+      case FamilyCurve::kComponents:
+        return tables_.components.data();
+      case FamilyCurve::kSolidComponents:
+        return tables_.solid_components.data();
+      case FamilyCurve::kHoles:
+        return tables_.holes.data();
+      case FamilyCurve::kRegularizedComponents:
+        return tables_.regularized_components.data();
+      case FamilyCurve::kRegularizedHoles:
+        return tables_.regularized_holes.data();
+    }
+    return nullptr;
+  }
+
+  // Destroyed in reverse: the tables (their frees queued on the system's stream), the system,
+  // then what it runs on.
+  std::shared_ptr<void> owner_;
+  std::unique_ptr<System> system_;
+  ResidentTableBuffers<System> tables_;
+  ResidentSizes sizes_;
+};
+
+}  // namespace galpha::detail

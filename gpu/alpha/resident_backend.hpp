@@ -1,0 +1,66 @@
+// The seam between ResidentAlphaFamily (resident_family.hpp) and the backend that keeps a family's
+// rank tables where they were built (device memory on CUDA; on OpenMP the host memory the build
+// computed them in, without a second copy): the queries that read them run there and only their
+// answers come back. Plain C++ and std types only; implemented by resident_arrays.cuh.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "core/family/alpha_ranks.hpp"
+#include "core/family/simplex_class.hpp"
+
+namespace galpha::detail {
+
+/// The per-level curves of a family (AlphaRanks' arrays of K + 1 values).
+enum class FamilyCurve { kComponents, kSolidComponents, kHoles, kRegularizedComponents, kRegularizedHoles };
+
+/// Every curve's value at one level.
+struct CurveValues {
+  uint32_t components = 0, solid_components = 0, holes = 0, regularized_components = 0, regularized_holes = 0;
+  uint64_t area_units = 0;
+};
+
+/// The rank tables of one family where its backend keeps them. Not thread-safe: the owner
+/// serializes calls. Every call may throw EngineError (or a Thrust/std exception).
+class ResidentTables {
+ public:
+  virtual ~ResidentTables() = default;
+
+  /// Bytes the tables hold where they live.
+  virtual size_t Bytes() const = 0;
+  /// K, the number of spectrum values.
+  virtual uint32_t num_ranks() const = 0;
+  /// The smallest level at which every distinct point (weighted: not hidden) lies on a triangle;
+  /// nullopt when none does (AlphaFamily::SolidLevel).
+  virtual std::optional<int64_t> solid_level() const = 0;
+
+  /// Classes at `level` (-1..K) of every input point, edge and triangle, into host arrays of
+  /// n, #edges and #triangles entries (SimplexClass values).
+  virtual void Classify(int64_t level, ClassifyMode mode, VertexRule rule, SimplexClass* vertices, SimplexClass* edges,
+                        SimplexClass* triangles) = 0;
+  /// The curves at `level` (0..K).
+  virtual CurveValues CurvesAt(int64_t level) = 0;
+  /// The first level in from..K where curve `a` is at most `max_a` and, when given, curve `b` at
+  /// most `max_b`; nullopt when none is.
+  virtual std::optional<int64_t> FirstLevelWhere(int64_t from, FamilyCurve a, uint32_t max_a,
+                                                 std::optional<std::pair<FamilyCurve, uint32_t>> b) = 0;
+  /// Master-list entries of `rank` (1..K).
+  virtual std::vector<MasterEntry> MasterList(int64_t rank) = 0;
+  /// spectrum[first, first + count) (indices 0..K-1).
+  virtual std::vector<double> Spectrum(int64_t first, int64_t count) = 0;
+  /// The simplex whose exact threshold is spectrum value `index` (0..K-1): a triangle id below the
+  /// triangle count, else the edge id plus it.
+  virtual uint32_t SpectrumSimplex(int64_t index) = 0;
+  /// [first, last): the spectrum indices whose nearest double lies in [lo, hi] (the values are
+  /// non-decreasing).
+  virtual std::pair<int64_t, int64_t> SpectrumIndicesBetween(double lo, double hi) = 0;
+  /// Every table into `out`'s arrays (the host form of the family); `out`'s comparison counts and
+  /// area scale are left as they are.
+  virtual void DownloadInto(AlphaRanks* out) = 0;
+};
+
+}  // namespace galpha::detail

@@ -1,0 +1,226 @@
+#include "gpu/alpha/resident_family.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "core/base/status_macros.hpp"
+#include "core/family/simplex_threshold.hpp"
+#include "gpu/alpha/alpha_build_parts.hpp"
+#include "gpu/alpha/resident_backend.hpp"
+#include "gpu/system/engine_status.hpp"
+
+namespace galpha {
+
+ResidentAlphaFamily::ResidentAlphaFamily(AlphaFamilyParts host, std::unique_ptr<detail::ResidentTables> tables)
+    : host_(std::move(host)), tables_(std::move(tables)), mutex_(std::make_unique<absl::Mutex>()) {
+  max_level_ = tables_->num_ranks();
+  solid_level_ = tables_->solid_level();
+  // 0.0 - w, as AlphaFamily: with a largest weight of 0 the bound is +0.
+  if (weighted()) min_alpha_sq_ = 0.0 - *std::max_element(host_.weights.begin(), host_.weights.end());
+}
+
+ResidentAlphaFamily::ResidentAlphaFamily(ResidentAlphaFamily&&) noexcept = default;
+ResidentAlphaFamily& ResidentAlphaFamily::operator=(ResidentAlphaFamily&&) noexcept = default;
+ResidentAlphaFamily::~ResidentAlphaFamily() = default;
+
+namespace {
+
+template <typename T>
+size_t VectorBytes(const HostVector<T>& v) {
+  return v.capacity() * sizeof(T);
+}
+
+/// Runs `body` on the tables, one call at a time, with the engine's exceptions as a status.
+template <typename Body>
+absl::Status OnTables(absl::Mutex& mutex, const std::string& what, Body&& body) {
+  absl::MutexLock lock(&mutex);
+  return detail::RunEngine(what, body);
+}
+
+}  // namespace
+
+size_t ResidentAlphaFamily::ResidentBytes() const {
+  absl::MutexLock lock(mutex_.get());
+  return tables_->Bytes();
+}
+
+size_t ResidentAlphaFamily::HostBytes() const {
+  return sizeof(*this) + VectorBytes(host_.points) + VectorBytes(host_.representative) + VectorBytes(host_.weights) +
+         VectorBytes(host_.hidden) + VectorBytes(host_.triangles) + VectorBytes(host_.edges) +
+         (host_.persistence ? host_.persistence->pairs.size() * sizeof(PersistencePair) : 0);
+}
+
+absl::StatusOr<int64_t> ResidentAlphaFamily::CountThresholds(const mpq_class& value, double lo, double hi,
+                                                             bool strict) const {
+  // Every spectrum value is the nearest double d of its exact threshold t, and the doubles do not
+  // decrease with the rank. If d < lo for a double lo <= value, then t < lo too (t lies within
+  // half a gap of d, below the next double, which is at most lo); if d > hi, t > hi. So only the
+  // indices whose double lies in [lo, hi] are compared exactly, by a binary search (the exact
+  // thresholds increase): one device search and a few reads, not the host's whole search.
+  int64_t first = 0, last = 0;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "finding the spectrum values near a threshold",
+                                  [&] { std::tie(first, last) = tables_->SpectrumIndicesBetween(lo, hi); }));
+  const SimplexGeometry geometry{host_.points, host_.weights, host_.triangles, host_.edges};
+  while (first < last) {
+    const int64_t mid = first + (last - first) / 2;
+    uint32_t simplex = 0;
+    GALPHA_RETURN_IF_ERROR(
+        OnTables(*mutex_, "reading a spectrum simplex", [&] { simplex = tables_->SpectrumSimplex(mid); }));
+    const int c = CompareSimplexThreshold(geometry, simplex, value);
+    if (strict ? c < 0 : c <= 0) {
+      first = mid + 1;
+    } else {
+      last = mid;
+    }
+  }
+  return first;
+}
+
+absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForAlphaSq(double alpha_sq) const {
+  if (std::isnan(alpha_sq)) return absl::InvalidArgumentError("alpha_sq is NaN");
+  if (alpha_sq < min_alpha_sq_) return -1;
+  if (std::isinf(alpha_sq)) return max_level();
+  return CountThresholds(mpq_class(alpha_sq), alpha_sq, alpha_sq, /*strict=*/false);
+}
+
+absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForAlpha(double alpha) const {
+  if (std::isnan(alpha)) return absl::InvalidArgumentError("alpha is NaN");
+  if (alpha < 0) return absl::InvalidArgumentError(absl::StrCat("alpha is a radius and must be >= 0, got ", alpha));
+  if (std::isinf(alpha)) return max_level();
+  const mpq_class radius(alpha);
+  const mpq_class alpha_sq = radius * radius;
+  if (alpha_sq < mpq_class(min_alpha_sq_)) return -1;  // weighted, every weight negative
+  // The doubles around alpha^2 (>= 0): mpq's get_d truncates, which is rounding down here.
+  double lo = DBL_MAX, hi = HUGE_VAL;
+  if (alpha_sq <= mpq_class(DBL_MAX)) {
+    lo = alpha_sq.get_d();
+    hi = mpq_class(lo) == alpha_sq ? lo : std::nextafter(lo, HUGE_VAL);
+  }
+  return CountThresholds(alpha_sq, lo, hi, /*strict=*/false);
+}
+
+absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForRank(int64_t rank) const {
+  if (rank < 0 || rank > max_level()) {
+    return absl::OutOfRangeError(
+        absl::StrCat("rank ", rank, " is outside 0..", max_level(), " (the spectrum has ", max_level(), " values)"));
+  }
+  return rank;
+}
+
+absl::StatusOr<int64_t> ResidentAlphaFamily::RankLowerBound(double alpha_sq) const {
+  if (std::isnan(alpha_sq) || (alpha_sq <= 0 && !weighted())) return 1;  // unweighted values are positive
+  if (std::isinf(alpha_sq)) return alpha_sq > 0 ? max_level() + 1 : 1;
+  GALPHA_ASSIGN_OR_RETURN(const int64_t below,
+                          CountThresholds(mpq_class(alpha_sq), alpha_sq, alpha_sq, /*strict=*/true));
+  return below + 1;
+}
+
+absl::StatusOr<Classification> ResidentAlphaFamily::ClassifyAll(int64_t level, ClassifyMode mode,
+                                                                VertexRule rule) const {
+  Classification c;
+  c.vertices.resize(host_.points.size());
+  c.edges.resize(host_.edges.size());
+  c.triangles.resize(host_.triangles.size());
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("classifying the family at level ", level), [&] {
+    tables_->Classify(level, mode, rule, c.vertices.data(), c.edges.data(), c.triangles.data());
+  }));
+  return c;
+}
+
+absl::StatusOr<TopologyAtLevel> ResidentAlphaFamily::TopologyAt(int64_t level) const {
+  TopologyAtLevel at;
+  if (level < 0) return at;
+  detail::CurveValues values;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the curves at level ", level),
+                                  [&] { values = tables_->CurvesAt(std::min(level, max_level())); }));
+  at.components = values.components;
+  at.solid_components = values.solid_components;
+  at.regularized_components = values.regularized_components;
+  at.holes = values.holes;
+  at.regularized_holes = values.regularized_holes;
+  return at;
+}
+
+absl::StatusOr<std::optional<int64_t>> ResidentAlphaFamily::OptimalLevelRegularized(
+    uint32_t n, std::optional<uint32_t> max_holes) const {
+  if (!solid_level_) return std::optional<int64_t>();
+  std::optional<int64_t> level;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "searching the solid components' curve", [&] {
+    level = tables_->FirstLevelWhere(
+        *solid_level_, detail::FamilyCurve::kSolidComponents, n,
+        max_holes ? std::make_optional(std::make_pair(detail::FamilyCurve::kRegularizedHoles, *max_holes))
+                  : std::nullopt);
+  }));
+  return level;
+}
+
+absl::StatusOr<std::optional<int64_t>> ResidentAlphaFamily::OptimalLevelGeneral(
+    uint32_t n, std::optional<uint32_t> max_holes) const {
+  // Components never increase with alpha, so the levels with at most n are a suffix, and the first
+  // of them with at most max_holes holes is AlphaFamily's answer (its binary search, then scan).
+  std::optional<int64_t> level;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "searching the components' curve", [&] {
+    level = tables_->FirstLevelWhere(
+        0, detail::FamilyCurve::kComponents, n,
+        max_holes ? std::make_optional(std::make_pair(detail::FamilyCurve::kHoles, *max_holes)) : std::nullopt);
+  }));
+  return level;
+}
+
+absl::StatusOr<std::vector<MasterEntry>> ResidentAlphaFamily::MasterList(int64_t rank) const {
+  std::vector<MasterEntry> entries;
+  if (rank < 1 || rank > max_level()) return entries;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the master list at rank ", rank),
+                                  [&] { entries = tables_->MasterList(rank); }));
+  return entries;
+}
+
+absl::StatusOr<std::vector<double>> ResidentAlphaFamily::Spectrum(int64_t first, int64_t count) const {
+  std::vector<double> values;
+  first = std::clamp<int64_t>(first, 0, max_level());
+  count = std::clamp<int64_t>(count, 0, max_level() - first);
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "reading the spectrum", [&] { values = tables_->Spectrum(first, count); }));
+  return values;
+}
+
+absl::StatusOr<AlphaFamily> ResidentAlphaFamily::ToHostFamily() const {
+  AlphaFamilyParts parts = host_;
+  GALPHA_RETURN_IF_ERROR(
+      OnTables(*mutex_, "downloading a resident family", [&] { tables_->DownloadInto(&parts.ranks); }));
+  return AlphaFamily(std::move(parts));
+}
+
+namespace {
+
+absl::StatusOr<ResidentAlphaFamily> BuildResident(absl::Span<const Point2> points, absl::Span<const double> weights,
+                                                  const BuildOptions& options) {
+  AlphaFamilyParts parts;
+  std::unique_ptr<detail::ResidentTables> tables;
+  GALPHA_RETURN_IF_ERROR(detail::BuildFamilyParts(points, weights, options, /*resident=*/true, &parts, &tables));
+  return ResidentAlphaFamily(std::move(parts), std::move(tables));
+}
+
+}  // namespace
+
+absl::StatusOr<ResidentAlphaFamily> BuildResidentAlphaFamily(absl::Span<const Point2> points,
+                                                             const BuildOptions& options) {
+  return BuildResident(points, {}, options);
+}
+
+absl::StatusOr<ResidentAlphaFamily> BuildWeightedResidentAlphaFamily(absl::Span<const Point2> points,
+                                                                     absl::Span<const double> weights,
+                                                                     const BuildOptions& options) {
+  if (weights.size() != points.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("weighted build: ", weights.size(), " weights for ", points.size(), " points"));
+  }
+  if (points.empty()) return BuildResident(points, {}, options);  // nothing to weigh
+  return BuildResident(points, weights, options);
+}
+
+}  // namespace galpha

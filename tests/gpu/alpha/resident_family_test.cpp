@@ -1,0 +1,287 @@
+// ResidentAlphaFamily (gpu/alpha/resident_family.hpp) against the family in host memory built on the
+// same backend (AlphaFamily, itself checked against CGAL and brute force): every query answered
+// where the tables live equals AlphaFamily's, and ToHostFamily() is the same family array for
+// array. Every generator, degenerate and tiny sets, weighted families; on both backends (the CUDA
+// instance reads the tables from device memory).
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/family/alpha_family.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "gpu/alpha/resident_family.hpp"
+#include "gtest/gtest.h"
+#include "tests/support/backend_fixture.hpp"
+#include "tests/support/point_generators.hpp"
+#include "tests/support/status_matchers.hpp"
+
+namespace galpha {
+namespace {
+
+using testing::IsOk;
+
+template <typename T>
+std::vector<T> AsVector(const HostVector<T>& v) {
+  return std::vector<T>(v.begin(), v.end());
+}
+
+std::vector<uint64_t> Packed(const HostVector<MasterEntry>& entries) {
+  std::vector<uint64_t> out;
+  for (const MasterEntry& e : entries) out.push_back(e.packed());
+  return out;
+}
+
+std::vector<uint64_t> Packed(const std::vector<MasterEntry>& entries) {
+  std::vector<uint64_t> out;
+  for (const MasterEntry& e : entries) out.push_back(e.packed());
+  return out;
+}
+
+class ResidentFamilyTest : public testing::BackendTest {
+ protected:
+  BuildOptions Options() const {
+    BuildOptions options;
+    options.backend = GetParam();
+    return options;
+  }
+
+  static void ExpectSameTables(const AlphaFamily& a, const AlphaFamily& b) {
+    EXPECT_EQ(AsVector(a.points()), AsVector(b.points()));
+    EXPECT_EQ(AsVector(a.representative()), AsVector(b.representative()));
+    EXPECT_EQ(a.num_unique(), b.num_unique());
+    EXPECT_EQ(AsVector(a.triangles()), AsVector(b.triangles()));
+    EXPECT_EQ(AsVector(a.edges()), AsVector(b.edges()));
+    EXPECT_EQ(AsVector(a.weights()), AsVector(b.weights()));
+    EXPECT_EQ(AsVector(a.hidden_flags()), AsVector(b.hidden_flags()));
+    const AlphaRanks& r = a.ranks();
+    const AlphaRanks& s = b.ranks();
+    EXPECT_EQ(AsVector(r.spectrum), AsVector(s.spectrum));
+    EXPECT_EQ(AsVector(r.spectrum_simplex), AsVector(s.spectrum_simplex));
+    EXPECT_EQ(AsVector(r.tri_rank), AsVector(s.tri_rank));
+    EXPECT_EQ(AsVector(r.edge_rho_rank), AsVector(s.edge_rho_rank));
+    EXPECT_EQ(AsVector(r.edge_mu_low), AsVector(s.edge_mu_low));
+    EXPECT_EQ(AsVector(r.edge_mu_high), AsVector(s.edge_mu_high));
+    EXPECT_EQ(AsVector(r.edge_triangles), AsVector(s.edge_triangles));
+    EXPECT_EQ(AsVector(r.vertex_mu_low), AsVector(s.vertex_mu_low));
+    EXPECT_EQ(AsVector(r.vertex_mu_high), AsVector(s.vertex_mu_high));
+    EXPECT_EQ(AsVector(r.vertex_tri_low), AsVector(s.vertex_tri_low));
+    EXPECT_EQ(AsVector(r.master_begin), AsVector(s.master_begin));
+    EXPECT_EQ(Packed(r.master), Packed(s.master));
+    EXPECT_EQ(AsVector(r.components), AsVector(s.components));
+    EXPECT_EQ(AsVector(r.solid_components), AsVector(s.solid_components));
+    EXPECT_EQ(AsVector(r.holes), AsVector(s.holes));
+    EXPECT_EQ(AsVector(r.regularized_components), AsVector(s.regularized_components));
+    EXPECT_EQ(AsVector(r.regularized_holes), AsVector(s.regularized_holes));
+    EXPECT_EQ(AsVector(r.area_units), AsVector(s.area_units));
+    EXPECT_EQ(r.area_scale.unit_log2, s.area_scale.unit_log2);
+    EXPECT_EQ(r.area_scale.error_units, s.area_scale.error_units);
+    EXPECT_EQ(a.SolidLevel(), b.SolidLevel());
+  }
+
+  /// Thresholds that probe the exact resolution: spectrum values, their neighbouring doubles, the
+  /// radii of those, and the edges of the domain.
+  static std::vector<double> ProbeValues(const AlphaFamily& host) {
+    std::vector<double> values = {0.0,
+                                  -0.0,
+                                  -1.0,
+                                  1e-300,
+                                  1e300,
+                                  std::numeric_limits<double>::infinity(),
+                                  -std::numeric_limits<double>::infinity(),
+                                  std::nan("")};
+    const HostVector<double>& spectrum = host.spectrum();
+    const size_t step = std::max<size_t>(1, spectrum.size() / 60);
+    for (size_t i = 0; i < spectrum.size(); i += step) {
+      const double d = spectrum[i];
+      values.push_back(d);
+      values.push_back(std::nextafter(d, -HUGE_VAL));
+      values.push_back(std::nextafter(d, HUGE_VAL));
+    }
+    if (!spectrum.empty()) values.push_back(spectrum[spectrum.size() - 1]);
+    return values;
+  }
+
+  void ExpectSameAnswers(const AlphaFamily& host, const ResidentAlphaFamily& resident, const std::string& where) {
+    SCOPED_TRACE(where);
+    ASSERT_EQ(resident.max_level(), host.max_level());
+    EXPECT_EQ(resident.num_unique(), host.num_unique());
+    EXPECT_EQ(resident.SolidLevel(), host.SolidLevel());
+    EXPECT_EQ(resident.min_alpha_sq(), host.min_alpha_sq());
+    EXPECT_EQ(resident.comparisons().filter, host.report().comparisons.filter);
+    EXPECT_EQ(resident.comparisons().bounded_exact, host.report().comparisons.bounded_exact);
+    EXPECT_EQ(resident.comparisons().cpu_fallback, host.report().comparisons.cpu_fallback);
+    const int64_t k = host.max_level();
+    if (host.points().size() > 0) {
+      EXPECT_GT(resident.ResidentBytes(), 0u);
+    }
+
+    // Thresholds resolve to the same levels (or the same errors).
+    for (const double value : ProbeValues(host)) {
+      SCOPED_TRACE("threshold " + std::to_string(value));
+      const absl::StatusOr<int64_t> sq = resident.LevelForAlphaSq(value);
+      const absl::StatusOr<int64_t> host_sq = host.LevelForAlphaSq(value);
+      ASSERT_EQ(sq.status().code(), host_sq.status().code());
+      if (host_sq.ok()) {
+        EXPECT_EQ(*sq, *host_sq);
+      }
+      const absl::StatusOr<int64_t> lower = resident.RankLowerBound(value);
+      ASSERT_THAT(lower, IsOk());
+      EXPECT_EQ(*lower, host.RankLowerBound(value));
+      for (const double alpha : {value, value > 0 ? std::sqrt(value) : value,
+                                 value > 0 ? std::nextafter(std::sqrt(value), HUGE_VAL) : value}) {
+        const absl::StatusOr<int64_t> r = resident.LevelForAlpha(alpha);
+        const absl::StatusOr<int64_t> h = host.LevelForAlpha(alpha);
+        ASSERT_EQ(r.status().code(), h.status().code()) << "alpha " << alpha;
+        if (h.ok()) {
+          EXPECT_EQ(*r, *h) << "alpha " << alpha;
+        }
+      }
+    }
+    for (const int64_t rank : {int64_t{-1}, int64_t{0}, k / 2, k, k + 1}) {
+      EXPECT_EQ(resident.LevelForRank(rank).status().code(), host.LevelForRank(rank).status().code());
+    }
+
+    // Classification at levels across the range, in every mode and vertex rule.
+    std::vector<int64_t> levels = {-1, 0, 1, k / 7, k / 3, k / 2, (2 * k) / 3, k - 1, k};
+    for (const int64_t level : levels) {
+      for (const ClassifyMode mode : {ClassifyMode::kGeneral, ClassifyMode::kRegularized}) {
+        for (const VertexRule rule : {VertexRule::kReport, VertexRule::kCgal}) {
+          const absl::StatusOr<Classification> r = resident.ClassifyAll(level, mode, rule);
+          ASSERT_THAT(r, IsOk());
+          const Classification h = host.ClassifyAll(level, mode, rule);
+          EXPECT_EQ(r->vertices, h.vertices) << "level " << level;
+          EXPECT_EQ(r->edges, h.edges) << "level " << level;
+          EXPECT_EQ(r->triangles, h.triangles) << "level " << level;
+        }
+      }
+    }
+
+    // The curves at every level (and beyond both ends).
+    for (int64_t level = -1; level <= k + 1; level += (k > 400 ? 7 : 1)) {
+      const absl::StatusOr<TopologyAtLevel> at = resident.TopologyAt(level);
+      ASSERT_THAT(at, IsOk());
+      ASSERT_EQ(at->components, host.Components(level)) << "level " << level;
+      ASSERT_EQ(at->solid_components, host.SolidComponents(level)) << "level " << level;
+      ASSERT_EQ(at->regularized_components, host.RegularizedComponents(level)) << "level " << level;
+      ASSERT_EQ(at->holes, host.Holes(level, ClassifyMode::kGeneral)) << "level " << level;
+      ASSERT_EQ(at->regularized_holes, host.Holes(level, ClassifyMode::kRegularized)) << "level " << level;
+    }
+
+    // Optimal levels.
+    for (const uint32_t n : {0u, 1u, 2u, 5u, 100u}) {
+      for (const std::optional<uint32_t> holes :
+           {std::optional<uint32_t>(), std::optional<uint32_t>(0u), std::optional<uint32_t>(3u)}) {
+        const absl::StatusOr<std::optional<int64_t>> general = resident.OptimalLevelGeneral(n, holes);
+        ASSERT_THAT(general, IsOk());
+        EXPECT_EQ(*general, host.OptimalLevelGeneral(n, holes)) << "n " << n;
+        const absl::StatusOr<std::optional<int64_t>> regularized = resident.OptimalLevelRegularized(n, holes);
+        ASSERT_THAT(regularized, IsOk());
+        EXPECT_EQ(*regularized, host.OptimalLevelRegularized(n, holes)) << "n " << n;
+      }
+    }
+
+    // Master list and spectrum slices.
+    for (int64_t rank = -1; rank <= k + 1; rank += (k > 400 ? 13 : 1)) {
+      const absl::StatusOr<std::vector<MasterEntry>> entries = resident.MasterList(rank);
+      ASSERT_THAT(entries, IsOk());
+      const absl::Span<const MasterEntry> h = host.MasterList(rank);
+      ASSERT_EQ(Packed(*entries), Packed(std::vector<MasterEntry>(h.begin(), h.end()))) << "rank " << rank;
+    }
+    const absl::StatusOr<std::vector<double>> whole = resident.Spectrum(0, k);
+    ASSERT_THAT(whole, IsOk());
+    EXPECT_EQ(*whole, AsVector(host.spectrum()));
+    const absl::StatusOr<std::vector<double>> tail = resident.Spectrum(k - 3, 100);
+    ASSERT_THAT(tail, IsOk());
+    EXPECT_EQ(tail->size(), static_cast<size_t>(std::min<int64_t>(k, 3)));
+
+    // The same family, array for array, once downloaded.
+    const absl::StatusOr<AlphaFamily> downloaded = resident.ToHostFamily();
+    ASSERT_THAT(downloaded, IsOk());
+    ExpectSameTables(*downloaded, host);
+  }
+
+  void ExpectSameAsHost(const std::vector<Point2>& points, const std::string& where) {
+    const absl::StatusOr<AlphaFamily> host = BuildAlphaFamily(points, Options());
+    ASSERT_THAT(host, IsOk()) << where;
+    const absl::StatusOr<ResidentAlphaFamily> resident = BuildResidentAlphaFamily(points, Options());
+    ASSERT_THAT(resident, IsOk()) << where;
+    ExpectSameAnswers(*host, *resident, where);
+  }
+};
+
+TEST_P(ResidentFamilyTest, EveryGenerator) {
+  for (const gen::NamedGenerator& generator : gen::AllDistributions()) {
+    for (const size_t n : {size_t{300}, size_t{4000}}) {
+      ExpectSameAsHost(generator.generate(n, 3), generator.name + " n " + std::to_string(n));
+      if (HasFatalFailure()) return;
+    }
+  }
+}
+
+TEST_P(ResidentFamilyTest, DegenerateAndTinySets) {
+  std::vector<Point2> grid;
+  for (int i = 0; i < 40; ++i) {
+    for (int j = 0; j < 30; ++j) grid.push_back({static_cast<double>(i), static_cast<double>(j)});
+  }
+  ExpectSameAsHost(grid, "40 x 30 grid");
+  std::vector<Point2> line;
+  for (int i = 0; i < 500; ++i) line.push_back({0.5 * i, 0.25 * i});
+  ExpectSameAsHost(line, "collinear");
+  std::vector<Point2> repeated = gen::Uniform(700, 9);
+  repeated.insert(repeated.end(), repeated.begin(), repeated.begin() + 700);
+  ExpectSameAsHost(repeated, "every point twice");
+  ExpectSameAsHost(std::vector<Point2>{}, "no points");
+  ExpectSameAsHost(std::vector<Point2>{{1, 2}}, "one point");
+  ExpectSameAsHost(std::vector<Point2>{{1, 2}, {1, 2}}, "one point twice");
+  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}}, "two points");
+  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {0, 1}}, "a triangle");
+  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, "a square (co-circular)");
+}
+
+TEST_P(ResidentFamilyTest, WeightedFamilies) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> weight(-0.0004, 0.0004);
+  for (const size_t n : {size_t{300}, size_t{5000}}) {
+    const std::vector<Point2> points = gen::Uniform(n, 5);
+    std::vector<double> weights(points.size());
+    for (double& w : weights) w = weight(rng);
+    // Some points hidden: a few heavy weights.
+    for (size_t i = 0; i < weights.size(); i += 97) weights[i] = 0.003;
+    const absl::StatusOr<AlphaFamily> host = BuildWeightedAlphaFamily(points, weights, Options());
+    ASSERT_THAT(host, IsOk());
+    ASSERT_FALSE(host->HiddenPoints().empty()) << "the heavy weights hide points";
+    const absl::StatusOr<ResidentAlphaFamily> resident = BuildWeightedResidentAlphaFamily(points, weights, Options());
+    ASSERT_THAT(resident, IsOk());
+    EXPECT_TRUE(resident->weighted());
+    ExpectSameAnswers(*host, *resident, "weighted uniform n " + std::to_string(n));
+  }
+  const std::vector<Point2> points = gen::Uniform(10, 1);
+  EXPECT_EQ(BuildWeightedResidentAlphaFamily(points, std::vector<double>(9, 0.0), Options()).status().code(),
+            absl::StatusCode::kInvalidArgument);
+}
+
+TEST_P(ResidentFamilyTest, BadInputIsRefusedAsByTheHostBuild) {
+  const std::vector<Point2> bad = {{0, 0}, {std::nan(""), 1}, {2, 2}};
+  const absl::StatusOr<ResidentAlphaFamily> resident = BuildResidentAlphaFamily(bad, Options());
+  const absl::StatusOr<AlphaFamily> host = BuildAlphaFamily(bad, Options());
+  ASSERT_FALSE(host.ok());
+  EXPECT_EQ(resident.status(), host.status());
+  if (GetParam() == Backend::kCuda) {
+    // A resident family owns its stream: a caller's stream is refused, not ignored.
+    BuildOptions options = Options();
+    int not_a_stream = 0;
+    options.cuda_stream = &not_a_stream;
+    const absl::StatusOr<ResidentAlphaFamily> refused = BuildResidentAlphaFamily(gen::Uniform(10, 1), options);
+    EXPECT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(refused.status().message().find("cuda_stream"), std::string::npos) << refused.status();
+  }
+}
+
+GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(ResidentFamilyTest);
+
+}  // namespace
+}  // namespace galpha
