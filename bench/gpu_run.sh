@@ -20,6 +20,8 @@
 #   identity the CUDA/CPU identity test alone
 #   topology topology_bench: Betti curves and persistence diagrams at 1M (GUDHI's exact persistence
 #           in the same run at 1M uniform and at 100K on the hard generators) and 10M uniform
+#   resident resident_bench: a resident family (rank tables kept on the device) against the family
+#           in host memory, at 1M on every generator and at 10M uniform
 #   profile Nsight Systems (nsys, when the machine has it) over one 1M-point family build: the
 #           kernels and the CUDA API calls (waits) by total time
 #   kernels Nsight Compute's kernel times, summed by name, of one 1M-point family build of each
@@ -105,7 +107,7 @@ for phase in "${phases[@]}"; do
       ;;
     test)
       for t in predicates_test predicates_device_test power_test radius_test weighted_radius_test triangulation_checks_test delaunay_test regular_test regular_cgal_test \
-               delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test weighted_family_cgal_test persistence_gudhi_test persistence_engine_test alpha_backend_identity_test; do
+               delaunay_cgal_test shape_test alpha_family_test alpha_bruteforce_test alpha_family_cgal_test weighted_family_cgal_test persistence_gudhi_test persistence_engine_test resident_family_test alpha_backend_identity_test; do
         [ -x ".carry/bin/$t" ] || continue
         # One process per test, so that a hang names its test and the rest still run.
         for name in $(".carry/bin/$t" --gtest_list_tests | awk '/^[^ ]/{suite=$1} /^  /{print suite $1}'); do
@@ -168,6 +170,12 @@ for phase in "${phases[@]}"; do
       run_step topology 90 .carry/bin/topology_bench --backend=cuda --sizes=10000000 --dists=uniform --repeat=2 \
         --gudhi-max=0
       grep -E '^\|' "$out/topology.log" | grep -v -- '---'
+      ;;
+    resident)
+      [ -x .carry/bin/resident_bench ] || { echo "no resident_bench in .carry"; status=1; continue; }
+      run_step resident 200 .carry/bin/resident_bench --backend=cuda --sizes=1000000 --repeat=3
+      run_step resident 120 .carry/bin/resident_bench --backend=cuda --sizes=10000000 --dists=uniform --repeat=2
+      grep -E '^\|' "$out/resident.log" | grep -v -- '---'
       ;;
     identity)
       # The CUDA/CPU identity test alone (every generator and data set): the quick correctness
