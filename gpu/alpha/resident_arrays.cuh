@@ -184,7 +184,7 @@ class ResidentTablesOn final : public ResidentTables {
 
   std::vector<MasterEntry> MasterList(int64_t rank) override {
     System& sys = *system_;
-    uint32_t bounds[2];
+    uint32_t bounds[2] = {0, 0};
     sys.Download({{bounds, tables_.master_begin.data() + rank, 2 * sizeof(uint32_t)}});
     std::vector<MasterEntry> entries(bounds[1] - bounds[0]);
     static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
