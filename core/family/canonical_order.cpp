@@ -46,13 +46,15 @@ void SortLexicographically(size_t count, size_t num_points, VerticesOf vertices_
 }  // namespace
 
 CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family) {
+  return ComputeCanonicalOrders(family.points().size(), family.edges(), family.triangles());
+}
+
+CanonicalOrders ComputeCanonicalOrders(size_t num_points, const HostVector<std::array<uint32_t, 2>>& edges,
+                                       const HostVector<std::array<uint32_t, 3>>& triangles) {
   CanonicalOrders orders;
-  const size_t num_points = family.points().size();
-  const auto& edges = family.edges();
   SortLexicographically<2>(
       edges.size(), num_points, [&](uint32_t e) { return SortedEdge(edges[e]); }, &orders.edge_order,
       &orders.edge_vertices);
-  const auto& triangles = family.triangles();
   SortLexicographically<3>(
       triangles.size(), num_points, [&](uint32_t t) { return SortedTriangle(triangles[t]); }, &orders.triangle_order,
       &orders.triangle_vertices);

@@ -32,5 +32,8 @@ inline std::array<uint32_t, 3> SortedTriangle(std::array<uint32_t, 3> t) {
 /// Linear passes on every core (a radix sort: core/family/radix_sort.hpp); the orders depend only
 /// on the triangulation, so callers compute them once.
 CanonicalOrders ComputeCanonicalOrders(const AlphaFamily& family);
+/// The same from the mesh alone (a resident family's, whose mesh is on the host).
+CanonicalOrders ComputeCanonicalOrders(size_t num_points, const HostVector<std::array<uint32_t, 2>>& edges,
+                                       const HostVector<std::array<uint32_t, 3>>& triangles);
 
 }  // namespace galpha

@@ -170,6 +170,24 @@ class ResidentTablesOn final : public ResidentTables {
     return v;
   }
 
+  std::vector<CurveValues> CurvesBetween(int64_t first, int64_t last) override {
+    const auto count = static_cast<size_t>(last - first + 1);
+    std::vector<uint32_t> components(count), solid(count), holes(count), regularized(count), regularized_holes(count);
+    std::vector<uint64_t> area(count);
+    const auto at = static_cast<size_t>(first);
+    system_->Download({{components.data(), tables_.components.data() + at, count * sizeof(uint32_t)},
+                       {solid.data(), tables_.solid_components.data() + at, count * sizeof(uint32_t)},
+                       {holes.data(), tables_.holes.data() + at, count * sizeof(uint32_t)},
+                       {regularized.data(), tables_.regularized_components.data() + at, count * sizeof(uint32_t)},
+                       {regularized_holes.data(), tables_.regularized_holes.data() + at, count * sizeof(uint32_t)},
+                       {area.data(), tables_.area_units.data() + at, count * sizeof(uint64_t)}});
+    std::vector<CurveValues> values(count);
+    for (size_t i = 0; i < count; ++i) {
+      values[i] = CurveValues{components[i], solid[i], holes[i], regularized[i], regularized_holes[i], area[i]};
+    }
+    return values;
+  }
+
   std::optional<int64_t> FirstLevelWhere(int64_t from, FamilyCurve a, uint32_t max_a,
                                          std::optional<std::pair<FamilyCurve, uint32_t>> b) override {
     System& sys = *system_;
@@ -182,14 +200,20 @@ class ResidentTablesOn final : public ResidentTables {
     return static_cast<int64_t>(*found);
   }
 
-  std::vector<MasterEntry> MasterList(int64_t rank) override {
-    System& sys = *system_;
-    uint32_t bounds[2] = {0, 0};
-    sys.Download({{bounds, tables_.master_begin.data() + rank, 2 * sizeof(uint32_t)}});
-    std::vector<MasterEntry> entries(bounds[1] - bounds[0]);
+  std::vector<uint32_t> MasterBegins(int64_t first_rank, int64_t count) override {
+    std::vector<uint32_t> begins(static_cast<size_t>(count));
+    if (count > 0) {
+      system_->Download(
+          {{begins.data(), tables_.master_begin.data() + first_rank, begins.size() * sizeof(uint32_t)}});
+    }
+    return begins;
+  }
+
+  std::vector<MasterEntry> MasterEntries(uint64_t position, uint64_t count) override {
     static_assert(sizeof(MasterEntry) == sizeof(uint64_t), "the packed entries are the list");
-    if (!entries.empty()) {
-      sys.Download({{entries.data(), tables_.master.data() + bounds[0], entries.size() * sizeof(uint64_t)}});
+    std::vector<MasterEntry> entries(count);
+    if (count > 0) {
+      system_->Download({{entries.data(), tables_.master.data() + position, count * sizeof(uint64_t)}});
     }
     return entries;
   }

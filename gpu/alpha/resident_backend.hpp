@@ -44,12 +44,16 @@ class ResidentTables {
                         SimplexClass* triangles) = 0;
   /// The curves at `level` (0..K).
   virtual CurveValues CurvesAt(int64_t level) = 0;
+  /// The curves at levels first..last (within 0..K), one entry a level.
+  virtual std::vector<CurveValues> CurvesBetween(int64_t first, int64_t last) = 0;
   /// The first level in from..K where curve `a` is at most `max_a` and, when given, curve `b` at
   /// most `max_b`; nullopt when none is.
   virtual std::optional<int64_t> FirstLevelWhere(int64_t from, FamilyCurve a, uint32_t max_a,
                                                  std::optional<std::pair<FamilyCurve, uint32_t>> b) = 0;
-  /// Master-list entries of `rank` (1..K).
-  virtual std::vector<MasterEntry> MasterList(int64_t rank) = 0;
+  /// master_begin[first_rank, first_rank + count) (ranks 0..K+1): where each rank's entries start.
+  virtual std::vector<uint32_t> MasterBegins(int64_t first_rank, int64_t count) = 0;
+  /// master[position, position + count).
+  virtual std::vector<MasterEntry> MasterEntries(uint64_t position, uint64_t count) = 0;
   /// spectrum[first, first + count) (indices 0..K-1).
   virtual std::vector<double> Spectrum(int64_t first, int64_t count) = 0;
   /// The simplex whose exact threshold is spectrum value `index` (0..K-1): a triangle id below the

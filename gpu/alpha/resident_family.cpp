@@ -146,6 +146,40 @@ absl::StatusOr<TopologyAtLevel> ResidentAlphaFamily::TopologyAt(int64_t level) c
   return at;
 }
 
+absl::StatusOr<std::vector<TopologyAtLevel>> ResidentAlphaFamily::TopologyBetween(int64_t first, int64_t last) const {
+  std::vector<TopologyAtLevel> out;
+  if (last < first) return out;
+  out.resize(static_cast<size_t>(last - first + 1));
+  // Levels below 0 are all zero; above K they repeat K's.
+  const int64_t lo = std::max<int64_t>(first, 0), hi = std::min(last, max_level());
+  std::vector<detail::CurveValues> values;
+  if (lo <= hi) {
+    GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the curves at levels ", lo, "..", hi),
+                                    [&] { values = tables_->CurvesBetween(lo, hi); }));
+  }
+  for (int64_t level = std::max<int64_t>(first, 0); level <= last; ++level) {
+    const detail::CurveValues& v = values[static_cast<size_t>(std::min(level, hi) - lo)];
+    out[static_cast<size_t>(level - first)] =
+        TopologyAtLevel{v.components, v.solid_components, v.regularized_components, v.holes, v.regularized_holes};
+  }
+  return out;
+}
+
+absl::StatusOr<double> ResidentAlphaFamily::RegularizedAreaApprox(int64_t level) const {
+  if (level < 0) return 0.0;
+  detail::CurveValues values;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the area curve at level ", level),
+                                  [&] { values = tables_->CurvesAt(std::min(level, max_level())); }));
+  return std::ldexp(static_cast<double>(values.area_units), host_.ranks.area_scale.unit_log2);
+}
+
+absl::StatusOr<double> ResidentAlphaFamily::PublishedAlphaSq(int64_t level) const {
+  if (level <= 0) return min_alpha_sq_;
+  GALPHA_ASSIGN_OR_RETURN(const std::vector<double> value, Spectrum(level - 1, 1));
+  if (value.size() != 1) return absl::OutOfRangeError(absl::StrCat("level ", level, " is above ", max_level()));
+  return value[0];
+}
+
 absl::StatusOr<std::optional<int64_t>> ResidentAlphaFamily::OptimalLevelRegularized(
     uint32_t n, std::optional<uint32_t> max_holes) const {
   if (!solid_level_) return std::optional<int64_t>();
@@ -173,10 +207,26 @@ absl::StatusOr<std::optional<int64_t>> ResidentAlphaFamily::OptimalLevelGeneral(
 }
 
 absl::StatusOr<std::vector<MasterEntry>> ResidentAlphaFamily::MasterList(int64_t rank) const {
+  if (rank < 1 || rank > max_level()) return std::vector<MasterEntry>();
+  GALPHA_ASSIGN_OR_RETURN(const std::vector<uint32_t> bounds, MasterBegins(rank, 2));
+  return MasterEntries(bounds[0], bounds[1] - bounds[0]);
+}
+
+absl::StatusOr<std::vector<uint32_t>> ResidentAlphaFamily::MasterBegins(int64_t first_rank, int64_t count) const {
+  if (first_rank < 0 || count < 0 || first_rank + count > max_level() + 2) {
+    return absl::OutOfRangeError(absl::StrCat("master-list starts ", first_rank, "..", first_rank + count - 1,
+                                              " are outside 0..", max_level() + 1));
+  }
+  std::vector<uint32_t> begins;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "reading the master list's starts",
+                                  [&] { begins = tables_->MasterBegins(first_rank, count); }));
+  return begins;
+}
+
+absl::StatusOr<std::vector<MasterEntry>> ResidentAlphaFamily::MasterEntries(uint64_t position, uint64_t count) const {
   std::vector<MasterEntry> entries;
-  if (rank < 1 || rank > max_level()) return entries;
-  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the master list at rank ", rank),
-                                  [&] { entries = tables_->MasterList(rank); }));
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "reading master-list entries",
+                                  [&] { entries = tables_->MasterEntries(position, count); }));
   return entries;
 }
 

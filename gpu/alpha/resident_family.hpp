@@ -69,6 +69,13 @@ class ResidentAlphaFamily {
   absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const;
   /// The curves at `level` (below 0: all zero; above K: K's).
   absl::StatusOr<TopologyAtLevel> TopologyAt(int64_t level) const;
+  /// The same at every level of first..last, in one download.
+  absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const;
+  /// AlphaFamily's RegularizedAreaApprox (core/family/area_ratio.hpp): the area curve's value at
+  /// `level` as a double; at K, the convex hull's.
+  absl::StatusOr<double> RegularizedAreaApprox(int64_t level) const;
+  /// PublishedAlphaSq (core/family/threshold.hpp): spectrum[level - 1], min_alpha_sq at or below 0.
+  absl::StatusOr<double> PublishedAlphaSq(int64_t level) const;
   /// AlphaFamily::OptimalLevelRegularized and OptimalLevelGeneral.
   absl::StatusOr<std::optional<int64_t>> OptimalLevelRegularized(
       uint32_t n, std::optional<uint32_t> max_holes = std::nullopt) const;
@@ -76,6 +83,10 @@ class ResidentAlphaFamily {
                                                              std::optional<uint32_t> max_holes = std::nullopt) const;
   /// AlphaFamily::MasterList (empty outside 1..K).
   absl::StatusOr<std::vector<MasterEntry>> MasterList(int64_t rank) const;
+  /// ranks().master_begin[first_rank, first_rank + count) (ranks 0..K+1) and master[position,
+  /// position + count): a master list read in pieces.
+  absl::StatusOr<std::vector<uint32_t>> MasterBegins(int64_t first_rank, int64_t count) const;
+  absl::StatusOr<std::vector<MasterEntry>> MasterEntries(uint64_t position, uint64_t count) const;
   /// spectrum[first, first + count) clipped to 0..K-1.
   absl::StatusOr<std::vector<double>> Spectrum(int64_t first, int64_t count) const;
 

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "core/family/alpha_family.hpp"
+#include "core/family/area_ratio.hpp"
+#include "core/family/threshold.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gpu/alpha/resident_family.hpp"
 #include "gtest/gtest.h"
@@ -170,6 +172,36 @@ class ResidentFamilyTest : public testing::BackendTest {
       ASSERT_EQ(at->holes, host.Holes(level, ClassifyMode::kGeneral)) << "level " << level;
       ASSERT_EQ(at->regularized_holes, host.Holes(level, ClassifyMode::kRegularized)) << "level " << level;
     }
+
+    // The curves over ranges in one read, the area curve and the published values.
+    const absl::StatusOr<std::vector<TopologyAtLevel>> range = resident.TopologyBetween(-2, k + 2);
+    ASSERT_THAT(range, IsOk());
+    ASSERT_EQ(range->size(), static_cast<size_t>(k + 5));
+    for (int64_t level = -2; level <= k + 2; ++level) {
+      const TopologyAtLevel& at = (*range)[static_cast<size_t>(level + 2)];
+      ASSERT_EQ(at.components, host.Components(level)) << "level " << level;
+      ASSERT_EQ(at.solid_components, host.SolidComponents(level)) << "level " << level;
+      ASSERT_EQ(at.regularized_components, host.RegularizedComponents(level)) << "level " << level;
+      ASSERT_EQ(at.holes, host.Holes(level, ClassifyMode::kGeneral)) << "level " << level;
+      ASSERT_EQ(at.regularized_holes, host.Holes(level, ClassifyMode::kRegularized)) << "level " << level;
+    }
+    for (const int64_t level : {int64_t{-1}, int64_t{0}, k / 2, k, k + 1}) {
+      const absl::StatusOr<double> area = resident.RegularizedAreaApprox(level);
+      ASSERT_THAT(area, IsOk());
+      EXPECT_EQ(*area, RegularizedAreaApprox(host, level)) << "level " << level;
+      if (level <= k) {
+        const absl::StatusOr<double> published = resident.PublishedAlphaSq(level);
+        ASSERT_THAT(published, IsOk());
+        EXPECT_EQ(*published, PublishedAlphaSq(host, level)) << "level " << level;
+      }
+    }
+    const absl::StatusOr<std::vector<uint32_t>> begins = resident.MasterBegins(0, k + 2);
+    ASSERT_THAT(begins, IsOk());
+    EXPECT_EQ(*begins, AsVector(host.ranks().master_begin));
+    EXPECT_FALSE(resident.MasterBegins(0, k + 3).ok());
+    const absl::StatusOr<std::vector<MasterEntry>> all = resident.MasterEntries(0, host.ranks().master.size());
+    ASSERT_THAT(all, IsOk());
+    EXPECT_EQ(Packed(*all), Packed(host.ranks().master));
 
     // Optimal levels.
     for (const uint32_t n : {0u, 1u, 2u, 5u, 100u}) {
