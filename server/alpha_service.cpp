@@ -108,12 +108,12 @@ struct StreamedReply {
   }
 };
 
-/// A unary answer of query_answers.hpp reads the family only while it answers; the streamed ones
-/// take the cached family itself, to keep it while their chunks are written.
+/// A unary answer of query_answers.hpp reads the family (in either form) only while it answers;
+/// the streamed ones take the cached family itself, to keep it while their chunks are written.
 template <typename Answer>
-auto FromAlphaFamily(Answer answer) {
+auto FromFamilyReader(Answer answer) {
   return [answer](const std::shared_ptr<const CachedFamily>& cached, const auto& request) {
-    return answer(cached->family(), request);
+    return answer(cached->reader(), request);
   };
 }
 
@@ -157,13 +157,28 @@ absl::StatusOr<std::unique_ptr<AlphaService>> AlphaService::Create(const Service
     service->streams_ = *std::move(streams);
     for (int i = 0; i < slots; ++i) slot_streams[static_cast<size_t>(i)] = service->streams_->stream(i);
   }
-  const size_t memory = options.build_memory_bytes > 0 ? options.build_memory_bytes : DefaultMemoryBudget(backend);
+  size_t memory = options.build_memory_bytes;
+  if (memory == 0) {
+    memory = DefaultMemoryBudget(backend);
+    if (backend == Backend::kCuda && options.device_cache_bytes > 0) {
+      // The GPU's memory is shared: resident families' tables take the device cache's part.
+      if (memory != 0 && options.device_cache_bytes >= memory) {
+        return absl::InvalidArgumentError(absl::StrCat("device_cache_bytes ", options.device_cache_bytes,
+                                                       " leaves no GPU memory for builds (90% of the GPU is ", memory,
+                                                       " bytes): lower it, or set build_memory_bytes"));
+      }
+      if (memory != 0) memory -= options.device_cache_bytes;
+    }
+  }
+  service->resident_families_ = backend == Backend::kCpu || options.device_cache_bytes > 0;
   service->cache_ =
-      std::make_unique<FamilyCache>(FamilyCache::Budgets{options.cache_bytes, options.compact_cache_bytes}, metrics);
+      std::make_unique<FamilyCache>(FamilyCache::Budgets{options.cache_bytes, options.compact_cache_bytes,
+                                                         backend == Backend::kCuda ? options.device_cache_bytes : 0},
+                                    metrics);
   service->scheduler_ = std::make_unique<BuildScheduler>(std::move(slot_streams), options.max_queued_builds,
                                                          options.max_tenant_queued_builds, memory, metrics);
   service->promoter_ = std::make_unique<FamilyPromoter>(
-      service->cache_.get(), service->scheduler_.get(), backend, kBuildBytesPerPoint,
+      service->cache_.get(), service->scheduler_.get(), backend, service->resident_families_, kBuildBytesPerPoint,
       [metrics](const BuildReport& report, double seconds) { metrics->RecordBuild(report, seconds); });
   metrics->SetBackend(service->backend_name_);
   service->SampleDeviceMemory();
@@ -238,25 +253,26 @@ grpc::ServerUnaryReactor* AlphaService::Describe(grpc::CallbackServerContext* co
 
 grpc::ServerUnaryReactor* AlphaService::Spectrum(grpc::CallbackServerContext* context,
                                                  const v1::SpectrumRequest* request, v1::SpectrumResponse* response) {
-  return AnswerQuery(context, "Spectrum", *request, FromAlphaFamily(AnswerSpectrum), UnaryReply(context, response));
+  return AnswerQuery(context, "Spectrum", *request, FromFamilyReader(AnswerSpectrum), UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::Components(grpc::CallbackServerContext* context,
                                                    const v1::ComponentsRequest* request,
                                                    v1::ComponentsResponse* response) {
-  return AnswerQuery(context, "Components", *request, FromAlphaFamily(AnswerComponents), UnaryReply(context, response));
+  return AnswerQuery(context, "Components", *request, FromFamilyReader(AnswerComponents),
+                     UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::OptimalAlpha(grpc::CallbackServerContext* context,
                                                      const v1::OptimalAlphaRequest* request,
                                                      v1::OptimalAlphaResponse* response) {
-  return AnswerQuery(context, "OptimalAlpha", *request, FromAlphaFamily(AnswerOptimalAlpha),
+  return AnswerQuery(context, "OptimalAlpha", *request, FromFamilyReader(AnswerOptimalAlpha),
                      UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::Betti(grpc::CallbackServerContext* context, const v1::BettiRequest* request,
                                               v1::BettiResponse* response) {
-  return AnswerQuery(context, "Betti", *request, FromAlphaFamily(AnswerBetti), UnaryReply(context, response));
+  return AnswerQuery(context, "Betti", *request, FromFamilyReader(AnswerBetti), UnaryReply(context, response));
 }
 
 grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* context, const v1::ReleaseRequest* request,

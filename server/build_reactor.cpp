@@ -150,9 +150,8 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   const auto deadline = start + std::chrono::duration_cast<Clock::duration>(limit);
   options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
   options.max_exact_comparisons = ExactComparisonLimit(points, service_->options_.exact_comparisons);
-  absl::StatusOr<AlphaFamily> family = build_->header.weighted()
-                                           ? BuildWeightedAlphaFamily(build_->points, build_->weights, options)
-                                           : BuildAlphaFamily(build_->points, options);
+  absl::StatusOr<std::shared_ptr<const CachedFamily>> family = BuildCachedFamily(
+      build_->points, build_->weights, build_->header.weighted(), options, service_->resident_families_, build_->frame);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   decoder_.ReleasePoints();
   if (!family.ok()) {
@@ -172,9 +171,8 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
     Respond(family.status());
     return;
   }
-  service_->metrics_->RecordBuild(family->report(), seconds);
-  std::shared_ptr<const CachedFamily> cached = ShareCachedFamily(*std::move(family), build_->frame);
-  auto inserted = service_->cache_->Insert(tenant_, build_->handle, std::move(cached));
+  service_->metrics_->RecordBuild((*family)->reader().report(), seconds);
+  auto inserted = service_->cache_->Insert(tenant_, build_->handle, *std::move(family));
   ReturnFreedHeapMemory();  // the engine's working memory and the points
   if (!inserted.ok()) {
     Respond(absl::IsResourceExhausted(inserted.status()) ? TagRefusal(inserted.status(), BuildRefusal::kCacheBytes)

@@ -8,10 +8,34 @@
 
 namespace galpha::server {
 
+namespace {
+
+/// The index orders and ordered vertices (ComputeOrders), charged up front.
+size_t OrderBytes(const FamilyReader& reader) {
+  return reader.edges().size() * 3 * sizeof(uint32_t) + reader.triangles().size() * 4 * sizeof(uint32_t);
+}
+
+}  // namespace
+
 CachedFamily::CachedFamily(AlphaFamily family, std::shared_ptr<const InputFrame> frame)
-    : family_(std::move(family)), frame_(std::move(frame)) {
-  bytes_ = sizeof(*this) + family_.HostBytes() + family_.edges().size() * 3 * sizeof(uint32_t) +
-           family_.triangles().size() * 4 * sizeof(uint32_t);
+    : host_(std::make_shared<const AlphaFamily>(std::move(family))),
+      reader_(std::make_unique<HostFamilyReader>(host_)),
+      frame_(std::move(frame)) {
+  bytes_ = sizeof(*this) + host_->HostBytes() + OrderBytes(*reader_);
+  if (frame_ != nullptr) bytes_ += frame_->input.capacity() * sizeof(Point2);
+}
+
+CachedFamily::CachedFamily(ResidentAlphaFamily family, std::shared_ptr<const InputFrame> frame)
+    : resident_(std::make_shared<const ResidentAlphaFamily>(std::move(family))),
+      reader_(std::make_unique<ResidentFamilyReader>(resident_)),
+      frame_(std::move(frame)) {
+  bytes_ = sizeof(*this) + resident_->HostBytes() + OrderBytes(*reader_);
+  // On the CPU backend the tables' "device" is this process's memory.
+  if (resident_->TablesInDeviceMemory()) {
+    device_bytes_ = resident_->ResidentBytes();
+  } else {
+    bytes_ += resident_->ResidentBytes();
+  }
   if (frame_ != nullptr) bytes_ += frame_->input.capacity() * sizeof(Point2);
 }
 
@@ -46,7 +70,7 @@ const std::vector<uint32_t>& CachedFamily::TriangleVerticesInOrder() const {
 }
 
 void CachedFamily::ComputeOrders() const {
-  CanonicalOrders orders = ComputeCanonicalOrders(family_);
+  CanonicalOrders orders = ComputeCanonicalOrders(reader_->points().size(), reader_->edges(), reader_->triangles());
   edge_order_ = std::move(orders.edge_order);
   edge_vertices_ = std::move(orders.edge_vertices);
   triangle_order_ = std::move(orders.triangle_order);
@@ -59,13 +83,41 @@ void ReturnFreedHeapMemory() {
 #endif
 }
 
+namespace {
+
+std::shared_ptr<const CachedFamily> Shared(CachedFamily* family) {
+  return std::shared_ptr<const CachedFamily>(family, [](const CachedFamily* f) {
+    delete f;
+    ReturnFreedHeapMemory();
+  });
+}
+
+}  // namespace
+
 std::shared_ptr<const CachedFamily> ShareCachedFamily(AlphaFamily family,
                                                       std::shared_ptr<const CachedFamily::InputFrame> frame) {
-  return std::shared_ptr<const CachedFamily>(new CachedFamily(std::move(family), std::move(frame)),
-                                             [](const CachedFamily* f) {
-                                               delete f;
-                                               ReturnFreedHeapMemory();
-                                             });
+  return Shared(new CachedFamily(std::move(family), std::move(frame)));
+}
+
+std::shared_ptr<const CachedFamily> ShareCachedFamily(ResidentAlphaFamily family,
+                                                      std::shared_ptr<const CachedFamily::InputFrame> frame) {
+  return Shared(new CachedFamily(std::move(family), std::move(frame)));
+}
+
+absl::StatusOr<std::shared_ptr<const CachedFamily>> BuildCachedFamily(
+    absl::Span<const Point2> points, absl::Span<const double> weights, bool weighted, BuildOptions options,
+    bool resident, std::shared_ptr<const CachedFamily::InputFrame> frame) {
+  if (resident) {
+    options.cuda_stream = nullptr;
+    absl::StatusOr<ResidentAlphaFamily> family = weighted ? BuildWeightedResidentAlphaFamily(points, weights, options)
+                                                          : BuildResidentAlphaFamily(points, options);
+    if (!family.ok()) return family.status();
+    return ShareCachedFamily(*std::move(family), std::move(frame));
+  }
+  absl::StatusOr<AlphaFamily> family =
+      weighted ? BuildWeightedAlphaFamily(points, weights, options) : BuildAlphaFamily(points, options);
+  if (!family.ok()) return family.status();
+  return ShareCachedFamily(*std::move(family), std::move(frame));
 }
 
 }  // namespace galpha::server

@@ -1,5 +1,7 @@
-// A family as the service holds it: the immutable AlphaFamily (whose report is the build summary a
-// Describe returns) and the index orders Classify streams in (computed on first use, once). No
+// A family as the service holds it, in host memory (AlphaFamily) or resident where it was built
+// (ResidentAlphaFamily: its rank tables in device memory after a CUDA build), read through one
+// interface (server/family_reader.hpp; the report is the build summary a Describe returns), and
+// the index orders Classify streams in (computed on first use, once). No
 // name: a BuildHeader.name is the label of one Build call, echoed in that call's answer only
 // (proto: BuildHeader), so the family that any caller of the tenant may reach keeps none.
 #pragma once
@@ -14,6 +16,9 @@
 #include "absl/synchronization/mutex.h"
 #include "core/family/alpha_family.hpp"
 #include "core/io/coordinate_system.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "gpu/alpha/resident_family.hpp"
+#include "server/family_reader.hpp"
 
 namespace galpha::server {
 
@@ -23,8 +28,17 @@ class CachedFamily {
   /// `frame`: where the points came from when the Build header named a CRS (may be null); its
   /// input points are charged to the family's bytes.
   explicit CachedFamily(AlphaFamily family, std::shared_ptr<const InputFrame> frame = nullptr);
+  /// A resident family: `bytes()` charges its host arrays and tables held in host memory,
+  /// `device_bytes()` its tables in device memory.
+  explicit CachedFamily(ResidentAlphaFamily family, std::shared_ptr<const InputFrame> frame = nullptr);
 
-  const AlphaFamily& family() const { return family_; }
+  /// Either form, read the same way.
+  const FamilyReader& reader() const { return *reader_; }
+  /// The family when it is held in host memory; null when it is resident (reader().HostFamily()
+  /// downloads one).
+  const AlphaFamily* host_family() const { return host_.get(); }
+  /// Whether the family is resident where it was built, and whether that is device memory.
+  bool resident() const { return host_ == nullptr; }
 
   /// Where the family's points came from when a Build header named a CRS: the CRS, the points as
   /// sent (for a geographic CRS; empty when the family's points are the points as sent), and the
@@ -39,9 +53,12 @@ class CachedFamily {
   /// late frame is not charged to the cache).
   std::shared_ptr<const InputFrame> Frame() const;
   void AttachFrameIfNone(std::shared_ptr<const InputFrame> frame) const;
-  /// Bytes charged to the cache: the family, plus the index orders and ordered vertices once
-  /// computed (charged up front so that the charge never changes while cached).
+  /// Host bytes charged to the cache: the family (of a resident one, what it holds on the host,
+  /// and its tables when the host is where they live), plus the index orders and ordered vertices
+  /// once computed (charged up front so that the charge never changes while cached).
   size_t bytes() const { return bytes_; }
+  /// Device bytes a resident family's tables hold (0 in host memory or on the CPU backend).
+  size_t device_bytes() const { return device_bytes_; }
 
   /// Edge ids sorted by their (smaller, larger) vertex pair; triangle ids by sorted vertex triple.
   const std::vector<uint32_t>& EdgeOrder() const;
@@ -54,8 +71,11 @@ class CachedFamily {
  private:
   void ComputeOrders() const;
 
-  AlphaFamily family_;
+  std::shared_ptr<const AlphaFamily> host_;
+  std::shared_ptr<const ResidentAlphaFamily> resident_;
+  std::unique_ptr<FamilyReader> reader_;
   size_t bytes_ = 0;
+  size_t device_bytes_ = 0;
   mutable absl::Mutex frame_mutex_;
   mutable std::shared_ptr<const InputFrame> frame_ ABSL_GUARDED_BY(frame_mutex_);
   mutable std::once_flag orders_once_;
@@ -72,5 +92,15 @@ void ReturnFreedHeapMemory();
 /// system right then.
 std::shared_ptr<const CachedFamily> ShareCachedFamily(AlphaFamily family,
                                                       std::shared_ptr<const CachedFamily::InputFrame> frame);
+std::shared_ptr<const CachedFamily> ShareCachedFamily(ResidentAlphaFamily family,
+                                                      std::shared_ptr<const CachedFamily::InputFrame> frame);
+
+/// Builds the family of `points` (`weighted`: with `weights`, one per point) in the form the
+/// service caches: resident where it is built when `resident` (its tables stay in the build's
+/// memory: GPU memory on CUDA, on its own stream, so `options.cuda_stream` is not used), else in
+/// host memory. The engine's errors as they are.
+absl::StatusOr<std::shared_ptr<const CachedFamily>> BuildCachedFamily(
+    absl::Span<const Point2> points, absl::Span<const double> weights, bool weighted, BuildOptions options,
+    bool resident, std::shared_ptr<const CachedFamily::InputFrame> frame);
 
 }  // namespace galpha::server

@@ -3,8 +3,8 @@
 namespace galpha::server {
 
 CompactFamily::CompactFamily(const CachedFamily& cached)
-    : points_(cached.family().points().begin(), cached.family().points().end()),
-      weights_(cached.family().weights().begin(), cached.family().weights().end()),
+    : points_(cached.reader().points().begin(), cached.reader().points().end()),
+      weights_(cached.reader().weights().begin(), cached.reader().weights().end()),
       frame_(cached.Frame()) {
   bytes_ = sizeof(*this) + points_.capacity() * sizeof(Point2) + weights_.capacity() * sizeof(double);
   // The frame may also be held by a resident copy that a query still streams from; it is

@@ -55,6 +55,12 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> FamilyCache::Insert(const st
                                                      " bytes of cache; the cache budget is ", budgets_.resident,
                                                      " bytes (raise --cache_bytes)"));
   }
+  const size_t device_bytes = family->device_bytes();
+  if (device_bytes > budgets_.device) {
+    return absl::ResourceExhaustedError(absl::StrCat("the family's tables need ", device_bytes,
+                                                     " bytes of GPU memory; the device cache budget is ",
+                                                     budgets_.device, " bytes (raise --device_cache_bytes)"));
+  }
   std::string key = Key(tenant, handle);
   std::lock_guard<std::mutex> lock(mutex_);
   if (const auto it = resident_index_.find(key); it != resident_index_.end()) {
@@ -66,10 +72,14 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> FamilyCache::Insert(const st
     ++stats_.promotions;
     if (observer_ != nullptr) observer_->OnPromotion();
   }
-  while (!resident_.empty() && stats_.resident.bytes + bytes > budgets_.resident) DemoteOldestLocked();
+  while (!resident_.empty() && (stats_.resident.bytes + bytes > budgets_.resident ||
+                                stats_.resident.device_bytes + device_bytes > budgets_.device)) {
+    DemoteOldestLocked();
+  }
   resident_.push_front(ResidentEntry{key, family});
   resident_index_.emplace(std::move(key), resident_.begin());
   stats_.resident.bytes += bytes;
+  stats_.resident.device_bytes += device_bytes;
   ReportSizeLocked();
   return family;
 }
@@ -79,6 +89,7 @@ void FamilyCache::DemoteOldestLocked() {
   resident_index_.erase(victim.key);
   resident_.pop_back();
   stats_.resident.bytes -= victim.family->bytes();
+  stats_.resident.device_bytes -= victim.family->device_bytes();
   // The copy of the points is made under the lock: a memory copy of 16 bytes a point (160 ms at
   // 100M points), short next to the build that needed the room.
   auto compact = budgets_.compact > 0 ? std::make_shared<const CompactFamily>(*victim.family) : nullptr;
@@ -117,6 +128,7 @@ bool FamilyCache::Erase(const std::string& tenant, const std::string& handle) {
   bool erased = DropCompactLocked(key);
   if (const auto it = resident_index_.find(key); it != resident_index_.end()) {
     stats_.resident.bytes -= it->second->family->bytes();
+    stats_.resident.device_bytes -= it->second->family->device_bytes();
     resident_.erase(it->second);
     resident_index_.erase(it);
     erased = true;
@@ -131,6 +143,7 @@ void FamilyCache::ReportSizeLocked() {
   if (observer_ == nullptr) return;
   observer_->OnSize(CacheTier::kResident, stats_.resident.bytes, stats_.resident.entries);
   observer_->OnSize(CacheTier::kCompact, stats_.compact.bytes, stats_.compact.entries);
+  observer_->OnDeviceSize(stats_.resident.device_bytes);
 }
 
 FamilyCache::Stats FamilyCache::GetStats() const {

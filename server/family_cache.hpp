@@ -37,6 +37,8 @@ class CacheObserver {
   virtual void OnDemotion() = 0;
   virtual void OnPromotion() = 0;
   virtual void OnSize(CacheTier tier, size_t bytes, size_t entries) = 0;
+  /// Device bytes the resident tier's families hold (resident on the GPU they were built on).
+  virtual void OnDeviceSize(size_t bytes) = 0;
 };
 
 class FamilyCache {
@@ -47,9 +49,13 @@ class FamilyCache {
     /// Bytes of compact entries (CompactFamily::bytes()); 0: no compact tier, a family pushed out
     /// of the resident tier is evicted.
     size_t compact = 0;
+    /// Device bytes of the resident tier's families whose tables stayed on the GPU
+    /// (CachedFamily::device_bytes()): a family is demoted when either budget of the tier is passed.
+    size_t device = 0;
   };
   struct TierStats {
     size_t bytes = 0;
+    size_t device_bytes = 0;  // the resident tier's families' tables on the GPU
     size_t entries = 0;
     uint64_t hits = 0;
     uint64_t evictions = 0;
@@ -83,7 +89,7 @@ class FamilyCache {
   /// Caches `family` in the resident tier (or keeps the one already there, which is returned),
   /// demoting the least recently used families until it fits. A compact entry of the same key is
   /// dropped: the family is back (a promotion). ResourceExhausted when the family is larger than
-  /// the resident budget.
+  /// the resident budget (host bytes or device bytes).
   absl::StatusOr<std::shared_ptr<const CachedFamily>> Insert(const std::string& tenant, const std::string& handle,
                                                              std::shared_ptr<const CachedFamily> family);
   /// Whether a family was dropped (from either tier).
@@ -92,6 +98,7 @@ class FamilyCache {
   Stats GetStats() const;
   size_t byte_budget() const { return budgets_.resident; }
   size_t compact_byte_budget() const { return budgets_.compact; }
+  size_t device_byte_budget() const { return budgets_.device; }
 
  private:
   struct ResidentEntry {

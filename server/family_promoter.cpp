@@ -16,11 +16,12 @@ struct FamilyPromoter::Rebuild {
   std::promise<Result> promise;
 };
 
-FamilyPromoter::FamilyPromoter(FamilyCache* cache, BuildScheduler* scheduler, Backend backend, size_t bytes_per_point,
-                               BuildRecorder record_build)
+FamilyPromoter::FamilyPromoter(FamilyCache* cache, BuildScheduler* scheduler, Backend backend, bool resident,
+                               size_t bytes_per_point, BuildRecorder record_build)
     : cache_(cache),
       scheduler_(scheduler),
       backend_(backend),
+      resident_(resident),
       bytes_per_point_(bytes_per_point),
       record_build_(std::move(record_build)) {}
 
@@ -85,9 +86,8 @@ void FamilyPromoter::Run(const std::shared_ptr<Rebuild>& rebuild, void* cuda_str
   // No time or comparison limit: these points were built within them once, and the engine is
   // deterministic.
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<AlphaFamily> family = compact.weights().empty()
-                                           ? BuildAlphaFamily(compact.points(), options)
-                                           : BuildWeightedAlphaFamily(compact.points(), compact.weights(), options);
+  absl::StatusOr<std::shared_ptr<const CachedFamily>> family = BuildCachedFamily(
+      compact.points(), compact.weights(), !compact.weights().empty(), options, resident_, compact.frame());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!family.ok()) {
     ReturnFreedHeapMemory();
@@ -97,9 +97,8 @@ void FamilyPromoter::Run(const std::shared_ptr<Rebuild>& rebuild, void* cuda_str
                                      compact.points().size(), " points failed: ", family.status().message())));
     return;
   }
-  if (record_build_) record_build_(family->report(), seconds);
-  std::shared_ptr<const CachedFamily> cached = ShareCachedFamily(*std::move(family), compact.frame());
-  Result inserted = cache_->Insert(rebuild->tenant, handle, std::move(cached));
+  if (record_build_) record_build_((*family)->reader().report(), seconds);
+  Result inserted = cache_->Insert(rebuild->tenant, handle, *std::move(family));
   ReturnFreedHeapMemory();  // the engine's working memory
   if (!inserted.ok()) {
     inserted = absl::Status(inserted.status().code(), absl::StrCat("handle ", handle,

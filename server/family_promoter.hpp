@@ -26,10 +26,11 @@ class FamilyPromoter {
   /// Called after every successful rebuild with its report and wall time (the build metrics).
   using BuildRecorder = std::function<void(const BuildReport& report, double seconds)>;
 
-  /// Rebuilds on `backend` through `scheduler`, charging `bytes_per_point` a point to its memory
-  /// admission, and caches the result in `cache`. All three must outlive the promoter's jobs
-  /// (destroy the scheduler first: its queued jobs then end without building).
-  FamilyPromoter(FamilyCache* cache, BuildScheduler* scheduler, Backend backend, size_t bytes_per_point,
+  /// Rebuilds on `backend` through `scheduler` (as resident families when `resident`:
+  /// BuildCachedFamily), charging `bytes_per_point` a point to its memory admission, and caches
+  /// the result in `cache`. All three must outlive the promoter's jobs (destroy the scheduler
+  /// first: its queued jobs then end without building).
+  FamilyPromoter(FamilyCache* cache, BuildScheduler* scheduler, Backend backend, bool resident, size_t bytes_per_point,
                  BuildRecorder record_build);
   ~FamilyPromoter();
   FamilyPromoter(const FamilyPromoter&) = delete;
@@ -56,6 +57,7 @@ class FamilyPromoter {
   FamilyCache* const cache_;
   BuildScheduler* const scheduler_;
   const Backend backend_;
+  const bool resident_;
   const size_t bytes_per_point_;
   const BuildRecorder record_build_;
   mutable std::mutex mutex_;

@@ -49,6 +49,9 @@ ABSL_FLAG(uint64_t, cache_bytes, uint64_t{8} << 30,
 ABSL_FLAG(uint64_t, compact_cache_bytes, uint64_t{4} << 30,
           "byte budget of the family cache's compact tier (16 B per point: families rebuilt when queried; 0: none, "
           "families pushed out of the resident tier are evicted)");
+ABSL_FLAG(uint64_t, device_cache_bytes, 0,
+          "GPU memory for families whose rank tables stay on the GPU after their build (no download; queries "
+          "answered there), taken from the builds' default budget; 0: CUDA families are copied to host memory");
 ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
 ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
 ABSL_FLAG(std::string, tls_key, "", "PEM private key");
@@ -127,6 +130,7 @@ int main(int argc, char** argv) {
   options.service.exact_comparisons.floor = absl::GetFlag(FLAGS_exact_comparisons_floor);
   options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
   options.service.compact_cache_bytes = absl::GetFlag(FLAGS_compact_cache_bytes);
+  options.service.device_cache_bytes = absl::GetFlag(FLAGS_device_cache_bytes);
   if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
     auto tokens = galpha::server::TenantTokens::ReadFile(path);
     if (!tokens.ok()) return Fail(std::string(tokens.status().message()));

@@ -56,6 +56,11 @@ struct ServerMetrics::Families {
                         .Register(r)),
         cache_entries(
             prometheus::BuildGauge().Name("galpha_cache_entries").Help("Families in the cache, by tier").Register(r)),
+        cache_device_bytes(prometheus::BuildGauge()
+                               .Name("galpha_cache_device_bytes")
+                               .Help("GPU memory held by the resident tier's families whose rank tables stayed on "
+                                     "the GPU they were built on (--device_cache_bytes)")
+                               .Register(r)),
         cache_hits(prometheus::BuildCounter()
                        .Name("galpha_cache_hits_total")
                        .Help("Cache lookups that found a family, by the tier it was in")
@@ -104,6 +109,7 @@ struct ServerMetrics::Families {
         promotions(cache_promotions.Add({})),
         bytes{&cache_bytes.Add({{"tier", "resident"}}), &cache_bytes.Add({{"tier", "compact"}})},
         entries{&cache_entries.Add({{"tier", "resident"}}), &cache_entries.Add({{"tier", "compact"}})},
+        device_bytes(cache_device_bytes.Add({})),
         in_flight(builds_in_flight.Add({})),
         queued(queue_length.Add({})),
         admitted(admitted_bytes.Add({})),
@@ -120,6 +126,7 @@ struct ServerMetrics::Families {
   prometheus::Family<prometheus::Counter>& rejected;
   prometheus::Family<prometheus::Gauge>& cache_bytes;
   prometheus::Family<prometheus::Gauge>& cache_entries;
+  prometheus::Family<prometheus::Gauge>& cache_device_bytes;
   prometheus::Family<prometheus::Counter>& cache_hits;
   prometheus::Family<prometheus::Counter>& cache_misses;
   prometheus::Family<prometheus::Counter>& cache_evictions;
@@ -142,6 +149,7 @@ struct ServerMetrics::Families {
   prometheus::Counter& promotions;
   std::array<prometheus::Gauge*, 2> bytes;
   std::array<prometheus::Gauge*, 2> entries;
+  prometheus::Gauge& device_bytes;
   prometheus::Gauge& in_flight;
   prometheus::Gauge& queued;
   prometheus::Gauge& admitted;
@@ -203,6 +211,8 @@ void ServerMetrics::OnSize(CacheTier tier, size_t bytes, size_t entries) {
   families_->bytes[static_cast<size_t>(tier)]->Set(static_cast<double>(bytes));
   families_->entries[static_cast<size_t>(tier)]->Set(static_cast<double>(entries));
 }
+
+void ServerMetrics::OnDeviceSize(size_t bytes) { families_->device_bytes.Set(static_cast<double>(bytes)); }
 
 void ServerMetrics::OnLoad(size_t queued, size_t running, size_t admitted_bytes) {
   families_->queued.Set(static_cast<double>(queued));

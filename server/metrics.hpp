@@ -44,6 +44,7 @@ class ServerMetrics final : public CacheObserver, public SchedulerObserver {
   void OnDemotion() override;
   void OnPromotion() override;
   void OnSize(CacheTier tier, size_t bytes, size_t entries) override;
+  void OnDeviceSize(size_t bytes) override;
   // SchedulerObserver
   void OnLoad(size_t queued, size_t running, size_t admitted_bytes) override;
 

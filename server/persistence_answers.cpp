@@ -17,16 +17,16 @@ namespace v1 = galpha::v1;
 
 class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
  public:
-  PersistenceSource(std::shared_ptr<const CachedFamily> cached, PersistenceDiagram diagram,
+  PersistenceSource(std::shared_ptr<const AlphaFamily> family, PersistenceDiagram diagram,
                     std::array<bool, 2> dimensions, double min_persistence)
-      : cached_(std::move(cached)),
+      : family_(std::move(family)),
         diagram_(std::move(diagram)),
         dimensions_(dimensions),
         min_persistence_(min_persistence) {}
 
   bool Next(v1::PersistenceResponse* message) override {
     message->Clear();
-    const AlphaFamily& family = cached_->family();
+    const AlphaFamily& family = *family_;
     for (; dimension_ < 2; ++dimension_, position_ = diagram_.dimension_begin[dimension_]) {
       if (!dimensions_[dimension_]) continue;
       const size_t end = diagram_.dimension_begin[dimension_ + 1];
@@ -58,7 +58,7 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
     for (uint32_t i = 0; i <= p.dimension + 1; ++i) message->add_killer_vertices(vertices.killer[i]);
   }
 
-  std::shared_ptr<const CachedFamily> cached_;
+  std::shared_ptr<const AlphaFamily> family_;  // the cached one, or a resident one's download
   PersistenceDiagram diagram_;
   std::array<bool, 2> dimensions_;
   double min_persistence_;
@@ -83,11 +83,14 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::PersistenceResponse>>> MakePersis
     return absl::InvalidArgumentError(
         absl::StrCat("min_persistence ", min_persistence, " is not a length: give 0 or more"));
   }
-  // On the GPU when the family was built there (gpu/alpha/persistence_engine.hpp).
+  // The diagram is computed from the family in host memory (a resident family's is downloaded for
+  // this call), on the GPU when the family was built there (gpu/alpha/persistence_engine.hpp).
+  absl::StatusOr<std::shared_ptr<const AlphaFamily>> family = cached->reader().HostFamily();
+  if (!family.ok()) return family.status();
   absl::StatusOr<PersistenceDiagram> diagram =
-      PersistenceDiagramOf(cached->family(), cached->EdgeOrder(), cached->TriangleOrder());
+      PersistenceDiagramOf(**family, cached->EdgeOrder(), cached->TriangleOrder());
   if (!diagram.ok()) return diagram.status();
-  return std::make_unique<PersistenceSource>(std::move(cached), *std::move(diagram), dimensions, min_persistence);
+  return std::make_unique<PersistenceSource>(*std::move(family), *std::move(diagram), dimensions, min_persistence);
 }
 
 }  // namespace galpha::server

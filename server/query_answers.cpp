@@ -33,18 +33,21 @@ char ClassByte(SimplexClass c) { return static_cast<char>(static_cast<int>(c) + 
 class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
  public:
   ClassifySource(std::shared_ptr<const CachedFamily> cached, Classification classes, ClassificationSummary counts,
-                 ResolvedLevel level, ClassifyMode mode, bool non_exterior_only, bool summary_only)
+                 ResolvedLevel level, TopologyAtLevel topology, double hull_area, ClassifyMode mode,
+                 bool non_exterior_only, bool summary_only)
       : cached_(std::move(cached)),
         classes_(std::move(classes)),
         counts_(counts),
         level_(level),
+        topology_(topology),
+        hull_area_(hull_area),
         mode_(mode),
         non_exterior_only_(non_exterior_only),
         phase_(summary_only ? Phase::kLastSummary : Phase::kSummary) {}
 
   bool Next(v1::ClassifyResponse* message) override {
     message->Clear();
-    const AlphaFamily& family = cached_->family();
+    const FamilyReader& family = cached_->reader();
     while (true) {
       switch (phase_) {
         case Phase::kSummary:
@@ -94,17 +97,16 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
   }
 
   void FillSummary(v1::ClassifySummary* summary) const {
-    const AlphaFamily& family = cached_->family();
     summary->set_level(level_.level);
     summary->set_alpha_sq(level_.alpha_sq);
     *summary->mutable_vertices() = ToClassCounts(counts_.vertices);
     *summary->mutable_edges() = ToClassCounts(counts_.edges);
     *summary->mutable_triangles() = ToClassCounts(counts_.triangles);
-    summary->set_components(family.Components(level_.level));
-    summary->set_solid_components(family.SolidComponents(level_.level));
+    summary->set_components(topology_.components);
+    summary->set_solid_components(topology_.solid_components);
     summary->set_interior_area(counts_.interior_area);
-    summary->set_holes(family.Holes(level_.level, mode_));
-    summary->set_hull_area(HullAreaApprox(family));
+    summary->set_holes(mode_ == ClassifyMode::kGeneral ? topology_.holes : topology_.regularized_holes);
+    summary->set_hull_area(hull_area_);
   }
 
   // Fills one chunk of edges or triangles from position_ on: the ordered vertices are copied in a
@@ -168,6 +170,8 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
   Classification classes_;
   ClassificationSummary counts_;
   ResolvedLevel level_;
+  TopologyAtLevel topology_;
+  double hull_area_;
   ClassifyMode mode_;
   bool non_exterior_only_;
   Phase phase_;
@@ -176,28 +180,25 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
 
 class MasterListSource final : public ChunkSource<v1::MasterListResponse> {
  public:
-  MasterListSource(std::shared_ptr<const CachedFamily> cached, int64_t first, int64_t last)
-      : cached_(std::move(cached)), rank_(first) {
-    const auto& begin = cached_->family().ranks().master_begin;
-    position_ = begin[static_cast<size_t>(first)];
-    end_ = begin[static_cast<size_t>(last) + 1];
-  }
+  /// `begins`: master_begin[first..last + 1]; `entries`: the entries of ranks first..last.
+  MasterListSource(std::shared_ptr<const CachedFamily> cached, int64_t first, std::vector<uint32_t> begins,
+                   std::vector<MasterEntry> entries)
+      : cached_(std::move(cached)), first_(first), begins_(std::move(begins)), entries_(std::move(entries)) {}
 
   bool Next(v1::MasterListResponse* message) override {
     message->Clear();
-    if (position_ >= end_) return false;
-    const AlphaFamily& family = cached_->family();
-    const auto& begin = family.ranks().master_begin;
-    const auto& master = family.ranks().master;
-    const size_t count = std::min<size_t>(kMasterEntriesPerChunk, end_ - position_);
+    if (position_ >= entries_.size()) return false;
+    const FamilyReader& family = cached_->reader();
+    const size_t offset = begins_[0];
+    const size_t count = std::min<size_t>(kMasterEntriesPerChunk, entries_.size() - position_);
     message->mutable_ranks()->Reserve(static_cast<int>(count));
     message->mutable_vertex_indices()->Reserve(static_cast<int>(count * 3));
     std::string* kinds = message->mutable_kinds();
     std::string* endpoints = message->mutable_endpoints();
     for (size_t i = 0; i < count; ++i, ++position_) {
-      while (position_ >= begin[static_cast<size_t>(rank_) + 1]) ++rank_;
-      const MasterEntry entry = master[position_];
-      message->add_ranks(static_cast<uint64_t>(rank_));
+      while (offset + position_ >= begins_[rank_index_ + 1]) ++rank_index_;
+      const MasterEntry entry = entries_[position_];
+      message->add_ranks(static_cast<uint64_t>(first_ + static_cast<int64_t>(rank_index_)));
       kinds->push_back(static_cast<char>(static_cast<int>(entry.kind()) + 1));
       endpoints->push_back(static_cast<char>(static_cast<int>(entry.endpoint()) + 1));
       switch (entry.kind()) {
@@ -217,9 +218,11 @@ class MasterListSource final : public ChunkSource<v1::MasterListResponse> {
 
  private:
   std::shared_ptr<const CachedFamily> cached_;
-  int64_t rank_;
+  int64_t first_;
+  std::vector<uint32_t> begins_;
+  std::vector<MasterEntry> entries_;
+  size_t rank_index_ = 0;
   size_t position_ = 0;
-  size_t end_ = 0;
 };
 
 class ShapeTextSource final : public ChunkSource<v1::ShapeResponse> {
@@ -281,7 +284,7 @@ class ShapeRingsSource final : public ChunkSource<v1::ShapeResponse> {
 
 }  // namespace
 
-absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::Threshold& threshold) {
+absl::StatusOr<ResolvedLevel> ResolveLevel(const FamilyReader& family, const v1::Threshold& threshold) {
   Threshold t;
   switch (threshold.value_case()) {
     case v1::Threshold::kRank:
@@ -303,7 +306,7 @@ absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const v1::
     case v1::Threshold::VALUE_NOT_SET:
       return absl::InvalidArgumentError("the request has no threshold: set alpha_sq, alpha, rank or ratio");
   }
-  return ResolveThreshold(family, t);
+  return family.Resolve(t);
 }
 
 absl::StatusOr<ClassifyMode> ToClassifyMode(v1::ClassifyMode mode) {
@@ -333,13 +336,13 @@ absl::StatusOr<VertexRule> ToVertexRule(v1::VertexRule rule) {
 }
 
 void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
-  const AlphaFamily& family = cached.family();
+  const FamilyReader& family = cached.reader();
   summary->set_points(family.points().size());
   summary->set_distinct_points(family.num_unique());
-  summary->set_duplicates(family.num_duplicates());
+  summary->set_duplicates(family.points().size() - family.num_unique());
   summary->set_triangles(family.triangles().size());
   summary->set_edges(family.edges().size());
-  summary->set_spectrum_size(family.spectrum().size());
+  summary->set_spectrum_size(static_cast<uint64_t>(family.max_level()));
   const BuildReport& report = family.report();
   summary->set_backend(report.backend);
   for (const StageTime& stage : report.stage_times) {
@@ -352,34 +355,42 @@ void FillBuildSummary(const CachedFamily& cached, v1::BuildSummary* summary) {
   summary->mutable_comparisons()->set_cpu_fallback(report.comparisons.cpu_fallback);
   summary->set_peak_memory_bytes(report.peak_memory_bytes);
   summary->set_family_bytes(cached.bytes());
+  summary->set_family_device_bytes(cached.device_bytes());
   if (const auto frame = cached.Frame()) summary->set_projection(frame->projection);
   summary->set_weighted(family.weighted());
   if (family.weighted()) {
     // Counted from the flags: HiddenPoints() would build the whole list for its length.
     uint64_t hidden = 0;
-    for (uint32_t v = 0; v < family.points().size(); ++v) hidden += family.hidden(v) ? 1 : 0;
+    for (const uint8_t flag : family.hidden_flags()) hidden += flag != 0 ? 1 : 0;
     summary->set_hidden_points(hidden);
   }
 }
 
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifySource(
     std::shared_ptr<const CachedFamily> cached, const v1::ClassifyRequest& request) {
-  const AlphaFamily& family = cached->family();
+  const FamilyReader& family = cached->reader();
   const absl::StatusOr<ClassifyMode> mode = ToClassifyMode(request.mode());
   if (!mode.ok()) return mode.status();
   const absl::StatusOr<VertexRule> rule = ToVertexRule(request.vertex_rule());
   if (!rule.ok()) return rule.status();
   auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
-  Classification classes = family.ClassifyAll(level->level, *mode, *rule);
-  const ClassificationSummary counts = SummarizeClassification(family, classes);
-  return std::make_unique<ClassifySource>(std::move(cached), std::move(classes), counts, *level, *mode,
-                                          request.non_exterior_only(), request.summary_only());
+  absl::StatusOr<Classification> classes = family.ClassifyAll(level->level, *mode, *rule);
+  if (!classes.ok()) return classes.status();
+  const ClassificationSummary counts =
+      SummarizeClassification(family.points(), family.representative(), family.triangles(), *classes);
+  const absl::StatusOr<std::vector<TopologyAtLevel>> topology = family.TopologyBetween(level->level, level->level);
+  if (!topology.ok()) return topology.status();
+  const absl::StatusOr<double> hull_area = family.HullAreaApprox();
+  if (!hull_area.ok()) return hull_area.status();
+  return std::make_unique<ClassifySource>(std::move(cached), *std::move(classes), counts, *level, topology->front(),
+                                          *hull_area, *mode, request.non_exterior_only(), request.summary_only());
 }
 
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::MasterListResponse>>> MakeMasterListSource(
     std::shared_ptr<const CachedFamily> cached, const v1::MasterListRequest& request) {
-  const int64_t k = cached->family().max_level();
+  const FamilyReader& family = cached->reader();
+  const int64_t k = family.max_level();
   const int64_t first = request.first_rank();
   const int64_t last = request.last_rank() == 0 ? first : request.last_rank();
   if (k == 0) {
@@ -393,7 +404,12 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::MasterListResponse>>> MakeMasterL
   if (last < first || last > k) {
     return absl::InvalidArgumentError(absl::StrCat("last_rank ", last, " is outside ", first, "..", k));
   }
-  return std::make_unique<MasterListSource>(std::move(cached), first, last);
+  absl::StatusOr<std::vector<uint32_t>> begins = family.MasterBegins(first, last - first + 2);
+  if (!begins.ok()) return begins.status();
+  absl::StatusOr<std::vector<MasterEntry>> entries =
+      family.MasterEntries(begins->front(), begins->back() - begins->front());
+  if (!entries.ok()) return entries.status();
+  return std::make_unique<MasterListSource>(std::move(cached), first, *std::move(begins), *std::move(entries));
 }
 
 // The shared_ptr is taken by value like every Make*Source's (one signature for the service's
@@ -406,9 +422,13 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
   }
   const absl::StatusOr<ClassifyMode> mode = ToClassifyMode(request.mode());
   if (!mode.ok()) return mode.status();
-  const AlphaFamily& family = cached->family();
-  auto level = ResolveLevel(family, request.threshold());
+  auto level = ResolveLevel(cached->reader(), request.threshold());
   if (!level.ok()) return level.status();
+  // Shapes are assembled from the family in host memory (for a resident family, a download for
+  // this call).
+  const absl::StatusOr<std::shared_ptr<const AlphaFamily>> host = cached->reader().HostFamily();
+  if (!host.ok()) return host.status();
+  const AlphaFamily& family = **host;
   const double min_hole_area = request.min_hole_area();
   if (std::isnan(min_hole_area) || min_hole_area < 0) {
     return absl::InvalidArgumentError(
@@ -444,7 +464,7 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
   }
 }
 
-absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family, const v1::SpectrumRequest& request) {
+absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const FamilyReader& family, const v1::SpectrumRequest& request) {
   const int64_t k = family.max_level();
   int64_t first = 1;
   switch (request.start_case()) {
@@ -456,7 +476,11 @@ absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family, c
       break;
     case v1::SpectrumRequest::kAtLeastAlphaSq:
       if (std::isnan(request.at_least_alpha_sq())) return absl::InvalidArgumentError("at_least_alpha_sq is NaN");
-      first = family.RankLowerBound(request.at_least_alpha_sq());
+      if (const absl::StatusOr<int64_t> bound = family.RankLowerBound(request.at_least_alpha_sq()); bound.ok()) {
+        first = *bound;
+      } else {
+        return bound.status();
+      }
       break;
     case v1::SpectrumRequest::START_NOT_SET:
       break;
@@ -471,9 +495,10 @@ absl::StatusOr<v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family, c
   response.set_first_rank(first);
   response.set_spectrum_size(k);
   const int64_t end = std::min<int64_t>(k, first - 1 + page);  // last rank on the page
-  const auto& spectrum = family.spectrum();
   if (end >= first) {
-    response.mutable_alpha_sq()->Add(spectrum.begin() + (first - 1), spectrum.begin() + end);
+    const absl::StatusOr<std::vector<double>> values = family.Spectrum(first - 1, end - first + 1);
+    if (!values.ok()) return values.status();
+    response.mutable_alpha_sq()->Add(values->begin(), values->end());
   }
   response.set_next_rank(end < k ? end + 1 : 0);
   return response;
@@ -487,7 +512,7 @@ struct LevelRange {
 };
 
 template <typename Request>
-absl::StatusOr<LevelRange> ResolveLevelRange(const AlphaFamily& family, const Request& request) {
+absl::StatusOr<LevelRange> ResolveLevelRange(const FamilyReader& family, const Request& request) {
   if (request.has_threshold()) {
     auto level = ResolveLevel(family, request.threshold());
     if (!level.ok()) return level.status();
@@ -509,52 +534,66 @@ absl::StatusOr<LevelRange> ResolveLevelRange(const AlphaFamily& family, const Re
 
 }  // namespace
 
-absl::StatusOr<v1::ComponentsResponse> AnswerComponents(const AlphaFamily& family,
+absl::StatusOr<v1::ComponentsResponse> AnswerComponents(const FamilyReader& family,
                                                         const v1::ComponentsRequest& request) {
   const absl::StatusOr<LevelRange> range = ResolveLevelRange(family, request);
   if (!range.ok()) return range.status();
+  const absl::StatusOr<std::vector<TopologyAtLevel>> curves = family.TopologyBetween(range->first, range->last);
+  if (!curves.ok()) return curves.status();
   v1::ComponentsResponse response;
   response.set_first_level(range->first);
-  for (int64_t level = range->first; level <= range->last; ++level) {
-    response.add_components(family.Components(level));
-    response.add_solid_components(family.SolidComponents(level));
+  for (const TopologyAtLevel& at : *curves) {
+    response.add_components(at.components);
+    response.add_solid_components(at.solid_components);
   }
   return response;
 }
 
-absl::StatusOr<v1::BettiResponse> AnswerBetti(const AlphaFamily& family, const v1::BettiRequest& request) {
+absl::StatusOr<v1::BettiResponse> AnswerBetti(const FamilyReader& family, const v1::BettiRequest& request) {
   const absl::StatusOr<LevelRange> range = ResolveLevelRange(family, request);
   if (!range.ok()) return range.status();
+  const absl::StatusOr<std::vector<TopologyAtLevel>> curves = family.TopologyBetween(range->first, range->last);
+  if (!curves.ok()) return curves.status();
   v1::BettiResponse response;
   response.set_first_level(range->first);
-  for (int64_t level = range->first; level <= range->last; ++level) {
-    response.add_components(family.Components(level));
-    response.add_holes(family.Holes(level, ClassifyMode::kGeneral));
-    response.add_regularized_components(family.RegularizedComponents(level));
-    response.add_regularized_holes(family.Holes(level, ClassifyMode::kRegularized));
+  for (const TopologyAtLevel& at : *curves) {
+    response.add_components(at.components);
+    response.add_holes(at.holes);
+    response.add_regularized_components(at.regularized_components);
+    response.add_regularized_holes(at.regularized_holes);
   }
   return response;
 }
 
-absl::StatusOr<v1::OptimalAlphaResponse> AnswerOptimalAlpha(const AlphaFamily& family,
+absl::StatusOr<v1::OptimalAlphaResponse> AnswerOptimalAlpha(const FamilyReader& family,
                                                             const v1::OptimalAlphaRequest& request) {
   if (request.max_components() < 1) return absl::InvalidArgumentError("max_components must be at least 1");
   const std::optional<uint32_t> max_holes =
       request.has_max_holes() ? std::optional<uint32_t>(request.max_holes()) : std::nullopt;
   v1::OptimalAlphaResponse response;
-  if (const std::optional<int64_t> level = family.OptimalLevelRegularized(request.max_components(), max_holes)) {
-    v1::OptimalLevel* out = response.mutable_regularized();
-    out->set_rank(*level);
-    out->set_alpha_sq(PublishedAlphaSq(family, *level));
-    out->set_components(family.SolidComponents(*level));
-    out->set_holes(family.Holes(*level, ClassifyMode::kRegularized));
+  // Each answer's level, published value and curves.
+  auto fill = [&](int64_t level, bool regularized, v1::OptimalLevel* out) -> absl::Status {
+    const absl::StatusOr<double> alpha_sq = family.PublishedAlphaSq(level);
+    if (!alpha_sq.ok()) return alpha_sq.status();
+    const absl::StatusOr<std::vector<TopologyAtLevel>> at = family.TopologyBetween(level, level);
+    if (!at.ok()) return at.status();
+    out->set_rank(level);
+    out->set_alpha_sq(*alpha_sq);
+    out->set_components(regularized ? at->front().solid_components : at->front().components);
+    out->set_holes(regularized ? at->front().regularized_holes : at->front().holes);
+    return absl::OkStatus();
+  };
+  const absl::StatusOr<std::optional<int64_t>> regularized =
+      family.OptimalLevelRegularized(request.max_components(), max_holes);
+  if (!regularized.ok()) return regularized.status();
+  if (*regularized) {
+    if (absl::Status filled = fill(**regularized, true, response.mutable_regularized()); !filled.ok()) return filled;
   }
-  if (const std::optional<int64_t> level = family.OptimalLevelGeneral(request.max_components(), max_holes)) {
-    v1::OptimalLevel* out = response.mutable_general();
-    out->set_rank(*level);
-    out->set_alpha_sq(PublishedAlphaSq(family, *level));
-    out->set_components(family.Components(*level));
-    out->set_holes(family.Holes(*level, ClassifyMode::kGeneral));
+  const absl::StatusOr<std::optional<int64_t>> general =
+      family.OptimalLevelGeneral(request.max_components(), max_holes);
+  if (!general.ok()) return general.status();
+  if (*general) {
+    if (absl::Status filled = fill(**general, false, response.mutable_general()); !filled.ok()) return filled;
   }
   return response;
 }

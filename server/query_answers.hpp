@@ -33,7 +33,7 @@ inline constexpr int64_t kMaxComponentLevels = 262144;
 /// A threshold resolved against a family (core/family/threshold.hpp).
 using ResolvedLevel = ResolvedThreshold;
 /// InvalidArgument: no threshold set, NaN, a negative alpha, a rank outside 0..K.
-absl::StatusOr<ResolvedLevel> ResolveLevel(const AlphaFamily& family, const galpha::v1::Threshold& threshold);
+absl::StatusOr<ResolvedLevel> ResolveLevel(const FamilyReader& family, const galpha::v1::Threshold& threshold);
 
 /// The engine's mode and vertex rule of a request's `mode` and `vertex_rule` (UNSPECIFIED: GENERAL,
 /// REPORT). InvalidArgument naming the field and the value for a number the enum does not define
@@ -67,14 +67,14 @@ absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::MasterListResponse>>> Mak
 absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ShapeResponse>>> MakeShapeSource(
     std::shared_ptr<const CachedFamily> cached, const galpha::v1::ShapeRequest& request);
 
-absl::StatusOr<galpha::v1::SpectrumResponse> AnswerSpectrum(const AlphaFamily& family,
+absl::StatusOr<galpha::v1::SpectrumResponse> AnswerSpectrum(const FamilyReader& family,
                                                             const galpha::v1::SpectrumRequest& request);
-absl::StatusOr<galpha::v1::ComponentsResponse> AnswerComponents(const AlphaFamily& family,
+absl::StatusOr<galpha::v1::ComponentsResponse> AnswerComponents(const FamilyReader& family,
                                                                 const galpha::v1::ComponentsRequest& request);
 /// Betti curves at a threshold or over a rank range (the same limits as Components).
-absl::StatusOr<galpha::v1::BettiResponse> AnswerBetti(const AlphaFamily& family,
+absl::StatusOr<galpha::v1::BettiResponse> AnswerBetti(const FamilyReader& family,
                                                       const galpha::v1::BettiRequest& request);
-absl::StatusOr<galpha::v1::OptimalAlphaResponse> AnswerOptimalAlpha(const AlphaFamily& family,
+absl::StatusOr<galpha::v1::OptimalAlphaResponse> AnswerOptimalAlpha(const FamilyReader& family,
                                                                     const galpha::v1::OptimalAlphaRequest& request);
 
 }  // namespace galpha::server

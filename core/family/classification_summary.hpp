@@ -18,5 +18,10 @@ struct ClassificationSummary {
 };
 
 ClassificationSummary SummarizeClassification(const AlphaFamily& family, const Classification& classes);
+/// The same from the arrays it reads (a resident family's host arrays).
+ClassificationSummary SummarizeClassification(const HostVector<Point2>& points,
+                                              const HostVector<uint32_t>& representative,
+                                              const HostVector<std::array<uint32_t, 3>>& triangles,
+                                              const Classification& classes);
 
 }  // namespace galpha

@@ -138,6 +138,7 @@ class ResidentTablesOn final : public ResidentTables {
            t.edge_triangles.size() * sizeof(EdgeTris) + t.hidden.size() + t.master.size() * sizeof(uint64_t) +
            t.area_units.size() * sizeof(unsigned long long);
   }
+  bool InDeviceMemory() const override { return !System::kHostMemory; }
   uint32_t num_ranks() const override { return sizes_.num_ranks; }
   std::optional<int64_t> solid_level() const override { return sizes_.solid_level; }
 
@@ -203,8 +204,7 @@ class ResidentTablesOn final : public ResidentTables {
   std::vector<uint32_t> MasterBegins(int64_t first_rank, int64_t count) override {
     std::vector<uint32_t> begins(static_cast<size_t>(count));
     if (count > 0) {
-      system_->Download(
-          {{begins.data(), tables_.master_begin.data() + first_rank, begins.size() * sizeof(uint32_t)}});
+      system_->Download({{begins.data(), tables_.master_begin.data() + first_rank, begins.size() * sizeof(uint32_t)}});
     }
     return begins;
   }

@@ -30,8 +30,9 @@ class ResidentTables {
  public:
   virtual ~ResidentTables() = default;
 
-  /// Bytes the tables hold where they live.
+  /// Bytes the tables hold where they live, and whether that is device memory (not the host's).
   virtual size_t Bytes() const = 0;
+  virtual bool InDeviceMemory() const = 0;
   /// K, the number of spectrum values.
   virtual uint32_t num_ranks() const = 0;
   /// The smallest level at which every distinct point (weighted: not hidden) lies on a triangle;

@@ -49,6 +49,8 @@ size_t ResidentAlphaFamily::ResidentBytes() const {
   return tables_->Bytes();
 }
 
+bool ResidentAlphaFamily::TablesInDeviceMemory() const { return tables_->InDeviceMemory(); }
+
 size_t ResidentAlphaFamily::HostBytes() const {
   return sizeof(*this) + VectorBytes(host_.points) + VectorBytes(host_.representative) + VectorBytes(host_.weights) +
          VectorBytes(host_.hidden) + VectorBytes(host_.triangles) + VectorBytes(host_.edges) +
@@ -225,8 +227,8 @@ absl::StatusOr<std::vector<uint32_t>> ResidentAlphaFamily::MasterBegins(int64_t 
 
 absl::StatusOr<std::vector<MasterEntry>> ResidentAlphaFamily::MasterEntries(uint64_t position, uint64_t count) const {
   std::vector<MasterEntry> entries;
-  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, "reading master-list entries",
-                                  [&] { entries = tables_->MasterEntries(position, count); }));
+  GALPHA_RETURN_IF_ERROR(
+      OnTables(*mutex_, "reading master-list entries", [&] { entries = tables_->MasterEntries(position, count); }));
   return entries;
 }
 

@@ -46,6 +46,9 @@ class ResidentAlphaFamily {
   const HostVector<std::array<uint32_t, 3>>& triangles() const { return host_.triangles; }
   const HostVector<std::array<uint32_t, 2>>& edges() const { return host_.edges; }
   bool weighted() const { return !host_.weights.empty(); }
+  /// Weighted: every input point's weight, and 1 for each hidden point (both empty unweighted).
+  const HostVector<double>& weights() const { return host_.weights; }
+  const HostVector<uint8_t>& hidden_flags() const { return host_.hidden; }
   const BuildReport& report() const { return host_.report; }
   const ComparisonCounts& comparisons() const { return host_.ranks.comparisons; }
   /// K, the number of spectrum values (the highest level).
@@ -55,6 +58,8 @@ class ResidentAlphaFamily {
 
   /// Bytes the rank tables hold where they live (device memory after a CUDA build).
   size_t ResidentBytes() const;
+  /// Whether the tables are in device memory (after a CUDA build) rather than the host's.
+  bool TablesInDeviceMemory() const;
   /// Host bytes: the points, weights and mesh.
   size_t HostBytes() const;
 

@@ -46,7 +46,9 @@ class RecordingObserver : public CacheObserver {
     last_entries[static_cast<size_t>(tier)] = entries;
     ++size_reports;
   }
+  void OnDeviceSize(size_t bytes) override { last_device_bytes = bytes; }
 
+  size_t last_device_bytes = 0;
   std::array<uint64_t, 2> hits{}, evictions{};
   uint64_t misses = 0, demotions = 0, promotions = 0, size_reports = 0;
   std::array<size_t, 2> last_bytes{}, last_entries{};
@@ -297,15 +299,15 @@ TEST_F(FamilyCacheTest, FamilyHeldByACallerOutlivesItsEviction) {
   ASSERT_THAT(cache.Insert("", "h-a", MakeFamily(gen::Uniform(40, 1), "held")), IsOk());
   std::shared_ptr<const CachedFamily> held = cache.Find("", "h-a");
   ASSERT_NE(held, nullptr);
-  const size_t points = held->family().points().size();
-  const size_t triangles = held->family().triangles().size();
+  const size_t points = held->reader().points().size();
+  const size_t triangles = held->reader().triangles().size();
   ASSERT_THAT(cache.Insert("", "h-b", b_), IsOk());
   ASSERT_THAT(cache.Insert("", "h-c", c_), IsOk());
   ASSERT_EQ(cache.Find("", "h-a"), nullptr) << "evicted";
   EXPECT_EQ(held.use_count(), 1) << "the caller's reference is the only one left";
-  EXPECT_EQ(held->family().points().size(), points);
-  EXPECT_EQ(held->family().triangles().size(), triangles);
-  EXPECT_EQ(held->EdgeOrder().size(), held->family().edges().size());
+  EXPECT_EQ(held->reader().points().size(), points);
+  EXPECT_EQ(held->reader().triangles().size(), triangles);
+  EXPECT_EQ(held->EdgeOrder().size(), held->reader().edges().size());
 }
 
 TEST_F(FamilyCacheTest, ConcurrentLookupsAndInsertsAreCounted) {
@@ -342,7 +344,7 @@ TEST_F(FamilyCacheTest, ConcurrentLookupsAndInsertsAreCounted) {
 
 /// `compact` holds exactly the points `family` was built from.
 void ExpectPointsOf(const CachedFamily& family, const CompactFamily& compact) {
-  const auto& points = family.family().points();
+  const auto& points = family.reader().points();
   EXPECT_TRUE(std::equal(points.begin(), points.end(), compact.points().begin(), compact.points().end(),
                          [](const Point2& p, const Point2& q) { return p.x == q.x && p.y == q.y; }));
 }
@@ -408,7 +410,7 @@ TEST_F(FamilyCacheTest, InsertOfADemotedFamilyPromotesIt) {
   const std::shared_ptr<const CachedFamily> rebuilt = MakeFamily(found.compact->points(), "a rebuilt");
   ASSERT_NE(rebuilt, nullptr);
   EXPECT_EQ(rebuilt->bytes(), a_->bytes());
-  const AlphaFamily &before = a_->family(), &after = rebuilt->family();
+  const AlphaFamily &before = *a_->host_family(), &after = *rebuilt->host_family();
   EXPECT_TRUE(std::equal(before.triangles().begin(), before.triangles().end(), after.triangles().begin(),
                          after.triangles().end()));
   EXPECT_TRUE(
@@ -512,7 +514,7 @@ TEST(CachedFamilyTest, OrdersArePermutationsSortedByVertexIndices) {
     const std::vector<Point2> points = generator.generate(300, 21);
     const std::shared_ptr<const CachedFamily> cached = MakeFamily(points, generator.name);
     ASSERT_NE(cached, nullptr);
-    const AlphaFamily& family = cached->family();
+    const AlphaFamily& family = *cached->host_family();
     const size_t bytes = cached->bytes();
 
     const std::vector<uint32_t>& edge_order = cached->EdgeOrder();
@@ -547,8 +549,8 @@ TEST(CachedFamilyTest, OrdersOfTinyInputs) {
     SCOPED_TRACE(n);
     const std::shared_ptr<const CachedFamily> cached = MakeFamily(gen::Uniform(n, 22), "tiny");
     ASSERT_NE(cached, nullptr);
-    ExpectIsPermutation(cached->EdgeOrder(), cached->family().edges().size());
-    ExpectIsPermutation(cached->TriangleOrder(), cached->family().triangles().size());
+    ExpectIsPermutation(cached->EdgeOrder(), cached->reader().edges().size());
+    ExpectIsPermutation(cached->TriangleOrder(), cached->reader().triangles().size());
   }
 }
 
@@ -564,7 +566,7 @@ TEST(CachedFamilyTest, OrdersAreSafeToComputeFromManyThreads) {
   for (size_t t = 0; t < seen.size(); ++t) {
     EXPECT_EQ(seen[t], t % 2 == 0 ? &cached->EdgeOrder() : &cached->TriangleOrder());
   }
-  ExpectIsPermutation(cached->EdgeOrder(), cached->family().edges().size());
+  ExpectIsPermutation(cached->EdgeOrder(), cached->reader().edges().size());
 }
 
 }  // namespace

@@ -64,7 +64,7 @@ class FamilyPromoterTest : public ::testing::Test {
   }
 
   FamilyPromoter MakePromoter(BuildScheduler* scheduler) {
-    return FamilyPromoter(cache_.get(), scheduler, Backend::kCpu, 640,
+    return FamilyPromoter(cache_.get(), scheduler, Backend::kCpu, /*resident=*/false, 640,
                           [this](const BuildReport&, double) { ++rebuilds_; });
   }
 
@@ -81,7 +81,7 @@ TEST_F(FamilyPromoterTest, RebuildsTheDemotedFamilyAndCachesIt) {
   ASSERT_THAT(promoted, IsOk());
   EXPECT_EQ(rebuilds_.load(), 1);
   EXPECT_EQ(promoter.in_flight(), 0u);
-  const AlphaFamily &before = a_->family(), &after = (*promoted)->family();
+  const AlphaFamily &before = *a_->host_family(), &after = *(*promoted)->host_family();
   EXPECT_NE(&before, &after);
   EXPECT_TRUE(std::equal(before.triangles().begin(), before.triangles().end(), after.triangles().begin(),
                          after.triangles().end()));

@@ -28,6 +28,7 @@ using testing::Families;
 using testing::LargeFamily;
 using testing::NamedFamily;
 using testing::Rank;
+using testing::ResolveOn;
 using testing::Thresholds;
 
 // ---- Classify -------------------------------------------------------------------------------------
@@ -94,23 +95,22 @@ void ExpectCountsEqual(const v1::ClassCounts& got, const v1::ClassCounts& expect
 }
 
 // Runs one Classify request against the family and checks every message.
-void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const v1::ClassifyRequest& request,
-                   size_t* chunks_out = nullptr) {
+void CheckClassify(const std::shared_ptr<const CachedFamily>& cached, const AlphaFamily& family,
+                   const v1::ClassifyRequest& request, size_t* chunks_out = nullptr) {
   SCOPED_TRACE(request.ShortDebugString());
-  const AlphaFamily& family = cached->family();
   auto source = MakeClassifySource(cached, request);
   ASSERT_THAT(source, IsOk());
   const std::vector<v1::ClassifyResponse> messages = Drain(**source);
   ASSERT_FALSE(messages.empty());
 
-  const int64_t level = ResolveLevel(family, request.threshold())->level;
+  const int64_t level = ResolveOn(family, request.threshold())->level;
   const ClassifyMode mode = *ToClassifyMode(request.mode());
   const Classification classes = family.ClassifyAll(level, mode, *ToVertexRule(request.vertex_rule()));
 
   ASSERT_EQ(messages[0].part_case(), v1::ClassifyResponse::kSummary);
   const v1::ClassifySummary& summary = messages[0].summary();
   EXPECT_EQ(summary.level(), level);
-  EXPECT_EQ(summary.alpha_sq(), ResolveLevel(family, request.threshold())->alpha_sq);
+  EXPECT_EQ(summary.alpha_sq(), ResolveOn(family, request.threshold())->alpha_sq);
   ExpectCountsEqual(summary.vertices(), Count(classes.vertices, &family.representative()));
   ExpectCountsEqual(summary.edges(), Count(classes.edges, nullptr));
   ExpectCountsEqual(summary.triangles(), Count(classes.triangles, nullptr));
@@ -170,7 +170,7 @@ TEST(QueryAnswersTest, ClassifyStreamsEverySimplexInOrder) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    for (const v1::Threshold& threshold : Thresholds(f.cached->family())) {
+    for (const v1::Threshold& threshold : Thresholds(*f.oracle)) {
       for (const v1::ClassifyMode mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
         for (const v1::VertexRule rule : {v1::VERTEX_RULE_REPORT, v1::VERTEX_RULE_CGAL}) {
           for (const bool non_exterior_only : {false, true}) {
@@ -179,7 +179,7 @@ TEST(QueryAnswersTest, ClassifyStreamsEverySimplexInOrder) {
             request.set_mode(mode);
             request.set_vertex_rule(rule);
             request.set_non_exterior_only(non_exterior_only);
-            CheckClassify(f.cached, request);
+            CheckClassify(f.cached, *f.oracle, request);
           }
         }
       }
@@ -191,7 +191,7 @@ TEST(QueryAnswersTest, ClassifyNonExteriorOnlyDropsExactlyTheExterior) {
   const std::shared_ptr<const CachedFamily>& cached = Families()[0].cached;
   ASSERT_NE(cached, nullptr);
   v1::ClassifyRequest request;
-  *request.mutable_threshold() = Rank(cached->family().max_level() / 3);
+  *request.mutable_threshold() = Rank(cached->host_family()->max_level() / 3);
   auto all = MakeClassifySource(cached, request);
   request.set_non_exterior_only(true);
   auto some = MakeClassifySource(cached, request);
@@ -222,11 +222,11 @@ TEST(QueryAnswersTest, ClassifySummaryOnlySendsOneMessage) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    for (const v1::Threshold& threshold : Thresholds(f.cached->family())) {
+    for (const v1::Threshold& threshold : Thresholds(*f.oracle)) {
       v1::ClassifyRequest request;
       *request.mutable_threshold() = threshold;
       request.set_summary_only(true);
-      CheckClassify(f.cached, request);
+      CheckClassify(f.cached, *f.oracle, request);
     }
   }
 }
@@ -236,23 +236,23 @@ TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
   ASSERT_NE(cached, nullptr);
   v1::ClassifyRequest request;
   EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-  *request.mutable_threshold() = Rank(cached->family().max_level() + 1);
+  *request.mutable_threshold() = Rank(cached->host_family()->max_level() + 1);
   EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
 TEST(QueryAnswersTest, ClassifyChunksNeverExceedTheLimit) {
   const std::shared_ptr<const CachedFamily> cached = LargeFamily();
   ASSERT_NE(cached, nullptr);
-  ASSERT_GT(cached->family().edges().size(), size_t{kSimplicesPerChunk}) << "the test needs several edge chunks";
-  for (const int64_t rank : {cached->family().max_level() / 2, cached->family().max_level()}) {
+  ASSERT_GT(cached->host_family()->edges().size(), size_t{kSimplicesPerChunk}) << "the test needs several edge chunks";
+  for (const int64_t rank : {cached->host_family()->max_level() / 2, cached->host_family()->max_level()}) {
     for (const bool non_exterior_only : {false, true}) {
       v1::ClassifyRequest request;
       *request.mutable_threshold() = Rank(rank);
       request.set_non_exterior_only(non_exterior_only);
       size_t chunks = 0;
-      CheckClassify(cached, request, &chunks);
+      CheckClassify(cached, *cached->host_family(), request, &chunks);
       // Every simplex is sent, or (at rank K) none is exterior: edges take two chunks.
-      if (!non_exterior_only || rank == cached->family().max_level()) {
+      if (!non_exterior_only || rank == cached->host_family()->max_level()) {
         EXPECT_GE(chunks, 4u) << "vertices, edges in two chunks, triangles";
       }
     }

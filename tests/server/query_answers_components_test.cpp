@@ -22,6 +22,7 @@ using galpha::testing::StatusIs;
 using testing::Families;
 using testing::NamedFamily;
 using testing::Rank;
+using testing::ResolveOn;
 using testing::Thresholds;
 
 // ---- Components / OptimalAlpha --------------------------------------------------------------------
@@ -30,15 +31,15 @@ TEST(QueryAnswersTest, ComponentsAtAThresholdAndOverARange) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
     for (const v1::Threshold& threshold : Thresholds(family)) {
       SCOPED_TRACE(threshold.ShortDebugString());
       v1::ComponentsRequest request;
       *request.mutable_threshold() = threshold;
-      const absl::StatusOr<v1::ComponentsResponse> response = AnswerComponents(family, request);
+      const absl::StatusOr<v1::ComponentsResponse> response = AnswerComponents(f.cached->reader(), request);
       ASSERT_THAT(response, IsOk());
-      const int64_t level = ResolveLevel(family, threshold)->level;
+      const int64_t level = ResolveOn(family, threshold)->level;
       EXPECT_EQ(response->first_level(), level);
       ASSERT_EQ(response->components_size(), 1);
       ASSERT_EQ(response->solid_components_size(), 1);
@@ -51,7 +52,7 @@ TEST(QueryAnswersTest, ComponentsAtAThresholdAndOverARange) {
       v1::ComponentsRequest request;
       request.mutable_ranks()->set_first(first);
       request.mutable_ranks()->set_last(last);
-      const absl::StatusOr<v1::ComponentsResponse> response = AnswerComponents(family, request);
+      const absl::StatusOr<v1::ComponentsResponse> response = AnswerComponents(f.cached->reader(), request);
       ASSERT_THAT(response, IsOk());
       EXPECT_EQ(response->first_level(), first);
       ASSERT_EQ(response->components_size(), last - first + 1);
@@ -68,9 +69,9 @@ TEST(QueryAnswersTest, ComponentsRefusesBadRequests) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
-    EXPECT_THAT(AnswerComponents(family, v1::ComponentsRequest()).status(),
+    EXPECT_THAT(AnswerComponents(f.cached->reader(), v1::ComponentsRequest()).status(),
                 StatusIs(absl::StatusCode::kInvalidArgument));
     const std::vector<std::pair<int64_t, int64_t>> bad = {{-1, 0}, {0, k + 1}, {1, 0}, {k + 1, k + 1}, {-5, -1}};
     for (const auto& [first, last] : bad) {
@@ -78,15 +79,15 @@ TEST(QueryAnswersTest, ComponentsRefusesBadRequests) {
       v1::ComponentsRequest request;
       request.mutable_ranks()->set_first(first);
       request.mutable_ranks()->set_last(last);
-      const auto response = AnswerComponents(family, request);
+      const auto response = AnswerComponents(f.cached->reader(), request);
       EXPECT_THAT(response.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     }
     v1::ComponentsRequest beyond;
     *beyond.mutable_threshold() = Rank(k + 1);
-    EXPECT_THAT(AnswerComponents(family, beyond).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(AnswerComponents(f.cached->reader(), beyond).status(), StatusIs(absl::StatusCode::kInvalidArgument));
     v1::ComponentsRequest no_value;
     no_value.mutable_threshold();  // a threshold with none of its three values
-    EXPECT_THAT(AnswerComponents(family, no_value).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(AnswerComponents(f.cached->reader(), no_value).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 
@@ -94,12 +95,12 @@ TEST(QueryAnswersTest, OptimalAlphaMatchesTheFamily) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     for (const uint32_t n : {1u, 2u, 3u, 5u, 10u, 100u, 1000000u}) {
       SCOPED_TRACE(n);
       v1::OptimalAlphaRequest request;
       request.set_max_components(n);
-      const absl::StatusOr<v1::OptimalAlphaResponse> response = AnswerOptimalAlpha(family, request);
+      const absl::StatusOr<v1::OptimalAlphaResponse> response = AnswerOptimalAlpha(f.cached->reader(), request);
       ASSERT_THAT(response, IsOk());
       const auto published = [&](int64_t level) {
         return level == 0 ? 0.0 : family.spectrum()[static_cast<size_t>(level - 1)];
@@ -121,7 +122,7 @@ TEST(QueryAnswersTest, OptimalAlphaMatchesTheFamily) {
         EXPECT_LE(response->general().components(), n);
       }
     }
-    const auto refused = AnswerOptimalAlpha(family, v1::OptimalAlphaRequest());
+    const auto refused = AnswerOptimalAlpha(f.cached->reader(), v1::OptimalAlphaRequest());
     EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }

@@ -34,7 +34,12 @@ const std::vector<NamedFamily>& Families() {
         {"two_equal_points", {{0.25, 0.5}, {0.25, 0.5}}},
     };
     auto* built = new std::vector<NamedFamily>();
-    for (const auto& [name, points] : inputs) built->push_back({name, MakeCachedFamily(points, name)});
+    for (const auto& [name, points] : inputs) {
+      std::shared_ptr<const CachedFamily> host = MakeCachedFamily(points, name);
+      std::shared_ptr<const AlphaFamily> oracle(host, host->host_family());
+      built->push_back({name, host, oracle});
+      built->push_back({name + "/resident", MakeResidentCachedFamily(points, name), oracle});
+    }
     return built;
   }();
   return *families;
@@ -43,6 +48,12 @@ const std::vector<NamedFamily>& Families() {
 std::shared_ptr<const CachedFamily> LargeFamily() {
   static const std::shared_ptr<const CachedFamily> family = MakeCachedFamily(gen::Uniform(50000, 8), "uniform_50000");
   return family;
+}
+
+absl::StatusOr<ResolvedLevel> ResolveOn(const AlphaFamily& family, const v1::Threshold& threshold) {
+  // A reader that does not own the family: it lives as long as the caller's reference.
+  const HostFamilyReader reader(std::shared_ptr<const AlphaFamily>(&family, [](const AlphaFamily*) {}));
+  return ResolveLevel(reader, threshold);
 }
 
 v1::Threshold Rank(int64_t rank) {

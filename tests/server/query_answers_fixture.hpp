@@ -17,16 +17,19 @@
 
 namespace galpha::server::testing {
 
+/// A family in one of the forms the service caches (`cached`: in host memory, or resident), and
+/// the same points' family in host memory, which the tests read their expectations from.
 struct NamedFamily {
   std::string name;
   std::shared_ptr<const CachedFamily> cached;
+  std::shared_ptr<const AlphaFamily> oracle;
 };
 
 /// Points (i, 2i + 1) in shuffled order: exactly collinear, so edges only.
 std::vector<Point2> OneLine(size_t n, uint64_t seed);
 
 /// The families every test runs on, built once: uniform, a grid, duplicates, two crossing lines,
-/// one line, and 0, 1, 2 (and 2 equal) points.
+/// one line, and 0, 1, 2 (and 2 equal) points, each in host memory and resident ("NAME/resident").
 const std::vector<NamedFamily>& Families();
 
 /// Enough points that every kind of Classify chunk, and the master list, span several messages.
@@ -36,6 +39,9 @@ v1::Threshold Rank(int64_t rank);
 v1::Threshold AlphaSq(double alpha_sq);
 v1::Threshold Alpha(double alpha);
 v1::Threshold Ratio(double ratio);
+
+/// ResolveLevel on a family in host memory (the tests' expectations).
+absl::StatusOr<ResolvedLevel> ResolveOn(const AlphaFamily& family, const v1::Threshold& threshold);
 
 /// Thresholds of every kind that hit interesting levels of `family`.
 std::vector<v1::Threshold> Thresholds(const AlphaFamily& family);

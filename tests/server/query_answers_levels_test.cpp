@@ -25,6 +25,7 @@ using testing::Families;
 using testing::NamedFamily;
 using testing::Rank;
 using testing::Ratio;
+using testing::ResolveOn;
 using testing::Thresholds;
 
 // ---- ResolveLevel ---------------------------------------------------------------------------------
@@ -33,17 +34,17 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
     for (int64_t rank = 0; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
-      const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(family, Rank(rank));
+      const absl::StatusOr<ResolvedLevel> resolved = ResolveOn(family, Rank(rank));
       ASSERT_THAT(resolved, IsOk());
       EXPECT_EQ(resolved->level, *family.LevelForRank(rank));
       EXPECT_EQ(resolved->alpha_sq, rank == 0 ? 0.0 : family.spectrum()[static_cast<size_t>(rank - 1)]);
     }
     for (const v1::Threshold& threshold : Thresholds(family)) {
       SCOPED_TRACE(threshold.ShortDebugString());
-      const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(family, threshold);
+      const absl::StatusOr<ResolvedLevel> resolved = ResolveOn(family, threshold);
       ASSERT_THAT(resolved, IsOk());
       switch (threshold.value_case()) {
         case v1::Threshold::kRank:
@@ -68,7 +69,7 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
     // Every spectrum value, as alpha_sq, resolves to its own rank (exact comparison).
     for (int64_t rank = 1; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
       const absl::StatusOr<ResolvedLevel> resolved =
-          ResolveLevel(family, AlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
+          ResolveOn(family, AlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
       ASSERT_THAT(resolved, IsOk());
       EXPECT_EQ(resolved->level, *family.LevelForAlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
     }
@@ -79,19 +80,19 @@ TEST(QueryAnswersTest, ResolveLevelRefusesBadThresholds) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
-    const absl::StatusOr<ResolvedLevel> none = ResolveLevel(family, v1::Threshold());
+    const absl::StatusOr<ResolvedLevel> none = ResolveOn(family, v1::Threshold());
     EXPECT_THAT(none.status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    const absl::StatusOr<ResolvedLevel> beyond = ResolveLevel(family, Rank(k + 1));
+    const absl::StatusOr<ResolvedLevel> beyond = ResolveOn(family, Rank(k + 1));
     EXPECT_THAT(beyond.status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveLevel(family, Ratio(1.5)).status(),
+    EXPECT_THAT(ResolveOn(family, Ratio(1.5)).status(),
                 StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("outside 0..1")));
     EXPECT_NE(beyond.status().message().find(absl::StrCat(k + 1)), absl::string_view::npos) << beyond.status();
-    EXPECT_THAT(ResolveLevel(family, Rank(-1)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveLevel(family, AlphaSq(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveLevel(family, Alpha(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveLevel(family, Alpha(-1.0)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveOn(family, Rank(-1)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveOn(family, AlphaSq(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveOn(family, Alpha(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveOn(family, Alpha(-1.0)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 
@@ -117,7 +118,7 @@ TEST(QueryAnswersTest, BuildSummaryDescribesTheFamily) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     v1::BuildSummary summary;
     FillBuildSummary(*f.cached, &summary);
     EXPECT_EQ(summary.name(), "") << "a family keeps no caller's name";

@@ -27,6 +27,7 @@ using testing::Families;
 using testing::LargeFamily;
 using testing::NamedFamily;
 using testing::Rank;
+using testing::ResolveOn;
 using testing::Thresholds;
 
 // ---- Shape ----------------------------------------------------------------------------------------
@@ -35,11 +36,11 @@ TEST(QueryAnswersTest, ShapeTextFormatsMatchTheWriters) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     for (const v1::Threshold& threshold : Thresholds(family)) {
       for (const v1::ClassifyMode mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
         SCOPED_TRACE(absl::StrCat(threshold.ShortDebugString(), " mode ", mode));
-        const int64_t level = ResolveLevel(family, threshold)->level;
+        const int64_t level = ResolveOn(family, threshold)->level;
         const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, *ToClassifyMode(mode)));
         ASSERT_THAT(shape, IsOk());
         const std::pair<v1::ShapeFormat, std::string> formats[] = {
@@ -72,12 +73,12 @@ TEST(QueryAnswersTest, ShapeTextFormatsMatchTheWriters) {
 TEST(QueryAnswersTest, ShapeTextOfALargeFamilySpansSeveralPieces) {
   const std::shared_ptr<const CachedFamily> cached = LargeFamily();
   ASSERT_NE(cached, nullptr);
-  const AlphaFamily& family = cached->family();
+  const AlphaFamily& family = *cached->host_family();
   v1::ShapeRequest request;
   *request.mutable_threshold() = Rank(family.max_level() / 3);
   request.set_format(v1::SHAPE_FORMAT_GEOJSON);
   const absl::StatusOr<ShapeGeometry> shape =
-      AssembleShape(family.ComplexAt(ResolveLevel(family, request.threshold())->level, ClassifyMode::kGeneral));
+      AssembleShape(family.ComplexAt(ResolveOn(family, request.threshold())->level, ClassifyMode::kGeneral));
   ASSERT_THAT(shape, IsOk());
   const std::string expected = ShapeToGeoJson(*shape, family.points());
   ASSERT_GT(expected.size(), kShapeTextBytesPerChunk) << "the test needs a text of several pieces";
@@ -143,11 +144,11 @@ TEST(QueryAnswersTest, ShapeRingsReproduceTheGeometry) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     for (const v1::Threshold& threshold : Thresholds(family)) {
       for (const v1::ClassifyMode mode : {v1::CLASSIFY_MODE_GENERAL, v1::CLASSIFY_MODE_REGULARIZED}) {
         SCOPED_TRACE(absl::StrCat(threshold.ShortDebugString(), " mode ", mode));
-        const int64_t level = ResolveLevel(family, threshold)->level;
+        const int64_t level = ResolveOn(family, threshold)->level;
         const absl::StatusOr<ShapeGeometry> shape = AssembleShape(family.ComplexAt(level, *ToClassifyMode(mode)));
         ASSERT_THAT(shape, IsOk());
         v1::ShapeRequest request;
@@ -174,7 +175,7 @@ TEST(QueryAnswersTest, ShapeRingsReproduceTheGeometry) {
 TEST(QueryAnswersTest, ShapeRingsOfALargeFamily) {
   const std::shared_ptr<const CachedFamily> cached = LargeFamily();
   ASSERT_NE(cached, nullptr);
-  const AlphaFamily& family = cached->family();
+  const AlphaFamily& family = *cached->host_family();
   for (const int64_t rank : {family.max_level() / 3, family.max_level() / 10}) {
     SCOPED_TRACE(rank);
     v1::ShapeRequest request;
@@ -199,7 +200,7 @@ TEST(QueryAnswersTest, ShapeRefusesBadRequests) {
   request.set_format(v1::SHAPE_FORMAT_WKT);
   request.clear_threshold();
   EXPECT_THAT(MakeShapeSource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-  *request.mutable_threshold() = Rank(cached->family().max_level() + 1);
+  *request.mutable_threshold() = Rank(cached->host_family()->max_level() + 1);
   EXPECT_THAT(MakeShapeSource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   request.set_format(static_cast<v1::ShapeFormat>(99));
   *request.mutable_threshold() = Rank(1);

@@ -27,7 +27,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
     for (const uint32_t page_size : {1u, 7u, 1000u, 0u, kMaxSpectrumPage}) {
       SCOPED_TRACE(page_size);
@@ -37,7 +37,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
       request.set_first_rank(1);
       for (int pages = 0;; ++pages) {
         ASSERT_LT(pages, 100000) << "next_rank never reaches 0";
-        const absl::StatusOr<v1::SpectrumResponse> page = AnswerSpectrum(family, request);
+        const absl::StatusOr<v1::SpectrumResponse> page = AnswerSpectrum(f.cached->reader(), request);
         ASSERT_THAT(page, IsOk());
         EXPECT_EQ(page->first_rank(), request.first_rank());
         EXPECT_EQ(page->spectrum_size(), k);
@@ -55,7 +55,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
       EXPECT_EQ(all, family.spectrum());
     }
     // Without a start: from rank 1, 65536 values per page.
-    const absl::StatusOr<v1::SpectrumResponse> whole = AnswerSpectrum(family, v1::SpectrumRequest());
+    const absl::StatusOr<v1::SpectrumResponse> whole = AnswerSpectrum(f.cached->reader(), v1::SpectrumRequest());
     ASSERT_THAT(whole, IsOk());
     EXPECT_EQ(whole->first_rank(), 1);
     EXPECT_EQ(std::vector<double>(whole->alpha_sq().begin(), whole->alpha_sq().end()), family.spectrum());
@@ -63,7 +63,7 @@ TEST(QueryAnswersTest, SpectrumPagesConcatenateToTheSpectrum) {
     // K + 1: an empty page at the end.
     v1::SpectrumRequest past;
     past.set_first_rank(k + 1);
-    const absl::StatusOr<v1::SpectrumResponse> empty = AnswerSpectrum(family, past);
+    const absl::StatusOr<v1::SpectrumResponse> empty = AnswerSpectrum(f.cached->reader(), past);
     ASSERT_THAT(empty, IsOk());
     EXPECT_EQ(empty->alpha_sq_size(), 0);
     EXPECT_EQ(empty->next_rank(), 0);
@@ -75,7 +75,7 @@ TEST(QueryAnswersTest, SpectrumFromAtLeastAlphaSq) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
     const auto& s = family.spectrum();
     std::vector<double> values = {-1.0, 0.0, 1e-300, std::numeric_limits<double>::infinity(), 1e300};
@@ -90,7 +90,7 @@ TEST(QueryAnswersTest, SpectrumFromAtLeastAlphaSq) {
       v1::SpectrumRequest request;
       request.set_at_least_alpha_sq(x);
       request.set_page_size(5);
-      const absl::StatusOr<v1::SpectrumResponse> page = AnswerSpectrum(family, request);
+      const absl::StatusOr<v1::SpectrumResponse> page = AnswerSpectrum(f.cached->reader(), request);
       ASSERT_THAT(page, IsOk());
       const int64_t first = family.RankLowerBound(x);
       EXPECT_EQ(page->first_rank(), first);
@@ -108,20 +108,21 @@ TEST(QueryAnswersTest, SpectrumRefusesBadRequests) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
     ASSERT_NE(f.cached, nullptr);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
     for (const int64_t first : {int64_t{0}, int64_t{-1}, k + 2}) {
       v1::SpectrumRequest request;
       request.set_first_rank(first);
-      EXPECT_THAT(AnswerSpectrum(family, request).status(), StatusIs(absl::StatusCode::kInvalidArgument)) << first;
+      EXPECT_THAT(AnswerSpectrum(f.cached->reader(), request).status(), StatusIs(absl::StatusCode::kInvalidArgument))
+          << first;
     }
     v1::SpectrumRequest too_large;
     too_large.set_page_size(kMaxSpectrumPage + 1);
-    const auto refused = AnswerSpectrum(family, too_large);
+    const auto refused = AnswerSpectrum(f.cached->reader(), too_large);
     EXPECT_THAT(refused.status(), StatusIs(absl::StatusCode::kInvalidArgument));
     v1::SpectrumRequest nan;
     nan.set_at_least_alpha_sq(std::nan(""));
-    EXPECT_THAT(AnswerSpectrum(family, nan).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(AnswerSpectrum(f.cached->reader(), nan).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 

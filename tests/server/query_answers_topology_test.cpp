@@ -37,11 +37,11 @@ using testing::Thresholds;
 TEST(QueryAnswersTopologyTest, BettiAtAThresholdAndOverARange) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     for (const v1::Threshold& threshold : Thresholds(family)) {
       v1::BettiRequest request;
       *request.mutable_threshold() = threshold;
-      const absl::StatusOr<v1::BettiResponse> response = AnswerBetti(family, request);
+      const absl::StatusOr<v1::BettiResponse> response = AnswerBetti(f.cached->reader(), request);
       ASSERT_THAT(response, IsOk());
       ASSERT_EQ(response->holes_size(), 1);
       const int64_t level = response->first_level();
@@ -53,7 +53,7 @@ TEST(QueryAnswersTopologyTest, BettiAtAThresholdAndOverARange) {
     v1::BettiRequest request;
     request.mutable_ranks()->set_first(0);
     request.mutable_ranks()->set_last(family.max_level());
-    const absl::StatusOr<v1::BettiResponse> response = AnswerBetti(family, request);
+    const absl::StatusOr<v1::BettiResponse> response = AnswerBetti(f.cached->reader(), request);
     ASSERT_THAT(response, IsOk());
     ASSERT_EQ(response->components_size(), family.max_level() + 1);
     for (int64_t level = 0; level <= family.max_level(); ++level) {
@@ -64,8 +64,9 @@ TEST(QueryAnswersTopologyTest, BettiAtAThresholdAndOverARange) {
       EXPECT_EQ(response->regularized_holes(i), family.Holes(level, ClassifyMode::kRegularized));
     }
     request.mutable_ranks()->set_last(family.max_level() + 1);
-    EXPECT_THAT(AnswerBetti(family, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(AnswerBetti(family, v1::BettiRequest()).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(AnswerBetti(f.cached->reader(), request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(AnswerBetti(f.cached->reader(), v1::BettiRequest()).status(),
+                StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 
@@ -73,12 +74,12 @@ TEST(QueryAnswersTopologyTest, BettiAtAThresholdAndOverARange) {
 TEST(QueryAnswersTopologyTest, OptimalAlphaWithAHoleBound) {
   for (const NamedFamily& f : Families()) {
     SCOPED_TRACE(f.name);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     for (uint32_t holes : {0u, 1u, 5u}) {
       v1::OptimalAlphaRequest request;
       request.set_max_components(1);
       request.set_max_holes(holes);
-      const absl::StatusOr<v1::OptimalAlphaResponse> response = AnswerOptimalAlpha(family, request);
+      const absl::StatusOr<v1::OptimalAlphaResponse> response = AnswerOptimalAlpha(f.cached->reader(), request);
       ASSERT_THAT(response, IsOk());
       const std::optional<int64_t> regularized = family.OptimalLevelRegularized(1, holes);
       ASSERT_EQ(response->has_regularized(), regularized.has_value());
@@ -106,10 +107,11 @@ TEST(QueryAnswersTopologyTest, OptimalAlphaWithAHoleBound) {
 // Every pair of the diagram in the stream, in order, named by its sorted vertices.
 TEST(QueryAnswersTopologyTest, PersistenceStreamsTheDiagram) {
   std::vector<NamedFamily> families = Families();
-  families.push_back({"large", LargeFamily()});
+  families.push_back(
+      {"large", LargeFamily(), std::shared_ptr<const AlphaFamily>(LargeFamily(), LargeFamily()->host_family())});
   for (const NamedFamily& f : families) {
     SCOPED_TRACE(f.name);
-    const AlphaFamily& family = f.cached->family();
+    const AlphaFamily& family = *f.oracle;
     const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(family);
     ASSERT_THAT(diagram, IsOk());
     auto source = MakePersistenceSource(f.cached, v1::PersistenceRequest());
@@ -160,7 +162,7 @@ TEST(QueryAnswersTopologyTest, PersistenceStreamsTheDiagram) {
 
 TEST(QueryAnswersTopologyTest, PersistenceFiltersByDimensionAndPersistence) {
   const std::shared_ptr<const CachedFamily> cached = LargeFamily();
-  const AlphaFamily& family = cached->family();
+  const AlphaFamily& family = *cached->host_family();
   const absl::StatusOr<PersistenceDiagram> diagram = ComputePersistence(family);
   ASSERT_THAT(diagram, IsOk());
   // The median finite persistence of H1: about half the holes pass.
@@ -251,7 +253,9 @@ TEST(QueryAnswersTopologyTest, ShapeFillsHolesBelowMinHoleArea) {
   EXPECT_NE(kept.find("), ("), std::string::npos) << "one hole ring: " << kept;
   EXPECT_EQ(also_kept, kept);
   EXPECT_EQ(filled.find("), ("), std::string::npos) << "no hole ring: " << filled;
-  EXPECT_EQ(cached->family().Holes(cached->family().LevelForAlphaSq(0.5).value(), ClassifyMode::kRegularized), 1u);
+  EXPECT_EQ(
+      cached->host_family()->Holes(cached->host_family()->LevelForAlphaSq(0.5).value(), ClassifyMode::kRegularized),
+      1u);
   EXPECT_NE(wkt(-1).find("min_hole_area"), std::string::npos);
   EXPECT_NE(wkt(std::nan("")).find("min_hole_area"), std::string::npos);
 }
