@@ -8,7 +8,10 @@
 //
 //   service_bench [--backend=auto|cpu|cuda] [--points=N] [--clients=1,2,4,8] [--repeat=R]
 //                 [--query-seconds=S] [--query-clients=Q] [--build-slots=K] [--cgal-max=N]
-//                 [--links=loopback,1gbit,10gbit]
+//                 [--links=loopback,1gbit,10gbit] [--device-cache-bytes=N]
+// --device-cache-bytes gives the server a device budget for resident families (CUDA builds keep
+// their tables on the GPU and answer from there: server/README.md, "Cache"); 0 (the default):
+// CUDA families are downloaded into host memory. The CPU backend's families are resident either way.
 #include <CGAL/Alpha_shape_2.h>
 #include <CGAL/Alpha_shape_face_base_2.h>
 #include <CGAL/Alpha_shape_vertex_base_2.h>
@@ -65,6 +68,7 @@ struct Options {
   size_t cgal_max = 1000000;
   /// "loopback" and tc rates ("1gbit", "10gbit", "100mbit"): the links Build and Classify cross.
   std::vector<std::string> links = {"loopback"};
+  size_t device_cache_bytes = 0;
 };
 
 /// A tc rate "<digits><kbit|mbit|gbit>" in bits per second; 0 when it is not one.
@@ -107,6 +111,8 @@ bool ParseOptions(int argc, char** argv, Options* options) {
       ok = absl::SimpleAtoi(value, &options->build_slots);
     } else if (name == "--cgal-max") {
       ok = absl::SimpleAtoi(value, &options->cgal_max);
+    } else if (name == "--device-cache-bytes") {
+      ok = absl::SimpleAtoi(value, &options->device_cache_bytes);
     } else if (name == "--links") {
       options->links = absl::StrSplit(value, ',');
       for (const std::string& link : options->links) ok = ok && (link == "loopback" || RateBits(link) > 0);
@@ -129,6 +135,7 @@ server::ServerOptions BenchServerOptions(const Options& options, const std::stri
   server_options.service.build_slots = options.build_slots;
   server_options.service.max_queued_builds = 256;
   server_options.service.cache_bytes = size_t{64} << 30;
+  server_options.service.device_cache_bytes = options.device_cache_bytes;
   server_options.service.max_in_flight_bytes = size_t{64} << 30;
   // The bench's clients are one anonymous tenant: its share must not be what limits them.
   server_options.service.max_tenant_queued_builds = 256;
@@ -390,12 +397,17 @@ int MeasurePromotion(const Options& options, const std::vector<Point2>& points, 
   const std::vector<Point2> other = gen::Uniform(options.points, 2);
   server::ServerOptions server_options = BenchServerOptions(options, "127.0.0.1:0");
   {
+    // Room for one family of either set (their sizes differ by a few percent), in the form the
+    // server caches it.
     BuildOptions build;
     build.backend = options.backend;
-    auto family = BuildAlphaFamily(points, build);
-    if (!family.ok()) return 1;
-    // Room for one family of either set (their sizes differ by a few percent).
-    server_options.service.cache_bytes = server::CachedFamily(*std::move(family)).bytes() * 5 / 4;
+    const bool on_cpu =
+        options.backend == Backend::kCpu || (options.backend == Backend::kAuto && !CudaBackendAvailable());
+    const bool resident = options.device_cache_bytes > 0 || on_cpu;
+    auto cached = server::BuildCachedFamily(points, {}, /*weighted=*/false, build, resident, nullptr);
+    if (!cached.ok()) return 1;
+    server_options.service.cache_bytes = (*cached)->bytes() * 5 / 4;
+    if (options.device_cache_bytes > 0) server_options.service.device_cache_bytes = (*cached)->device_bytes() * 5 / 4;
   }
   auto server = server::GalphaServer::Start(server_options);
   if (!server.ok()) {
@@ -466,9 +478,12 @@ int Run(const Options& options) {
   }
   const int port = (*server)->port();
   const std::string backend = (*server)->service().backend_name();
-  std::printf("service_bench: %zu uniform points, %s backend, %zu build slots, best of %d, %u host threads\n\n",
-              options.points, backend.c_str(), (*server)->service().build_slots(), options.repeat,
-              std::thread::hardware_concurrency());
+  std::printf(
+      "service_bench: %zu uniform points, %s backend, %zu build slots, best of %d, %u host threads, device cache %zu "
+      "bytes (%s)\n\n",
+      options.points, backend.c_str(), (*server)->service().build_slots(), options.repeat,
+      std::thread::hardware_concurrency(), options.device_cache_bytes,
+      backend == "cpu" || options.device_cache_bytes > 0 ? "families resident where built" : "families in host memory");
   auto client = Client(port);
   const std::vector<Point2> points = gen::Uniform(options.points, 1);
 

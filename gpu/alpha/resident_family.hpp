@@ -2,7 +2,7 @@
 // after a CUDA build; on the OpenMP backend the host memory the build computed them in, with no
 // second copy), queryable at once: classification, curves, optimal levels, master-list and
 // spectrum slices run there and only their answers come back (issue 16; docs/design.md,
-// "Resident families"). The points and the mesh (triangles, edges, duplicate map) are kept on the
+// "Engine API"). The points and the mesh (triangles, edges, duplicate map) are kept on the
 // host, where geometry and exact threshold comparisons read them. ToHostFamily() gives the same
 // family as BuildAlphaFamily, array for array.
 #pragma once
