@@ -107,8 +107,8 @@ ResidentResult RunOne(const std::string& name, const std::vector<Point2>& points
     r.same &= resident_classes->vertices == host_classes.vertices && resident_classes->edges == host_classes.edges &&
               resident_classes->triangles == host_classes.triangles;
     const absl::StatusOr<TopologyAtLevel> at = resident->TopologyAt(level);
-    r.same &= at.ok() && at->components == host->Components(level) &&
-              at->holes == host->Holes(level, ClassifyMode::kGeneral);
+    r.same &=
+        at.ok() && at->components == host->Components(level) && at->holes == host->Holes(level, ClassifyMode::kGeneral);
 
     start = std::chrono::steady_clock::now();
     const absl::StatusOr<AlphaFamily> downloaded = resident->ToHostFamily();
