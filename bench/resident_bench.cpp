@@ -7,8 +7,9 @@
 // usable) of each form and their ratio; the host form's "download" stage and the resident one's
 // "keep_resident"; ClassifyAll at the middle level from each form; ToHostFamily (the download done
 // later, when asked); bytes per input point that each form holds (resident: where the tables live,
-// and on the host). Every answer of the resident family at the middle level is checked against
-// the host family's (the bench fails on a difference).
+// and on the host), and each build's engine working-memory peak. Every answer of the resident
+// family at the middle level is checked against the host family's (the bench fails on a
+// difference).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -51,6 +52,8 @@ struct ResidentResult {
   double host_classify_ms = kNone, resident_classify_ms = kNone;
   double to_host_ms = kNone;
   double host_bytes_per_point = 0, resident_device_per_point = 0, resident_host_per_point = 0;
+  // The engine's working-memory peak (its ledger: device memory on CUDA, host memory on the CPU).
+  double host_peak_per_point = 0, resident_peak_per_point = 0;
   bool same = true;
   std::string error;
 };
@@ -74,6 +77,8 @@ ResidentResult RunOne(const std::string& name, const std::vector<Point2>& points
       r.download_ms = StageMs(host->report(), "download");
     }
     r.backend = host->report().backend;
+    r.host_peak_per_point =
+        static_cast<double>(host->report().peak_memory_bytes) / static_cast<double>(std::max<size_t>(1, r.n));
     r.host_bytes_per_point = static_cast<double>(host->HostBytes()) / static_cast<double>(std::max<size_t>(1, r.n));
 
     start = std::chrono::steady_clock::now();
@@ -91,6 +96,8 @@ ResidentResult RunOne(const std::string& name, const std::vector<Point2>& points
         static_cast<double>(resident->ResidentBytes()) / static_cast<double>(std::max<size_t>(1, r.n));
     r.resident_host_per_point =
         static_cast<double>(resident->HostBytes()) / static_cast<double>(std::max<size_t>(1, r.n));
+    r.resident_peak_per_point =
+        static_cast<double>(resident->report().peak_memory_bytes) / static_cast<double>(std::max<size_t>(1, r.n));
 
     const int64_t level = host->max_level() / 2;
     start = std::chrono::steady_clock::now();
@@ -127,11 +134,13 @@ void PrintRow(const ResidentResult& r) {
     std::printf("| %s | %zu | error: %s |\n", r.name.c_str(), r.n, r.error.c_str());
     return;
   }
-  std::printf("| %s | %zu | %s | %.1f | %.1f | %.2fx | %.1f | %.1f | %.2f | %.2f | %.1f | %.0f | %.0f + %.0f | %s |\n",
-              r.name.c_str(), r.n, r.backend.c_str(), r.host_call_ms, r.resident_call_ms,
-              r.host_call_ms / r.resident_call_ms, r.download_ms, r.keep_ms, r.host_classify_ms, r.resident_classify_ms,
-              r.to_host_ms, r.host_bytes_per_point, r.resident_device_per_point, r.resident_host_per_point,
-              r.same ? "same" : "DIFFERENT");
+  std::printf(
+      "| %s | %zu | %s | %.1f | %.1f | %.2fx | %.1f | %.1f | %.2f | %.2f | %.1f | %.0f | %.0f + %.0f | %.0f / %.0f | "
+      "%s |\n",
+      r.name.c_str(), r.n, r.backend.c_str(), r.host_call_ms, r.resident_call_ms, r.host_call_ms / r.resident_call_ms,
+      r.download_ms, r.keep_ms, r.host_classify_ms, r.resident_classify_ms, r.to_host_ms, r.host_bytes_per_point,
+      r.resident_device_per_point, r.resident_host_per_point, r.host_peak_per_point, r.resident_peak_per_point,
+      r.same ? "same" : "DIFFERENT");
   std::fflush(stdout);
 }
 
@@ -155,8 +164,8 @@ int Main(int argc, char** argv) {
       "| input | n | backend | host family: whole call ms | resident family: whole call ms | host / resident | "
       "host's download stage ms | resident's keep stage ms | ClassifyAll from the host family ms | "
       "ClassifyAll from the resident family ms | ToHostFamily ms | host family B/pt | resident B/pt (tables + host) | "
-      "answers |\n"
-      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+      "engine peak B/pt (host / resident build) | answers |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
   bool failed = false;
   auto run = [&](const std::string& name, const std::vector<Point2>& points) {
     std::fprintf(stderr, "running %s n=%zu\n", name.c_str(), points.size());
