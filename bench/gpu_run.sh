@@ -185,6 +185,9 @@ for phase in "${phases[@]}"; do
       ;;
     service)
       run_step service 300 env GALPHA_SERVICE_BACKEND=cuda .carry/bin/service_test
+      # Again with the families resident on the GPU (the cache's device budget).
+      run_step service 300 env GALPHA_SERVICE_BACKEND=cuda GALPHA_SERVICE_DEVICE_CACHE_BYTES=8000000000 \
+        .carry/bin/service_test
       grep -E '^\[  (PASSED|FAILED) |Failure' "$out/service.log" | head -n 20
       # shellcheck disable=SC2086
       run_step service 420 .carry/bin/service_bench ${GALPHA_SERVICE_BENCH_ARGS:---backend=cuda --points=1000000 --clients=1,2,4,8 --repeat=3}

@@ -31,6 +31,11 @@ ServerOptions TestServerOptions() {
   options.drain_notice = std::chrono::milliseconds(0);
   options.drain_grace = std::chrono::milliseconds(5000);
   options.service.backend = TestBackend() == "cuda" ? Backend::kCuda : Backend::kCpu;
+  // GALPHA_SERVICE_DEVICE_CACHE_BYTES: on CUDA, every test's families resident on the GPU (a GPU
+  // run sets it for a second pass of the suite; bench/gpu_run.sh service).
+  if (const char* bytes = std::getenv("GALPHA_SERVICE_DEVICE_CACHE_BYTES"); bytes != nullptr) {
+    options.service.device_cache_bytes = std::strtoull(bytes, nullptr, 10);
+  }
   return options;
 }
 
