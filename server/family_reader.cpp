@@ -113,6 +113,12 @@ absl::StatusOr<ResolvedThreshold> ResidentFamilyReader::Resolve(const Threshold&
   return resolved;
 }
 
+absl::StatusOr<ShapeComplex> ResidentFamilyReader::ComplexAt(int64_t level, ClassifyMode mode) const {
+  GALPHA_ASSIGN_OR_RETURN(const Classification classes, family_->ClassifyAll(level, mode, VertexRule::kReport));
+  return ComplexFromClasses(family_->points(), family_->representative(), family_->triangles(), family_->edges(),
+                            classes, mode);
+}
+
 absl::StatusOr<std::shared_ptr<const AlphaFamily>> ResidentFamilyReader::HostFamily() const {
   GALPHA_ASSIGN_OR_RETURN(AlphaFamily host, family_->ToHostFamily());
   return std::make_shared<const AlphaFamily>(std::move(host));

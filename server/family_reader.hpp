@@ -39,6 +39,8 @@ class FamilyReader {
   virtual absl::StatusOr<ResolvedThreshold> Resolve(const Threshold& threshold) const = 0;
   virtual absl::StatusOr<int64_t> RankLowerBound(double alpha_sq) const = 0;
   virtual absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const = 0;
+  /// AlphaFamily::ComplexAt (a resident family's from its classes: ComplexFromClasses).
+  virtual absl::StatusOr<ShapeComplex> ComplexAt(int64_t level, ClassifyMode mode) const = 0;
   virtual absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const = 0;
   virtual absl::StatusOr<double> HullAreaApprox() const = 0;
   virtual absl::StatusOr<double> PublishedAlphaSq(int64_t level) const = 0;
@@ -53,7 +55,7 @@ class FamilyReader {
   virtual absl::StatusOr<std::vector<MasterEntry>> MasterEntries(uint64_t position, uint64_t count) const = 0;
 
   /// The family in host memory, for the answers a resident family does not compute where it lives
-  /// yet (shapes, persistence, area ratios): the family itself, or for a resident one its tables
+  /// yet (persistence, area ratios): the family itself, or for a resident one its tables
   /// downloaded for this call (freed with the returned pointer).
   virtual absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const = 0;
 };
@@ -77,6 +79,9 @@ class HostFamilyReader final : public FamilyReader {
   absl::StatusOr<ResolvedThreshold> Resolve(const Threshold& threshold) const override;
   absl::StatusOr<int64_t> RankLowerBound(double alpha_sq) const override;
   absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const override;
+  absl::StatusOr<ShapeComplex> ComplexAt(int64_t level, ClassifyMode mode) const override {
+    return family_->ComplexAt(level, mode);
+  }
   absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const override;
   absl::StatusOr<double> HullAreaApprox() const override;
   absl::StatusOr<double> PublishedAlphaSq(int64_t level) const override;
@@ -114,6 +119,7 @@ class ResidentFamilyReader final : public FamilyReader {
   absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const override {
     return family_->ClassifyAll(level, mode, rule);
   }
+  absl::StatusOr<ShapeComplex> ComplexAt(int64_t level, ClassifyMode mode) const override;
   absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const override {
     return family_->TopologyBetween(first, last);
   }

@@ -422,19 +422,18 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
   }
   const absl::StatusOr<ClassifyMode> mode = ToClassifyMode(request.mode());
   if (!mode.ok()) return mode.status();
-  auto level = ResolveLevel(cached->reader(), request.threshold());
+  const FamilyReader& family = cached->reader();
+  auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
-  // Shapes are assembled from the family in host memory (for a resident family, a download for
-  // this call).
-  const absl::StatusOr<std::shared_ptr<const AlphaFamily>> host = cached->reader().HostFamily();
-  if (!host.ok()) return host.status();
-  const AlphaFamily& family = **host;
   const double min_hole_area = request.min_hole_area();
   if (std::isnan(min_hole_area) || min_hole_area < 0) {
     return absl::InvalidArgumentError(
         absl::StrCat("min_hole_area ", min_hole_area, " is not an area: give 0 (keep every hole) or more"));
   }
-  auto shape = AssembleShape(family.ComplexAt(level->level, *mode));
+  // The complex from the classes (a resident family's computed where its tables live).
+  absl::StatusOr<ShapeComplex> complex = family.ComplexAt(level->level, *mode);
+  if (!complex.ok()) return complex.status();
+  auto shape = AssembleShape(*complex);
   if (!shape.ok()) return shape.status();
   // Areas in the family's units (metres for a projected geographic set).
   if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family.points(), min_hole_area);

@@ -206,20 +206,26 @@ std::optional<int64_t> AlphaFamily::OptimalLevelGeneral(uint32_t n, std::optiona
 }
 
 ShapeComplex AlphaFamily::ComplexAt(int64_t level, ClassifyMode mode) const {
+  return ComplexFromClasses(parts_.points, parts_.representative, parts_.triangles, parts_.edges,
+                            ClassifyAll(level, mode, VertexRule::kReport), mode);
+}
+
+ShapeComplex ComplexFromClasses(absl::Span<const Point2> points, const HostVector<uint32_t>& representative,
+                                const HostVector<std::array<uint32_t, 3>>& triangles,
+                                const HostVector<std::array<uint32_t, 2>>& edges, const Classification& classes,
+                                ClassifyMode mode) {
   ShapeComplex complex;
-  complex.points = absl::MakeConstSpan(parts_.points);
-  for (uint32_t t = 0; t < parts_.triangles.size(); ++t) {
-    if (ClassifyTriangle(t, level) == SimplexClass::kInterior) complex.triangles.push_back(parts_.triangles[t]);
+  complex.points = points;
+  for (uint32_t t = 0; t < triangles.size(); ++t) {
+    if (classes.triangles[t] == SimplexClass::kInterior) complex.triangles.push_back(triangles[t]);
   }
   if (mode == ClassifyMode::kGeneral) {
-    for (uint32_t e = 0; e < parts_.edges.size(); ++e) {
-      if (ClassifyEdge(e, level, mode) == SimplexClass::kSingular) complex.singular_edges.push_back(parts_.edges[e]);
+    for (uint32_t e = 0; e < edges.size(); ++e) {
+      if (classes.edges[e] == SimplexClass::kSingular) complex.singular_edges.push_back(edges[e]);
     }
-    for (uint32_t v = 0; v < parts_.points.size(); ++v) {
-      if (parts_.representative[v] == v &&
-          ClassifyVertex(v, level, mode, VertexRule::kReport) == SimplexClass::kSingular) {
+    for (uint32_t v = 0; v < points.size(); ++v) {
+      if (representative[v] == v && classes.vertices[v] == SimplexClass::kSingular)
         complex.isolated_points.push_back(v);
-      }
     }
   }
   return complex;

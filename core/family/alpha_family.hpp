@@ -147,4 +147,13 @@ class AlphaFamily {
   double min_alpha_sq_ = 0.0;
 };
 
+/// The complex at a level as geometry input from the classes of every simplex at that level, as
+/// ClassifyAll(level, mode, VertexRule::kReport) gives them: triangles INTERIOR, and in GENERAL mode
+/// the SINGULAR edges and the distinct points whose vertex is SINGULAR. AlphaFamily::ComplexAt is
+/// this; a resident family, whose classes are computed where its tables live, calls it too.
+ShapeComplex ComplexFromClasses(absl::Span<const Point2> points, const HostVector<uint32_t>& representative,
+                                const HostVector<std::array<uint32_t, 3>>& triangles,
+                                const HostVector<std::array<uint32_t, 2>>& edges, const Classification& classes,
+                                ClassifyMode mode);
+
 }  // namespace galpha

@@ -158,6 +158,15 @@ class ResidentFamilyTest : public testing::BackendTest {
           EXPECT_EQ(r->vertices, h.vertices) << "level " << level;
           EXPECT_EQ(r->edges, h.edges) << "level " << level;
           EXPECT_EQ(r->triangles, h.triangles) << "level " << level;
+          if (rule == VertexRule::kReport) {
+            // The shape's complex from the resident classes is the host family's.
+            const ShapeComplex from_classes = ComplexFromClasses(resident.points(), resident.representative(),
+                                                                 resident.triangles(), resident.edges(), *r, mode);
+            const ShapeComplex expected = host.ComplexAt(level, mode);
+            EXPECT_EQ(from_classes.triangles, expected.triangles) << "level " << level;
+            EXPECT_EQ(from_classes.singular_edges, expected.singular_edges) << "level " << level;
+            EXPECT_EQ(from_classes.isolated_points, expected.isolated_points) << "level " << level;
+          }
         }
       }
     }
