@@ -60,10 +60,11 @@ class FamilyReader {
   virtual absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const = 0;
 };
 
-/// A family in host memory.
-class HostFamilyReader final : public FamilyReader {
+/// The host arrays both forms hold, by the same names: read from the family of type `Family`.
+template <class Family>
+class FamilyReaderOf : public FamilyReader {
  public:
-  explicit HostFamilyReader(std::shared_ptr<const AlphaFamily> family) : family_(std::move(family)) {}
+  explicit FamilyReaderOf(std::shared_ptr<const Family> family) : family_(std::move(family)) {}
 
   const HostVector<Point2>& points() const override { return family_->points(); }
   const HostVector<double>& weights() const override { return family_->weights(); }
@@ -75,6 +76,15 @@ class HostFamilyReader final : public FamilyReader {
   bool weighted() const override { return family_->weighted(); }
   const BuildReport& report() const override { return family_->report(); }
   int64_t max_level() const override { return family_->max_level(); }
+
+ protected:
+  std::shared_ptr<const Family> family_;
+};
+
+/// A family in host memory.
+class HostFamilyReader final : public FamilyReaderOf<AlphaFamily> {
+ public:
+  using FamilyReaderOf::FamilyReaderOf;
 
   absl::StatusOr<ResolvedThreshold> Resolve(const Threshold& threshold) const override;
   absl::StatusOr<int64_t> RankLowerBound(double alpha_sq) const override;
@@ -93,26 +103,12 @@ class HostFamilyReader final : public FamilyReader {
   absl::StatusOr<std::vector<uint32_t>> MasterBegins(int64_t first_rank, int64_t count) const override;
   absl::StatusOr<std::vector<MasterEntry>> MasterEntries(uint64_t position, uint64_t count) const override;
   absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const override { return family_; }
-
- private:
-  std::shared_ptr<const AlphaFamily> family_;
 };
 
 /// A resident family.
-class ResidentFamilyReader final : public FamilyReader {
+class ResidentFamilyReader final : public FamilyReaderOf<ResidentAlphaFamily> {
  public:
-  explicit ResidentFamilyReader(std::shared_ptr<const ResidentAlphaFamily> family) : family_(std::move(family)) {}
-
-  const HostVector<Point2>& points() const override { return family_->points(); }
-  const HostVector<double>& weights() const override { return family_->weights(); }
-  const HostVector<uint32_t>& representative() const override { return family_->representative(); }
-  uint32_t num_unique() const override { return family_->num_unique(); }
-  const HostVector<std::array<uint32_t, 3>>& triangles() const override { return family_->triangles(); }
-  const HostVector<std::array<uint32_t, 2>>& edges() const override { return family_->edges(); }
-  const HostVector<uint8_t>& hidden_flags() const override { return family_->hidden_flags(); }
-  bool weighted() const override { return family_->weighted(); }
-  const BuildReport& report() const override { return family_->report(); }
-  int64_t max_level() const override { return family_->max_level(); }
+  using FamilyReaderOf::FamilyReaderOf;
 
   absl::StatusOr<ResolvedThreshold> Resolve(const Threshold& threshold) const override;
   absl::StatusOr<int64_t> RankLowerBound(double alpha_sq) const override { return family_->RankLowerBound(alpha_sq); }
@@ -145,9 +141,6 @@ class ResidentFamilyReader final : public FamilyReader {
     return family_->MasterEntries(position, count);
   }
   absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const override;
-
- private:
-  std::shared_ptr<const ResidentAlphaFamily> family_;
 };
 
 }  // namespace galpha::server

@@ -74,29 +74,18 @@ int64_t CountAtMost(const AlphaFamilyParts& p, const mpq_class& value) {
 }  // namespace
 
 absl::StatusOr<int64_t> AlphaFamily::LevelForAlphaSq(double alpha_sq) const {
-  if (std::isnan(alpha_sq)) return absl::InvalidArgumentError("alpha_sq is NaN");
-  if (alpha_sq < min_alpha_sq_) return -1;
-  if (std::isinf(alpha_sq)) return max_level();
-  return CountAtMost(parts_, mpq_class(alpha_sq));
+  const LevelQuery query = StartLevelForAlphaSq(alpha_sq, min_alpha_sq_, max_level());
+  if (query.answer) return *query.answer;
+  return CountAtMost(parts_, query.alpha_sq);
 }
 
 absl::StatusOr<int64_t> AlphaFamily::LevelForAlpha(double alpha) const {
-  if (std::isnan(alpha)) return absl::InvalidArgumentError("alpha is NaN");
-  if (alpha < 0) return absl::InvalidArgumentError(absl::StrCat("alpha is a radius and must be >= 0, got ", alpha));
-  if (std::isinf(alpha)) return max_level();
-  const mpq_class radius(alpha);
-  const mpq_class alpha_sq = radius * radius;
-  if (alpha_sq < mpq_class(min_alpha_sq_)) return -1;  // weighted, every weight negative
-  return CountAtMost(parts_, alpha_sq);
+  const LevelQuery query = StartLevelForAlpha(alpha, min_alpha_sq_, max_level());
+  if (query.answer) return *query.answer;
+  return CountAtMost(parts_, query.alpha_sq);
 }
 
-absl::StatusOr<int64_t> AlphaFamily::LevelForRank(int64_t rank) const {
-  if (rank < 0 || rank > max_level()) {
-    return absl::OutOfRangeError(
-        absl::StrCat("rank ", rank, " is outside 0..", max_level(), " (the spectrum has ", max_level(), " values)"));
-  }
-  return rank;
-}
+absl::StatusOr<int64_t> AlphaFamily::LevelForRank(int64_t rank) const { return LevelOfRank(rank, max_level()); }
 
 int64_t AlphaFamily::RankLowerBound(double alpha_sq) const {
   if (std::isnan(alpha_sq) || (alpha_sq <= 0 && !weighted())) return 1;  // unweighted values are positive

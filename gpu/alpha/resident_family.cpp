@@ -84,35 +84,24 @@ absl::StatusOr<int64_t> ResidentAlphaFamily::CountThresholds(const mpq_class& va
 }
 
 absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForAlphaSq(double alpha_sq) const {
-  if (std::isnan(alpha_sq)) return absl::InvalidArgumentError("alpha_sq is NaN");
-  if (alpha_sq < min_alpha_sq_) return -1;
-  if (std::isinf(alpha_sq)) return max_level();
-  return CountThresholds(mpq_class(alpha_sq), alpha_sq, alpha_sq, /*strict=*/false);
+  const LevelQuery query = StartLevelForAlphaSq(alpha_sq, min_alpha_sq_, max_level());
+  if (query.answer) return *query.answer;
+  return CountThresholds(query.alpha_sq, alpha_sq, alpha_sq, /*strict=*/false);
 }
 
 absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForAlpha(double alpha) const {
-  if (std::isnan(alpha)) return absl::InvalidArgumentError("alpha is NaN");
-  if (alpha < 0) return absl::InvalidArgumentError(absl::StrCat("alpha is a radius and must be >= 0, got ", alpha));
-  if (std::isinf(alpha)) return max_level();
-  const mpq_class radius(alpha);
-  const mpq_class alpha_sq = radius * radius;
-  if (alpha_sq < mpq_class(min_alpha_sq_)) return -1;  // weighted, every weight negative
+  const LevelQuery query = StartLevelForAlpha(alpha, min_alpha_sq_, max_level());
+  if (query.answer) return *query.answer;
   // The doubles around alpha^2 (>= 0): mpq's get_d truncates, which is rounding down here.
   double lo = DBL_MAX, hi = HUGE_VAL;
-  if (alpha_sq <= mpq_class(DBL_MAX)) {
-    lo = alpha_sq.get_d();
-    hi = mpq_class(lo) == alpha_sq ? lo : std::nextafter(lo, HUGE_VAL);
+  if (query.alpha_sq <= mpq_class(DBL_MAX)) {
+    lo = query.alpha_sq.get_d();
+    hi = mpq_class(lo) == query.alpha_sq ? lo : std::nextafter(lo, HUGE_VAL);
   }
-  return CountThresholds(alpha_sq, lo, hi, /*strict=*/false);
+  return CountThresholds(query.alpha_sq, lo, hi, /*strict=*/false);
 }
 
-absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForRank(int64_t rank) const {
-  if (rank < 0 || rank > max_level()) {
-    return absl::OutOfRangeError(
-        absl::StrCat("rank ", rank, " is outside 0..", max_level(), " (the spectrum has ", max_level(), " values)"));
-  }
-  return rank;
-}
+absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForRank(int64_t rank) const { return LevelOfRank(rank, max_level()); }
 
 absl::StatusOr<int64_t> ResidentAlphaFamily::RankLowerBound(double alpha_sq) const {
   if (std::isnan(alpha_sq) || (alpha_sq <= 0 && !weighted())) return 1;  // unweighted values are positive
