@@ -2,8 +2,6 @@
 
 #include <chrono>
 #include <string>
-#include <system_error>
-#include <thread>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -66,52 +64,36 @@ absl::Status BuildFamilyParts(absl::Span<const Point2> points, absl::Span<const 
                                 std::string(cancelled_error("the triangulation").message()));
     }
   };
-  AlphaFamilyParts& parts = *parts_out;
-  // The family keeps its own copy of the input. On CUDA it is made by a host thread while the
-  // device builds (160 MB, about 8 ms, at 10M points); on the CPU backend after the build, whose
-  // cores it would compete for.
-  auto copy_input = [&] {
-    parts.points.resize(points.size());
-    detail::ParallelCopy(parts.points.data(), points.data(), points.size() * sizeof(Point2));
-    if (weighted) {
-      parts.weights.resize(weights.size());
-      detail::ParallelCopy(parts.weights.data(), weights.data(), weights.size() * sizeof(double));
-    }
-  };
-  std::thread input_copy;
-  if (backend == Backend::kCuda) {
-    try {
-      input_copy = std::thread(copy_input);
-    } catch (const std::system_error&) {
-      // No thread to spare: the copy is made after the build instead.
-    }
-  }
-  const absl::Status engine = detail::RunEngine(absl::StrCat("building the alpha family of ", n, " points"), [&] {
+  GALPHA_RETURN_IF_ERROR(detail::RunEngine(absl::StrCat("building the alpha family of ", n, " points"), [&] {
     if (backend == Backend::kCuda) {
       detail::BuildFamilyOnCuda(points.data(), weight_data, n, options.cuda_stream, hooks, &built);
     } else {
       detail::BuildFamilyOnCpu(points.data(), weight_data, n, hooks, &built);
     }
-  });
-  if (input_copy.joinable()) input_copy.join();
-  GALPHA_RETURN_IF_ERROR(engine);
+  }));
   report("alpha", 0.9);
   if (stop_requested()) return cancelled_error("the alpha pipeline");
 
   const auto assemble_start = std::chrono::steady_clock::now();
+  AlphaFamilyParts& parts = *parts_out;
   parts.report.backend = BackendName(backend);
   parts.report.stage_times.push_back({"validate", validate_seconds});
   for (StageTime& stage : built.stage_times) parts.report.stage_times.push_back(std::move(stage));
   parts.report.peak_memory_bytes = built.peak_memory_bytes;
   parts.report.comparisons = built.ranks.comparisons;
-  if (parts.points.size() != points.size()) copy_input();  // not made beside the build
+  parts.points.resize(points.size());
+  detail::ParallelCopy(parts.points.data(), points.data(), points.size() * sizeof(Point2));
   parts.representative = std::move(built.representative);
   parts.num_unique = built.num_unique;
   parts.triangles = std::move(built.triangles);
   parts.edges = std::move(built.edges);
   parts.ranks = std::move(built.ranks);
   if (built.has_persistence) parts.persistence = std::move(built.persistence);
-  if (weighted) parts.hidden = std::move(built.hidden);
+  if (weighted) {
+    parts.weights.resize(weights.size());
+    detail::ParallelCopy(parts.weights.data(), weights.data(), weights.size() * sizeof(double));
+    parts.hidden = std::move(built.hidden);
+  }
   // The stage list is complete before the family owns it; the constructor's own pass over the
   // points is the little it leaves out.
   parts.report.stage_times.push_back({"assemble", SecondsSince(assemble_start)});
