@@ -11,7 +11,7 @@
 //                 [--links=loopback,1gbit,10gbit] [--device-cache-bytes=N]
 // --device-cache-bytes gives the server a device budget for resident families (CUDA builds keep
 // their tables on the GPU and answer from there: server/README.md, "Cache"); 0 (the default):
-// CUDA families are downloaded into host memory. The CPU backend's families are resident either way.
+// CUDA families are downloaded into host memory, as the CPU backend's are.
 #include <CGAL/Alpha_shape_2.h>
 #include <CGAL/Alpha_shape_face_base_2.h>
 #include <CGAL/Alpha_shape_vertex_base_2.h>
@@ -403,7 +403,7 @@ int MeasurePromotion(const Options& options, const std::vector<Point2>& points, 
     build.backend = options.backend;
     const bool on_cpu =
         options.backend == Backend::kCpu || (options.backend == Backend::kAuto && !CudaBackendAvailable());
-    const bool resident = options.device_cache_bytes > 0 || on_cpu;
+    const bool resident = options.device_cache_bytes > 0 && !on_cpu;
     auto cached = server::BuildCachedFamily(points, {}, /*weighted=*/false, build, resident, nullptr);
     if (!cached.ok()) return 1;
     server_options.service.cache_bytes = (*cached)->bytes() * 5 / 4;
@@ -483,7 +483,7 @@ int Run(const Options& options) {
       "bytes (%s)\n\n",
       options.points, backend.c_str(), (*server)->service().build_slots(), options.repeat,
       std::thread::hardware_concurrency(), options.device_cache_bytes,
-      backend == "cpu" || options.device_cache_bytes > 0 ? "families resident where built" : "families in host memory");
+      backend == "cuda" && options.device_cache_bytes > 0 ? "families resident on the GPU" : "families in host memory");
   auto client = Client(port);
   const std::vector<Point2> points = gen::Uniform(options.points, 1);
 

@@ -170,7 +170,7 @@ absl::StatusOr<std::unique_ptr<AlphaService>> AlphaService::Create(const Service
       if (memory != 0) memory -= options.device_cache_bytes;
     }
   }
-  service->resident_families_ = backend == Backend::kCpu || options.device_cache_bytes > 0;
+  service->resident_families_ = backend == Backend::kCuda && options.device_cache_bytes > 0;
   service->cache_ =
       std::make_unique<FamilyCache>(FamilyCache::Budgets{options.cache_bytes, options.compact_cache_bytes,
                                                          backend == Backend::kCuda ? options.device_cache_bytes : 0},

@@ -63,10 +63,9 @@ struct ServiceOptions {
   /// rebuilt when a query asks for them; server/family_cache.hpp); 0: no compact tier.
   size_t compact_cache_bytes = size_t{4} << 30;
   /// GPU memory for families whose rank tables stay on the GPU after their build (resident
-  /// families: no download, queries answered there; docs/operations.md "Cache tiers"), taken from
-  /// the builds' default memory budget; 0: CUDA families are copied to host memory. On the CPU
-  /// backend every family is resident (its tables are the build's own host buffers, charged to
-  /// cache_bytes) and this budget is unused.
+  /// families: no download, queries answered there; server/README.md "Cache"), taken from the
+  /// builds' default memory budget; 0: CUDA families are copied to host memory. Unused on the CPU
+  /// backend, whose families are held in host memory.
   size_t device_cache_bytes = 0;
   TenantTokens tokens;
 };
@@ -141,7 +140,7 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   ServerMetrics* metrics_;
   Backend backend_ = Backend::kCpu;
   std::string backend_name_;
-  /// Whether builds keep their tables where they are built (the CPU backend, or a device cache).
+  /// Whether CUDA builds keep their tables on the GPU (a device cache budget).
   bool resident_families_ = false;
   std::unique_ptr<CudaStreamPool> streams_;
   std::unique_ptr<FamilyCache> cache_;

@@ -150,8 +150,9 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
   const auto deadline = start + std::chrono::duration_cast<Clock::duration>(limit);
   options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
   options.max_exact_comparisons = ExactComparisonLimit(points, service_->options_.exact_comparisons);
-  absl::StatusOr<std::shared_ptr<const CachedFamily>> family = BuildCachedFamily(
-      build_->points, build_->weights, build_->header.weighted(), options, service_->resident_families_, build_->frame);
+  absl::StatusOr<std::shared_ptr<const CachedFamily>> family =
+      BuildCachedFamily(build_->points, build_->weights, build_->header.weighted(), options,
+                        service_->resident_families_ && service_->cache_->FitsDeviceTier(points), build_->frame);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   decoder_.ReleasePoints();
   if (!family.ok()) {

@@ -99,6 +99,11 @@ class FamilyCache {
   size_t byte_budget() const { return budgets_.resident; }
   size_t compact_byte_budget() const { return budgets_.compact; }
   size_t device_byte_budget() const { return budgets_.device; }
+  /// Whether a family of `points` points kept on the GPU fits the device budget at all (its
+  /// tables measured at most 352 B a point on every generator at 1M on an H100, bench/README.md
+  /// "Resident families"; 400 with headroom): a larger one is built into host memory instead.
+  bool FitsDeviceTier(size_t points) const { return points * kResidentDeviceBytesPerPoint <= budgets_.device; }
+  static constexpr size_t kResidentDeviceBytesPerPoint = 400;
 
  private:
   struct ResidentEntry {

@@ -86,8 +86,9 @@ void FamilyPromoter::Run(const std::shared_ptr<Rebuild>& rebuild, void* cuda_str
   // No time or comparison limit: these points were built within them once, and the engine is
   // deterministic.
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<std::shared_ptr<const CachedFamily>> family = BuildCachedFamily(
-      compact.points(), compact.weights(), !compact.weights().empty(), options, resident_, compact.frame());
+  absl::StatusOr<std::shared_ptr<const CachedFamily>> family =
+      BuildCachedFamily(compact.points(), compact.weights(), !compact.weights().empty(), options,
+                        resident_ && cache_->FitsDeviceTier(compact.points().size()), compact.frame());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!family.ok()) {
     ReturnFreedHeapMemory();

@@ -26,9 +26,9 @@ class FamilyPromoter {
   /// Called after every successful rebuild with its report and wall time (the build metrics).
   using BuildRecorder = std::function<void(const BuildReport& report, double seconds)>;
 
-  /// Rebuilds on `backend` through `scheduler` (as resident families when `resident`:
-  /// BuildCachedFamily), charging `bytes_per_point` a point to its memory admission, and caches
-  /// the result in `cache`. All three must outlive the promoter's jobs (destroy the scheduler
+  /// Rebuilds on `backend` through `scheduler` (as resident families when `resident` and the
+  /// family fits the cache's device budget: BuildCachedFamily), charging `bytes_per_point` a point to its memory
+  /// admission, and caches the result in `cache`. All three must outlive the promoter's jobs (destroy the scheduler
   /// first: its queued jobs then end without building).
   FamilyPromoter(FamilyCache* cache, BuildScheduler* scheduler, Backend backend, bool resident, size_t bytes_per_point,
                  BuildRecorder record_build);

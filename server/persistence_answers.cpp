@@ -17,9 +17,10 @@ namespace v1 = galpha::v1;
 
 class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
  public:
-  PersistenceSource(std::shared_ptr<const AlphaFamily> family, PersistenceDiagram diagram,
-                    std::array<bool, 2> dimensions, double min_persistence)
-      : family_(std::move(family)),
+  PersistenceSource(std::shared_ptr<const CachedFamily> cached, std::shared_ptr<const AlphaFamily> family,
+                    PersistenceDiagram diagram, std::array<bool, 2> dimensions, double min_persistence)
+      : cached_(std::move(cached)),
+        family_(std::move(family)),
         diagram_(std::move(diagram)),
         dimensions_(dimensions),
         min_persistence_(min_persistence) {}
@@ -58,7 +59,8 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
     for (uint32_t i = 0; i <= p.dimension + 1; ++i) message->add_killer_vertices(vertices.killer[i]);
   }
 
-  std::shared_ptr<const AlphaFamily> family_;  // the cached one, or a resident one's download
+  std::shared_ptr<const CachedFamily> cached_;  // kept while the stream runs, as every source's
+  std::shared_ptr<const AlphaFamily> family_;   // the cached one, or a resident one's download
   PersistenceDiagram diagram_;
   std::array<bool, 2> dimensions_;
   double min_persistence_;
@@ -68,11 +70,8 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
 
 }  // namespace
 
-// The shared_ptr is taken by value like every Make*Source's (one signature for the service's query
-// helper), though this one only reads through it: the source keeps the host family it answers from.
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::PersistenceResponse>>> MakePersistenceSource(
-    std::shared_ptr<const CachedFamily> cached,  // NOLINT(performance-unnecessary-value-param)
-    const v1::PersistenceRequest& request) {
+    std::shared_ptr<const CachedFamily> cached, const v1::PersistenceRequest& request) {
   std::array<bool, 2> dimensions = {request.dimensions().empty(), request.dimensions().empty()};
   for (uint32_t d : request.dimensions()) {
     if (d > 1) {
@@ -93,7 +92,8 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::PersistenceResponse>>> MakePersis
   absl::StatusOr<PersistenceDiagram> diagram =
       PersistenceDiagramOf(**family, cached->EdgeOrder(), cached->TriangleOrder());
   if (!diagram.ok()) return diagram.status();
-  return std::make_unique<PersistenceSource>(*std::move(family), *std::move(diagram), dimensions, min_persistence);
+  return std::make_unique<PersistenceSource>(std::move(cached), *std::move(family), *std::move(diagram), dimensions,
+                                             min_persistence);
 }
 
 }  // namespace galpha::server

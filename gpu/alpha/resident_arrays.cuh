@@ -140,6 +140,7 @@ class ResidentTablesOn final : public ResidentTables {
   }
   bool InDeviceMemory() const override { return !System::kHostMemory; }
   uint32_t num_ranks() const override { return sizes_.num_ranks; }
+  uint64_t num_master() const override { return sizes_.num_master; }
   std::optional<int64_t> solid_level() const override { return sizes_.solid_level; }
 
   void Classify(int64_t level, ClassifyMode mode, VertexRule rule, SimplexClass* vertices, SimplexClass* edges,

@@ -33,8 +33,9 @@ class ResidentTables {
   /// Bytes the tables hold where they live, and whether that is device memory (not the host's).
   virtual size_t Bytes() const = 0;
   virtual bool InDeviceMemory() const = 0;
-  /// K, the number of spectrum values.
+  /// K, the number of spectrum values, and the master list's length.
   virtual uint32_t num_ranks() const = 0;
+  virtual uint64_t num_master() const = 0;
   /// The smallest level at which every distinct point (weighted: not hidden) lies on a triangle;
   /// nullopt when none does (AlphaFamily::SolidLevel).
   virtual std::optional<int64_t> solid_level() const = 0;

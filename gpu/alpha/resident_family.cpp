@@ -142,9 +142,9 @@ absl::StatusOr<std::vector<TopologyAtLevel>> ResidentAlphaFamily::TopologyBetwee
   if (last < first) return out;
   out.resize(static_cast<size_t>(last - first + 1));
   // Levels below 0 are all zero; above K they repeat K's.
-  const int64_t lo = std::max<int64_t>(first, 0), hi = std::min(last, max_level());
+  const int64_t hi = std::min(last, max_level()), lo = std::min(std::max<int64_t>(first, 0), hi);
   std::vector<detail::CurveValues> values;
-  if (lo <= hi) {
+  if (last >= 0) {
     GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the curves at levels ", lo, "..", hi),
                                     [&] { values = tables_->CurvesBetween(lo, hi); }));
   }
@@ -215,6 +215,10 @@ absl::StatusOr<std::vector<uint32_t>> ResidentAlphaFamily::MasterBegins(int64_t 
 }
 
 absl::StatusOr<std::vector<MasterEntry>> ResidentAlphaFamily::MasterEntries(uint64_t position, uint64_t count) const {
+  if (position + count > tables_->num_master()) {
+    return absl::OutOfRangeError(absl::StrCat("master-list entries ", position, "..", position + count,
+                                              " pass its end, ", tables_->num_master()));
+  }
   std::vector<MasterEntry> entries;
   GALPHA_RETURN_IF_ERROR(
       OnTables(*mutex_, "reading master-list entries", [&] { entries = tables_->MasterEntries(position, count); }));

@@ -37,14 +37,14 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
     const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
     for (int64_t rank = 0; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
-      const absl::StatusOr<ResolvedLevel> resolved = ResolveOn(family, Rank(rank));
+      const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(f.cached->reader(), Rank(rank));
       ASSERT_THAT(resolved, IsOk());
       EXPECT_EQ(resolved->level, *family.LevelForRank(rank));
       EXPECT_EQ(resolved->alpha_sq, rank == 0 ? 0.0 : family.spectrum()[static_cast<size_t>(rank - 1)]);
     }
     for (const v1::Threshold& threshold : Thresholds(family)) {
       SCOPED_TRACE(threshold.ShortDebugString());
-      const absl::StatusOr<ResolvedLevel> resolved = ResolveOn(family, threshold);
+      const absl::StatusOr<ResolvedLevel> resolved = ResolveLevel(f.cached->reader(), threshold);
       ASSERT_THAT(resolved, IsOk());
       switch (threshold.value_case()) {
         case v1::Threshold::kRank:
@@ -69,7 +69,7 @@ TEST(QueryAnswersTest, ResolveLevelMatchesTheFamily) {
     // Every spectrum value, as alpha_sq, resolves to its own rank (exact comparison).
     for (int64_t rank = 1; rank <= k; rank += std::max<int64_t>(1, k / 50)) {
       const absl::StatusOr<ResolvedLevel> resolved =
-          ResolveOn(family, AlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
+          ResolveLevel(f.cached->reader(), AlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
       ASSERT_THAT(resolved, IsOk());
       EXPECT_EQ(resolved->level, *family.LevelForAlphaSq(family.spectrum()[static_cast<size_t>(rank - 1)]));
     }
@@ -82,17 +82,19 @@ TEST(QueryAnswersTest, ResolveLevelRefusesBadThresholds) {
     ASSERT_NE(f.cached, nullptr);
     const AlphaFamily& family = *f.oracle;
     const int64_t k = family.max_level();
-    const absl::StatusOr<ResolvedLevel> none = ResolveOn(family, v1::Threshold());
+    const absl::StatusOr<ResolvedLevel> none = ResolveLevel(f.cached->reader(), v1::Threshold());
     EXPECT_THAT(none.status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    const absl::StatusOr<ResolvedLevel> beyond = ResolveOn(family, Rank(k + 1));
+    const absl::StatusOr<ResolvedLevel> beyond = ResolveLevel(f.cached->reader(), Rank(k + 1));
     EXPECT_THAT(beyond.status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveOn(family, Ratio(1.5)).status(),
+    EXPECT_THAT(ResolveLevel(f.cached->reader(), Ratio(1.5)).status(),
                 StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("outside 0..1")));
     EXPECT_NE(beyond.status().message().find(absl::StrCat(k + 1)), absl::string_view::npos) << beyond.status();
-    EXPECT_THAT(ResolveOn(family, Rank(-1)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveOn(family, AlphaSq(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveOn(family, Alpha(std::nan(""))).status(), StatusIs(absl::StatusCode::kInvalidArgument));
-    EXPECT_THAT(ResolveOn(family, Alpha(-1.0)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(f.cached->reader(), Rank(-1)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(f.cached->reader(), AlphaSq(std::nan(""))).status(),
+                StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(f.cached->reader(), Alpha(std::nan(""))).status(),
+                StatusIs(absl::StatusCode::kInvalidArgument));
+    EXPECT_THAT(ResolveLevel(f.cached->reader(), Alpha(-1.0)).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   }
 }
 

@@ -9,6 +9,7 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/family/alpha_family.hpp"
@@ -194,6 +195,16 @@ class ResidentFamilyTest : public testing::BackendTest {
       ASSERT_EQ(at.holes, host.Holes(level, ClassifyMode::kGeneral)) << "level " << level;
       ASSERT_EQ(at.regularized_holes, host.Holes(level, ClassifyMode::kRegularized)) << "level " << level;
     }
+    for (const auto& [first, last] : {std::pair<int64_t, int64_t>{k + 3, k + 5}, {-5, -1}, {-1, 0}, {k, k + 1}}) {
+      const absl::StatusOr<std::vector<TopologyAtLevel>> part = resident.TopologyBetween(first, last);
+      ASSERT_THAT(part, IsOk());
+      ASSERT_EQ(part->size(), static_cast<size_t>(last - first + 1));
+      for (int64_t level = first; level <= last; ++level) {
+        EXPECT_EQ((*part)[static_cast<size_t>(level - first)].components, host.Components(level)) << "level " << level;
+        EXPECT_EQ((*part)[static_cast<size_t>(level - first)].holes, host.Holes(level, ClassifyMode::kGeneral))
+            << "level " << level;
+      }
+    }
     for (const int64_t level : {int64_t{-1}, int64_t{0}, k / 2, k, k + 1}) {
       const absl::StatusOr<double> area = resident.RegularizedAreaApprox(level);
       ASSERT_THAT(area, IsOk());
@@ -211,6 +222,7 @@ class ResidentFamilyTest : public testing::BackendTest {
     const absl::StatusOr<std::vector<MasterEntry>> all = resident.MasterEntries(0, host.ranks().master.size());
     ASSERT_THAT(all, IsOk());
     EXPECT_EQ(Packed(*all), Packed(host.ranks().master));
+    EXPECT_EQ(resident.MasterEntries(0, host.ranks().master.size() + 1).status().code(), absl::StatusCode::kOutOfRange);
 
     // Optimal levels.
     for (const uint32_t n : {0u, 1u, 2u, 5u, 100u}) {
