@@ -265,4 +265,35 @@ const NamedGenerator* FindDistribution(const std::string& name) {
   return nullptr;
 }
 
+std::vector<NamedPoints> SmallDegenerateSets() {
+  std::vector<NamedPoints> sets;
+  std::vector<Point2> grid;
+  for (int i = 0; i < 60; ++i) {
+    for (int j = 0; j < 45; ++j) grid.push_back({static_cast<double>(i), static_cast<double>(j)});
+  }
+  std::vector<Point2> holed;
+  for (size_t i = 0; i < grid.size(); ++i) {
+    if (i % 3 != 1) holed.push_back(grid[i]);
+  }
+  sets.push_back({"60 x 45 grid", std::move(grid)});
+  sets.push_back({"grid with every third point removed", std::move(holed)});
+  std::vector<Point2> line;
+  for (int i = 0; i < 3000; ++i) line.push_back({0.5 * i, 0.25 * i});
+  sets.push_back({"collinear, evenly spaced", std::move(line)});
+  std::vector<Point2> spread_line;
+  for (int i = 0; i < 2000; ++i) spread_line.push_back({1.0 * i * i, 0.0});
+  sets.push_back({"collinear, gaps growing along the line", std::move(spread_line)});
+  std::vector<Point2> repeated = Uniform(1500, 9);
+  const size_t distinct = repeated.size();
+  for (int copy = 0; copy < 2; ++copy) repeated.insert(repeated.end(), repeated.begin(), repeated.begin() + distinct);
+  sets.push_back({"every point three times", std::move(repeated)});
+  sets.push_back({"no points", {}});
+  sets.push_back({"one point", {{1, 2}}});
+  sets.push_back({"one point twice", {{1, 2}, {1, 2}}});
+  sets.push_back({"two points", {{0, 0}, {1, 0}}});
+  sets.push_back({"a triangle", {{0, 0}, {1, 0}, {0, 1}}});
+  sets.push_back({"a square (co-circular)", {{0, 0}, {1, 0}, {1, 1}, {0, 1}}});
+  return sets;
+}
+
 }  // namespace galpha::gen

@@ -80,4 +80,16 @@ std::vector<NamedGenerator> AllDistributions();
 /// The distribution named `name` in AllDistributions(), or nullptr.
 const NamedGenerator* FindDistribution(const std::string& name);
 
+/// A small fixed input with the name tests print.
+struct NamedPoints {
+  std::string name;
+  std::vector<Point2> points;
+};
+
+/// The degenerate and tiny sets the engine's comparison tests share: a 60 x 45 integer grid (ties
+/// everywhere) and the same with every third point removed, evenly spaced and spreading collinear
+/// points, 1,500 uniform points each three times, and 0, 1, 1 twice, 2, 3 and 4 co-circular
+/// points.
+std::vector<NamedPoints> SmallDegenerateSets();
+
 }  // namespace galpha::gen

@@ -93,34 +93,9 @@ TEST_P(PersistenceEngineTest, EveryGenerator) {
 }
 
 TEST_P(PersistenceEngineTest, DegenerateSets) {
-  // A grid: births tie everywhere, and ties are broken by canonical position, which makes the
+  // The grid's births tie everywhere, and ties are broken by canonical position, which makes the
   // forests' weights increase along rows and columns: the rounds' slowest case.
-  std::vector<Point2> grid;
-  for (int i = 0; i < 60; ++i) {
-    for (int j = 0; j < 45; ++j) grid.push_back({static_cast<double>(i), static_cast<double>(j)});
-  }
-  ExpectSameAsHost(grid, "60 x 45 grid");
-  std::vector<Point2> holed;
-  for (size_t i = 0; i < grid.size(); ++i) {
-    if (i % 3 != 1) holed.push_back(grid[i]);
-  }
-  ExpectSameAsHost(holed, "grid with every third point removed");
-  std::vector<Point2> line;
-  for (int i = 0; i < 3000; ++i) line.push_back({0.5 * i, 0.25 * i});
-  ExpectSameAsHost(line, "collinear, evenly spaced");
-  std::vector<Point2> spread_line;
-  for (int i = 0; i < 2000; ++i) spread_line.push_back({1.0 * i * i, 0.0});
-  ExpectSameAsHost(spread_line, "collinear, gaps growing along the line");
-  std::vector<Point2> repeated = gen::Uniform(1500, 9);
-  const size_t distinct = repeated.size();
-  for (int copy = 0; copy < 2; ++copy) repeated.insert(repeated.end(), repeated.begin(), repeated.begin() + distinct);
-  ExpectSameAsHost(repeated, "every point three times");
-  ExpectSameAsHost(std::vector<Point2>{}, "no points");
-  ExpectSameAsHost(std::vector<Point2>{{1, 2}}, "one point");
-  ExpectSameAsHost(std::vector<Point2>{{1, 2}, {1, 2}}, "one point twice");
-  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}}, "two points");
-  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {0, 1}}, "a triangle");
-  ExpectSameAsHost(std::vector<Point2>{{0, 0}, {1, 0}, {1, 1}, {0, 1}}, "a square (co-circular)");
+  for (const gen::NamedPoints& set : gen::SmallDegenerateSets()) ExpectSameAsHost(set.points, set.name);
 }
 
 // BuildOptions::persistence: the diagram computed in the build, from the family's arrays where they
