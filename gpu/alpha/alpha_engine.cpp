@@ -24,6 +24,16 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 namespace detail {
 
+absl::StatusOr<absl::Span<const double>> WeightsToBuildWith(absl::Span<const Point2> points,
+                                                            absl::Span<const double> weights) {
+  if (weights.size() != points.size()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("weighted build: ", weights.size(), " weights for ", points.size(), " points"));
+  }
+  if (points.empty()) return absl::Span<const double>();  // nothing to weigh
+  return weights;
+}
+
 absl::Status BuildFamilyParts(absl::Span<const Point2> points, absl::Span<const double> weights,
                               const BuildOptions& options, bool resident, AlphaFamilyParts* parts_out,
                               std::unique_ptr<ResidentTables>* tables) {
@@ -122,12 +132,8 @@ absl::StatusOr<AlphaFamily> BuildAlphaFamily(absl::Span<const Point2> points, co
 
 absl::StatusOr<AlphaFamily> BuildWeightedAlphaFamily(absl::Span<const Point2> points, absl::Span<const double> weights,
                                                      const BuildOptions& options) {
-  if (weights.size() != points.size()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("weighted build: ", weights.size(), " weights for ", points.size(), " points"));
-  }
-  if (points.empty()) return BuildFamily(points, {}, options);  // nothing to weigh
-  return BuildFamily(points, weights, options);
+  GALPHA_ASSIGN_OR_RETURN(const absl::Span<const double> used, detail::WeightsToBuildWith(points, weights));
+  return BuildFamily(points, used, options);
 }
 
 bool IsExactComparisonLimit(const absl::Status& status) {

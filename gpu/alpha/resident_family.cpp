@@ -260,12 +260,8 @@ absl::StatusOr<ResidentAlphaFamily> BuildResidentAlphaFamily(absl::Span<const Po
 absl::StatusOr<ResidentAlphaFamily> BuildWeightedResidentAlphaFamily(absl::Span<const Point2> points,
                                                                      absl::Span<const double> weights,
                                                                      const BuildOptions& options) {
-  if (weights.size() != points.size()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("weighted build: ", weights.size(), " weights for ", points.size(), " points"));
-  }
-  if (points.empty()) return BuildResident(points, {}, options);  // nothing to weigh
-  return BuildResident(points, weights, options);
+  GALPHA_ASSIGN_OR_RETURN(const absl::Span<const double> used, detail::WeightsToBuildWith(points, weights));
+  return BuildResident(points, used, options);
 }
 
 }  // namespace galpha

@@ -38,7 +38,7 @@ const std::vector<NamedFamily>& Families() {
       std::shared_ptr<const CachedFamily> host = MakeCachedFamily(points, name);
       std::shared_ptr<const AlphaFamily> oracle(host, host->host_family());
       built->push_back({name, host, oracle});
-      built->push_back({name + "/resident", MakeResidentCachedFamily(points, name), oracle});
+      built->push_back({name + "/resident", MakeCachedFamily(points, name, /*resident=*/true), oracle});
     }
     return built;
   }();
