@@ -20,6 +20,7 @@
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
 #include <thrust/scan.h>
 #include <thrust/sequence.h>
 #include <thrust/transform.h>
@@ -86,6 +87,16 @@ struct ForestOutputs {
   uint32_t mark_xor = 0;
   /// Whether edges of rank kNeverRank are graph edges (the curves leave them out).
   bool keep_never = false;
+  /// Several graphs in one run (disjoint node ranges, so that their rounds share launches and
+  /// waits): the nodes from part_begin[0] on are the second graph's, from part_begin[1] on the
+  /// third's, and graph k's merges count in part_merges[k] (merges_at_rank is part_merges[0]).
+  uint32_t part_begin[2] = {~0u, ~0u};
+  uint32_t* part_merges[2] = {nullptr, nullptr};
+
+  GALPHA_HD uint32_t* MergesOf(uint32_t node) const {
+    if (node >= part_begin[1]) return part_merges[1];
+    return node >= part_begin[0] ? part_merges[0] : merges_at_rank;
+  }
 };
 
 /// A component hooks to the other end of its lightest edge, except the smaller of two components
@@ -103,7 +114,9 @@ struct HookComponent {
     const uint32_t other = target[c];
     if (best[other] == best[c] && c < other) return;  // the other side hooks to us
     parent[c] = other;
-    if (out.merges_at_rank != nullptr) AtomicIncrement(&out.merges_at_rank[static_cast<uint32_t>(best[c] >> 32)]);
+    if (out.merges_at_rank != nullptr) {
+      AtomicIncrement(&out.MergesOf(c)[static_cast<uint32_t>(best[c] >> 32)]);
+    }
     if (out.forest_mark != nullptr) out.forest_mark[(static_cast<uint32_t>(best[c]) ^ out.mark_xor) - 1u] = 1;
   }
 };
@@ -186,24 +199,24 @@ struct IsGraphEdge {
   }
 };
 
-/// Finds the minimum spanning forest of the graph whose edges are `edges` (one entry per edge,
-/// weights unique; rank kNeverRank for an edge that never appears) over nodes 0..num_nodes and
-/// reports its edges as `out` asks. `edges` is used as working space (clobbered).
+/// Finds the minimum spanning forest of a graph over nodes 0..num_nodes whose edges are the
+/// `num_active` entries of `active` (graph edges only: no loops, and kNeverRank edges only when
+/// `out` keeps them; weights unique), and reports its edges as `out` asks. `active` and `scratch`
+/// (as long) are working space (clobbered).
 ///
 /// A round's kernels are recorded once and replayed (the host's launch cost bounded the rounds,
 /// as in the triangulation's flip loop): the live edge and label counts stay on the device, and
 /// the host waits once a round, for whether edges were left and whether the pointer jumps
 /// converged.
 template <class System>
-void SpanningForest(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes,
-                    const ForestOutputs& out) {
+void ForestOfGraphEdges(System& sys, WeightedEdge* active, uint32_t num_active, WeightedEdge* scratch,
+                        uint32_t num_nodes, const ForestOutputs& out) {
   auto policy = sys.policy();
-  Buffer<WeightedEdge, System> active(sys, num_edges);
-  const uint32_t num_ranked = static_cast<uint32_t>(
-      thrust::copy_if(policy, edges, edges + num_edges, active.data(), IsGraphEdge{out.keep_never}) - active.data());
-  WeightedEdge* kept = edges;  // the compactions' target from here on
-  Buffer<uint32_t, System> labels(sys, num_nodes), kept_labels(sys, num_nodes), parent(sys, num_nodes),
-      target(sys, num_nodes);
+  WeightedEdge* kept = scratch;  // the compactions' target
+  Buffer<uint32_t, System> labels(sys, num_nodes), parent(sys, num_nodes), target(sys, num_nodes);
+  // The labels' compaction target: `target`, whose entries a round reads only before the
+  // compaction and writes again before it reads them in the next round.
+  uint32_t* kept_labels = target.data();
   Buffer<unsigned long long, System> best(sys, num_nodes);
   enum Count { kLiveEdges, kLiveLabels, kKeptEdges, kKeptLabels, kJumped, kNumCounts };
   Buffer<uint32_t, System> counts(sys, kNumCounts);
@@ -211,7 +224,7 @@ void SpanningForest(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32
   thrust::sequence(policy, labels.data(), labels.data() + num_nodes);
   thrust::sequence(policy, parent.data(), parent.data() + num_nodes);
   thrust::fill_n(policy, best.data(), num_nodes, ~0ull);
-  const uint32_t initial[kNumCounts] = {num_ranked, num_nodes, 0, 0, 0};
+  const uint32_t initial[kNumCounts] = {num_active, num_nodes, 0, 0, 0};
   sys.FromHost(count, initial, kNumCounts);
 
   // Hook trees are shallow on realistic input: a few jumps flatten them. The jumps run in groups,
@@ -230,8 +243,8 @@ void SpanningForest(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32
     // Every component with an edge left merges in a round: at most log2(nodes) + 1 rounds.
     if (round > 64) throw EngineError(EngineError::Kind::kInternal, "component rounds did not converge");
     sys.Replay(hook_round, [&] {
-      sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active.data(), best.data()});
-      sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active.data(), best.data(), target.data()});
+      sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active, best.data()});
+      sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active, best.data(), target.data()});
       sys.ForEachBelow(count + kLiveLabels,
                        HookComponent{labels.data(), best.data(), target.data(), parent.data(), out});
       jump_group();
@@ -248,12 +261,12 @@ void SpanningForest(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32
     }
     sys.Replay(shrink_round, [&] {
       sys.ForEachBelow(count + kLiveLabels, ResetBest{labels.data(), best.data()});
-      sys.ForEachBelow(count + kLiveEdges, RelabelEdge{active.data(), parent.data()});
-      sys.AppendIf(count + kLiveEdges, 1, active.data(), active.data(), JoinsTwoComponents{}, kept, count + kKeptEdges);
-      sys.AppendIf(count + kLiveLabels, 1, labels.data(), labels.data(), IsRoot{parent.data()}, kept_labels.data(),
+      sys.ForEachBelow(count + kLiveEdges, RelabelEdge{active, parent.data()});
+      sys.AppendIf(count + kLiveEdges, 1, active, active, JoinsTwoComponents{}, kept, count + kKeptEdges);
+      sys.AppendIf(count + kLiveLabels, 1, labels.data(), labels.data(), IsRoot{parent.data()}, kept_labels,
                    count + kKeptLabels);
-      sys.ForEachBelow(count + kKeptEdges, CopyItem<WeightedEdge>{kept, active.data()});
-      sys.ForEachBelow(count + kKeptLabels, CopyItem<uint32_t>{kept_labels.data(), labels.data()});
+      sys.ForEachBelow(count + kKeptEdges, CopyItem<WeightedEdge>{kept, active});
+      sys.ForEachBelow(count + kKeptLabels, CopyItem<uint32_t>{kept_labels, labels.data()});
       sys.RunSingle(TakeKeptCounts{count + kLiveEdges, count + kLiveLabels, count + kKeptEdges, count + kKeptLabels});
     });
   }
@@ -264,9 +277,11 @@ struct GeneralGraphEdge {
   const EdgeIdx* edges;
   const uint32_t* rho;
   const uint32_t* mu_low;
+  uint32_t first_node = 0;  // where the graph's nodes start in a run of several graphs
   GALPHA_HD WeightedEdge operator()(uint32_t e) const {
     const uint32_t birth = EdgeBirthRank(rho[e], mu_low[e]);
-    return WeightedEdge{edges[e].v[0], edges[e].v[1], (static_cast<uint64_t>(birth) << 32) | e};
+    return WeightedEdge{first_node + edges[e].v[0], first_node + edges[e].v[1],
+                        (static_cast<uint64_t>(birth) << 32) | e};
   }
 };
 
@@ -274,9 +289,13 @@ struct GeneralGraphEdge {
 struct SolidGraphEdge {
   const EdgeTris* edge_tris;
   const uint32_t* mu_high;
+  uint32_t first_node = 0;
   GALPHA_HD WeightedEdge operator()(uint32_t e) const {
-    if (mu_high[e] == kNeverRank) return WeightedEdge{0, 0, (static_cast<uint64_t>(kNeverRank) << 32) | e};
-    return WeightedEdge{static_cast<uint32_t>(edge_tris[e].t[0]), static_cast<uint32_t>(edge_tris[e].t[1]),
+    if (mu_high[e] == kNeverRank) {
+      return WeightedEdge{first_node, first_node, (static_cast<uint64_t>(kNeverRank) << 32) | e};
+    }
+    return WeightedEdge{first_node + static_cast<uint32_t>(edge_tris[e].t[0]),
+                        first_node + static_cast<uint32_t>(edge_tris[e].t[1]),
                         (static_cast<uint64_t>(mu_high[e]) << 32) | e};
   }
 };
@@ -294,8 +313,10 @@ struct CountTriangleBirth {
 struct RegularizedGraphEdge {
   const EdgeIdx* edges;
   const uint32_t* mu_low;
+  uint32_t first_node = 0;
   GALPHA_HD WeightedEdge operator()(uint32_t e) const {
-    return WeightedEdge{edges[e].v[0], edges[e].v[1], (static_cast<uint64_t>(mu_low[e]) << 32) | e};
+    return WeightedEdge{first_node + edges[e].v[0], first_node + edges[e].v[1],
+                        (static_cast<uint64_t>(mu_low[e]) << 32) | e};
   }
 };
 
@@ -344,6 +365,169 @@ struct CountRegularizedVertex {
   }
 };
 
+// ---- Pruning by the cycle property ----------------------------------------------------------------
+//
+// With unique weights the minimum spanning forest is unique, and the heaviest edge of any cycle is
+// not in it (swapping it for a lighter edge of the cycle that crosses the same cut would give a
+// lighter forest). So every edge that is the heaviest of some cycle can be dropped before the
+// rounds, all at once: the forest of what is left is the same forest, since none of the dropped
+// edges was in it. A triangulation offers cycles for free: in a graph whose nodes are points, each
+// triangle's three edges; in a graph whose nodes are triangles (joined across edges), the edges
+// around an interior vertex. Dropping the heaviest of each takes a third to a half of the edges
+// out of every round (each triangle, each interior vertex drops one).
+//
+// A cycle counts only when all its edges are graph edges: a kNeverRank edge (no graph edge unless
+// kept) outweighs every ranked one, so a cycle through it drops only that edge, which is no loss.
+// A vertex on the hull has hull edges (mu-high kNeverRank) around it in the solid graph, so its
+// fan, which is no cycle there, never drops a ranked edge either.
+
+/// The cycles an edge lies on: its triangles (`edge_tris`, for graphs over points) or the fans
+/// around its two ends (`edges`, for graphs over triangles); one of the two is null.
+struct EdgeCycles {
+  const EdgeTris* edge_tris;
+  const EdgeIdx* edges;
+  /// Writes the edge's cycle ids into ids; returns how many (0 to 2).
+  GALPHA_HD int Of(uint32_t e, uint32_t ids[2]) const {
+    int count = 0;
+    for (int k = 0; k < 2; ++k) {
+      if (edge_tris != nullptr) {
+        if (edge_tris[e].t[k] >= 0) ids[count++] = static_cast<uint32_t>(edge_tris[e].t[k]);
+      } else {
+        ids[count++] = edges[e].v[k];
+      }
+    }
+    return count;
+  }
+};
+
+GALPHA_HD inline void AtomicMaxU64(unsigned long long* p, unsigned long long v) {
+#if defined(__CUDA_ARCH__)
+  atomicMax(p, v);
+#else
+  unsigned long long old = __atomic_load_n(p, __ATOMIC_RELAXED);
+  while (v > old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
+#endif
+}
+
+/// Each edge offers its weight to its cycles; a cycle keeps the heaviest (cycle_max starts at 0).
+/// An edge that is no graph edge offers the most a weight can be: a cycle through it is none.
+template <class Graph>
+struct OfferWeightToCycles {
+  Graph graph;
+  EdgeCycles cycles;
+  unsigned long long* cycle_max;
+  bool keep_never;
+  GALPHA_HD void operator()(uint32_t e) const {
+    const WeightedEdge edge = graph(e);
+    const unsigned long long weight = IsGraphEdge{keep_never}(edge) ? edge.weight : ~0ull;
+    uint32_t ids[2];
+    const int count = cycles.Of(e, ids);
+    for (int k = 0; k < count; ++k) AtomicMaxU64(&cycle_max[ids[k]], weight);
+  }
+};
+
+/// Whether an edge goes into the rounds: a graph edge that is the heaviest of none of its cycles.
+template <class Graph>
+struct IsForestCandidate {
+  Graph graph;
+  EdgeCycles cycles;
+  const unsigned long long* cycle_max;
+  bool keep_never;
+  GALPHA_HD bool operator()(uint32_t e) const {
+    const WeightedEdge edge = graph(e);
+    if (!IsGraphEdge{keep_never}(edge)) return false;
+    uint32_t ids[2];
+    const int count = cycles.Of(e, ids);
+    for (int k = 0; k < count; ++k) {
+      if (cycle_max[ids[k]] == edge.weight) return false;
+    }
+    return true;
+  }
+};
+
+/// The edges of a graph held in an array, as a generator.
+struct EdgeAt {
+  const WeightedEdge* edges;
+  GALPHA_HD WeightedEdge operator()(uint32_t e) const { return edges[e]; }
+};
+
+struct IsFlagged {
+  GALPHA_HD bool operator()(uint8_t flag) const { return flag != 0; }
+};
+
+/// Several graphs over the same edge ids, pruned and packed into one forest run.
+template <class System>
+class ForestRun {
+ public:
+  ForestRun(System& sys, uint32_t num_edges, uint32_t max_cycles, uint32_t num_graphs)
+      : sys_(sys), num_edges_(num_edges), flags_(sys, size_t{num_edges} * num_graphs), cycle_max_(sys, max_cycles) {}
+
+  /// Flags graph `index`'s candidate edges (the generator `graph` places its nodes).
+  template <class Graph>
+  void Flag(uint32_t index, Graph graph, EdgeCycles cycles, uint32_t num_cycles) {
+    auto policy = sys_.policy();
+    thrust::counting_iterator<uint32_t> zero(0);
+    thrust::fill_n(policy, cycle_max_.data(), num_cycles, 0ull);
+    thrust::for_each_n(policy, zero, num_edges_, OfferWeightToCycles<Graph>{graph, cycles, cycle_max_.data(), false});
+    thrust::transform(policy, zero, zero + num_edges_, flags_.data() + size_t{index} * num_edges_,
+                      IsForestCandidate<Graph>{graph, cycles, cycle_max_.data(), false});
+  }
+
+  /// Packs the flagged edges of every graph (the same generators, in the same order) and runs the
+  /// forest over all their nodes.
+  template <class... Graphs>
+  void Run(uint32_t num_nodes, const ForestOutputs& out, Graphs... graphs) {
+    auto policy = sys_.policy();
+    cycle_max_.Reset();
+    const size_t num_flags = size_t{num_edges_} * sizeof...(Graphs);
+    const auto total =
+        static_cast<uint32_t>(thrust::count_if(policy, flags_.data(), flags_.data() + num_flags, IsFlagged{}));
+    Buffer<WeightedEdge, System> active(sys_, total), scratch(sys_, total);
+    WeightedEdge* end = active.data();
+    uint32_t index = 0;
+    thrust::counting_iterator<uint32_t> zero(0);
+    auto pack = [&](auto graph) {
+      end = thrust::copy_if(policy, thrust::make_transform_iterator(zero, graph),
+                            thrust::make_transform_iterator(zero + num_edges_, graph),
+                            flags_.data() + size_t{index} * num_edges_, end, IsFlagged{});
+      ++index;
+    };
+    (pack(graphs), ...);
+    flags_.Reset();
+    ForestOfGraphEdges(sys_, active.data(), total, scratch.data(), num_nodes, out);
+  }
+
+ private:
+  System& sys_;
+  uint32_t num_edges_;
+  Buffer<uint8_t, System> flags_;
+  Buffer<unsigned long long, System> cycle_max_;
+};
+
+/// The minimum spanning forest of the graph whose edges are `edges` (one entry per edge, weights
+/// unique; loops and, unless `out` keeps them, kNeverRank edges are no graph edges) over nodes
+/// 0..num_nodes, reported as `out` asks; `cycles` (num_cycles of them) prune it first. `edges` is
+/// used as working space (clobbered).
+template <class System>
+void SpanningForest(System& sys, WeightedEdge* edges, uint32_t num_edges, uint32_t num_nodes, EdgeCycles cycles,
+                    uint32_t num_cycles, const ForestOutputs& out) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<WeightedEdge, System> active(sys, num_edges);
+  uint32_t num_active = 0;
+  {
+    Buffer<unsigned long long, System> cycle_max(sys, num_cycles);
+    thrust::fill_n(policy, cycle_max.data(), num_cycles, 0ull);
+    thrust::for_each_n(policy, zero, num_edges,
+                       OfferWeightToCycles<EdgeAt>{EdgeAt{edges}, cycles, cycle_max.data(), out.keep_never});
+    num_active = static_cast<uint32_t>(
+        thrust::copy_if(policy, edges, edges + num_edges, zero, active.data(),
+                        IsForestCandidate<EdgeAt>{EdgeAt{edges}, cycles, cycle_max.data(), out.keep_never}) -
+        active.data());
+  }
+  ForestOfGraphEdges(sys, active.data(), num_active, edges, num_nodes, out);
+}
+
 /// What the curves are computed from (device or host arrays of the system).
 struct TopologyCurvesIn {
   uint32_t num_points, num_unique, num_tri, num_edges, num_ranks;
@@ -375,11 +559,47 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t levels = in.num_ranks + 1;
-  Buffer<WeightedEdge, System> graph(sys, in.num_edges);
-  Buffer<uint32_t, System> merges(sys, levels), births(sys, levels), edge_births(sys, levels),
-      regularized_edge_births(sys, levels), regularized_vertices(sys, levels);
   auto prefix = [&](uint32_t* counts) { thrust::inclusive_scan(policy, counts, counts + levels, counts); };
-  // Triangles, edges (both senses) and regularized vertices present at each level (prefix counts).
+
+  // The three forests in one run, over disjoint node ranges: the general graph (points, edges at
+  // their births), the regularized graph (points, edges with their first triangle) and the solid
+  // graph (triangles, joined by edges as they become interior). Their merges are counted where
+  // the curves go (each curve is written over its own merge counts below).
+  const uint64_t num_nodes = 2 * uint64_t{in.num_points} + in.num_tri;
+  if (num_nodes >= UINT32_MAX) {  // 4n at most, and the input has at most 2^30 points
+    throw EngineError(EngineError::Kind::kInternal, "too many points and triangles for the component curves");
+  }
+  const GeneralGraphEdge general{in.edges, in.edge_rho, in.edge_mu_low, 0};
+  const RegularizedGraphEdge regularized{in.edges, in.edge_mu_low, in.num_points};
+  const SolidGraphEdge solid{in.edge_tris, in.edge_mu_high, 2 * in.num_points};
+  const EdgeCycles triangles{in.edge_tris, nullptr}, fans{nullptr, in.edges};
+  uint32_t* general_merges = out.components;
+  uint32_t* regularized_merges = out.regularized_components;
+  uint32_t* solid_merges = out.solid_components;
+  {
+    ForestRun<System> run(sys, in.num_edges, in.num_tri > in.num_points ? in.num_tri : in.num_points, 3);
+    run.Flag(0, general, triangles, in.num_tri);
+    run.Flag(1, regularized, triangles, in.num_tri);
+    run.Flag(2, solid, fans, in.num_points);
+    for (uint32_t* merges : {general_merges, regularized_merges, solid_merges}) {
+      thrust::fill_n(policy, merges, levels, 0u);
+    }
+    ForestOutputs forest_out;
+    forest_out.merges_at_rank = general_merges;
+    forest_out.part_begin[0] = in.num_points;
+    forest_out.part_begin[1] = 2 * in.num_points;
+    forest_out.part_merges[0] = regularized_merges;
+    forest_out.part_merges[1] = solid_merges;
+    run.Run(static_cast<uint32_t>(num_nodes), forest_out, general, regularized, solid);
+  }
+  prefix(general_merges);
+  prefix(regularized_merges);
+  prefix(solid_merges);
+
+  // Triangles, edges (both senses) and regularized vertices present at each level (prefix counts),
+  // counted after the forests, whose working space is gone by then.
+  Buffer<uint32_t, System> births(sys, levels), edge_births(sys, levels), regularized_edge_births(sys, levels),
+      regularized_vertices(sys, levels);
   thrust::fill_n(policy, births.data(), levels, 0u);
   thrust::fill_n(policy, edge_births.data(), levels, 0u);
   thrust::fill_n(policy, regularized_edge_births.data(), levels, 0u);
@@ -393,29 +613,15 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   prefix(edge_births.data());
   prefix(regularized_edge_births.data());
   prefix(regularized_vertices.data());
-  // General: components and holes from one forest.
-  thrust::transform(policy, zero, zero + in.num_edges, graph.data(),
-                    GeneralGraphEdge{in.edges, in.edge_rho, in.edge_mu_low});
-  thrust::fill_n(policy, merges.data(), levels, 0u);
-  SpanningForest(sys, graph.data(), in.num_edges, in.num_points, ForestOutputs{merges.data()});
-  prefix(merges.data());
-  thrust::transform(policy, zero, zero + levels, out.components, CurveAt{nullptr, merges.data(), in.num_unique});
-  thrust::transform(policy, zero, zero + levels, out.holes, HolesAt{edge_births.data(), births.data(), merges.data()});
-  // Regularized: the forest of edges taken with their first triangle.
-  thrust::transform(policy, zero, zero + in.num_edges, graph.data(), RegularizedGraphEdge{in.edges, in.edge_mu_low});
-  thrust::fill_n(policy, merges.data(), levels, 0u);
-  SpanningForest(sys, graph.data(), in.num_edges, in.num_points, ForestOutputs{merges.data()});
-  prefix(merges.data());
-  thrust::transform(policy, zero, zero + levels, out.regularized_components,
-                    CurveAt{regularized_vertices.data(), merges.data(), 0u});
+
+  // The holes read the forests' merges before the component curves overwrite them.
+  thrust::transform(policy, zero, zero + levels, out.holes, HolesAt{edge_births.data(), births.data(), general_merges});
   thrust::transform(policy, zero, zero + levels, out.regularized_holes,
-                    HolesAt{regularized_edge_births.data(), births.data(), merges.data()});
-  // Solid.
-  thrust::transform(policy, zero, zero + in.num_edges, graph.data(), SolidGraphEdge{in.edge_tris, in.edge_mu_high});
-  thrust::fill_n(policy, merges.data(), levels, 0u);
-  SpanningForest(sys, graph.data(), in.num_edges, in.num_tri, ForestOutputs{merges.data()});
-  prefix(merges.data());
-  thrust::transform(policy, zero, zero + levels, out.solid_components, CurveAt{births.data(), merges.data(), 0u});
+                    HolesAt{regularized_edge_births.data(), births.data(), regularized_merges});
+  thrust::transform(policy, zero, zero + levels, out.components, CurveAt{nullptr, general_merges, in.num_unique});
+  thrust::transform(policy, zero, zero + levels, out.regularized_components,
+                    CurveAt{regularized_vertices.data(), regularized_merges, 0u});
+  thrust::transform(policy, zero, zero + levels, out.solid_components, CurveAt{births.data(), solid_merges, 0u});
 }
 
 }  // namespace galpha::detail

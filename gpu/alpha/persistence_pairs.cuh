@@ -492,9 +492,9 @@ struct InForest {
 /// The forest of a graph (edges one per family edge, clobbered), marked by canonical position,
 /// and its elder-rule kills.
 template <class System>
-void ElderRuleForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint32_t num_nodes, const uint64_t* node_age,
-                     uint32_t mark_xor, bool host_finish, uint8_t* forest_mark, uint64_t* killed_age,
-                     ForestPairing* report) {
+void ElderRuleForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint32_t num_nodes, EdgeCycles cycles,
+                     uint32_t num_cycles, const uint64_t* node_age, uint32_t mark_xor, bool host_finish,
+                     uint8_t* forest_mark, uint64_t* killed_age, ForestPairing* report) {
   auto policy = sys.policy();
   thrust::fill_n(policy, forest_mark, num_edges, uint8_t{0});
   Buffer<WeightedEdge, System> forest(sys, num_edges);
@@ -503,7 +503,7 @@ void ElderRuleForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint3
   out.forest_mark = forest_mark;
   out.mark_xor = mark_xor;
   out.keep_never = true;
-  SpanningForest(sys, graph, num_edges, num_nodes, out);
+  SpanningForest(sys, graph, num_edges, num_nodes, cycles, num_cycles, out);
   // The forest's edges, as the graph gave them (SpanningForest relabelled its copy).
   const auto num_forest = static_cast<uint32_t>(
       thrust::copy_if(policy, forest.data(), forest.data() + num_edges, graph, InForest{forest_mark, mark_xor}) -
@@ -643,8 +643,9 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     Buffer<uint64_t, System> age(sys, in.num_points);
     thrust::transform(policy, zero, zero + in.num_points, age.data(), IdentityAge{});
     thrust::transform(policy, zero, zero + num_edges, graph.data(), PrimalEdge{in.edges, key});
-    ElderRuleForest(sys, graph.data(), num_edges, in.num_points, age.data(), 0u, host_finish, primal_forest.data(),
-                    primal_killed.data(), &out->report.forests[0]);
+    // Cycles: each triangle's edges.
+    ElderRuleForest(sys, graph.data(), num_edges, in.num_points, EdgeCycles{in.edge_tris, nullptr}, num_tri, age.data(),
+                    0u, host_finish, primal_forest.data(), primal_killed.data(), &out->report.forests[0]);
   }
   // H0's pairs go to the host while the dual forest is computed. The host array has room for
   // every H1 pair too (at most one a dual forest edge: num_tri); it is not zeroed first
@@ -673,8 +674,9 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     thrust::transform(policy, zero, zero + (num_tri + 1), age.data(),
                       DualNodeAge{in.tri_rank, triangle_position.data(), num_tri});
     thrust::transform(policy, zero, zero + num_edges, graph.data(), DualEdge{in.edge_tris, num_tri, key});
-    ElderRuleForest(sys, graph.data(), num_edges, num_tri + 1, age.data(), 0xFFFFFFFFu, host_finish, dual_forest.data(),
-                    dual_killed.data(), &out->report.forests[1]);
+    // Cycles: the edges around each vertex (around a hull vertex through the outer face).
+    ElderRuleForest(sys, graph.data(), num_edges, num_tri + 1, EdgeCycles{nullptr, in.edges}, in.num_points, age.data(),
+                    0xFFFFFFFFu, host_finish, dual_forest.data(), dual_killed.data(), &out->report.forests[1]);
   }
   timer.EndStage("persistence_h1");
   graph.Reset();
