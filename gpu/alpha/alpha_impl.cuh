@@ -885,10 +885,12 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   std::optional<PendingDownloadOf<System>> tables_download;
   if (resident == nullptr)
     tables_download.emplace(StartTablesDownload(sys, mesh, edge_tris, ranks, values, intervals, out));
-  MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
-  timer.EndStage("master_list");
+  // The curves before the master list: their forests' working space is the build's largest, and
+  // the master list is not yet held beside it.
   ComponentCounts<System> components = CountComponents(sys, mesh, edge_tris, ranks, intervals);
   timer.EndStage("components");
+  MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
+  timer.EndStage("master_list");
   if (persistence) {
     // While the tables download: the arrays it reads are the family's, where they lie.
     PersistenceOut diagram;

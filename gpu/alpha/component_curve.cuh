@@ -26,6 +26,7 @@
 #include <thrust/transform.h>
 
 #include <cstdint>
+#include <optional>
 
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
@@ -65,18 +66,6 @@ struct OfferLightestEdge {
   }
 };
 
-/// The edge a component chose tells it where to hook.
-struct RecordHookTarget {
-  const WeightedEdge* edges;
-  const unsigned long long* best;
-  uint32_t* target;
-  GALPHA_HD void operator()(uint32_t i) const {
-    const WeightedEdge e = edges[i];
-    if (best[e.a] == e.weight) target[e.a] = e.b;
-    if (best[e.b] == e.weight) target[e.b] = e.a;
-  }
-};
-
 /// What a spanning forest reports of its edges (either may be null).
 struct ForestOutputs {
   /// Forest edges counted at their rank (a weight's high word).
@@ -99,25 +88,37 @@ struct ForestOutputs {
   }
 };
 
-/// A component hooks to the other end of its lightest edge, except the smaller of two components
-/// that chose the same edge (the only cycles Borůvka can form with unique weights); each hooked
-/// edge is a forest edge, reported as `out` asks.
-struct HookComponent {
-  const uint32_t* labels;
+/// The edge a component chose tells it where to hook (the persistence pairing's hook paths).
+struct RecordHookTarget {
+  const WeightedEdge* edges;
   const unsigned long long* best;
-  const uint32_t* target;
+  uint32_t* target;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const WeightedEdge e = edges[i];
+    if (best[e.a] == e.weight) target[e.a] = e.b;
+    if (best[e.b] == e.weight) target[e.b] = e.a;
+  }
+};
+
+/// A component hooks to the other end of its lightest edge, except the smaller of two components
+/// that chose the same edge (the only cycles Borůvka can form with unique weights): the edge's
+/// own thread hooks each side that chose it (a component's lightest edge is one edge of the live
+/// list, its weight being unique). Each hooked edge is a forest edge, reported as `out` asks.
+struct HookAcrossEdge {
+  const WeightedEdge* edges;
+  const unsigned long long* best;
   uint32_t* parent;
   ForestOutputs out;
   GALPHA_HD void operator()(uint32_t i) const {
-    const uint32_t c = labels[i];
-    if (best[c] == ~0ull) return;  // no edge leaves this component any more
-    const uint32_t other = target[c];
-    if (best[other] == best[c] && c < other) return;  // the other side hooks to us
+    const WeightedEdge e = edges[i];
+    const bool a_chose = best[e.a] == e.weight, b_chose = best[e.b] == e.weight;
+    if (a_chose && !(b_chose && e.a < e.b)) Hook(e.a, e.b, e.weight);
+    if (b_chose && !(a_chose && e.b < e.a)) Hook(e.b, e.a, e.weight);
+  }
+  GALPHA_HD void Hook(uint32_t c, uint32_t other, unsigned long long weight) const {
     parent[c] = other;
-    if (out.merges_at_rank != nullptr) {
-      AtomicIncrement(&out.MergesOf(c)[static_cast<uint32_t>(best[c] >> 32)]);
-    }
-    if (out.forest_mark != nullptr) out.forest_mark[(static_cast<uint32_t>(best[c]) ^ out.mark_xor) - 1u] = 1;
+    if (out.merges_at_rank != nullptr) AtomicIncrement(&out.MergesOf(c)[static_cast<uint32_t>(weight >> 32)]);
+    if (out.forest_mark != nullptr) out.forest_mark[(static_cast<uint32_t>(weight) ^ out.mark_xor) - 1u] = 1;
   }
 };
 
@@ -201,8 +202,10 @@ struct IsGraphEdge {
 
 /// Finds the minimum spanning forest of a graph over nodes 0..num_nodes whose edges are the
 /// `num_active` entries of `active` (graph edges only: no loops, and kNeverRank edges only when
-/// `out` keeps them; weights unique), and reports its edges as `out` asks. `active` and `scratch`
-/// (as long) are working space (clobbered).
+/// `out` keeps them; weights unique), and reports its edges as `out` asks. `active` is working
+/// space (clobbered), and so is `scratch` (as long as `active`) where the caller has one to spare;
+/// without it (null) the compactions' target is allocated after the first round, as long as the
+/// edges that round leaves.
 ///
 /// A round's kernels are recorded once and replayed (the host's launch cost bounded the rounds,
 /// as in the triangulation's flip loop): the live edge and label counts stay on the device, and
@@ -212,12 +215,11 @@ template <class System>
 void ForestOfGraphEdges(System& sys, WeightedEdge* active, uint32_t num_active, WeightedEdge* scratch,
                         uint32_t num_nodes, const ForestOutputs& out) {
   auto policy = sys.policy();
-  WeightedEdge* kept = scratch;  // the compactions' target
-  Buffer<uint32_t, System> labels(sys, num_nodes), parent(sys, num_nodes), target(sys, num_nodes);
-  // The labels' compaction target: `target`, whose entries a round reads only before the
-  // compaction and writes again before it reads them in the next round.
-  uint32_t* kept_labels = target.data();
+  Buffer<uint32_t, System> labels(sys, num_nodes), parent(sys, num_nodes);
   Buffer<unsigned long long, System> best(sys, num_nodes);
+  // The labels' compaction target: the lightest-edge words, which a round reads only before the
+  // compaction and resets for the live labels after it (no other word is read).
+  uint32_t* kept_labels = reinterpret_cast<uint32_t*>(best.data());
   enum Count { kLiveEdges, kLiveLabels, kKeptEdges, kKeptLabels, kJumped, kNumCounts };
   Buffer<uint32_t, System> counts(sys, kNumCounts);
   uint32_t* count = counts.data();
@@ -226,6 +228,8 @@ void ForestOfGraphEdges(System& sys, WeightedEdge* active, uint32_t num_active, 
   thrust::fill_n(policy, best.data(), num_nodes, ~0ull);
   const uint32_t initial[kNumCounts] = {num_active, num_nodes, 0, 0, 0};
   sys.FromHost(count, initial, kNumCounts);
+  std::optional<Buffer<WeightedEdge, System>> own_scratch;
+  WeightedEdge* kept = scratch;  // the compactions' target
 
   // Hook trees are shallow on realistic input: a few jumps flatten them. The jumps run in groups,
   // and only the last of a group reports whether it still moved a pointer.
@@ -244,9 +248,7 @@ void ForestOfGraphEdges(System& sys, WeightedEdge* active, uint32_t num_active, 
     if (round > 64) throw EngineError(EngineError::Kind::kInternal, "component rounds did not converge");
     sys.Replay(hook_round, [&] {
       sys.ForEachBelow(count + kLiveEdges, OfferLightestEdge{active, best.data()});
-      sys.ForEachBelow(count + kLiveEdges, RecordHookTarget{active, best.data(), target.data()});
-      sys.ForEachBelow(count + kLiveLabels,
-                       HookComponent{labels.data(), best.data(), target.data(), parent.data(), out});
+      sys.ForEachBelow(count + kLiveEdges, HookAcrossEdge{active, best.data(), parent.data(), out});
       jump_group();
     });
     // The round's wait: whether edges were left for it (none: it changed nothing, and the forest
@@ -259,14 +261,24 @@ void ForestOfGraphEdges(System& sys, WeightedEdge* active, uint32_t num_active, 
       sys.Replay(more_jumps, jump_group);
       jumped = sys.Read(count + kJumped);
     }
+    if (kept == nullptr && !own_scratch) {
+      // The first round's edges relabelled (the shrink does it again, to the same labels) and
+      // counted: the target needs room for those that still join two components.
+      thrust::for_each_n(policy, thrust::counting_iterator<uint32_t>(0), live_edges,
+                         RelabelEdge{active, parent.data()});
+      const auto left =
+          static_cast<size_t>(thrust::count_if(policy, active, active + live_edges, JoinsTwoComponents{}));
+      own_scratch.emplace(sys, left);
+      kept = own_scratch->data();
+    }
     sys.Replay(shrink_round, [&] {
-      sys.ForEachBelow(count + kLiveLabels, ResetBest{labels.data(), best.data()});
       sys.ForEachBelow(count + kLiveEdges, RelabelEdge{active, parent.data()});
       sys.AppendIf(count + kLiveEdges, 1, active, active, JoinsTwoComponents{}, kept, count + kKeptEdges);
       sys.AppendIf(count + kLiveLabels, 1, labels.data(), labels.data(), IsRoot{parent.data()}, kept_labels,
                    count + kKeptLabels);
       sys.ForEachBelow(count + kKeptEdges, CopyItem<WeightedEdge>{kept, active});
       sys.ForEachBelow(count + kKeptLabels, CopyItem<uint32_t>{kept_labels, labels.data()});
+      sys.ForEachBelow(count + kKeptLabels, ResetBest{labels.data(), best.data()});
       sys.RunSingle(TakeKeptCounts{count + kLiveEdges, count + kLiveLabels, count + kKeptEdges, count + kKeptLabels});
     });
   }
@@ -482,7 +494,7 @@ class ForestRun {
     const size_t num_flags = size_t{num_edges_} * sizeof...(Graphs);
     const auto total =
         static_cast<uint32_t>(thrust::count_if(policy, flags_.data(), flags_.data() + num_flags, IsFlagged{}));
-    Buffer<WeightedEdge, System> active(sys_, total), scratch(sys_, total);
+    Buffer<WeightedEdge, System> active(sys_, total);
     WeightedEdge* end = active.data();
     uint32_t index = 0;
     thrust::counting_iterator<uint32_t> zero(0);
@@ -494,7 +506,7 @@ class ForestRun {
     };
     (pack(graphs), ...);
     flags_.Reset();
-    ForestOfGraphEdges(sys_, active.data(), total, scratch.data(), num_nodes, out);
+    ForestOfGraphEdges(sys_, active.data(), total, nullptr, num_nodes, out);
   }
 
  private:
