@@ -96,12 +96,12 @@ absl::StatusOr<ResolvedThreshold> ResidentFamilyReader::Resolve(const Threshold&
       level = family_->LevelForAlpha(threshold.value);
       resolved.alpha_sq = threshold.value * threshold.value;
       break;
-    case Threshold::Kind::kRatio: {
-      // The ratio's exact area comparisons read every edge's triangles: answered by the family in
-      // host memory (a download for this call).
-      GALPHA_ASSIGN_OR_RETURN(const std::shared_ptr<const AlphaFamily> host, HostFamily());
-      return ResolveThreshold(*host, threshold);
-    }
+    case Threshold::Kind::kRatio:
+      level = family_->LevelForAreaRatio(threshold.value);
+      if (level.ok()) {
+        GALPHA_ASSIGN_OR_RETURN(resolved.alpha_sq, family_->PublishedAlphaSq(*level));
+      }
+      break;
   }
   if (!level.ok()) {
     if (level.status().code() == absl::StatusCode::kInvalidArgument) {

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "core/base/status_macros.hpp"
 #include "core/family/alpha_ranks.hpp"
 
 namespace galpha {
@@ -126,47 +127,67 @@ double RegularizedAreaApprox(const AlphaFamily& family, int64_t level) {
 
 double HullAreaApprox(const AlphaFamily& family) { return RegularizedAreaApprox(family, family.max_level()); }
 
-absl::StatusOr<int64_t> LevelForAreaRatio(const AlphaFamily& family, double ratio) {
+absl::StatusOr<AreaRatioBracket> BracketAreaRatio(const AreaCurveReader& curve, double ratio) {
   if (!(ratio >= 0.0 && ratio <= 1.0)) {
     return absl::InvalidArgumentError(
         absl::StrCat("ratio ", ratio, " is outside 0..1 (the share of the convex hull's area the shape must cover)"));
   }
-  const int64_t k = family.max_level();
-  if (ratio == 0.0) return 0;  // every area is >= 0
+  const int64_t k = curve.max_level;
+  if (ratio == 0.0) return AreaRatioBracket{-1, 0};     // every area is >= 0
+  if (!curve.complete) return AreaRatioBracket{-1, k};  // level k always qualifies (ratio <= 1)
   const DyadicRatio dyadic = DyadicOf(ratio);
-  const AlphaRanks& r = family.ranks();
   // The filter: with exact areas X (in units) within E of the curve Q at every level,
   //   Q_L - E >= ratio (Q_K + E)  proves X_L >= ratio X_K, and
   //   Q_L + E <  ratio (Q_K - E)  proves X_L <  ratio X_K.
   // Both are monotone in L (Q never decreases): two binary searches bound the answer to (low, high].
-  int64_t low = -1, high = k;  // level k always qualifies: X_K >= ratio X_K for ratio <= 1
-  if (r.area_units.size() == static_cast<size_t>(k) + 1) {
-    const __int128 error = static_cast<__int128>(r.area_scale.error_units);
-    const uint64_t hull = r.area_units[static_cast<size_t>(k)];
-    const __int128 need_up = ScaleBy(dyadic, hull + r.area_scale.error_units, /*round_up=*/true);
-    const __int128 need_down =
-        hull >= r.area_scale.error_units ? ScaleBy(dyadic, hull - r.area_scale.error_units, false) : 0;
-    auto surely_enough = [&](int64_t level) {
-      return static_cast<__int128>(r.area_units[static_cast<size_t>(level)]) - error >= need_up;
-    };
-    auto surely_short = [&](int64_t level) {
-      return static_cast<__int128>(r.area_units[static_cast<size_t>(level)]) + error < need_down;
-    };
-    high = FirstLevelWhere(0, k, surely_enough);  // or k, which qualifies anyway
-    // The largest surely-short level below it (surely_short holds, then fails, as L grows).
-    low = FirstLevelWhere(0, high, [&](int64_t level) { return !surely_short(level); }) - 1;
-  }
-  if (high == low + 1) return high;
+  const __int128 error = static_cast<__int128>(curve.error_units);
+  absl::Status read_failure;
+  auto units = [&](int64_t level) -> __int128 {
+    absl::StatusOr<uint64_t> value = curve.units_at(level);
+    if (!value.ok()) {
+      if (read_failure.ok()) read_failure = value.status();
+      return 0;
+    }
+    return static_cast<__int128>(*value);
+  };
+  const __int128 hull = units(k);
+  const __int128 need_up = ScaleBy(dyadic, static_cast<uint64_t>(hull) + curve.error_units, /*round_up=*/true);
+  const __int128 need_down =
+      hull >= error ? ScaleBy(dyadic, static_cast<uint64_t>(hull - error), /*round_up=*/false) : 0;
+  auto surely_enough = [&](int64_t level) { return units(level) - error >= need_up; };
+  auto surely_short = [&](int64_t level) { return units(level) + error < need_down; };
+  AreaRatioBracket bracket;
+  bracket.high = FirstLevelWhere(0, k, surely_enough);  // or k, which qualifies anyway
+  // The largest surely-short level below it (surely_short holds, then fails, as L grows).
+  bracket.low = FirstLevelWhere(0, bracket.high, [&](int64_t level) { return !surely_short(level); }) - 1;
+  if (!read_failure.ok()) return read_failure;
+  return bracket;
+}
+
+int64_t LevelForAreaRatioWithin(const AlphaFamily& family, double ratio, AreaRatioBracket bracket) {
+  if (bracket.decided()) return bracket.high;
   // Undecided levels: exact areas, by binary search in (low, high] (high qualifies).
+  const DyadicRatio dyadic = DyadicOf(ratio);
   const IntegerCoordinates grid(absl::MakeConstSpan(family.points()));
   const mpz_class hull_times_mantissa =
-      TwiceAreaExact(family, k, grid) * mpz_class(static_cast<unsigned long>(dyadic.mantissa));
+      TwiceAreaExact(family, family.max_level(), grid) * mpz_class(static_cast<unsigned long>(dyadic.mantissa));
   auto exactly_enough = [&](int64_t level) {
     mpz_class twice = TwiceAreaExact(family, level, grid);
     twice <<= static_cast<mp_bitcnt_t>(dyadic.shift);
     return twice >= hull_times_mantissa;
   };
-  return FirstLevelWhere(low + 1, high, exactly_enough);
+  return FirstLevelWhere(bracket.low + 1, bracket.high, exactly_enough);
+}
+
+absl::StatusOr<int64_t> LevelForAreaRatio(const AlphaFamily& family, double ratio) {
+  const AlphaRanks& r = family.ranks();
+  AreaCurveReader curve;
+  curve.max_level = family.max_level();
+  curve.complete = r.area_units.size() == static_cast<size_t>(curve.max_level) + 1;
+  curve.error_units = r.area_scale.error_units;
+  curve.units_at = [&r](int64_t level) -> absl::StatusOr<uint64_t> { return r.area_units[static_cast<size_t>(level)]; };
+  GALPHA_ASSIGN_OR_RETURN(const AreaRatioBracket bracket, BracketAreaRatio(curve, ratio));
+  return LevelForAreaRatioWithin(family, ratio, bracket);
 }
 
 }  // namespace galpha

@@ -9,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.hpp"
+#include "core/family/area_ratio.hpp"
 #include "core/family/simplex_threshold.hpp"
 #include "gpu/alpha/alpha_build_parts.hpp"
 #include "gpu/alpha/resident_backend.hpp"
@@ -162,6 +163,23 @@ absl::StatusOr<double> ResidentAlphaFamily::RegularizedAreaApprox(int64_t level)
   GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the area curve at level ", level),
                                   [&] { values = tables_->CurvesAt(std::min(level, max_level())); }));
   return std::ldexp(static_cast<double>(values.area_units), host_.ranks.area_scale.unit_log2);
+}
+
+absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForAreaRatio(double ratio) const {
+  AreaCurveReader curve;
+  curve.max_level = max_level();
+  curve.complete = true;  // the build computes every level's value
+  curve.error_units = host_.ranks.area_scale.error_units;
+  curve.units_at = [this](int64_t level) -> absl::StatusOr<uint64_t> {
+    detail::CurveValues values;
+    GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("reading the area curve at level ", level),
+                                    [&] { values = tables_->CurvesAt(level); }));
+    return values.area_units;
+  };
+  GALPHA_ASSIGN_OR_RETURN(const AreaRatioBracket bracket, BracketAreaRatio(curve, ratio));
+  if (bracket.decided()) return bracket.high;
+  GALPHA_ASSIGN_OR_RETURN(const AlphaFamily host, ToHostFamily());
+  return LevelForAreaRatioWithin(host, ratio, bracket);
 }
 
 absl::StatusOr<double> ResidentAlphaFamily::PublishedAlphaSq(int64_t level) const {

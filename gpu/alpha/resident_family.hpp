@@ -79,6 +79,9 @@ class ResidentAlphaFamily {
   /// AlphaFamily's RegularizedAreaApprox (core/family/area_ratio.hpp): the area curve's value at
   /// `level` as a double; at K, the convex hull's.
   absl::StatusOr<double> RegularizedAreaApprox(int64_t level) const;
+  /// LevelForAreaRatio (core/family/area_ratio.hpp): the certified curve is read where it lives
+  /// (a few values); a ratio it cannot decide reads the tables into host memory for the exact areas.
+  absl::StatusOr<int64_t> LevelForAreaRatio(double ratio) const;
   /// PublishedAlphaSq (core/family/threshold.hpp): spectrum[level - 1], min_alpha_sq at or below 0.
   absl::StatusOr<double> PublishedAlphaSq(int64_t level) const;
   /// AlphaFamily::OptimalLevelRegularized and OptimalLevelGeneral.
