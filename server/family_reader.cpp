@@ -6,6 +6,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.hpp"
 #include "core/family/area_ratio.hpp"
+#include "gpu/alpha/persistence_engine.hpp"
 
 namespace galpha::server {
 
@@ -117,6 +118,16 @@ absl::StatusOr<ShapeComplex> ResidentFamilyReader::ComplexAt(int64_t level, Clas
   GALPHA_ASSIGN_OR_RETURN(const Classification classes, family_->ClassifyAll(level, mode, VertexRule::kReport));
   return ComplexFromClasses(family_->points(), family_->representative(), family_->triangles(), family_->edges(),
                             classes, mode);
+}
+
+absl::StatusOr<PersistenceDiagram> HostFamilyReader::Persistence(absl::Span<const uint32_t> edge_order,
+                                                                 absl::Span<const uint32_t> triangle_order) const {
+  return PersistenceDiagramOf(*family_, edge_order, triangle_order);
+}
+
+absl::StatusOr<PersistenceDiagram> ResidentFamilyReader::Persistence(absl::Span<const uint32_t>,
+                                                                     absl::Span<const uint32_t>) const {
+  return family_->Persistence();  // the device sorts its canonical orders itself
 }
 
 absl::StatusOr<std::shared_ptr<const AlphaFamily>> ResidentFamilyReader::HostFamily() const {

@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/family/alpha_family.hpp"
+#include "core/family/persistence_pair.hpp"
 #include "core/family/threshold.hpp"
 #include "gpu/alpha/resident_family.hpp"
 
@@ -54,9 +56,15 @@ class FamilyReader {
   virtual absl::StatusOr<std::vector<uint32_t>> MasterBegins(int64_t first_rank, int64_t count) const = 0;
   virtual absl::StatusOr<std::vector<MasterEntry>> MasterEntries(uint64_t position, uint64_t count) const = 0;
 
-  /// The family in host memory, for the answers a resident family does not compute where it lives
-  /// yet (persistence, area ratios): the family itself, or for a resident one its tables
-  /// downloaded for this call (freed with the returned pointer).
+  /// The persistence diagram: PersistenceDiagramOf (gpu/alpha/persistence_engine.hpp; the
+  /// canonical orders the cache keeps, when given) for a family in host memory, computed where the
+  /// tables live for a resident one (ResidentAlphaFamily::Persistence). The same diagram.
+  virtual absl::StatusOr<PersistenceDiagram> Persistence(absl::Span<const uint32_t> edge_order,
+                                                         absl::Span<const uint32_t> triangle_order) const = 0;
+
+  /// The family in host memory, for answers a resident family does not compute where it lives:
+  /// the family itself, or for a resident one its tables downloaded for this call (freed with the
+  /// returned pointer).
   virtual absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const = 0;
 };
 
@@ -102,6 +110,8 @@ class HostFamilyReader final : public FamilyReaderOf<AlphaFamily> {
   absl::StatusOr<std::vector<double>> Spectrum(int64_t first_index, int64_t count) const override;
   absl::StatusOr<std::vector<uint32_t>> MasterBegins(int64_t first_rank, int64_t count) const override;
   absl::StatusOr<std::vector<MasterEntry>> MasterEntries(uint64_t position, uint64_t count) const override;
+  absl::StatusOr<PersistenceDiagram> Persistence(absl::Span<const uint32_t> edge_order,
+                                                 absl::Span<const uint32_t> triangle_order) const override;
   absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const override { return family_; }
 };
 
@@ -140,6 +150,8 @@ class ResidentFamilyReader final : public FamilyReaderOf<ResidentAlphaFamily> {
   absl::StatusOr<std::vector<MasterEntry>> MasterEntries(uint64_t position, uint64_t count) const override {
     return family_->MasterEntries(position, count);
   }
+  absl::StatusOr<PersistenceDiagram> Persistence(absl::Span<const uint32_t> edge_order,
+                                                 absl::Span<const uint32_t> triangle_order) const override;
   absl::StatusOr<std::shared_ptr<const AlphaFamily>> HostFamily() const override;
 };
 

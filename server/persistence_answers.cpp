@@ -17,17 +17,19 @@ namespace v1 = galpha::v1;
 
 class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
  public:
-  PersistenceSource(std::shared_ptr<const CachedFamily> cached, std::shared_ptr<const AlphaFamily> family,
-                    PersistenceDiagram diagram, std::array<bool, 2> dimensions, double min_persistence)
+  /// `spectrum` is the family's spectrum values (the host family's own, or `spectrum_copy`'s).
+  PersistenceSource(std::shared_ptr<const CachedFamily> cached, std::vector<double> spectrum_copy,
+                    absl::Span<const double> spectrum, PersistenceDiagram diagram, std::array<bool, 2> dimensions,
+                    double min_persistence)
       : cached_(std::move(cached)),
-        family_(std::move(family)),
+        spectrum_copy_(std::move(spectrum_copy)),
+        spectrum_(spectrum_copy_.empty() ? spectrum : absl::MakeConstSpan(spectrum_copy_)),
         diagram_(std::move(diagram)),
         dimensions_(dimensions),
         min_persistence_(min_persistence) {}
 
   bool Next(v1::PersistenceResponse* message) override {
     message->Clear();
-    const AlphaFamily& family = *family_;
     for (; dimension_ < 2; ++dimension_, position_ = diagram_.dimension_begin[dimension_]) {
       if (!dimensions_[dimension_]) continue;
       const size_t end = diagram_.dimension_begin[dimension_ + 1];
@@ -35,8 +37,8 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
       uint32_t count = 0;
       for (; position_ < end && count < kPersistencePairsPerChunk; ++position_) {
         const PersistencePair& p = diagram_.pairs[position_];
-        if (!PersistsAtLeast(family, p, min_persistence_)) continue;
-        Append(family, p, RankValue(family, p.birth_rank), RankValue(family, p.death_rank), message);
+        if (!PersistsAtLeast(spectrum_, p, min_persistence_)) continue;
+        Append(p, message);
         ++count;
       }
       if (count > 0) {
@@ -48,19 +50,21 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
   }
 
  private:
-  static void Append(const AlphaFamily& family, const PersistencePair& p, double birth, double death,
-                     v1::PersistenceResponse* message) {
+  void Append(const PersistencePair& p, v1::PersistenceResponse* message) const {
     message->add_birth_rank(p.birth_rank);
     message->add_death_rank(p.essential() ? -1 : static_cast<int64_t>(p.death_rank));
-    message->add_birth_alpha_sq(birth);
-    message->add_death_alpha_sq(death);
-    const PairVertices vertices = VerticesOf(family, p);
+    message->add_birth_alpha_sq(RankValue(spectrum_, p.birth_rank));
+    message->add_death_alpha_sq(RankValue(spectrum_, p.death_rank));
+    const FamilyReader& family = cached_->reader();
+    const PairVertices vertices =
+        VerticesOf(absl::MakeConstSpan(family.edges()), absl::MakeConstSpan(family.triangles()), p);
     for (uint32_t i = 0; i <= p.dimension; ++i) message->add_creator_vertices(vertices.creator[i]);
     for (uint32_t i = 0; i <= p.dimension + 1; ++i) message->add_killer_vertices(vertices.killer[i]);
   }
 
   std::shared_ptr<const CachedFamily> cached_;  // kept while the stream runs, as every source's
-  std::shared_ptr<const AlphaFamily> family_;   // the cached one, or a resident one's download
+  std::vector<double> spectrum_copy_;           // a resident family's spectrum, read for this call
+  absl::Span<const double> spectrum_;
   PersistenceDiagram diagram_;
   std::array<bool, 2> dimensions_;
   double min_persistence_;
@@ -85,15 +89,24 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::PersistenceResponse>>> MakePersis
     return absl::InvalidArgumentError(
         absl::StrCat("min_persistence ", min_persistence, " is not a length: give 0 or more"));
   }
-  // The diagram is computed from the family in host memory (a resident family's is downloaded for
-  // this call), on the GPU when the family was built there (gpu/alpha/persistence_engine.hpp).
-  absl::StatusOr<std::shared_ptr<const AlphaFamily>> family = cached->reader().HostFamily();
-  if (!family.ok()) return family.status();
-  absl::StatusOr<PersistenceDiagram> diagram =
-      PersistenceDiagramOf(**family, cached->EdgeOrder(), cached->TriangleOrder());
+  // The diagram is computed where the family lives (a resident family's on its device, only the
+  // mesh uploaded; a host family's on the GPU when it was built there:
+  // gpu/alpha/persistence_engine.hpp), and the values are read from its spectrum (a resident
+  // family's downloaded once, 8 bytes a value).
+  const FamilyReader& reader = cached->reader();
+  absl::StatusOr<PersistenceDiagram> diagram = reader.Persistence(cached->EdgeOrder(), cached->TriangleOrder());
   if (!diagram.ok()) return diagram.status();
-  return std::make_unique<PersistenceSource>(std::move(cached), *std::move(family), *std::move(diagram), dimensions,
-                                             min_persistence);
+  std::vector<double> spectrum_copy;
+  absl::Span<const double> spectrum;
+  if (const AlphaFamily* host = cached->host_family(); host != nullptr) {
+    spectrum = absl::MakeConstSpan(host->spectrum());
+  } else {
+    absl::StatusOr<std::vector<double>> values = reader.Spectrum(0, reader.max_level());
+    if (!values.ok()) return values.status();
+    spectrum_copy = *std::move(values);
+  }
+  return std::make_unique<PersistenceSource>(std::move(cached), std::move(spectrum_copy), spectrum, *std::move(diagram),
+                                             dimensions, min_persistence);
 }
 
 }  // namespace galpha::server

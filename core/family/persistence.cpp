@@ -86,30 +86,39 @@ void SortRuns(HostVector<PersistencePair>::iterator begin, HostVector<Persistenc
 
 }  // namespace
 
-double RankValue(const AlphaFamily& family, uint32_t rank) {
+double RankValue(absl::Span<const double> spectrum, uint32_t rank) {
   if (rank == kNeverRank) return std::numeric_limits<double>::infinity();
   if (rank == 0) return 0.0;
-  return family.spectrum()[rank - 1];
+  return spectrum[rank - 1];
 }
 
-PairVertices VerticesOf(const AlphaFamily& family, const PersistencePair& pair) {
+double RankValue(const AlphaFamily& family, uint32_t rank) {
+  return RankValue(absl::MakeConstSpan(family.spectrum()), rank);
+}
+
+PairVertices VerticesOf(absl::Span<const std::array<uint32_t, 2>> edges,
+                        absl::Span<const std::array<uint32_t, 3>> triangles, const PersistencePair& pair) {
   PairVertices out;
   if (pair.dimension == 0) {
     out.creator[0] = pair.creator;
     if (!pair.essential()) {
-      const auto edge = SortedEdge(family.edges()[pair.killer]);
+      const auto edge = SortedEdge(edges[pair.killer]);
       std::copy(edge.begin(), edge.end(), out.killer.begin());
     }
   } else {
-    out.creator = SortedEdge(family.edges()[pair.creator]);
-    if (!pair.essential()) out.killer = SortedTriangle(family.triangles()[pair.killer]);
+    out.creator = SortedEdge(edges[pair.creator]);
+    if (!pair.essential()) out.killer = SortedTriangle(triangles[pair.killer]);
   }
   return out;
 }
 
-bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence) {
+PairVertices VerticesOf(const AlphaFamily& family, const PersistencePair& pair) {
+  return VerticesOf(absl::MakeConstSpan(family.edges()), absl::MakeConstSpan(family.triangles()), pair);
+}
+
+bool PersistsAtLeast(absl::Span<const double> spectrum, const PersistencePair& pair, double min_persistence) {
   if (pair.essential()) return true;
-  const double birth = RankValue(family, pair.birth_rank), death = RankValue(family, pair.death_rank);
+  const double birth = RankValue(spectrum, pair.birth_rank), death = RankValue(spectrum, pair.death_rank);
   // The rounded difference is within half an ulp of the exact one, so a bound two doubles away or
   // more is on the same side of both; only a bound at the difference or next to it needs the
   // exact rationals.
@@ -119,6 +128,10 @@ bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, dou
     return difference > min_persistence;
   }
   return mpq_class(death) - mpq_class(birth) >= mpq_class(min_persistence);
+}
+
+bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence) {
+  return PersistsAtLeast(absl::MakeConstSpan(family.spectrum()), pair, min_persistence);
 }
 
 absl::StatusOr<PersistenceDiagram> ComputePersistence(const AlphaFamily& family) {

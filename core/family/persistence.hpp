@@ -43,14 +43,20 @@ struct PairVertices {
   std::array<uint32_t, 3> killer{kNoVertex, kNoVertex, kNoVertex};
 };
 PairVertices VerticesOf(const AlphaFamily& family, const PersistencePair& pair);
+/// The same from a family's mesh (a resident family's host arrays).
+PairVertices VerticesOf(absl::Span<const std::array<uint32_t, 2>> edges,
+                        absl::Span<const std::array<uint32_t, 3>> triangles, const PersistencePair& pair);
 
 /// Whether `pair` is listed under a minimum persistence (alpha_sq units, on the published values:
 /// RankValue(death) - RankValue(birth) >= min_persistence, compared exactly); essential classes
 /// always are.
 bool PersistsAtLeast(const AlphaFamily& family, const PersistencePair& pair, double min_persistence);
+/// The same from a family's spectrum values (AlphaFamily::spectrum()).
+bool PersistsAtLeast(absl::Span<const double> spectrum, const PersistencePair& pair, double min_persistence);
 
 /// The value of a rank as the family reports it: 0 for rank 0, the spectrum's nearest double for
 /// 1..K, +infinity for kNeverRank.
 double RankValue(const AlphaFamily& family, uint32_t rank);
+double RankValue(absl::Span<const double> spectrum, uint32_t rank);
 
 }  // namespace galpha

@@ -14,4 +14,9 @@ void PersistenceOnCpu(const PersistenceIn& host, bool host_finish, PersistenceOu
 /// uploading the arrays.
 void PersistenceOnCuda(const PersistenceIn& host, bool host_finish, void* stream, PersistenceOut* out);
 
+/// On the CUDA backend, on `stream`, for a family whose tables are in device memory already (a
+/// resident family's): `in`'s edge triangles and rank tables are device pointers, its mesh (edges,
+/// triangles, representatives, hidden flags) host pointers, and only the mesh is uploaded.
+void PersistenceOnCudaWithTables(const PersistenceIn& in, bool host_finish, void* stream, PersistenceOut* out);
+
 }  // namespace galpha::detail

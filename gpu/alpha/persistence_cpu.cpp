@@ -7,7 +7,7 @@ namespace galpha::detail {
 
 void PersistenceOnCpu(const PersistenceIn& host, bool host_finish, PersistenceOut* out) {
   CpuSystem system;
-  PersistenceDiagramFromHost(system, host, host_finish, out);
+  PersistenceDiagramUploading(system, host, /*upload_tables=*/true, host_finish, out);
 }
 
 }  // namespace galpha::detail

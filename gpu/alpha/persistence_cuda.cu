@@ -10,12 +10,17 @@ namespace galpha::detail {
 void PersistenceOnCuda(const PersistenceIn& host, bool host_finish, void* stream, PersistenceOut* out) {
   if (stream != nullptr) {
     CudaSystem system(static_cast<cudaStream_t>(stream));
-    PersistenceDiagramFromHost(system, host, host_finish, out);
+    PersistenceDiagramUploading(system, host, /*upload_tables=*/true, host_finish, out);
     return;
   }
   OwnedStream owned;
   CudaSystem system(owned.get());
-  PersistenceDiagramFromHost(system, host, host_finish, out);
+  PersistenceDiagramUploading(system, host, /*upload_tables=*/true, host_finish, out);
+}
+
+void PersistenceOnCudaWithTables(const PersistenceIn& in, bool host_finish, void* stream, PersistenceOut* out) {
+  CudaSystem system(static_cast<cudaStream_t>(stream));
+  PersistenceDiagramUploading(system, in, /*upload_tables=*/false, host_finish, out);
 }
 
 }  // namespace galpha::detail

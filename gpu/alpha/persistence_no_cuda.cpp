@@ -8,4 +8,8 @@ void PersistenceOnCuda(const PersistenceIn&, bool, void*, PersistenceOut*) {
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 
+void PersistenceOnCudaWithTables(const PersistenceIn&, bool, void*, PersistenceOut*) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
 }  // namespace galpha::detail

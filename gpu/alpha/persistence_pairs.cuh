@@ -705,27 +705,33 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
 }
 
 /// The diagram from a family's arrays in host memory (`host`): the CUDA system uploads them first
-/// (stage "persistence_upload"), the OpenMP system reads them where they are.
+/// (stage "persistence_upload"), the OpenMP system reads them where they are. Without
+/// `upload_tables`, `host`'s edge triangles and rank tables are in the system's memory already (a
+/// resident family's) and only the mesh is uploaded.
 template <class System>
-void PersistenceDiagramFromHost(System& sys, const PersistenceIn& host, bool host_finish, PersistenceOut* out) {
+void PersistenceDiagramUploading(System& sys, const PersistenceIn& host, bool upload_tables, bool host_finish,
+                                 PersistenceOut* out) {
   StageTimer<System> timer(sys, &out->report.stage_times);
   if constexpr (System::kHostMemory) {
     PersistenceDiagramOnSystem(sys, host, host_finish, timer, out);
   } else {
+    const size_t tables_edges = upload_tables ? host.num_edges : 0, tables_tri = upload_tables ? host.num_tri : 0;
     Buffer<EdgeIdx, System> edges(sys, host.num_edges);
-    Buffer<EdgeTris, System> edge_tris(sys, host.num_edges);
+    Buffer<EdgeTris, System> edge_tris(sys, tables_edges);
     Buffer<TriIdx, System> triangles(sys, host.num_tri);
-    Buffer<uint32_t, System> rho(sys, host.num_edges), mu_low(sys, host.num_edges), tri_rank(sys, host.num_tri),
+    Buffer<uint32_t, System> rho(sys, tables_edges), mu_low(sys, tables_edges), tri_rank(sys, tables_tri),
         representative(sys, host.num_points);
     Buffer<uint8_t, System> hidden(sys, host.hidden != nullptr ? host.num_points : 0);
     std::vector<HostCopy> copies = {
         {const_cast<EdgeIdx*>(host.edges), edges.data(), host.num_edges * sizeof(EdgeIdx)},
-        {const_cast<EdgeTris*>(host.edge_tris), edge_tris.data(), host.num_edges * sizeof(EdgeTris)},
         {const_cast<TriIdx*>(host.triangles), triangles.data(), host.num_tri * sizeof(TriIdx)},
-        {const_cast<uint32_t*>(host.edge_rho_rank), rho.data(), host.num_edges * sizeof(uint32_t)},
-        {const_cast<uint32_t*>(host.edge_mu_low), mu_low.data(), host.num_edges * sizeof(uint32_t)},
-        {const_cast<uint32_t*>(host.tri_rank), tri_rank.data(), host.num_tri * sizeof(uint32_t)},
         {const_cast<uint32_t*>(host.representative), representative.data(), host.num_points * sizeof(uint32_t)}};
+    if (upload_tables) {
+      copies.push_back({const_cast<EdgeTris*>(host.edge_tris), edge_tris.data(), host.num_edges * sizeof(EdgeTris)});
+      copies.push_back({const_cast<uint32_t*>(host.edge_rho_rank), rho.data(), host.num_edges * sizeof(uint32_t)});
+      copies.push_back({const_cast<uint32_t*>(host.edge_mu_low), mu_low.data(), host.num_edges * sizeof(uint32_t)});
+      copies.push_back({const_cast<uint32_t*>(host.tri_rank), tri_rank.data(), host.num_tri * sizeof(uint32_t)});
+    }
     if (host.hidden != nullptr) {
       copies.push_back({const_cast<uint8_t*>(host.hidden), hidden.data(), host.num_points * sizeof(uint8_t)});
     }
@@ -735,11 +741,11 @@ void PersistenceDiagramFromHost(System& sys, const PersistenceIn& host, bool hos
                            host.num_edges,
                            host.num_tri,
                            edges.data(),
-                           edge_tris.data(),
+                           upload_tables ? edge_tris.data() : host.edge_tris,
                            triangles.data(),
-                           rho.data(),
-                           mu_low.data(),
-                           tri_rank.data(),
+                           upload_tables ? rho.data() : host.edge_rho_rank,
+                           upload_tables ? mu_low.data() : host.edge_mu_low,
+                           upload_tables ? tri_rank.data() : host.tri_rank,
                            representative.data(),
                            host.hidden != nullptr ? hidden.data() : nullptr};
     PersistenceDiagramOnSystem(sys, in, host_finish, timer, out);

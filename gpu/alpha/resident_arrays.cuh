@@ -20,6 +20,8 @@
 
 #include "core/family/simplex_class.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/alpha/persistence_backend.hpp"
+#include "gpu/alpha/persistence_pairs.cuh"
 #include "gpu/alpha/resident_backend.hpp"
 #include "gpu/system/engine_system.cuh"
 
@@ -236,6 +238,20 @@ class ResidentTablesOn final : public ResidentTables {
     const int64_t first = thrust::lower_bound(sys.policy(), begin, end, lo) - begin;
     const int64_t last = thrust::upper_bound(sys.policy(), begin, end, hi) - begin;
     return {first, std::max(first, last)};
+  }
+
+  void Persistence(const PersistenceIn& mesh, bool host_finish, PersistenceOut* out) override {
+    const ResidentTableBuffers<System>& t = tables_;
+    PersistenceIn in = mesh;
+    in.edge_tris = t.edge_triangles.data();
+    in.edge_rho_rank = t.edge_rho_rank.data();
+    in.edge_mu_low = t.edge_mu_low.data();
+    in.tri_rank = t.tri_rank.data();
+    if constexpr (System::kHostMemory) {
+      PersistenceOnCpu(in, host_finish, out);
+    } else {
+      PersistenceOnCudaWithTables(in, host_finish, system_->stream(), out);
+    }
   }
 
   void DownloadInto(AlphaRanks* out) override {

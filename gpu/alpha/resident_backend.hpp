@@ -24,6 +24,9 @@ struct CurveValues {
   uint64_t area_units = 0;
 };
 
+struct PersistenceIn;
+struct PersistenceOut;
+
 /// The rank tables of one family where its backend keeps them. Not thread-safe: the owner
 /// serializes calls. Every call may throw EngineError (or a Thrust/std exception).
 class ResidentTables {
@@ -67,6 +70,10 @@ class ResidentTables {
   /// Every table into `out`'s arrays (the host form of the family); `out`'s comparison counts and
   /// area scale are left as they are.
   virtual void DownloadInto(AlphaRanks* out) = 0;
+  /// The persistence diagram (persistence_pairs.cuh) from the tables where they live and the mesh
+  /// in `mesh` (host arrays: edges, triangles, representatives, hidden flags; its table pointers
+  /// are not read): only the mesh is uploaded.
+  virtual void Persistence(const PersistenceIn& mesh, bool host_finish, PersistenceOut* out) = 0;
 };
 
 }  // namespace galpha::detail

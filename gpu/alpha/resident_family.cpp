@@ -12,6 +12,7 @@
 #include "core/family/area_ratio.hpp"
 #include "core/family/simplex_threshold.hpp"
 #include "gpu/alpha/alpha_build_parts.hpp"
+#include "gpu/alpha/persistence_pairs.cuh"
 #include "gpu/alpha/resident_backend.hpp"
 #include "gpu/system/engine_status.hpp"
 
@@ -180,6 +181,32 @@ absl::StatusOr<int64_t> ResidentAlphaFamily::LevelForAreaRatio(double ratio) con
   if (bracket.decided()) return bracket.high;
   GALPHA_ASSIGN_OR_RETURN(const AlphaFamily host, ToHostFamily());
   return LevelForAreaRatioWithin(host, ratio, bracket);
+}
+
+absl::StatusOr<PersistenceDiagram> ResidentAlphaFamily::Persistence() const {
+  static_assert(sizeof(detail::EdgeIdx) == sizeof(host_.edges[0]));
+  static_assert(sizeof(detail::TriIdx) == sizeof(host_.triangles[0]));
+  const detail::PersistenceIn mesh{static_cast<uint32_t>(host_.points.size()),
+                                   static_cast<uint32_t>(host_.edges.size()),
+                                   static_cast<uint32_t>(host_.triangles.size()),
+                                   reinterpret_cast<const detail::EdgeIdx*>(host_.edges.data()),
+                                   nullptr,
+                                   reinterpret_cast<const detail::TriIdx*>(host_.triangles.data()),
+                                   nullptr,
+                                   nullptr,
+                                   nullptr,
+                                   host_.representative.data(),
+                                   host_.hidden.empty() ? nullptr : host_.hidden.data()};
+  detail::PersistenceOut out;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_,
+                                  absl::StrCat("computing the persistence diagram of ", host_.points.size(), " points"),
+                                  [&] { tables_->Persistence(mesh, /*host_finish=*/true, &out); }));
+  PersistenceDiagram diagram;
+  diagram.pairs = std::move(out.pairs);
+  diagram.dimension_begin[0] = 0;
+  diagram.dimension_begin[1] = out.num_h0;
+  diagram.dimension_begin[2] = diagram.pairs.size();
+  return diagram;
 }
 
 absl::StatusOr<double> ResidentAlphaFamily::PublishedAlphaSq(int64_t level) const {

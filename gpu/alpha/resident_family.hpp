@@ -98,6 +98,10 @@ class ResidentAlphaFamily {
   /// spectrum[first, first + count) clipped to 0..K-1.
   absl::StatusOr<std::vector<double>> Spectrum(int64_t first, int64_t count) const;
 
+  /// The persistence diagram (ComputePersistenceOnBackend's, pair for pair) computed where the
+  /// tables live: on CUDA only the mesh is uploaded for it.
+  absl::StatusOr<PersistenceDiagram> Persistence() const;
+
   /// The same family in host memory: the tables downloaded, the host arrays copied.
   absl::StatusOr<AlphaFamily> ToHostFamily() const;
 

@@ -144,6 +144,8 @@ class CudaSystem {
   CudaSystem& operator=(const CudaSystem&) = delete;
 
   auto policy() { return thrust::cuda::par_nosync(temp_).on(stream_); }
+  /// The stream the system's work runs on (work of another system on it follows this one's).
+  cudaStream_t stream() const { return stream_; }
 
   template <class T>
   T* Allocate(size_t count) {

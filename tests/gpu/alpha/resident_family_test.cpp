@@ -14,6 +14,7 @@
 
 #include "core/family/alpha_family.hpp"
 #include "core/family/area_ratio.hpp"
+#include "core/family/persistence.hpp"
 #include "core/family/threshold.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gpu/alpha/resident_family.hpp"
@@ -279,6 +280,18 @@ class ResidentFamilyTest : public testing::BackendTest {
     const absl::StatusOr<std::vector<double>> tail = resident.Spectrum(k - 3, 100);
     ASSERT_THAT(tail, IsOk());
     EXPECT_EQ(tail->size(), static_cast<size_t>(std::min<int64_t>(k, 3)));
+
+    // The persistence diagram where the tables live, pair for pair the host union-finds' (the
+    // oracle: core/family/persistence.cpp).
+    const absl::StatusOr<PersistenceDiagram> diagram = resident.Persistence();
+    ASSERT_THAT(diagram, IsOk());
+    const absl::StatusOr<PersistenceDiagram> expected = ComputePersistence(host);
+    ASSERT_THAT(expected, IsOk());
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(diagram->dimension_begin[d], expected->dimension_begin[d]) << d;
+    ASSERT_EQ(diagram->pairs.size(), expected->pairs.size());
+    for (size_t i = 0; i < expected->pairs.size(); ++i) {
+      ASSERT_TRUE(diagram->pairs[i] == expected->pairs[i]) << "pair " << i;
+    }
 
     // The same family, array for array, once downloaded.
     const absl::StatusOr<AlphaFamily> downloaded = resident.ToHostFamily();
