@@ -51,6 +51,15 @@ GALPHA_HD inline void AtomicMinU64(unsigned long long* p, unsigned long long v) 
 #endif
 }
 
+GALPHA_HD inline void AtomicMaxU64(unsigned long long* p, unsigned long long v) {
+#if defined(__CUDA_ARCH__)
+  atomicMax(p, v);
+#else
+  unsigned long long old = __atomic_load_n(p, __ATOMIC_RELAXED);
+  while (v > old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
+#endif
+}
+
 // The working edges carry the current component labels of their ends (relabelled every round),
 // and the rounds visit only the live labels and edges: both shrink at least by half a round, so
 // the total work is linear, not (nodes x rounds).
@@ -388,10 +397,11 @@ struct CountRegularizedVertex {
 // around an interior vertex. Dropping the heaviest of each takes a third to a half of the edges
 // out of every round (each triangle, each interior vertex drops one).
 //
-// A cycle counts only when all its edges are graph edges: a kNeverRank edge (no graph edge unless
-// kept) outweighs every ranked one, so a cycle through it drops only that edge, which is no loss.
-// A vertex on the hull has hull edges (mu-high kNeverRank) around it in the solid graph, so its
-// fan, which is no cycle there, never drops a ranked edge either.
+// A cycle counts only when all its edges are graph edges: an edge that is none (a loop, or a
+// kNeverRank edge the graph leaves out) offers the largest weight there is, so a cycle through it
+// drops nothing. A vertex on the hull has hull edges (mu-high kNeverRank) around it in the solid
+// graph, so its fan, which is no cycle there, drops nothing either; in the persistence diagram's
+// dual graph the hull edges join the outer face, and a hull vertex's fan is a cycle through it.
 
 /// The cycles an edge lies on: its triangles (`edge_tris`, for graphs over points) or the fans
 /// around its two ends (`edges`, for graphs over triangles); one of the two is null.
@@ -411,15 +421,6 @@ struct EdgeCycles {
     return count;
   }
 };
-
-GALPHA_HD inline void AtomicMaxU64(unsigned long long* p, unsigned long long v) {
-#if defined(__CUDA_ARCH__)
-  atomicMax(p, v);
-#else
-  unsigned long long old = __atomic_load_n(p, __ATOMIC_RELAXED);
-  while (v > old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
-#endif
-}
 
 /// Each edge offers its weight to its cycles; a cycle keeps the heaviest (cycle_max starts at 0).
 /// An edge that is no graph edge offers the most a weight can be: a cycle through it is none.
@@ -474,7 +475,8 @@ class ForestRun {
   ForestRun(System& sys, uint32_t num_edges, uint32_t max_cycles, uint32_t num_graphs)
       : sys_(sys), num_edges_(num_edges), flags_(sys, size_t{num_edges} * num_graphs), cycle_max_(sys, max_cycles) {}
 
-  /// Flags graph `index`'s candidate edges (the generator `graph` places its nodes).
+  /// Flags graph `index`'s candidate edges (the generator `graph` places its nodes; kNeverRank
+  /// edges are no graph edges: the curves count edges that appear).
   template <class Graph>
   void Flag(uint32_t index, Graph graph, EdgeCycles cycles, uint32_t num_cycles) {
     auto policy = sys_.policy();

@@ -39,13 +39,8 @@ absl::StatusOr<PersistenceDiagram> ComputePersistenceOnBackend(const AlphaFamily
           detail::PersistenceOnCpu(in, options.host_finish, &out);
         }
       }));
-  PersistenceDiagram diagram;
-  diagram.pairs = std::move(out.pairs);
-  diagram.dimension_begin[0] = 0;
-  diagram.dimension_begin[1] = out.num_h0;
-  diagram.dimension_begin[2] = diagram.pairs.size();
   if (report != nullptr) *report = std::move(out.report);
-  return diagram;
+  return detail::TakeDiagram(&out);
 }
 
 absl::StatusOr<PersistenceDiagram> PersistenceDiagramOf(const AlphaFamily& family,

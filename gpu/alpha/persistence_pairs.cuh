@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <numeric>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/family/alpha_ranks.hpp"
@@ -64,6 +65,16 @@ struct PersistenceOut {
   size_t num_h0 = 0;
   PersistenceReport report;
 };
+
+/// The diagram of `out` (its pairs moved out) in core/family/persistence.hpp's form.
+inline PersistenceDiagram TakeDiagram(PersistenceOut* out) {
+  PersistenceDiagram diagram;
+  diagram.pairs = std::move(out->pairs);
+  diagram.dimension_begin[0] = 0;
+  diagram.dimension_begin[1] = out->num_h0;
+  diagram.dimension_begin[2] = diagram.pairs.size();
+  return diagram;
+}
 
 // ---- Canonical positions -------------------------------------------------------------------------
 

@@ -201,12 +201,7 @@ absl::StatusOr<PersistenceDiagram> ResidentAlphaFamily::Persistence() const {
   GALPHA_RETURN_IF_ERROR(OnTables(*mutex_,
                                   absl::StrCat("computing the persistence diagram of ", host_.points.size(), " points"),
                                   [&] { tables_->Persistence(mesh, /*host_finish=*/true, &out); }));
-  PersistenceDiagram diagram;
-  diagram.pairs = std::move(out.pairs);
-  diagram.dimension_begin[0] = 0;
-  diagram.dimension_begin[1] = out.num_h0;
-  diagram.dimension_begin[2] = diagram.pairs.size();
-  return diagram;
+  return detail::TakeDiagram(&out);
 }
 
 absl::StatusOr<double> ResidentAlphaFamily::PublishedAlphaSq(int64_t level) const {
