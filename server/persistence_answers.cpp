@@ -17,13 +17,14 @@ namespace v1 = galpha::v1;
 
 class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
  public:
-  /// `spectrum` is the family's spectrum values (the host family's own, or `spectrum_copy`'s).
-  PersistenceSource(std::shared_ptr<const CachedFamily> cached, std::vector<double> spectrum_copy,
-                    absl::Span<const double> spectrum, PersistenceDiagram diagram, std::array<bool, 2> dimensions,
-                    double min_persistence)
+  /// `resident_spectrum`: a resident family's spectrum values, read for this call (a family in
+  /// host memory is read where it is, and passes none).
+  PersistenceSource(std::shared_ptr<const CachedFamily> cached, std::vector<double> resident_spectrum,
+                    PersistenceDiagram diagram, std::array<bool, 2> dimensions, double min_persistence)
       : cached_(std::move(cached)),
-        spectrum_copy_(std::move(spectrum_copy)),
-        spectrum_(spectrum_copy_.empty() ? spectrum : absl::MakeConstSpan(spectrum_copy_)),
+        resident_spectrum_(std::move(resident_spectrum)),
+        spectrum_(cached_->host_family() != nullptr ? absl::MakeConstSpan(cached_->host_family()->spectrum())
+                                                    : absl::MakeConstSpan(resident_spectrum_)),
         diagram_(std::move(diagram)),
         dimensions_(dimensions),
         min_persistence_(min_persistence) {}
@@ -63,7 +64,7 @@ class PersistenceSource final : public ChunkSource<v1::PersistenceResponse> {
   }
 
   std::shared_ptr<const CachedFamily> cached_;  // kept while the stream runs, as every source's
-  std::vector<double> spectrum_copy_;           // a resident family's spectrum, read for this call
+  std::vector<double> resident_spectrum_;
   absl::Span<const double> spectrum_;
   PersistenceDiagram diagram_;
   std::array<bool, 2> dimensions_;
@@ -96,16 +97,13 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::PersistenceResponse>>> MakePersis
   const FamilyReader& reader = cached->reader();
   absl::StatusOr<PersistenceDiagram> diagram = reader.Persistence(cached->EdgeOrder(), cached->TriangleOrder());
   if (!diagram.ok()) return diagram.status();
-  std::vector<double> spectrum_copy;
-  absl::Span<const double> spectrum;
-  if (const AlphaFamily* host = cached->host_family(); host != nullptr) {
-    spectrum = absl::MakeConstSpan(host->spectrum());
-  } else {
+  std::vector<double> resident_spectrum;
+  if (cached->host_family() == nullptr) {
     absl::StatusOr<std::vector<double>> values = reader.Spectrum(0, reader.max_level());
     if (!values.ok()) return values.status();
-    spectrum_copy = *std::move(values);
+    resident_spectrum = *std::move(values);
   }
-  return std::make_unique<PersistenceSource>(std::move(cached), std::move(spectrum_copy), spectrum, *std::move(diagram),
+  return std::make_unique<PersistenceSource>(std::move(cached), std::move(resident_spectrum), *std::move(diagram),
                                              dimensions, min_persistence);
 }
 
