@@ -262,4 +262,25 @@ GALPHA_HD inline bool RadiusCongruent(const Point2* a, int na, const Point2* b, 
   return true;
 }
 
+/// A hash of the congruence form RadiusCongruent compares (zeros of either sign alike): two
+/// simplices it calls congruent get equal hashes, so sorting by the hash puts each class of
+/// congruent simplices together. Equal hashes prove nothing (a collision): whoever groups by them
+/// confirms each neighbour with RadiusCongruent.
+GALPHA_HD inline uint64_t CongruenceHash(const Point2* p, int n) {
+  using namespace radius_detail;
+  const CongruenceForm form = CongruenceFormOf(p, n);
+  uint64_t h = static_cast<uint64_t>(n) * 0x9e3779b97f4a7c15ULL;
+  const int m = n == 2 ? 1 : 3;
+  for (int k = 0; k < m; ++k) {
+    const EdgeLengthForm& e = form.edge[k];
+    const double parts[4] = {e.major_head, e.major_tail, e.minor_head, e.minor_tail};
+    for (const double d : parts) {
+      h ^= exact::DoubleBits(d == 0.0 ? 0.0 : d);  // -0 == +0 in the form's comparison
+      h *= 0xbf58476d1ce4e5b9ULL;
+      h ^= h >> 31;
+    }
+  }
+  return h;
+}
+
 }  // namespace galpha

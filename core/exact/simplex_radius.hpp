@@ -57,6 +57,16 @@ GALPHA_HD inline bool SimplexRadiusCongruent(const Point2* a, const double* wa, 
   return wa != nullptr ? WeightedRadiusCongruent(a, wa, na, b, wb, nb) : RadiusCongruent(a, na, b, nb);
 }
 
+/// A hash that SimplexRadiusCongruent's equal pairs share (CongruenceHash; weighted, with the
+/// first weight mixed in: congruent weighted simplices carry one weight throughout). Equal hashes
+/// prove nothing.
+GALPHA_HD inline uint64_t SimplexCongruenceHash(const Point2* p, const double* w, int n) {
+  const uint64_t h = CongruenceHash(p, n);
+  if (w == nullptr) return h;
+  const uint64_t weight = exact::DoubleBits(w[0] == 0.0 ? 0.0 : w[0]);
+  return (h ^ weight) * 0x94d049bb133111ebULL;
+}
+
 /// rho^2 when it is exactly a double computed exactly (unweighted grids; never claimed weighted).
 GALPHA_HD inline bool ExactDoubleSimplexRadiusSq(const Point2* p, const double* w, int n, double* out) {
   return w == nullptr && ExactDoubleRadiusSq(p, n, out);

@@ -1,12 +1,19 @@
 // The spectrum's long runs of near ties, ordered by refined keys (core/exact/radius_refined.hpp)
 // instead of by exact comparisons inside each run. Runs longer than kMaxDeviceRun used to go to
 // the host whole (a three-way quicksort with exact comparisons: 44 s for a 1000 x 1000 lattice
-// perturbed by single ulps); here every entry of such a run gets a key certified within 2^-150,
-// the entries are radix-sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
-// and only adjacent entries the keys cannot separate are compared exactly: O(n) comparisons, all in
-// parallel, on the backend's cores.
+// perturbed by single ulps); here the entries of such a run are first grouped into classes of
+// congruent simplices (equal values, proved by RadiusCongruent: a lattice's long runs are mostly
+// copies of a few cells), every class gets a key certified within 2^-150 from its first member,
+// the classes are radix-sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
+// and only adjacent classes the keys cannot separate are compared exactly: O(n) comparisons, all
+// in parallel, on the backend's cores. Each class's other members then follow its first one.
 //
 // Why the result is exact:
+//  - A class is a range of entries of one run, sorted by a hash of their congruence form, in which
+//    every entry is congruent to the one before (checked exactly: a hash collision only splits a
+//    class), so all of them have one exact value. Ordering the classes orders the entries, and the
+//    members after the first are marked equal to it.
+//  - Below, "entry" is a class, represented by its first member.
 //  - Two adjacent entries whose keys are separated (RefinedKeysSeparated) have exact values in
 //    that order, and since the keys are sorted by truncations within 3 * 2^-160 of their values and
 //    each is within its certified error of its entry's value, every entry before the pair is below
@@ -61,10 +68,11 @@
 
 namespace galpha::detail {
 
-/// One entry of a long run with its refined key.
+/// One congruence group of a long run (its first member's simplex) with its refined key.
 struct RefinedEntry {
-  uint32_t run;  // the run's index in the run list
-  uint32_t id;   // the simplex
+  uint32_t run;    // the run's index in the run list
+  uint32_t id;     // the simplex
+  uint32_t group;  // the group's index in the grouping order (CongruenceGroups)
   RefinedRadiusSq key;
 };
 
@@ -111,10 +119,11 @@ struct CutLinksOfOneDouble {
   }
 };
 
-/// The refined key of the entry at `position`; marks its run unrefinable when it has none.
+/// The refined key of group k, from its first member at spectrum position `positions[k]`; marks
+/// its run unrefinable when it has none.
 struct ComputeRefinedEntry {
   SimplexPoints simplex;
-  const uint32_t* positions;
+  const uint32_t* positions;  // per group
   const uint32_t* run_of;
   const uint32_t* ids;
   RefinedEntry* entries;
@@ -124,6 +133,7 @@ struct ComputeRefinedEntry {
     RefinedEntry entry;
     entry.run = run_of[i] - 1;
     entry.id = ids[i];
+    entry.group = k;
     Point2 p[3];
     double w[3];
     const int n = simplex(entry.id, p, w);
@@ -131,15 +141,6 @@ struct ComputeRefinedEntry {
     if (!entry.key.ok) run_unrefinable[entry.run] = 1;
     entries[k] = entry;
   }
-};
-
-/// Puts the sorted entries back at their run's positions (positions ascend, and sorting by run
-/// first keeps every run's entries over its own positions).
-struct ScatterRefinedIds {
-  const uint32_t* positions;
-  const RefinedEntry* entries;
-  uint32_t* ids;
-  GALPHA_HD void operator()(uint32_t k) const { ids[positions[k]] = entries[k].id; }
 };
 
 /// Verdict on sorted entries k - 1 and k of the same refinable run: kPairSeparated (a certified
@@ -175,6 +176,111 @@ struct JudgeRefinedPair {
     comparisons[k] = 1;
     const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
     verdict[k] = order == Order::kLess ? kPairLess : order == Order::kEqual ? kPairEqual : kPairBad;
+  }
+};
+
+/// The grouping key of long-run entry k (spectrum position positions[k]): its run and the hash of
+/// its congruence form, so that sorting by it puts each run's congruent simplices together.
+struct CongruenceGroupKey {
+  SimplexPoints simplex;
+  const uint32_t* positions;
+  const uint32_t* run_of;
+  const uint32_t* ids;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const uint32_t i = positions[k];
+    Point2 p[3];
+    double w[3];
+    const int n = simplex(ids[i], p, w);
+    return (SimplexCongruenceHash(p, simplex.Weights(w), n) ^ run_of[i]) * 0x9e3779b97f4a7c15ULL;
+  }
+};
+
+/// 1 where a congruence group starts among the entries in grouping order (member[s]: the entry at
+/// grouping position s): at the first entry, a new key, a new run, or a neighbour that the exact
+/// congruence test does not confirm (a hash collision: the group is only smaller).
+struct StartsCongruenceGroup {
+  SimplexPoints simplex;
+  const uint64_t* key;
+  const uint32_t* member;
+  const uint32_t* positions;
+  const uint32_t* run_of;
+  const uint32_t* ids;
+  GALPHA_HD uint32_t operator()(uint32_t s) const {
+    if (s == 0 || key[s] != key[s - 1]) return 1;
+    const uint32_t i = positions[member[s]], h = positions[member[s - 1]];
+    if (run_of[i] != run_of[h]) return 1;
+    Point2 pa[3], pb[3];
+    double wa[3], wb[3];
+    const int na = simplex(ids[h], pa, wa), nb = simplex(ids[i], pb, wb);
+    return SimplexRadiusCongruent(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb) ? 0u : 1u;
+  }
+};
+
+/// 1 at a grouping position where a new group starts (group_of: 1-based inclusive scan).
+struct StartsGroupOf {
+  const uint32_t* group_of;
+  GALPHA_HD bool operator()(uint32_t s) const { return s == 0 || group_of[s] != group_of[s - 1]; }
+};
+
+/// The spectrum position of group g's first member (its representative, whose key the group
+/// shares exactly).
+struct GroupLeaderPosition {
+  const uint32_t* group_first;  // grouping position of each group's first member
+  const uint32_t* member;
+  const uint32_t* positions;
+  GALPHA_HD uint32_t operator()(uint32_t g) const { return positions[member[group_first[g]]]; }
+};
+
+/// The simplex of the entry at grouping position s (read before the spectrum is rewritten).
+struct MemberId {
+  const uint32_t* member;
+  const uint32_t* positions;
+  const uint32_t* ids;
+  GALPHA_HD uint32_t operator()(uint32_t s) const { return ids[positions[member[s]]]; }
+};
+
+/// The number of members of the group at sorted position k.
+struct GroupSizeOfEntry {
+  const RefinedEntry* entries;
+  const uint32_t* group_first;  // num_groups + 1 entries
+  GALPHA_HD uint32_t operator()(uint32_t k) const {
+    const uint32_t g = entries[k].group;
+    return group_first[g + 1] - group_first[g];
+  }
+};
+
+/// Marks where each sorted group's members begin among the run positions (for a maximum scan).
+struct MarkExpandedStart {
+  const uint32_t* expanded_start;
+  uint32_t* leader_of;
+  GALPHA_HD void operator()(uint32_t k) const { leader_of[expanded_start[k]] = k; }
+};
+
+/// Lays the groups out over the runs' positions in sorted order, each group's members after its
+/// first one, and gives every position its run, verdict (a member after the first: kPairEqual,
+/// proved by congruence) and cluster. Sorting by run first keeps each run over its own positions
+/// (they ascend, and a run's groups hold as many members as it has positions).
+struct ExpandGroups {
+  const RefinedEntry* entries;
+  const uint32_t* expanded_start;
+  const uint32_t* leader_of;  // sorted position of the group that covers each expanded position
+  const uint32_t* group_first;
+  const uint32_t* member_id;  // by grouping position
+  const uint32_t* positions;
+  const uint8_t* verdict;      // per sorted group
+  const uint32_t* cluster_of;  // per sorted group
+  uint32_t* ids;
+  uint32_t* run;  // per expanded position
+  uint8_t* expanded_verdict;
+  uint32_t* expanded_cluster;
+  GALPHA_HD void operator()(uint32_t e) const {
+    const uint32_t k = leader_of[e];
+    const uint32_t j = e - expanded_start[k];
+    const RefinedEntry& entry = entries[k];
+    ids[positions[e]] = member_id[group_first[entry.group] + j];
+    run[e] = entry.run;
+    expanded_verdict[e] = j == 0 ? verdict[k] : kPairEqual;
+    expanded_cluster[e] = cluster_of[k];
   }
 };
 
@@ -280,24 +386,21 @@ struct GiveUpUnsettled {
   }
 };
 
-/// Puts a sorted bad cluster back over its own sorted positions, its ids into the spectrum, and
-/// its verdicts: a value's first entry kPairLess (the cluster's first stays kPairSeparated), the
-/// others kPairEqual. A cluster left undecided keeps its first order and verdicts.
+/// Puts a sorted bad cluster back over its own sorted positions with its verdicts: a value's first
+/// entry kPairLess (the cluster's first stays kPairSeparated), the others kPairEqual. A cluster
+/// left undecided keeps its first order and verdicts.
 struct ScatterSortedCluster {
   const RefinedEntry* by_slot;  // entries[item[j]]
   const uint32_t* bad_k;        // slot -> its position in the cluster's range (ascending)
-  const uint32_t* positions;
   const uint32_t* cluster_of;
   const uint32_t* segment;
   const uint8_t* cluster_undecided;
   RefinedEntry* entries;
-  uint32_t* ids;
   uint8_t* verdict;
   GALPHA_HD void operator()(uint32_t j) const {
     const uint32_t k = bad_k[j];
     if (cluster_undecided[cluster_of[k] - 1]) return;
     entries[k] = by_slot[j];
-    ids[positions[k]] = by_slot[j].id;
     if (verdict[k] == kPairSeparated) return;  // the cluster's first slot
     verdict[k] = segment[j] != segment[j - 1] ? kPairLess : kPairEqual;
   }
@@ -317,29 +420,30 @@ struct MarkBadCluster {
   }
 };
 
-/// Writes the verdicts into the spectrum: entries of a good cluster become runs of one (links
-/// cut), with new_value 0 for an entry equal to the one before; a bad cluster keeps its links;
-/// every separated pair is cut and starts a new value. Runs left unrefinable are not touched.
+/// Writes the verdicts of the expanded positions (ExpandGroups) into the spectrum: entries of a
+/// good cluster become runs of one (links cut), with new_value 0 for an entry equal to the one
+/// before; a bad cluster keeps its links; every separated pair is cut and starts a new value. Runs
+/// left unrefinable are not touched.
 struct ApplyRefinedVerdicts {
   const uint32_t* positions;
-  const RefinedEntry* entries;
+  const uint32_t* run;  // per expanded position
   const uint8_t* run_unrefinable;
   const uint8_t* verdict;
   const uint32_t* cluster_of;
   const uint8_t* cluster_bad;
   uint8_t* link;       // link[i]: entries i and i + 1 may tie
   uint8_t* new_value;  // 1 where an exact value starts
-  GALPHA_HD void operator()(uint32_t k) const {
-    if (run_unrefinable[entries[k].run]) return;
-    const uint32_t i = positions[k];
-    if (verdict[k] == kPairSeparated) {
-      if (k > 0 && entries[k - 1].run == entries[k].run) link[i - 1] = 0;
+  GALPHA_HD void operator()(uint32_t e) const {
+    if (run_unrefinable[run[e]]) return;
+    const uint32_t i = positions[e];
+    if (verdict[e] == kPairSeparated) {
+      if (e > 0 && run[e - 1] == run[e]) link[i - 1] = 0;
       new_value[i] = 1;  // a run's first entry, or above everything before it
       return;
     }
-    if (cluster_bad[cluster_of[k] - 1]) return;  // the cluster stays one run for the exact repair
+    if (cluster_bad[cluster_of[e] - 1]) return;  // the cluster stays one run for the exact repair
     link[i - 1] = 0;
-    new_value[i] = verdict[k] == kPairEqual ? 0 : 1;
+    new_value[i] = verdict[e] == kPairEqual ? 0 : 1;
   }
 };
 
@@ -369,9 +473,9 @@ void SortRefinedEntries(System& sys, Buffer<RefinedEntry, System>* entries, uint
 /// Sorts the entries of bad clusters exactly by rounds of three-way partitions (see above) and sets
 /// their verdicts, clearing `cluster_bad` for the clusters that come out in exact order.
 template <class System>
-void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* positions, RefinedEntry* entries,
-                     const uint32_t* cluster_of, uint32_t num_clusters, uint32_t num_refined, uint32_t* ids,
-                     Buffer<uint8_t, System>* verdict, Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
+void SortBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
+                     uint32_t num_clusters, uint32_t num_refined, Buffer<uint8_t, System>* verdict,
+                     Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   if (thrust::count(policy, cluster_bad->data(), cluster_bad->data() + num_clusters, uint8_t{1}) == 0) return;
@@ -418,8 +522,8 @@ void SortBadClusters(System& sys, const SimplexPoints& simplex, const uint32_t* 
   Buffer<RefinedEntry, System> by_slot(sys, num_slots);
   thrust::gather(policy, item.data(), item.data() + num_slots, entries, by_slot.data());
   thrust::for_each_n(policy, zero, num_slots,
-                     ScatterSortedCluster{by_slot.data(), bad_k.data(), positions, cluster_of, segment.data(),
-                                          cluster_undecided.data(), entries, ids, verdict->data()});
+                     ScatterSortedCluster{by_slot.data(), bad_k.data(), cluster_of, segment.data(),
+                                          cluster_undecided.data(), entries, verdict->data()});
   thrust::fill_n(policy, cluster_bad->data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict->data(), cluster_of, cluster_bad->data()});
 }
@@ -458,37 +562,82 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   one_double.Reset();
   if (num_refined == 0) return 1;  // links may have been cut: the caller lists the runs again
 
-  Buffer<RefinedEntry, System> entries(sys, num_refined);
+  // Congruent entries of a run are equal, and a lattice's long runs are mostly such copies (a
+  // lattice nudged by single ulps at 1M: 4.6M entries in 106K classes). Each class is keyed,
+  // sorted and judged once, by its first member, and its other members follow that one.
+  Buffer<uint32_t, System> member(sys, num_refined);  // grouping position -> entry
+  thrust::sequence(policy, member.data(), member.data() + num_refined);
+  Buffer<uint32_t, System> group_of(sys, num_refined);  // 1-based, by grouping position
+  {
+    Buffer<uint64_t, System> group_key(sys, num_refined);
+    thrust::transform(policy, zero, zero + num_refined, group_key.data(),
+                      CongruenceGroupKey{simplex, positions.data(), run_of.data(), ids});
+    thrust::stable_sort_by_key(policy, group_key.data(), group_key.data() + num_refined, member.data());
+    const auto group_starts = thrust::make_transform_iterator(
+        zero, StartsCongruenceGroup{simplex, group_key.data(), member.data(), positions.data(), run_of.data(), ids});
+    thrust::inclusive_scan(policy, group_starts, group_starts + num_refined, group_of.data());
+  }
+  const uint32_t num_groups = sys.Read(group_of.data() + (num_refined - 1));
+  Buffer<uint32_t, System> group_first(sys, num_groups + 1);  // grouping position of each first member
+  thrust::copy_if(policy, zero, zero + num_refined, group_first.data(), StartsGroupOf{group_of.data()});
+  thrust::fill_n(policy, group_first.data() + num_groups, 1, num_refined);
+  group_of.Reset();
+  Buffer<uint32_t, System> member_id(sys, num_refined);
+  thrust::transform(policy, zero, zero + num_refined, member_id.data(), MemberId{member.data(), positions.data(), ids});
+  Buffer<uint32_t, System> leader_positions(sys, num_groups);
+  thrust::transform(policy, zero, zero + num_groups, leader_positions.data(),
+                    GroupLeaderPosition{group_first.data(), member.data(), positions.data()});
+  member.Reset();
+
+  Buffer<RefinedEntry, System> entries(sys, num_groups);
   Buffer<uint8_t, System> run_unrefinable(sys, num_runs);
   thrust::fill_n(policy, run_unrefinable.data(), num_runs, uint8_t{0});
-  thrust::for_each_n(
-      policy, zero, num_refined,
-      ComputeRefinedEntry{simplex, positions.data(), run_of.data(), ids, entries.data(), run_unrefinable.data()});
+  thrust::for_each_n(policy, zero, num_groups,
+                     ComputeRefinedEntry{simplex, leader_positions.data(), run_of.data(), ids, entries.data(),
+                                         run_unrefinable.data()});
   run_of.Reset();
-  SortRefinedEntries(sys, &entries, num_refined);
-  thrust::for_each_n(policy, zero, num_refined, ScatterRefinedIds{positions.data(), entries.data(), ids});
+  leader_positions.Reset();
+  SortRefinedEntries(sys, &entries, num_groups);
 
-  Buffer<uint8_t, System> verdict(sys, num_refined);
-  Buffer<uint32_t, System> comparisons(sys, num_refined);
-  thrust::for_each_n(
-      policy, zero, num_refined,
-      JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(), comparisons.data()});
-  counts->bounded_exact += thrust::reduce(policy, comparisons.data(), comparisons.data() + num_refined, uint64_t{0});
-  comparisons.Reset();
+  Buffer<uint8_t, System> verdict(sys, num_groups);
+  {
+    Buffer<uint32_t, System> comparisons(sys, num_groups);
+    thrust::for_each_n(
+        policy, zero, num_groups,
+        JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(), comparisons.data()});
+    counts->bounded_exact += thrust::reduce(policy, comparisons.data(), comparisons.data() + num_groups, uint64_t{0});
+  }
 
-  Buffer<uint32_t, System> cluster_of(sys, num_refined);
+  Buffer<uint32_t, System> cluster_of(sys, num_groups);
   const auto cluster_starts = thrust::make_transform_iterator(zero, ClusterStartAsU32{verdict.data()});
-  thrust::inclusive_scan(policy, cluster_starts, cluster_starts + num_refined, cluster_of.data());
+  thrust::inclusive_scan(policy, cluster_starts, cluster_starts + num_groups, cluster_of.data());
   uint32_t num_clusters = 0;
-  sys.ToHost(&num_clusters, cluster_of.data() + (num_refined - 1), 1);
+  sys.ToHost(&num_clusters, cluster_of.data() + (num_groups - 1), 1);
   Buffer<uint8_t, System> cluster_bad(sys, num_clusters);
   thrust::fill_n(policy, cluster_bad.data(), num_clusters, uint8_t{0});
-  thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict.data(), cluster_of.data(), cluster_bad.data()});
-  SortBadClusters(sys, simplex, positions.data(), entries.data(), cluster_of.data(), num_clusters, num_refined, ids,
-                  &verdict, &cluster_bad, counts);
+  thrust::for_each_n(policy, zero, num_groups, MarkBadCluster{verdict.data(), cluster_of.data(), cluster_bad.data()});
+  SortBadClusters(sys, simplex, entries.data(), cluster_of.data(), num_clusters, num_groups, &verdict, &cluster_bad,
+                  counts);
+
+  // The groups, in their exact order, over the runs' positions.
+  Buffer<uint32_t, System> expanded_start(sys, num_groups);
+  const auto sizes = thrust::make_transform_iterator(zero, GroupSizeOfEntry{entries.data(), group_first.data()});
+  thrust::exclusive_scan(policy, sizes, sizes + num_groups, expanded_start.data());
+  Buffer<uint32_t, System> leader_of(sys, num_refined);
+  thrust::fill_n(policy, leader_of.data(), num_refined, 0u);
+  thrust::for_each_n(policy, zero, num_groups, MarkExpandedStart{expanded_start.data(), leader_of.data()});
+  thrust::inclusive_scan(policy, leader_of.data(), leader_of.data() + num_refined, leader_of.data(),
+                         thrust::maximum<uint32_t>());
+  Buffer<uint32_t, System> expanded_run(sys, num_refined), expanded_cluster(sys, num_refined);
+  Buffer<uint8_t, System> expanded_verdict(sys, num_refined);
   thrust::for_each_n(policy, zero, num_refined,
-                     ApplyRefinedVerdicts{positions.data(), entries.data(), run_unrefinable.data(), verdict.data(),
-                                          cluster_of.data(), cluster_bad.data(), link, new_value});
+                     ExpandGroups{entries.data(), expanded_start.data(), leader_of.data(), group_first.data(),
+                                  member_id.data(), positions.data(), verdict.data(), cluster_of.data(), ids,
+                                  expanded_run.data(), expanded_verdict.data(), expanded_cluster.data()});
+  thrust::for_each_n(
+      policy, zero, num_refined,
+      ApplyRefinedVerdicts{positions.data(), expanded_run.data(), run_unrefinable.data(), expanded_verdict.data(),
+                           expanded_cluster.data(), cluster_bad.data(), link, new_value});
   return num_refined;
 }
 

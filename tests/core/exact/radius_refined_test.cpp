@@ -261,5 +261,56 @@ TEST(RefinedRadiusSqTest, TranslatesAreProvenEqual) {
   }
 }
 
+// The grouping hash of the spectrum's long runs must give every pair RadiusCongruent accepts one
+// hash (otherwise congruent entries would be keyed apart: slower, never wrong); over a perturbed
+// lattice's cells in every orientation, and for zero differences of either sign.
+TEST(RefinedRadiusSqTest, CongruentSimplicesShareTheirHash) {
+  std::mt19937_64 rng(12);
+  std::uniform_int_distribution<int> ulps(-2, 2), flip(0, 7), cell(0, 50);
+  std::vector<std::vector<Point2>> simplices;
+  for (int c = 0; c < 400; ++c) {
+    const double h = 0.125;
+    const double x0 = 1000.0 + h * cell(rng), y0 = 2000.0 + h * cell(rng);
+    std::vector<Point2> tri = {{Ulps(x0, ulps(rng)), Ulps(y0, ulps(rng))},
+                               {Ulps(x0 + h, ulps(rng)), Ulps(y0, ulps(rng))},
+                               {Ulps(x0, ulps(rng)), Ulps(y0 + h, ulps(rng))}};
+    const int t = flip(rng);
+    for (Point2& p : tri) {
+      double x = p.x - x0, y = p.y - y0;  // exact: Sterbenz
+      if (t & 1) x = -x;
+      if (t & 2) y = -y;
+      if (t & 4) std::swap(x, y);
+      p = {x + 5000.0, y + 7000.0};
+    }
+    simplices.push_back(tri);
+    simplices.push_back({tri[0], tri[1]});
+  }
+  int congruent_pairs = 0, shared_without_congruence = 0;
+  for (size_t i = 0; i < simplices.size(); ++i) {
+    for (size_t j = i + 1; j < simplices.size(); ++j) {
+      const auto& a = simplices[i];
+      const auto& b = simplices[j];
+      const int na = static_cast<int>(a.size()), nb = static_cast<int>(b.size());
+      const bool same_hash = CongruenceHash(a.data(), na) == CongruenceHash(b.data(), nb);
+      if (RadiusCongruent(a.data(), na, b.data(), nb)) {
+        ++congruent_pairs;
+        EXPECT_TRUE(same_hash) << "pair " << i << ", " << j;
+      } else if (same_hash) {
+        ++shared_without_congruence;
+      }
+    }
+  }
+  EXPECT_GT(congruent_pairs, 100);
+  EXPECT_EQ(shared_without_congruence, 0);  // not required, but a 64-bit hash should not collide here
+  // A zero difference of either sign: RadiusCongruent compares -0 == +0, and so must the hash.
+  const Point2 plus[2] = {{0.0, 0.0}, {3.0, 0.0}}, minus[2] = {{0.0, 0.0}, {3.0, -0.0}};
+  ASSERT_TRUE(RadiusCongruent(plus, 2, minus, 2));
+  EXPECT_EQ(CongruenceHash(plus, 2), CongruenceHash(minus, 2));
+  const Point2 flat_plus[3] = {{0.0, 0.0}, {3.0, 0.0}, {0.0, 4.0}},
+               flat_minus[3] = {{0.0, -0.0}, {3.0, 0.0}, {-0.0, 4.0}};
+  ASSERT_TRUE(RadiusCongruent(flat_plus, 3, flat_minus, 3));
+  EXPECT_EQ(CongruenceHash(flat_plus, 3), CongruenceHash(flat_minus, 3));
+}
+
 }  // namespace
 }  // namespace galpha
