@@ -178,7 +178,7 @@ GALPHA_HD GALPHA_FORCEINLINE int PowerSign(Point2 a, double wa, Point2 b, double
 
 namespace power_detail {
 
-/// [1,u,z](i,j,k) with z = x^2 + y^2 - w, exactly, from scaled coordinates (as MinorUZSign, on
+/// [1,u,z](i,j,k) with z = x^2 + y^2 - w, exactly, from scaled coordinates (u_i (z_j - z_k) + ..., on
 /// weighted lifts of up to 5 components); returns its sign.
 GALPHA_HD GALPHA_POWER_COLD inline int WeightedMinorUZSign(const double* u, const double (*z)[5], const int* zl, int i,
                                                            int j, int k) {

@@ -150,25 +150,6 @@ GALPHA_HD inline int SumSumDiff(int lp, const double* p, int lq, const double* q
   return ExpansionDiffZeroElim(lt, t, lr, r, out);
 }
 
-/// [1,u,z](i,j,k) = u_i (z_j - z_k) + u_j (z_k - z_i) + u_k (z_i - z_j), exactly, from scaled
-/// coordinates u and exact lifts z (4 components each); returns its sign. Sizes: z differences
-/// 8, scaled 16, sum 48.
-GALPHA_HD GALPHA_PRED_COLD inline int MinorUZSign(const double* u, const double (*z)[4], const int* zl, int i, int j,
-                                                  int k) {
-  const int idx[3] = {i, j, k};
-  double acc[48], next[48];
-  int accl = 0;
-  for (int t = 0; t < 3; ++t) {
-    const int p = idx[t], q = idx[(t + 1) % 3], r = idx[(t + 2) % 3];
-    double zd[8], term[16];
-    const int zdl = ExpansionDiffZeroElim(zl[q], z[q], zl[r], z[r], zd);
-    const int tl = ScaleExpansionZeroElim(zdl, zd, u[p], term);
-    accl = ExpansionSumZeroElim(accl, acc, tl, term, next);
-    for (int m = 0; m < accl; ++m) acc[m] = next[m];
-  }
-  return ExpansionSign(accl, acc);
-}
-
 /// sign(u - v), exactly (a comparison cannot round).
 GALPHA_HD GALPHA_FORCEINLINE int CompareSign(double u, double v) { return (u > v) - (u < v); }
 
@@ -574,6 +555,19 @@ GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSoSDegenerate(Point2 a, uint32_t i
   return parity * t;
 }
 
+/// Sign of the minor [1,u,z](i,j,k) (MinorUZSign) for three collinear points i, j, k, from one
+/// coordinate u of each (x or y; z is the lift x^2 + y^2). On their line p = p_i + tau (p_k - p_i)
+/// the lift is quadratic in tau, so by column operations the minor is
+/// (u_k - u_i) |p_k - p_i|^2 det[[1, tau, tau^2]] = (u_k - u_i) |p_k - p_i|^2 tau_j (1 - tau_j), whose
+/// sign is sign(u_k - u_i) sign(tau_j) sign(1 - tau_j) = sign(u_k - u_i) sign(u_j - u_i)
+/// sign(u_k - u_j) whenever u_k != u_i (tau_j = (u_j - u_i) / (u_k - u_i)); when u_k == u_i the
+/// minor is 0, as the first factor says. Duplicates give 0 as the minor does (two equal rows).
+/// Comparisons only: no lifts, no expansions (every degenerate in-circle test of two crossing lines
+/// of points, four points on one line, ends here).
+GALPHA_HD inline int CollinearMinorUZSign(double ui, double uj, double uk) {
+  return CompareSign(uk, ui) * CompareSign(uj, ui) * CompareSign(uk, uj);
+}
+
 /// The SoS sign of det4 [[1, x, y, z]] (rows r0..r3 sorted by index, z = x^2 + y^2 perturbed as
 /// an independent coordinate) once its exact value is known to be 0: the sign of the first nonzero
 /// coefficient, in order of increasing eps power, of
@@ -590,20 +584,16 @@ GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSoSDegenerate(Point2 a, uint32_t i
 GALPHA_HD inline int Det4SoSSign(const Point2* p) {
   int t = -Orient2dSign(p[1], p[2], p[3]);  // 2: decides unless r1, r2, r3 are collinear
   if (t != 0) return t;
-  double x[4] = {0.0, 0.0, 0.0, 0.0}, y[4] = {0.0, 0.0, 0.0, 0.0}, z[4][4];
-  int zl[4];
-  ScaleForInCircle<4>(p, x, y);  // leaves the zeros when every coordinate is 0
-  for (int i = 0; i < 4; ++i) zl[i] = Lift(x[i], y[i], z[i]);
-  t = MinorUZSign(x, z, zl, 1, 2, 3);               // 3
-  if (t == 0) t = -MinorUZSign(y, z, zl, 1, 2, 3);  // 4
-  if (t == 0) t = Orient2dSign(p[0], p[2], p[3]);   // 5
-  if (t == 0) t = CompareSign(p[3].x, p[2].x);      // 6
-  if (t == 0) t = -CompareSign(p[3].y, p[2].y);     // 7
-  if (t == 0) t = -Orient2dSign(p[0], p[1], p[3]);  // 14
-  if (t == 0) t = -CompareSign(p[3].x, p[1].x);     // 15
-  if (t == 0) t = CompareSign(p[3].y, p[1].y);      // 16
-  if (t == 0) t = CompareSign(p[3].x, p[0].x);      // 17
-  return t != 0 ? t : -1;                           // 18
+  t = CollinearMinorUZSign(p[1].x, p[2].x, p[3].x);               // 3
+  if (t == 0) t = -CollinearMinorUZSign(p[1].y, p[2].y, p[3].y);  // 4
+  if (t == 0) t = Orient2dSign(p[0], p[2], p[3]);                 // 5
+  if (t == 0) t = CompareSign(p[3].x, p[2].x);                    // 6
+  if (t == 0) t = -CompareSign(p[3].y, p[2].y);                   // 7
+  if (t == 0) t = -Orient2dSign(p[0], p[1], p[3]);                // 14
+  if (t == 0) t = -CompareSign(p[3].x, p[1].x);                   // 15
+  if (t == 0) t = CompareSign(p[3].y, p[1].y);                    // 16
+  if (t == 0) t = CompareSign(p[3].x, p[0].x);                    // 17
+  return t != 0 ? t : -1;                                         // 18
 }
 
 /// The SoS in-circle sign once the exact in-circle determinant is known to be 0.
