@@ -555,8 +555,8 @@ class DelaunayBuilder {
   static constexpr int kSawEdgePoint = 7;
   static constexpr int kRedundantCount = 8;
   static constexpr int kNumCounts = 9;
-  // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): four items
-  // a lane of its 256, where a grid iteration's launches cost more than the block's passes.
+  // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): one item a
+  // lane of its 1,024, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;
   // The one-block iterations of a whole build: far more than any measured (two_lines at 1M: about
   // 3,700 flip iterations in all), and few enough (seconds, at a few us each) that a loop that did
