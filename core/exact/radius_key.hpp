@@ -65,6 +65,32 @@ GALPHA_HD inline uint64_t RadiusKeyFromScaled(double m, int e, bool* in_range) {
 constexpr double kMinScaledLengthSq = 0x1p-900;
 /// Smallest scaled |D| it accepts (D^2 must stay normal).
 constexpr double kMinScaledArea = 0x1p-400;
+/// Smallest nonzero scaled edge coordinate the thin-triangle stage accepts: its Two-Products are
+/// then at least 2^-800 with tails on a grid of 2^-904, exactly representable.
+constexpr double kMinScaledThinCoordinate = 0x1p-400;
+
+/// Whether u - v was exact in doubles (Two-Diff's tail is zero).
+GALPHA_HD inline bool ExactDifference(double u, double v) {
+  double hi, lo;
+  TwoDiff(u, v, hi, lo);
+  return lo == 0.0;
+}
+
+/// Whether a scaled coordinate is zero or large enough for the thin-triangle stage.
+GALPHA_HD inline bool ThinStageCoordinateOk(double v) { return v == 0.0 || Abs(v) >= kMinScaledThinCoordinate; }
+
+/// The cross product ax by - ay bx of two exact edge vectors as its exact value's top component
+/// (two Two-Products, their exact difference compressed: a nonoverlapping expansion's top
+/// component is within 2^-51.99 of its value, relatively), 0 exactly when the vectors are parallel.
+GALPHA_HD inline double ExactCrossTop(double ax, double ay, double bx, double by) {
+  double l1, l0, r1, r0;
+  TwoProduct(ax, by, l1, l0);
+  TwoProduct(ay, bx, r1, r0);
+  double left[2], right[2], cross[4];
+  const int ln = TwoToExpansion(l1, l0, left), rn = TwoToExpansion(r1, r0, right);
+  const int n = Compress(ExpansionDiffZeroElim(ln, left, rn, right, cross), cross);
+  return n == 0 ? 0.0 : cross[n - 1];
+}
 
 }  // namespace radius_detail
 
@@ -108,9 +134,28 @@ GALPHA_HD inline RadiusSqApprox ApproxRadiusSq(const Point2* p, int n) {
     const double sum = Add(Abs(left), Abs(right));
     // |D - area| <= 3.01 * 2^-53 * sum + 2^-53 |area|: demand |area| >= sum * 2^-6, so that D's
     // relative error stays below 2^-45 + 2^-52; rho^2's then stays below 2^-42.
-    if (lengths_ok && Abs(area) >= Mul(sum, 0x1p-6) && Abs(area) >= kMinScaledArea) {
+    // A thin triangle (the cross product lost more than 6 bits to cancellation: two lines of
+    // points, long triangles between them) whose edge vectors were exact doubles (near
+    // neighbours, integer coordinates) gets its cross product exactly, rounded once (relative
+    // error 2^-51.99), instead of the exact terms in local memory below. Its lengths then err by
+    // at most 3 roundings each, so rho^2 errs by under 14 * 2^-53 + 2 * 2^-51.99 + 3 * 2^-53,
+    // below 2^-48: far inside kRadiusSqRelErr.
+    double cross = area;
+    bool cross_ok = Abs(area) >= Mul(sum, 0x1p-6);
+    if (!cross_ok && lengths_ok && ExactDifference(p[1].x, p[0].x) && ExactDifference(p[1].y, p[0].y) &&
+        ExactDifference(p[2].x, p[0].x) && ExactDifference(p[2].y, p[0].y) && ExactDifference(p[2].x, p[1].x) &&
+        ExactDifference(p[2].y, p[1].y) && ThinStageCoordinateOk(dx[0]) && ThinStageCoordinateOk(dy[0]) &&
+        ThinStageCoordinateOk(dx[1]) && ThinStageCoordinateOk(dy[1])) {
+      cross = ExactCrossTop(dx[0], dy[0], dx[1], dy[1]);
+      if (cross == 0.0) {  // collinear: an infinite radius
+        out.key = kInfiniteRadiusKey;
+        return out;
+      }
+      cross_ok = true;
+    }
+    if (lengths_ok && cross_ok && Abs(cross) >= kMinScaledArea) {
       const double num = Mul(Mul(len[0], len[1]), len[2]);
-      const double den = Mul(area, area);
+      const double den = Mul(cross, cross);
       bool in_range = true;
       // A product of lengths that left the normal range lost its relative accuracy: such
       // triangles take the exact path. The quotient is formed from the significands so that it

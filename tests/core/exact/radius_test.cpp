@@ -56,6 +56,17 @@ std::vector<Simplex> Family(const std::string& name, int count, uint64_t seed) {
       s.p[0] = {ax, ay};
       s.p[1] = {bx, by};
       s.p[2] = {Ulps(0.5 * (ax + bx), ulps(rng)), Ulps(0.5 * (ay + by), ulps(rng))};
+    } else if (name == "lines") {
+      // Two crossing lines of integer points (the two_lines generator's): a far point of one line
+      // and two near neighbours on the other, the thin triangles of that triangulation (their
+      // first edge vectors nearly parallel), with exact edge vectors; and edges between the lines.
+      std::uniform_int_distribution<int64_t> far(-1000000, 1000000), near(1, 40);
+      const int64_t t = far(rng), u = t + near(rng), w = far(rng);
+      const auto first_line = [](int64_t k) { return Point2{3.0 * k, 2.0 * k + 5.0}; };
+      const auto second_line = [](int64_t k) { return Point2{1.0 * k, 7.0 - 4.0 * k}; };
+      s.p[0] = second_line(w);
+      s.p[1] = first_line(t);
+      if (s.n == 3) s.p[2] = first_line(u);
     } else {
       for (int k = 0; k < s.n; ++k) {
         s.p[k] = {offset + std::ldexp(small(rng), scale), offset + std::ldexp(small(rng), scale)};
@@ -122,6 +133,33 @@ TEST_P(RadiusTest, CertifiedKeysOrderExactValues) {
   if (GetParam() != "mixed") {
     EXPECT_EQ(certified, static_cast<int>(simplices.size()));
   }
+}
+
+// A certified key's value (its 51 kept bits) is within kRadiusSqRelErr of the exact rho^2, plus
+// the truncation to those bits: the bound kRadiusKeyGap is derived from.
+TEST_P(RadiusTest, CertifiedKeyValuesAreWithinTheirBound) {
+  const std::vector<Simplex> simplices = Family(GetParam(), 400, 13);
+  int checked = 0;
+  for (const Simplex& s : simplices) {
+    const RadiusSqApprox a = ApproxRadiusSq(s.p, s.n);
+    const std::optional<mpq_class> exact = RadiusSqRational(s.p, s.n);
+    if (!a.certified || !exact) continue;
+    ASSERT_NE(a.key, kInfiniteRadiusKey) << Show(s);
+    const int64_t field = static_cast<int64_t>(a.key >> 51);
+    const uint64_t mantissa = a.key & ((uint64_t{1} << 51) - 1);
+    mpq_class value((uint64_t{1} << 51) | mantissa);
+    const int64_t exponent = field - 4096 - 51;
+    if (exponent >= 0) {
+      mpq_mul_2exp(value.get_mpq_t(), value.get_mpq_t(), static_cast<mp_bitcnt_t>(exponent));
+    } else {
+      mpq_div_2exp(value.get_mpq_t(), value.get_mpq_t(), static_cast<mp_bitcnt_t>(-exponent));
+    }
+    mpq_class error = value - *exact;
+    if (error < 0) error = -error;
+    EXPECT_LE(error, mpq_class(std::ldexp(1.0, -40) + std::ldexp(1.0, -50)) * *exact) << Show(s);
+    ++checked;
+  }
+  EXPECT_GT(checked, static_cast<int>(simplices.size()) / 2);
 }
 
 TEST_P(RadiusTest, NearestDoubleMatchesGmp) {
@@ -262,7 +300,7 @@ TEST(RadiusTest, EnclosuresSeparateNearTies) {
 
 INSTANTIATE_TEST_SUITE_P(Families, RadiusTest,
                          ::testing::Values("uniform", "grid", "nudged", "offset1e9", "offset1e15", "tiny", "subnormal",
-                                           "mixed", "flat"));
+                                           "mixed", "flat", "lines"));
 
 TEST(RadiusTest, HandComputedValues) {
   // Unit square's triangle (0,0) (1,0) (1,1): circumradius^2 = 1/2; its side as an edge: 1/4.
