@@ -573,9 +573,12 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
     thrust::transform(policy, zero, zero + num_refined, group_key.data(),
                       CongruenceGroupKey{simplex, positions.data(), run_of.data(), ids});
     thrust::stable_sort_by_key(policy, group_key.data(), group_key.data() + num_refined, member.data());
-    const auto group_starts = thrust::make_transform_iterator(
-        zero, StartsCongruenceGroup{simplex, group_key.data(), member.data(), positions.data(), run_of.data(), ids});
-    thrust::inclusive_scan(policy, group_starts, group_starts + num_refined, group_of.data());
+    // The starts are written first and then scanned: the congruence test reads two simplices, too
+    // much work for a scan's input iterator, whose tiles wait on their predecessors.
+    thrust::transform(
+        policy, zero, zero + num_refined, group_of.data(),
+        StartsCongruenceGroup{simplex, group_key.data(), member.data(), positions.data(), run_of.data(), ids});
+    thrust::inclusive_scan(policy, group_of.data(), group_of.data() + num_refined, group_of.data());
   }
   const uint32_t num_groups = sys.Read(group_of.data() + (num_refined - 1));
   Buffer<uint32_t, System> group_first(sys, num_groups + 1);  // grouping position of each first member
