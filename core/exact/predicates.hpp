@@ -555,7 +555,8 @@ GALPHA_HD GALPHA_PRED_COLD inline int Orient2dSoSDegenerate(Point2 a, uint32_t i
   return parity * t;
 }
 
-/// Sign of the minor [1,u,z](i,j,k) (MinorUZSign) for three collinear points i, j, k, from one
+/// Sign of the minor [1,u,z](i,j,k) = u_i (z_j - z_k) + u_j (z_k - z_i) + u_k (z_i - z_j) for three
+/// collinear points i, j, k, from one
 /// coordinate u of each (x or y; z is the lift x^2 + y^2). On their line p = p_i + tau (p_k - p_i)
 /// the lift is quadratic in tau, so by column operations the minor is
 /// (u_k - u_i) |p_k - p_i|^2 det[[1, tau, tau^2]] = (u_k - u_i) |p_k - p_i|^2 tau_j (1 - tau_j), whose

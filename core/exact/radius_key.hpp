@@ -76,7 +76,9 @@ GALPHA_HD inline bool ExactDifference(double u, double v) {
   return lo == 0.0;
 }
 
-/// Whether a scaled coordinate is zero or large enough for the thin-triangle stage.
+/// Whether a scaled coordinate is zero or large enough for the thin-triangle stage. (A nonzero
+/// difference that the scaling rounded to zero was below 2^-1073: against the stage's
+/// |cross| >= 2^-400 its absence is an error below 2^-670, relatively.)
 GALPHA_HD inline bool ThinStageCoordinateOk(double v) { return v == 0.0 || Abs(v) >= kMinScaledThinCoordinate; }
 
 /// The cross product ax by - ay bx of two exact edge vectors as its exact value's top component
@@ -88,7 +90,7 @@ GALPHA_HD inline double ExactCrossTop(double ax, double ay, double bx, double by
   TwoProduct(ay, bx, r1, r0);
   double left[2], right[2], cross[4];
   const int ln = TwoToExpansion(l1, l0, left), rn = TwoToExpansion(r1, r0, right);
-  const int n = Compress(ExpansionDiffZeroElim(ln, left, rn, right, cross), cross);
+  const int n = Compress<4>(ExpansionDiffZeroElim(ln, left, rn, right, cross), cross);
   return n == 0 ? 0.0 : cross[n - 1];
 }
 

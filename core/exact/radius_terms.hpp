@@ -57,10 +57,12 @@ GALPHA_HD GALPHA_FORCEINLINE bool Finite(double v) { return v - v == 0.0; }
 constexpr int kBoundedCapacity = 64;
 
 /// Shewchuk's Compress: the same value in a nonoverlapping expansion with no more components (in
-/// practice far fewer). In place.
+/// practice far fewer). In place; n is at most kCapacity (a small capacity keeps the scratch in
+/// registers on the device).
+template <int kCapacity = kBoundedCapacity>
 GALPHA_HD inline int Compress(int n, double* e) {
   if (n <= 1) return n;
-  double g[kBoundedCapacity];
+  double g[kCapacity];
   double q = e[n - 1];
   int bottom = n - 1;
   for (int i = n - 2; i >= 0; --i) {

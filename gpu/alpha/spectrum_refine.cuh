@@ -72,7 +72,7 @@ namespace galpha::detail {
 struct RefinedEntry {
   uint32_t run;    // the run's index in the run list
   uint32_t id;     // the simplex
-  uint32_t group;  // the group's index in the grouping order (CongruenceGroups)
+  uint32_t group;  // the group's index in grouping order (RefineLongRuns)
   RefinedRadiusSq key;
 };
 
