@@ -573,8 +573,9 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
     thrust::transform(policy, zero, zero + num_refined, group_key.data(),
                       CongruenceGroupKey{simplex, positions.data(), run_of.data(), ids});
     thrust::stable_sort_by_key(policy, group_key.data(), group_key.data() + num_refined, member.data());
-    // The starts are written first and then scanned: the congruence test reads two simplices, too
-    // much work for a scan's input iterator, whose tiles wait on their predecessors.
+    // The starts are written first and then scanned, so that the congruence test (two simplices
+    // read) is not done inside the scan, whose tiles wait on their predecessors. It was meant to
+    // remove a slow refine stage seen in one run; the next run still had one: not shown to matter.
     thrust::transform(
         policy, zero, zero + num_refined, group_of.data(),
         StartsCongruenceGroup{simplex, group_key.data(), member.data(), positions.data(), run_of.data(), ids});
