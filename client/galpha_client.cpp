@@ -128,36 +128,55 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   message.mutable_header()->set_crs(options.crs);
   message.mutable_header()->set_weighted(weighted);
   bool open = writer->Write(message);
-  // Chunks are encoded in batches, one thread a chunk (each with its own encoder), then written in
-  // order: encoding costs 4-16 ms a 1 MiB chunk on one core, as much as sending it over 1 Gb/s.
-  const size_t batch = options.encoding == PointEncoding::kRaw
-                           ? 1
-                           : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads);
-  std::vector<std::unique_ptr<wire::PointChunkEncoder>> encoders;
-  for (size_t i = 0; i < batch; ++i) encoders.push_back(std::make_unique<wire::PointChunkEncoder>(options.zstd_level));
-  std::vector<v1::BuildRequest> messages(batch);
-  std::vector<absl::Status> statuses(batch);
+  // Chunks are encoded ahead of the writes, one thread a chunk, up to `window` at once, and
+  // written in order as each is ready: encoding costs 2-16 ms a 1 MiB chunk on one core (zstd and
+  // the trial encodings), as much as sending it over 1 Gb/s, so the writes of the first chunks
+  // overlap the encoding of the next ones instead of waiting for a whole batch.
+  const size_t window = options.encoding == PointEncoding::kRaw
+                            ? 1
+                            : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads);
+  const size_t chunk_count = (points.size() + kPointsPerChunk - 1) / kPointsPerChunk;
+  struct Slot {
+    std::unique_ptr<wire::PointChunkEncoder> encoder;
+    v1::BuildRequest message;
+    absl::Status status;
+    std::thread worker;
+  };
+  std::vector<Slot> slots(window);
+  for (Slot& slot : slots) slot.encoder = std::make_unique<wire::PointChunkEncoder>(options.zstd_level);
+  const auto encode = [&](size_t chunk) {
+    Slot& slot = slots[chunk % window];
+    const size_t begin = chunk * kPointsPerChunk;
+    const size_t count = std::min(kPointsPerChunk, points.size() - begin);
+    slot.status = EncodeChunk(points.subspan(begin, count), weighted ? weights.subspan(begin, count) : weights,
+                              options.encoding, slot.encoder.get(), &slot.message);
+  };
+  // With one slot there is nothing to overlap: each chunk is encoded on this thread.
+  const auto start = [&](size_t chunk) {
+    if (window > 1) slots[chunk % window].worker = std::thread(encode, chunk);
+  };
+  for (size_t chunk = 0; chunk < std::min(window, chunk_count); ++chunk) start(chunk);
   absl::Status encoded;
-  for (size_t first = 0; open && encoded.ok() && first < points.size(); first += batch * kPointsPerChunk) {
-    const size_t chunks = std::min(batch, (points.size() - first + kPointsPerChunk - 1) / kPointsPerChunk);
-    const auto encode = [&](size_t i) {
-      const size_t begin = first + i * kPointsPerChunk;
-      const size_t count = std::min(kPointsPerChunk, points.size() - begin);
-      statuses[i] = EncodeChunk(points.subspan(begin, count), weighted ? weights.subspan(begin, count) : weights,
-                                options.encoding, encoders[i].get(), &messages[i]);
-    };
-    std::vector<std::thread> threads;
-    for (size_t i = 1; i < chunks; ++i) threads.emplace_back(encode, i);
-    encode(0);
-    for (std::thread& thread : threads) thread.join();
-    for (size_t i = 0; i < chunks && open; ++i) {
-      encoded = statuses[i];
-      if (!encoded.ok()) break;
-      result.upload_bytes += messages[i].ByteSizeLong();
-      open = writer->Write(messages[i]);
-      const size_t sent = std::min(points.size(), first + (i + 1) * kPointsPerChunk);
-      if (open && options.progress) options.progress(sent);
+  size_t written = 0;  // chunks written; the ones after it up to written + window may be encoding
+  for (; open && encoded.ok() && written < chunk_count; ++written) {
+    Slot& slot = slots[written % window];
+    if (window > 1) {
+      slot.worker.join();
+    } else {
+      encode(written);
     }
+    encoded = slot.status;
+    if (!encoded.ok()) break;
+    result.upload_bytes += slot.message.ByteSizeLong();
+    open = writer->Write(slot.message);  // serializes the message: the slot is free again after it
+    if (written + window < chunk_count) start(written + window);
+    const size_t sent = std::min(points.size(), (written + 1) * kPointsPerChunk);
+    if (open && options.progress) options.progress(sent);
+  }
+  // After a failure (a bad chunk, or the server's answer ending the stream) the chunks still being
+  // encoded are waited for, then dropped.
+  for (Slot& slot : slots) {
+    if (slot.worker.joinable()) slot.worker.join();
   }
   if (!encoded.ok()) {
     context.TryCancel();
