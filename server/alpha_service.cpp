@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <memory>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -135,6 +136,7 @@ AlphaService::AlphaService(const ServiceOptions& options, ServerMetrics* metrics
     : options_(options),
       metrics_(metrics),
       in_flight_(options.max_in_flight_bytes, options.max_tenant_in_flight_bytes),
+      decode_pool_(std::thread::hardware_concurrency()),
       upload_watchdog_(options.upload_idle_timeout) {}
 
 AlphaService::~AlphaService() = default;

@@ -15,6 +15,7 @@
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
 #include "server/build_time_limit.hpp"
+#include "server/chunk_decode_pool.hpp"
 #include "server/exact_comparison_limit.hpp"
 #include "server/family_cache.hpp"
 #include "server/family_promoter.hpp"
@@ -146,6 +147,8 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   std::unique_ptr<FamilyCache> cache_;
   std::unique_ptr<FamilyPromoter> promoter_;  // before scheduler_: its jobs call it
   InFlightBytes in_flight_;
+  /// Decodes the Build streams' encoded chunks, one thread a core (build_stream.hpp).
+  ChunkDecodePool decode_pool_;
   UploadWatchdog upload_watchdog_;
   std::atomic<bool> draining_{false};
   // Last: its workers run builds that use everything above, so it stops first.

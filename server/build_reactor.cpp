@@ -12,6 +12,7 @@
 #include "server/build_time_limit.hpp"
 #include "server/exact_comparison_limit.hpp"
 #include "server/grpc_status.hpp"
+#include "server/heap_trim.hpp"
 #include "server/query_answers.hpp"
 
 namespace galpha::server {
@@ -31,7 +32,7 @@ BuildReactor::BuildReactor(AlphaService* service, grpc::CallbackServerContext* c
       response_(response),
       record_(service->metrics_, "Build"),
       decoder_(BuildStreamLimits{service->options_.max_points_per_build}, &service->in_flight_,
-               tenant.ok() ? *tenant : std::string()) {
+               tenant.ok() ? *tenant : std::string(), &service->decode_pool_) {
   if (!tenant.ok()) {
     Respond(tenant.status());
     return;
@@ -83,7 +84,7 @@ void BuildReactor::OnReadDone(bool ok) {
     if (upload_over_) return;  // the watchdog ended the call
     if (ok) {
       last_activity_ = Clock::now().time_since_epoch().count();
-      refused = decoder_.Add(request_);
+      refused = decoder_.Add(std::move(request_));
       if (refused.ok()) {
         StartRead(&request_);
         return;

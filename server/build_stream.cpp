@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -79,14 +80,54 @@ size_t InFlightBytes::held_by(const std::string& tenant) const {
   return it == held_by_tenant_.end() ? 0 : it->second;
 }
 
-BuildStreamDecoder::BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant)
-    : limits_(limits), in_flight_(in_flight), tenant_(std::move(tenant)) {}
+BuildStreamDecoder::BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant,
+                                       ChunkDecodePool* decode_pool)
+    : limits_(limits), in_flight_(in_flight), tenant_(std::move(tenant)), decode_pool_(decode_pool) {}
 
 BuildStreamDecoder::~BuildStreamDecoder() {
+  WaitForDecodes();  // their tasks write into decoded_ and report here
   if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(tenant_, reserved_);
 }
 
+void BuildStreamDecoder::WaitForDecodes() {
+  std::unique_lock<std::mutex> lock(decodes_mutex_);
+  decodes_idle_.wait(lock, [&] { return decoding_ == 0; });
+}
+
+absl::Status BuildStreamDecoder::DecodeFailure() {
+  std::unique_lock<std::mutex> lock(decodes_mutex_);
+  if (!decode_failed_) return absl::OkStatus();
+  // An earlier chunk may still be decoding and fail too: the answer is the earliest failure's, so
+  // that it does not depend on the order in which the pool's threads finished.
+  decodes_idle_.wait(lock, [&] { return decoding_ == 0; });
+  return decode_failure_;
+}
+
+void BuildStreamDecoder::DecodeOnPool(galpha::v1::BuildRequest message, const wire::ChunkPosition& at, uint64_t first) {
+  Point2* points = &decoded_.points[first];
+  double* weights = decoded_.header.weighted() ? &decoded_.weights[first] : nullptr;
+  {
+    std::lock_guard<std::mutex> lock(decodes_mutex_);
+    ++decoding_;
+  }
+  // std::function needs a copyable task: the message travels in a shared_ptr.
+  auto owned = std::make_shared<galpha::v1::BuildRequest>(std::move(message));
+  decode_pool_->Submit([this, owned, at, points, weights](wire::PointChunkDecoder& decoder) {
+    const galpha::v1::EncodedPointChunk& chunk = owned->encoded_points();
+    absl::Status decoded =
+        weights != nullptr ? decoder.DecodeWeighted(chunk, at, points, weights) : decoder.Decode(chunk, at, points);
+    std::lock_guard<std::mutex> lock(decodes_mutex_);
+    if (!decoded.ok() && (!decode_failed_ || at.chunk_index < failed_chunk_)) {
+      decode_failed_ = true;
+      failed_chunk_ = at.chunk_index;
+      decode_failure_ = std::move(decoded);
+    }
+    if (--decoding_ == 0) decodes_idle_.notify_all();
+  });
+}
+
 void BuildStreamDecoder::ReleasePoints() {
+  WaitForDecodes();
   HostVector<Point2>().swap(decoded_.points);
   HostVector<double>().swap(decoded_.weights);
   if (in_flight_ != nullptr && reserved_ > 0) in_flight_->Release(tenant_, reserved_);
@@ -123,6 +164,7 @@ absl::Status BuildStreamDecoder::Grow(uint64_t count) {
   if (absl::Status s = Reserve(count * PointBytes()); !s.ok()) return s;
   const size_t after = decoded_.points.size() + count;
   if (after > decoded_.points.capacity()) {
+    WaitForDecodes();  // the pool writes into the vectors that are about to move
     // Capacity grows with the bytes that arrived (doubling, as a vector does, but never past an
     // announced count), not with the announcement: an announced 100M points would otherwise
     // map 1.6 GB per stream before a single point arrives.
@@ -137,8 +179,9 @@ absl::Status BuildStreamDecoder::Grow(uint64_t count) {
   return absl::OkStatus();
 }
 
-absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
+absl::Status BuildStreamDecoder::Add(galpha::v1::BuildRequest message) {
   if (finished_) return absl::FailedPreconditionError("the build stream already ended");
+  if (absl::Status failed = DecodeFailure(); !failed.ok()) return failed;
   switch (message.part_case()) {
     case galpha::v1::BuildRequest::kHeader: {
       if (has_header_) return absl::InvalidArgumentError("the build stream has a second header");
@@ -230,6 +273,10 @@ absl::Status BuildStreamDecoder::Add(const galpha::v1::BuildRequest& message) {
       const uint64_t count = chunk.point_count();
       if (absl::Status s = CheckPointCount(before + count); !s.ok()) return s;
       if (absl::Status s = Grow(count); !s.ok()) return s;
+      if (decode_pool_ != nullptr) {
+        DecodeOnPool(std::move(message), at, before);
+        return absl::OkStatus();
+      }
       absl::Status decoded =
           weighted ? chunk_decoder_.DecodeWeighted(chunk, at, &decoded_.points[before], &decoded_.weights[before])
                    : chunk_decoder_.Decode(chunk, at, &decoded_.points[before]);
@@ -255,6 +302,8 @@ absl::StatusOr<DecodedBuild*> BuildStreamDecoder::Finish() {
   if (finished_) return absl::FailedPreconditionError("the build stream already ended");
   finished_ = true;
   chunk_decoder_.ReleaseScratch();  // the decoder outlives the stream while the build runs
+  WaitForDecodes();
+  if (absl::Status failed = DecodeFailure(); !failed.ok()) return failed;
   if (!has_header_) return absl::InvalidArgumentError("the build stream is empty: it needs a header, then points");
   const uint64_t expected = decoded_.header.expected_points();
   if (expected > 0 && decoded_.points.size() != expected) {

@@ -4,6 +4,7 @@
 // the unit tests drive it directly.
 #pragma once
 
+#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "proto/codec/point_chunk_codec.hpp"
 #include "server/cached_family.hpp"
+#include "server/chunk_decode_pool.hpp"
 
 namespace galpha::server {
 
@@ -81,10 +83,13 @@ absl::Status FrameByCrs(DecodedBuild* build);
 class BuildStreamDecoder {
  public:
   /// `in_flight` may be null (no limit on bytes in flight); it must outlive the decoder. `tenant`
-  /// is whose bytes these are ("" without authentication: one anonymous tenant).
-  BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant = "");
-  /// Releases the bytes this stream holds in `in_flight` (also after Finish: the builder keeps
-  /// the decoder alive while it uses the points).
+  /// is whose bytes these are ("" without authentication: one anonymous tenant). With a
+  /// `decode_pool` (which must outlive the decoder), encoded chunks are decompressed there while
+  /// the stream goes on (see Add); without one, in Add.
+  BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant = "",
+                     ChunkDecodePool* decode_pool = nullptr);
+  /// Waits for the chunks still decoding, then releases the bytes this stream holds in
+  /// `in_flight` (also after Finish: the builder keeps the decoder alive while it uses the points).
   ~BuildStreamDecoder();
   BuildStreamDecoder(const BuildStreamDecoder&) = delete;
   BuildStreamDecoder& operator=(const BuildStreamDecoder&) = delete;
@@ -98,16 +103,23 @@ class BuildStreamDecoder {
   /// header announcing more than a limit could ever hold is refused at once). Every limit counts
   /// decoded points, 16 bytes each (24 weighted): an encoded chunk's stated count is checked and its decoded bytes
   /// reserved before it is decompressed.
-  absl::Status Add(const galpha::v1::BuildRequest& message);
+  ///
+  /// With a decode pool, an encoded chunk that passes those checks is decompressed on the pool
+  /// (the message is kept until then), and what only its decoding finds (a malformed payload, a
+  /// NaN) is answered by the next Add or by Finish: the stream is refused a message or a few later,
+  /// with the error of the earliest chunk that failed, and its points are not taken back. Without
+  /// one, a refused chunk adds nothing and holds nothing.
+  absl::Status Add(galpha::v1::BuildRequest message);
 
-  /// The end of the stream. InvalidArgument: no header (an empty stream), or fewer points than
-  /// the header announced. The decoder keeps its reservation until destroyed.
+  /// The end of the stream, once every chunk has decoded. InvalidArgument: no header (an empty
+  /// stream), fewer points than the header announced, or a chunk whose decoding failed. The
+  /// decoder keeps its reservation until destroyed.
   absl::StatusOr<DecodedBuild*> Finish();
 
   uint64_t points_received() const { return decoded_.points.size(); }
 
-  /// Frees the points and gives back the bytes reserved for them (the builder calls this once the
-  /// engine has copied them).
+  /// Frees the points (after the chunks still decoding into them) and gives back the bytes reserved
+  /// for them (the builder calls this once the engine has copied them).
   void ReleasePoints();
 
  private:
@@ -116,8 +128,15 @@ class BuildStreamDecoder {
   size_t PointBytes() const;
   // The point limits for a stream of `after` points: ResourceExhausted or InvalidArgument.
   absl::Status CheckPointCount(uint64_t after) const;
-  // `count` more points at the end of decoded_.points, their bytes reserved first.
+  // `count` more points at the end of decoded_.points, their bytes reserved first. When the
+  // vectors must move, the chunks decoding into them finish first.
   absl::Status Grow(uint64_t count);
+  // Queues the decoding of `message`'s encoded chunk into the points from `first` on.
+  void DecodeOnPool(galpha::v1::BuildRequest message, const wire::ChunkPosition& at, uint64_t first);
+  // Blocks until no chunk of this stream is decoding.
+  void WaitForDecodes();
+  // The error of the earliest chunk whose decoding failed (after the chunks still decoding), or OK.
+  absl::Status DecodeFailure();
 
   const BuildStreamLimits limits_;
   InFlightBytes* const in_flight_;
@@ -128,6 +147,15 @@ class BuildStreamDecoder {
   uint64_t chunks_ = 0;  // point chunks so far, raw and encoded (errors name encoded ones by index)
   DecodedBuild decoded_;
   wire::PointChunkDecoder chunk_decoder_;
+
+  // Chunks on the pool: how many are still decoding, and the earliest that failed.
+  ChunkDecodePool* const decode_pool_;
+  std::mutex decodes_mutex_;
+  std::condition_variable decodes_idle_;
+  size_t decoding_ = 0;
+  bool decode_failed_ = false;
+  uint64_t failed_chunk_ = 0;
+  absl::Status decode_failure_;
 };
 
 }  // namespace galpha::server

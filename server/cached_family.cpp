@@ -1,10 +1,9 @@
 #include "server/cached_family.hpp"
 
-#include <malloc.h>
-
 #include <utility>
 
 #include "core/family/canonical_order.hpp"
+#include "server/heap_trim.hpp"
 
 namespace galpha::server {
 
@@ -75,12 +74,6 @@ void CachedFamily::ComputeOrders() const {
   edge_vertices_ = std::move(orders.edge_vertices);
   triangle_order_ = std::move(orders.triangle_order);
   triangle_vertices_ = std::move(orders.triangle_vertices);
-}
-
-void ReturnFreedHeapMemory() {
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
 }
 
 namespace {

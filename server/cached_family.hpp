@@ -83,10 +83,6 @@ class CachedFamily {
   mutable std::vector<uint32_t> edge_vertices_, triangle_vertices_;
 };
 
-/// Gives freed heap memory back to the system: a build frees hundreds of bytes per point at once,
-/// and without this glibc keeps it, so the process would sit at its peak forever.
-void ReturnFreedHeapMemory();
-
 /// `family` as the cache shares it: its last owner (the cache, or a query still streaming from it
 /// after a release, demotion or eviction) frees hundreds of megabytes, and gives them back to the
 /// system right then.

@@ -5,6 +5,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "gpu/alpha/alpha_engine.hpp"
+#include "server/heap_trim.hpp"
 
 namespace galpha::server {
 

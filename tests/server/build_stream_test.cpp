@@ -5,10 +5,12 @@
 #include "server/build_stream.hpp"
 
 #include <cmath>
+#include <condition_variable>
 #include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -668,68 +670,163 @@ TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirW
   EXPECT_EQ((*none)->handle, PointSetHandle(std::vector<Point2>{}));
 }
 
-TEST(BuildStreamDecoderTest, WeightedStreamRefusalsNameThePointAndTheWeight) {
-  {
-    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-    ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
-    EXPECT_THAT(
-        decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1})),
-        StatusIs(absl::StatusCode::kInvalidArgument,
-                 ::testing::HasSubstr("4 doubles, not a multiple of 3, after point 0: the header is weighted")));
-  }
-  {
-    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-    ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
-    ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1, 0, 2})), IsOk());
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{3, 3, 0.5, 4, 4, nan})),
-                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("point 3 has a NaN weight")));
-    const std::vector<Point2> two = {{5, 5}, {6, 6}};
-    const std::vector<double> infinite = {1.0, -std::numeric_limits<double>::infinity()};
-    wire::PointChunkEncoder encoder;
-    wire::ChunkEncoding float64;
-    v1::BuildRequest encoded;
-    ASSERT_THAT(encoder.Encode(two, infinite, float64, encoded.mutable_encoded_points()), IsOk());
-    EXPECT_THAT(decoder.Add(encoded), StatusIs(absl::StatusCode::kInvalidArgument,
-                                               ::testing::HasSubstr("(from point 2): point 3 has an infinite weight")));
-    EXPECT_EQ(decoder.points_received(), 2u) << "refused chunks add nothing";
-  }
-  {
-    // An unweighted stream takes no weight scale, and a weighted integer chunk needs one.
-    const std::vector<Point2> two = {{1, 2}, {3, 4}};
-    const std::vector<double> weights = {0.5, 0.25};
-    wire::PointChunkEncoder encoder;
-    wire::ChunkEncoding integers;
-    integers.value_type = v1::POINT_VALUE_TYPE_INT32;
-    integers.x_scale.set_scale(1.0);
-    integers.y_scale.set_scale(1.0);
-    integers.w_scale.set_scale(0.25);
-    v1::BuildRequest weighted_chunk;
-    ASSERT_THAT(encoder.Encode(two, weights, integers, weighted_chunk.mutable_encoded_points()), IsOk());
-    BuildStreamDecoder unweighted(BuildStreamLimits{}, nullptr);
-    ASSERT_THAT(unweighted.Add(Header(0)), IsOk());
-    EXPECT_THAT(unweighted.Add(weighted_chunk),
-                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the stream is not weighted")));
-    v1::BuildRequest no_scale = weighted_chunk;
-    no_scale.mutable_encoded_points()->clear_w_scale();
-    BuildStreamDecoder weighted(BuildStreamLimits{}, nullptr);
-    ASSERT_THAT(weighted.Add(WeightedHeader(0)), IsOk());
-    EXPECT_THAT(weighted.Add(no_scale), StatusIs(absl::StatusCode::kInvalidArgument,
-                                                 ::testing::HasSubstr("needs w_scale (the stream is weighted)")));
-    ASSERT_THAT(weighted.Add(weighted_chunk), IsOk());
-    absl::StatusOr<DecodedBuild*> decoded = weighted.Finish();
-    ASSERT_THAT(decoded, IsOk());
-    EXPECT_EQ((*decoded)->weights[1], 0.25);
-  }
+TEST(BuildStreamDecoderTest,
+     WeightedStreamRefusalsNameThePointAndTheWeight){{BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
+EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1})),
+            StatusIs(absl::StatusCode::kInvalidArgument,
+                     ::testing::HasSubstr("4 doubles, not a multiple of 3, after point 0: the header is weighted")));
+}  // namespace
+{
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1, 0, 2})), IsOk());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{3, 3, 0.5, 4, 4, nan})),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("point 3 has a NaN weight")));
+  const std::vector<Point2> two = {{5, 5}, {6, 6}};
+  const std::vector<double> infinite = {1.0, -std::numeric_limits<double>::infinity()};
+  wire::PointChunkEncoder encoder;
+  wire::ChunkEncoding float64;
+  v1::BuildRequest encoded;
+  ASSERT_THAT(encoder.Encode(two, infinite, float64, encoded.mutable_encoded_points()), IsOk());
+  EXPECT_THAT(decoder.Add(encoded), StatusIs(absl::StatusCode::kInvalidArgument,
+                                             ::testing::HasSubstr("(from point 2): point 3 has an infinite weight")));
+  EXPECT_EQ(decoder.points_received(), 2u) << "refused chunks add nothing";
+}
+{
+  // An unweighted stream takes no weight scale, and a weighted integer chunk needs one.
+  const std::vector<Point2> two = {{1, 2}, {3, 4}};
+  const std::vector<double> weights = {0.5, 0.25};
+  wire::PointChunkEncoder encoder;
+  wire::ChunkEncoding integers;
+  integers.value_type = v1::POINT_VALUE_TYPE_INT32;
+  integers.x_scale.set_scale(1.0);
+  integers.y_scale.set_scale(1.0);
+  integers.w_scale.set_scale(0.25);
+  v1::BuildRequest weighted_chunk;
+  ASSERT_THAT(encoder.Encode(two, weights, integers, weighted_chunk.mutable_encoded_points()), IsOk());
+  BuildStreamDecoder unweighted(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(unweighted.Add(Header(0)), IsOk());
+  EXPECT_THAT(unweighted.Add(weighted_chunk),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the stream is not weighted")));
+  v1::BuildRequest no_scale = weighted_chunk;
+  no_scale.mutable_encoded_points()->clear_w_scale();
+  BuildStreamDecoder weighted(BuildStreamLimits{}, nullptr);
+  ASSERT_THAT(weighted.Add(WeightedHeader(0)), IsOk());
+  EXPECT_THAT(weighted.Add(no_scale), StatusIs(absl::StatusCode::kInvalidArgument,
+                                               ::testing::HasSubstr("needs w_scale (the stream is weighted)")));
+  ASSERT_THAT(weighted.Add(weighted_chunk), IsOk());
+  absl::StatusOr<DecodedBuild*> decoded = weighted.Finish();
+  ASSERT_THAT(decoded, IsOk());
+  EXPECT_EQ((*decoded)->weights[1], 0.25);
+}
 #ifdef GALPHA_WITH_PROJ
-  {
-    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-    v1::BuildRequest header = WeightedHeader(0);
-    header.mutable_header()->set_crs("EPSG:4326");
-    EXPECT_THAT(decoder.Add(header),
-                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("weights need planar coordinates")));
-  }
+{
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+  v1::BuildRequest header = WeightedHeader(0);
+  header.mutable_header()->set_crs("EPSG:4326");
+  EXPECT_THAT(decoder.Add(header),
+              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("weights need planar coordinates")));
+}
 #endif
+}  // namespace galpha::server
+
+// Chunks decoded on a pool land where they belong: many small encoded chunks, some raw ones between
+// them, no announced count (so the vectors move several times while chunks are decoding), points
+// bit for bit and the handle as for the points themselves; weighted streams too.
+TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
+  ChunkDecodePool pool(4);
+  const std::vector<Point2> points = gen::Uniform(20000, 47);
+  const std::vector<double> weights = AwkwardWeights(points.size());
+  const auto all = absl::MakeConstSpan(points);
+  const auto all_weights = absl::MakeConstSpan(weights);
+  for (const bool weighted : {false, true}) {
+    SCOPED_TRACE(weighted ? "weighted" : "unweighted");
+    InFlightBytes in_flight(0);
+    BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight, "", &pool);
+    ASSERT_THAT(decoder.Add(weighted ? WeightedHeader(0) : Header(0)), IsOk());
+    wire::PointChunkEncoder encoder;
+    size_t encoded_chunks = 0;
+    for (size_t first = 0, size = 37; first < points.size(); first += size, size = size * 3 / 2 + 1) {
+      const size_t count = std::min(size, points.size() - first);
+      const auto part = all.subspan(first, count);
+      const auto part_weights = weighted ? all_weights.subspan(first, count) : absl::Span<const double>();
+      v1::BuildRequest message;
+      if ((first / size) % 3 == 2) {  // every third chunk raw
+        message = weighted ? WeightedChunk(part, part_weights) : Chunk(part);
+      } else {
+        ASSERT_THAT(encoder.EncodeSmallest(part, part_weights, &message), IsOk());
+        encoded_chunks += message.has_encoded_points() ? 1 : 0;
+      }
+      ASSERT_THAT(decoder.Add(std::move(message)), IsOk()) << "chunk from point " << first;
+    }
+    ASSERT_GE(encoded_chunks, 5u);
+    absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+    ASSERT_THAT(decoded, IsOk());
+    ASSERT_EQ((*decoded)->points.size(), points.size());
+    for (size_t i = 0; i < points.size(); ++i) {
+      ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
+      ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
+      if (weighted) {
+        ASSERT_EQ(Bits((*decoded)->weights[i]), Bits(weights[i])) << i;
+      }
+    }
+    EXPECT_EQ((*decoded)->handle, weighted ? WeightedPointSetHandle(points, weights) : PointSetHandle(points));
+    EXPECT_EQ(in_flight.held(), points.size() * (weighted ? 24u : 16u));
+  }
+}
+
+// A chunk that only its decoding refuses, on a pool: the stream is refused by a later message or by
+// Finish, always with the error of the earliest such chunk (the one the decoder without a pool
+// names), whatever order the pool's threads finish in.
+TEST(BuildStreamDecoderTest, ChunksThatFailOnAPoolRefuseTheStreamWithTheEarliestError) {
+  constexpr size_t kThreads = 4;
+  ChunkDecodePool pool(kThreads);
+  const std::vector<Point2> points = gen::Uniform(1000, 48);
+  const auto all = absl::MakeConstSpan(points);
+  const std::string expected = "encoded point chunk 3 (from point 300): its data is not a zstd frame";
+  const auto chunk = [&](size_t i) {
+    return i == 3 || i == 5 ? UndecodableChunk(100) : EncodedChunk(all.subspan(100 * i, 100));
+  };
+  for (int round = 0; round < 20; ++round) {
+    // As it comes: chunk 3 usually fails before a later message, which is then refused.
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);
+    ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+    absl::Status refused;
+    for (size_t i = 0; i < 10 && refused.ok(); ++i) refused = decoder.Add(chunk(i));
+    if (refused.ok()) refused = decoder.Finish().status();
+    ASSERT_THAT(refused, StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr(expected)))
+        << "round " << round;
+  }
+  for (int round = 0; round < 20; ++round) {
+    // Every chunk queued before any decodes (the pool's threads held at a gate): both bad chunks
+    // fail, in either order, and Finish answers with the first one's error. A raw chunk of 1,000
+    // points first, so that the vectors move before the first encoded chunk and never while the
+    // gate holds the decodes (a move waits for them).
+    std::mutex mutex;
+    std::condition_variable opened;
+    bool open = false;
+    for (size_t i = 0; i < kThreads; ++i) {
+      pool.Submit([&](wire::PointChunkDecoder&) {
+        std::unique_lock<std::mutex> lock(mutex);
+        opened.wait(lock, [&] { return open; });
+      });
+    }
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);
+    ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+    ASSERT_THAT(decoder.Add(Chunk(all)), IsOk());
+    for (size_t i = 0; i < 8; ++i) ASSERT_THAT(decoder.Add(chunk(i)), IsOk()) << "nothing decoded yet";
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      open = true;
+    }
+    opened.notify_all();
+    EXPECT_THAT(decoder.Finish().status(),
+                StatusIs(absl::StatusCode::kInvalidArgument,
+                         ::testing::HasSubstr("encoded point chunk 4 (from point 1300): its data is not a zstd frame")))
+        << "round " << round;
+  }
 }
 
 }  // namespace
