@@ -154,9 +154,11 @@ void TransformWords(const std::vector<Word>& words, size_t axes, v1::PointTransf
       previous = w;
     }
   }
-  for (size_t b = 0; b < sizeof(Word); ++b) {
-    unsigned char* plane = out + b * count;
-    for (size_t j = 0; j < count; ++j) plane[j] = static_cast<unsigned char>(planar[j] >> (8 * b));
+  // One pass over the words, each byte to its plane: a pass per plane read every word eight times
+  // (15% of the client's encoding time at 1M uniform points, with the trial encodings).
+  for (size_t j = 0; j < count; ++j) {
+    const Word w = planar[j];
+    for (size_t b = 0; b < sizeof(Word); ++b) out[b * count + j] = static_cast<unsigned char>(w >> (8 * b));
   }
 }
 
@@ -406,23 +408,30 @@ bool AxisIntegers(const Column& column, const v1::AxisScale& scale, int64_t* sma
 }
 
 // The smallest power-of-two step 2^-k under which every value of the axis is an integer of at
-// most 53 bits; nullopt when none is.
+// most 53 bits; nullopt when none is. From the bits: a finite nonzero double is an odd integer
+// times 2^e (its significand without the trailing zeros), so it is a multiple of 2^-k exactly when
+// k >= -e. The scan stops as soon as some |v| 2^k reaches 2^54 (k only grows): no step of this kind
+// can work then (AxisIntegers would refuse it), which for full-precision doubles happens within
+// the first few values. (A frexp and an ldexp of every value cost 8x more: a quarter of the
+// client's encoding time at 1M uniform points.)
 std::optional<v1::AxisScale> PowerOfTwoScale(const Column& column) {
+  constexpr uint64_t kFraction = (uint64_t{1} << 52) - 1;
   int k = 0;
+  int top = std::numeric_limits<int>::min();  // the largest floor(log2 |v|) so far
   for (size_t i = 0; i < column.size; ++i) {
     const double v = column[i];
     if (!std::isfinite(v)) return std::nullopt;
     if (v == 0) continue;
-    int exponent = 0;
-    // v = m * 2^exponent with m in [0.5, 1): m * 2^53 is an integer; its trailing zeros lower k.
-    const double mantissa = std::frexp(v, &exponent);
-    auto m = static_cast<int64_t>(std::ldexp(std::fabs(mantissa), 53));
-    int needed = 53 - exponent;
-    while (needed > 0 && (m & 1) == 0) {
-      m >>= 1;
-      --needed;
-    }
-    k = std::max(k, needed);
+    const uint64_t bits = Bits(v);
+    const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+    // v = significand * 2^unit; subnormals have no hidden bit.
+    const uint64_t significand = biased == 0 ? (bits & kFraction) : ((bits & kFraction) | (uint64_t{1} << 52));
+    const int unit = biased == 0 ? -1074 : biased - 1075;
+    const int lowest_bit = unit + __builtin_ctzll(significand);
+    const int highest_bit = unit + 63 - __builtin_clzll(significand);
+    k = std::max(k, -lowest_bit);
+    top = std::max(top, highest_bit);
+    if (k + top >= 54) return std::nullopt;
   }
   if (k > 1000) return std::nullopt;
   v1::AxisScale scale;

@@ -178,6 +178,40 @@ TEST(PointChunkCodec, FindsTheScalesTheDataWasWrittenWith) {
   EXPECT_FALSE(FindScaledIntegers(std::vector<Point2>{{1e300, 1}, {1e-300, 1}}).has_value());
 }
 
+// The power-of-two step (read from the doubles' bits): the finest one the values need, accepted
+// up to integers of exactly 2^53 and refused one binade above; binary fractions finer than any
+// decimal step tried (10^-22) take it.
+TEST(PointChunkCodec, PowerOfTwoStepIsTheFinestTheValuesNeedWithin53Bits) {
+  const double fine = std::ldexp(3.0, -30);  // 30 binary digits: no decimal step up to 10^-22 gives it
+  const std::optional<ScaledAxes> binary =
+      FindScaledIntegers(std::vector<Point2>{{fine, 0}, {5, 1}, {-std::ldexp(7.0, -12), 2}});
+  ASSERT_TRUE(binary.has_value());
+  EXPECT_EQ(binary->x.scale(), std::ldexp(1.0, -30));
+  EXPECT_EQ(binary->value_type, v1::POINT_VALUE_TYPE_INT64);
+  // 2^43 on a step of 2^-10 is the integer 2^53: the largest accepted.
+  const std::optional<ScaledAxes> widest =
+      FindScaledIntegers(std::vector<Point2>{{std::ldexp(1.0, -10), 0}, {std::ldexp(1.0, 43), 1}});
+  ASSERT_TRUE(widest.has_value());
+  EXPECT_EQ(widest->x.scale(), std::ldexp(1.0, -10));
+  // 2^44 would be 2^54: no step of either kind works.
+  EXPECT_FALSE(
+      FindScaledIntegers(std::vector<Point2>{{std::ldexp(1.0, -10), 0}, {std::ldexp(1.0, 44), 1}}).has_value());
+  // Subnormals need steps below 2^-1000: refused.
+  EXPECT_FALSE(
+      FindScaledIntegers(std::vector<Point2>{{std::ldexp(3.0, -1074), 0}, {std::ldexp(1.0, -1070), 1}}).has_value());
+  // Every form round-trips bit for bit.
+  PointChunkEncoder encoder;
+  PointChunkDecoder decoder;
+  const std::vector<Point2> points = {{fine, 0}, {5, 1}, {-std::ldexp(7.0, -12), 2}};
+  ChunkEncoding encoding{binary->value_type,         binary->x, binary->y, v1::POINT_TRANSFORM_DELTA_SHUFFLE,
+                         v1::POINT_COMPRESSION_ZSTD, {}};
+  v1::EncodedPointChunk chunk;
+  ASSERT_THAT(encoder.Encode(points, encoding, &chunk), IsOk());
+  std::vector<Point2> decoded(points.size());
+  ASSERT_THAT(decoder.Decode(chunk, ChunkPosition{}, decoded.data()), IsOk());
+  ExpectBitIdentical(decoded, points);
+}
+
 TEST(PointChunkCodec, ScaledValueIsNeverFused) {
   // With scale 0.1, X = 3 and offset -0.3 the unfused result (two roundings) and an FMA (one)
   // differ: the product rounds to 0.30000000000000004 first. The server must give the former.
