@@ -55,6 +55,10 @@ class InFlightBytes {
   std::map<std::string, size_t> held_by_tenant_;  // only tenants holding bytes
 };
 
+/// Points of a header's announced count that the decoder allocates for at the first chunk (64 MiB
+/// of address space; more only as points arrive).
+inline constexpr uint64_t kTrustedAnnouncedPoints = uint64_t{1} << 22;
+
 /// Longest BuildHeader.name, in bytes: a label, not a payload (it is kept with the family and sent
 /// back with every Build and Describe answer).
 inline constexpr size_t kMaxBuildNameBytes = 256;

@@ -733,8 +733,9 @@ EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1})),
 }  // namespace galpha::server
 
 // Chunks decoded on a pool land where they belong: many small encoded chunks, some raw ones between
-// them, no announced count (so the vectors move several times while chunks are decoding), points
-// bit for bit and the handle as for the points themselves; weighted streams too.
+// them, with no announced count (so the vectors move several times while chunks are decoding)
+// and with one (allocated at the first chunk), points bit for bit and the handle as for the
+// points themselves; weighted streams too.
 TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
   ChunkDecodePool pool(4);
   const std::vector<Point2> points = gen::Uniform(20000, 47);
@@ -742,38 +743,40 @@ TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
   const auto all = absl::MakeConstSpan(points);
   const auto all_weights = absl::MakeConstSpan(weights);
   for (const bool weighted : {false, true}) {
-    SCOPED_TRACE(weighted ? "weighted" : "unweighted");
-    InFlightBytes in_flight(0);
-    BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight, "", &pool);
-    ASSERT_THAT(decoder.Add(weighted ? WeightedHeader(0) : Header(0)), IsOk());
-    wire::PointChunkEncoder encoder;
-    size_t encoded_chunks = 0;
-    for (size_t first = 0, size = 37; first < points.size(); first += size, size = size * 3 / 2 + 1) {
-      const size_t count = std::min(size, points.size() - first);
-      const auto part = all.subspan(first, count);
-      const auto part_weights = weighted ? all_weights.subspan(first, count) : absl::Span<const double>();
-      v1::BuildRequest message;
-      if ((first / size) % 3 == 2) {  // every third chunk raw
-        message = weighted ? WeightedChunk(part, part_weights) : Chunk(part);
-      } else {
-        ASSERT_THAT(encoder.EncodeSmallest(part, part_weights, &message), IsOk());
-        encoded_chunks += message.has_encoded_points() ? 1 : 0;
+    for (const uint64_t announced : {uint64_t{0}, uint64_t{points.size()}}) {
+      SCOPED_TRACE(absl::StrCat(weighted ? "weighted" : "unweighted", ", announced ", announced));
+      InFlightBytes in_flight(0);
+      BuildStreamDecoder decoder(BuildStreamLimits{}, &in_flight, "", &pool);
+      ASSERT_THAT(decoder.Add(weighted ? WeightedHeader(announced) : Header(announced)), IsOk());
+      wire::PointChunkEncoder encoder;
+      size_t encoded_chunks = 0;
+      for (size_t first = 0, size = 37; first < points.size(); first += size, size = size * 3 / 2 + 1) {
+        const size_t count = std::min(size, points.size() - first);
+        const auto part = all.subspan(first, count);
+        const auto part_weights = weighted ? all_weights.subspan(first, count) : absl::Span<const double>();
+        v1::BuildRequest message;
+        if ((first / size) % 3 == 2) {  // every third chunk raw
+          message = weighted ? WeightedChunk(part, part_weights) : Chunk(part);
+        } else {
+          ASSERT_THAT(encoder.EncodeSmallest(part, part_weights, &message), IsOk());
+          encoded_chunks += message.has_encoded_points() ? 1 : 0;
+        }
+        ASSERT_THAT(decoder.Add(std::move(message)), IsOk()) << "chunk from point " << first;
       }
-      ASSERT_THAT(decoder.Add(std::move(message)), IsOk()) << "chunk from point " << first;
-    }
-    ASSERT_GE(encoded_chunks, 5u);
-    absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
-    ASSERT_THAT(decoded, IsOk());
-    ASSERT_EQ((*decoded)->points.size(), points.size());
-    for (size_t i = 0; i < points.size(); ++i) {
-      ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
-      ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
-      if (weighted) {
-        ASSERT_EQ(Bits((*decoded)->weights[i]), Bits(weights[i])) << i;
+      ASSERT_GE(encoded_chunks, 5u);
+      absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+      ASSERT_THAT(decoded, IsOk());
+      ASSERT_EQ((*decoded)->points.size(), points.size());
+      for (size_t i = 0; i < points.size(); ++i) {
+        ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
+        ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
+        if (weighted) {
+          ASSERT_EQ(Bits((*decoded)->weights[i]), Bits(weights[i])) << i;
+        }
       }
+      EXPECT_EQ((*decoded)->handle, weighted ? WeightedPointSetHandle(points, weights) : PointSetHandle(points));
+      EXPECT_EQ(in_flight.held(), points.size() * (weighted ? 24u : 16u));
     }
-    EXPECT_EQ((*decoded)->handle, weighted ? WeightedPointSetHandle(points, weights) : PointSetHandle(points));
-    EXPECT_EQ(in_flight.held(), points.size() * (weighted ? 24u : 16u));
   }
 }
 
