@@ -783,6 +783,39 @@ TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
 // A chunk that only its decoding refuses, on a pool: the stream is refused by a later message or by
 // Finish, always with the error of the earliest such chunk (the one the decoder without a pool
 // names), whatever order the pool's threads finish in.
+// Holds a pool's threads until opened, so that every chunk of a stream is queued before any is
+// decoded. Opens when it goes out of scope (an ASSERT may leave early), and only then returns
+// once every held thread has let go of it.
+class PoolGate {
+ public:
+  PoolGate(ChunkDecodePool* pool, size_t threads) : held_(threads) {
+    for (size_t i = 0; i < threads; ++i) {
+      pool->Submit([this](wire::PointChunkDecoder&) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        changed_.wait(lock, [&] { return open_; });
+        --held_;
+        changed_.notify_all();
+      });
+    }
+  }
+  ~PoolGate() {
+    Open();
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return held_ == 0; });
+  }
+  void Open() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_ = true;
+    changed_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool open_ = false;
+  size_t held_;
+};
+
 TEST(BuildStreamDecoderTest, ChunksThatFailOnAPoolRefuseTheStreamWithTheEarliestError) {
   constexpr size_t kThreads = 4;
   ChunkDecodePool pool(kThreads);
@@ -807,24 +840,13 @@ TEST(BuildStreamDecoderTest, ChunksThatFailOnAPoolRefuseTheStreamWithTheEarliest
     // fail, in either order, and Finish answers with the first one's error. A raw chunk of 1,000
     // points first, so that the vectors move before the first encoded chunk and never while the
     // gate holds the decodes (a move waits for them).
-    std::mutex mutex;
-    std::condition_variable opened;
-    bool open = false;
-    for (size_t i = 0; i < kThreads; ++i) {
-      pool.Submit([&](wire::PointChunkDecoder&) {
-        std::unique_lock<std::mutex> lock(mutex);
-        opened.wait(lock, [&] { return open; });
-      });
-    }
+    // The decoder first: it is destroyed last, once the gate has let the decodes it waits for run.
     BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);
+    PoolGate gate(&pool, kThreads);
     ASSERT_THAT(decoder.Add(Header(0)), IsOk());
     ASSERT_THAT(decoder.Add(Chunk(all)), IsOk());
     for (size_t i = 0; i < 8; ++i) ASSERT_THAT(decoder.Add(chunk(i)), IsOk()) << "nothing decoded yet";
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      open = true;
-    }
-    opened.notify_all();
+    gate.Open();
     EXPECT_THAT(decoder.Finish().status(),
                 StatusIs(absl::StatusCode::kInvalidArgument,
                          ::testing::HasSubstr("encoded point chunk 4 (from point 1300): its data is not a zstd frame")))
