@@ -2,7 +2,12 @@
 
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
+#include <cstdio>
 #include <memory>
+#include <optional>
+#include <string>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -196,6 +201,17 @@ void AlphaService::SampleDeviceMemory() {
   if (backend_ != Backend::kCuda) return;
   if (auto memory = QueryDeviceMemory(); memory.ok()) {
     metrics_->SetDeviceMemoryInUse(static_cast<double>(memory->total_bytes - memory->free_bytes));
+  }
+}
+
+void AlphaService::ReleaseIdleDeviceMemory() {
+  if (backend_ != Backend::kCuda || options_.device_idle_release.count() <= 0 || scheduler_ == nullptr) return;
+  const std::optional<std::chrono::steady_clock::time_point> idle = scheduler_->IdleSince();
+  if (!idle || std::chrono::steady_clock::now() - *idle < options_.device_idle_release) return;
+  if (absl::Status released = ReleaseUnusedDeviceMemory(); !released.ok()) {
+    // Not fatal (the memory stays in the pool, as it would without this), but said once.
+    static std::atomic<bool> told{false};
+    if (!told.exchange(true)) std::fprintf(stderr, "galpha_server: %s\n", std::string(released.message()).c_str());
   }
 }
 

@@ -68,6 +68,10 @@ struct ServiceOptions {
   /// builds' default memory budget; 0: CUDA families are copied to host memory. Unused on the CPU
   /// backend, whose families are held in host memory.
   size_t device_cache_bytes = 0;
+  /// After this long with no build running or queued, the device memory that CUDA's pool keeps
+  /// for reuse (freed by builds, and by families that left the device) goes back to the device,
+  /// checked once a second; the first build after it maps its memory again. 0: kept for good.
+  std::chrono::milliseconds device_idle_release{2000};
   TenantTokens tokens;
 };
 
@@ -90,6 +94,9 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   void StartDraining();
   /// Samples device memory into the metrics (the server calls this periodically on a GPU).
   void SampleDeviceMemory();
+  /// Gives the device memory the pool keeps for reuse back to the device when no build has run or
+  /// waited for ServiceOptions::device_idle_release (the server calls this periodically on a GPU).
+  void ReleaseIdleDeviceMemory();
 
   grpc::ServerReadReactor<galpha::v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
                                                            galpha::v1::BuildResponse* response) override;

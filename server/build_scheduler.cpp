@@ -116,10 +116,17 @@ void BuildScheduler::WorkerLoop(BuildSlot slot) {
     if (!draining) {
       --running_;
       admitted_bytes_ -= pending.memory_bytes;
+      if (running_ == 0) idle_since_ = std::chrono::steady_clock::now();
     }
     ReportLoad();
     changed_.notify_all();
   }
+}
+
+std::optional<std::chrono::steady_clock::time_point> BuildScheduler::IdleSince() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (running_ > 0 || !queue_.empty()) return std::nullopt;
+  return idle_since_;
 }
 
 }  // namespace galpha::server

@@ -5,12 +5,14 @@
 // happens it fails alone.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -64,6 +66,10 @@ class BuildScheduler {
   /// finish. Returns at once.
   void Stop();
 
+  /// Since when no job has run or waited (the construction, or the end of the last job); nullopt
+  /// while one runs or waits.
+  std::optional<std::chrono::steady_clock::time_point> IdleSince() const;
+
   size_t slots() const { return workers_.size(); }
   size_t max_queue() const { return max_queue_; }
   size_t max_queue_per_tenant() const { return max_queue_per_tenant_; }
@@ -88,10 +94,11 @@ class BuildScheduler {
   const size_t max_queue_per_tenant_;
   const size_t memory_budget_;
   SchedulerObserver* const observer_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Pending> queue_;
   size_t running_ = 0;
+  std::chrono::steady_clock::time_point idle_since_ = std::chrono::steady_clock::now();
   size_t admitted_bytes_ = 0;
   bool stopping_ = false;
   std::vector<std::thread> workers_;

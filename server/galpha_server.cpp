@@ -80,6 +80,7 @@ void GalphaServer::SampleLoop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stopped_) {
     lock.unlock();
+    service_->ReleaseIdleDeviceMemory();
     service_->SampleDeviceMemory();
     lock.lock();
     stopped_changed_.wait_for(lock, std::chrono::seconds(1), [&] { return stopped_; });

@@ -35,6 +35,9 @@ ABSL_FLAG(uint64_t, max_tenant_in_flight_bytes, uint64_t{4} << 30,
 ABSL_FLAG(int, upload_idle_timeout_ms, 30000,
           "a Build stream with no message for this long is ended with DEADLINE_EXCEEDED and its points dropped; "
           "0: never");
+ABSL_FLAG(int, device_idle_release_ms, 2000,
+          "after this long with no build running or queued, the GPU memory the builds' pool keeps for reuse goes "
+          "back to the device (checked once a second); 0: kept for good");
 ABSL_FLAG(double, build_time_multiple, 50,
           "a build may run this many times its expected time (60 ns a point on CUDA, 14 us a point over the "
           "host's cores on the CPU), then stops with DEADLINE_EXCEEDED; 0: no limit");
@@ -119,6 +122,8 @@ int main(int argc, char** argv) {
   options.service.max_tenant_in_flight_bytes = absl::GetFlag(FLAGS_max_tenant_in_flight_bytes);
   if (absl::GetFlag(FLAGS_upload_idle_timeout_ms) < 0) return Fail("--upload_idle_timeout_ms must be >= 0");
   options.service.upload_idle_timeout = std::chrono::milliseconds(absl::GetFlag(FLAGS_upload_idle_timeout_ms));
+  if (absl::GetFlag(FLAGS_device_idle_release_ms) < 0) return Fail("--device_idle_release_ms must be >= 0");
+  options.service.device_idle_release = std::chrono::milliseconds(absl::GetFlag(FLAGS_device_idle_release_ms));
   if (!(absl::GetFlag(FLAGS_build_time_multiple) >= 0)) return Fail("--build_time_multiple must be >= 0");
   if (absl::GetFlag(FLAGS_build_time_floor_ms) < 0) return Fail("--build_time_floor_ms must be >= 0");
   options.service.build_time.multiple = absl::GetFlag(FLAGS_build_time_multiple);

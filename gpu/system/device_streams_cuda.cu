@@ -21,6 +21,23 @@ absl::StatusOr<DeviceMemory> QueryDeviceMemory() {
   return memory;
 }
 
+absl::Status ReleaseUnusedDeviceMemory() {
+  int device = 0;
+  if (cudaGetDevice(&device) != cudaSuccess) {
+    cudaGetLastError();
+    return absl::UnavailableError("no CUDA device is visible");
+  }
+  // The pool the engine allocates from (gpu/system/cuda_system.cu configures it).
+  cudaMemPool_t pool = nullptr;
+  cudaError_t result = cudaDeviceGetDefaultMemPool(&pool, device);
+  if (result == cudaSuccess) result = cudaMemPoolTrimTo(pool, 0);
+  if (result != cudaSuccess) {
+    cudaGetLastError();
+    return absl::InternalError(absl::StrCat("releasing the memory pool's unused memory: ", cudaGetErrorString(result)));
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<std::unique_ptr<CudaStreamPool>> CudaStreamPool::Create(int count) {
   int devices = 0;
   if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {

@@ -8,6 +8,8 @@ absl::StatusOr<DeviceMemory> QueryDeviceMemory() {
   return absl::UnavailableError("this build of galpha has no CUDA backend");
 }
 
+absl::Status ReleaseUnusedDeviceMemory() { return absl::UnavailableError("this build of galpha has no CUDA backend"); }
+
 absl::StatusOr<std::unique_ptr<CudaStreamPool>> CudaStreamPool::Create(int) {
   return absl::UnavailableError("this build of galpha has no CUDA backend");
 }

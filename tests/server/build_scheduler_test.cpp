@@ -14,7 +14,9 @@
 #include <future>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -524,6 +526,36 @@ TEST(BuildSchedulerTest, RefusalsAreTaggedWithTheirReason) {
   const absl::Status stopped = scheduler.Submit("", 1, [](const BuildSlot&, bool) { ADD_FAILURE() << "ran"; });
   EXPECT_THAT(stopped, StatusIs(absl::StatusCode::kUnavailable));
   EXPECT_EQ(RefusalLabelOf(stopped), "draining");
+}
+
+// IdleSince (what the service waits on before it gives the device's pooled memory back): set
+// from the start, absent while a job runs or waits, and the end of the last job afterwards.
+TEST(BuildSchedulerTest, IdleSinceIsTheEndOfTheLastJob) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point before = Clock::now();
+  BuildScheduler scheduler({nullptr}, /*max_queue=*/4, kNoTenantCap, /*memory_budget_bytes=*/0, nullptr);
+  ASSERT_TRUE(scheduler.IdleSince().has_value()) << "idle from the start";
+  EXPECT_GE(*scheduler.IdleSince(), before);
+  Gate started, release, finished;
+  ASSERT_THAT(scheduler.Submit("", 1,
+                               [&](const BuildSlot&, bool) {
+                                 started.Open();
+                                 release.Wait();
+                               }),
+              IsOk());
+  ASSERT_THAT(scheduler.Submit("", 1, [&](const BuildSlot&, bool) { finished.Open(); }), IsOk());
+  ASSERT_TRUE(started.Wait());
+  EXPECT_FALSE(scheduler.IdleSince().has_value()) << "a job runs and one waits";
+  const Clock::time_point released = Clock::now();
+  release.Open();
+  ASSERT_TRUE(finished.Wait());
+  // The second job has run; its worker marks the scheduler idle once it has returned.
+  std::optional<Clock::time_point> idle;
+  for (int i = 0; i < 2000 && !(idle = scheduler.IdleSince()).has_value(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_TRUE(idle.has_value());
+  EXPECT_GE(*idle, released);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/io/point_set_handle.hpp"
+#include "gpu/system/device_streams.hpp"
 #include "tests/server/service_test_calls.hpp"
 #include "tests/server/service_test_support.hpp"
 #include "tests/support/point_generators.hpp"
@@ -25,6 +26,7 @@ using testing::ClientOf;
 using ::testing::Not;
 using testing::ScrapeMetric;
 using testing::StartServer;
+using testing::TestBackend;
 using testing::TestServerOptions;
 using testing::WaitFor;
 
@@ -67,6 +69,41 @@ TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
   // A family larger than the whole budget is refused, not cached half-way.
   auto huge = client->Build(gen::Uniform(20000, 23));
   EXPECT_THAT(huge.status(), StatusIs(absl::StatusCode::kResourceExhausted));
+}
+
+/// The device's used memory in bytes (0 without a GPU).
+size_t DeviceBytesInUse() {
+  const absl::StatusOr<DeviceMemory> memory = QueryDeviceMemory();
+  return memory.ok() ? memory->total_bytes - memory->free_bytes : 0;
+}
+
+// On a GPU, the memory CUDA's pool keeps after builds goes back to the device once the server has
+// been idle for --device_idle_release_ms: after a 1M-point build and its release, the device's
+// used memory returns to what it was before the build (without the release it would stay at the
+// build's high-water mark, hundreds of megabytes up).
+TEST(ServiceTest, IdleDeviceMemoryGoesBackToTheDevice) {
+  if (TestBackend() != "cuda") GTEST_SKIP() << "needs the CUDA backend (GALPHA_SERVICE_BACKEND=cuda)";
+  ServerOptions options = TestServerOptions();
+  options.service.device_idle_release = std::chrono::milliseconds(1000);
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  // A first build loads the engine's kernels and creates its pools: the baseline is taken after
+  // it has been released and the idle release has run.
+  const std::vector<Point2> warm = gen::Uniform(100000, 61);
+  ASSERT_THAT(client->Build(warm), IsOk());
+  ASSERT_THAT(client->Release(PointSetHandle(warm)), IsOk());
+  std::this_thread::sleep_for(std::chrono::milliseconds(3000));
+  const size_t baseline = DeviceBytesInUse();
+  const std::vector<Point2> points = gen::Uniform(1000000, 62);
+  ASSERT_THAT(client->Build(points), IsOk());
+  const size_t built = DeviceBytesInUse();  // before the idle release can run (1 s)
+  ASSERT_GT(built, baseline + (size_t{100} << 20)) << "the premise: the build left its pool memory on the device";
+  ASSERT_THAT(client->Release(PointSetHandle(points)), IsOk());
+  size_t now = 0;
+  EXPECT_TRUE(WaitFor([&] { return (now = DeviceBytesInUse()) <= baseline + (size_t{64} << 20); }, 10))
+      << "used " << now / 1000000 << " MB of device memory, " << baseline / 1000000 << " MB before the build and "
+      << built / 1000000 << " MB after it";
 }
 
 /// Every message of a Classify stream, serialized: two answers are the same when these are.
