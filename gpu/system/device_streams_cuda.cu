@@ -27,9 +27,13 @@ absl::Status ReleaseUnusedDeviceMemory() {
     cudaGetLastError();
     return absl::UnavailableError("no CUDA device is visible");
   }
+  // Memory freed on a stream after the host last waited on it still counts as in use for the pool
+  // (a build's buffers are freed after its last wait), so the host waits for the device first:
+  // the caller is idle, so only queries' short kernels can be running.
+  cudaError_t result = cudaDeviceSynchronize();
   // The pool the engine allocates from (gpu/system/cuda_system.cu configures it).
   cudaMemPool_t pool = nullptr;
-  cudaError_t result = cudaDeviceGetDefaultMemPool(&pool, device);
+  if (result == cudaSuccess) result = cudaDeviceGetDefaultMemPool(&pool, device);
   if (result == cudaSuccess) result = cudaMemPoolTrimTo(pool, 0);
   if (result != cudaSuccess) {
     cudaGetLastError();
