@@ -18,7 +18,7 @@ libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthre
 # then run side by side: CI's 2 cores were otherwise half idle in this step.
 # The decoder with the CRS functions that refuse (coordinate_system_no_proj.cpp): a header's crs is
 # then an error, decided without PROJ's database; the fuzzer aims at the decoder.
-clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
+clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/chunk_decode_pool.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
   core/io/coordinate_system_no_proj.cpp proto/codec/point_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
   $(pkg-config --libs libzstd) &
 builds=($!)
