@@ -12,6 +12,11 @@
 // --device-cache-bytes gives the server a device budget for resident families (CUDA builds keep
 // their tables on the GPU and answer from there: server/README.md, "Cache"); 0 (the default):
 // CUDA families are downloaded into host memory, as the CPU backend's are.
+// --stress=SETSxPOINTS (e.g. 8x20000000) runs only the stress scenario of issue 16: SETS clients
+// build SETS distinct point sets at once, then each queries every family (Describe and a Classify
+// summary; a family the cache pushed out is rebuilt by the query), then every family is released;
+// it prints the failures, the cache's movements, the device memory before, at the peak and after
+// the release (the server gives its pool's memory back after --device_idle_release_ms of idleness).
 #include <CGAL/Alpha_shape_2.h>
 #include <CGAL/Alpha_shape_face_base_2.h>
 #include <CGAL/Alpha_shape_vertex_base_2.h>
@@ -29,6 +34,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -48,6 +54,7 @@
 #include "client/galpha_client.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
+#include "gpu/system/device_streams.hpp"
 #include "server/galpha_server.hpp"
 #include "tests/support/point_generators.hpp"
 
@@ -69,6 +76,9 @@ struct Options {
   /// "loopback" and tc rates ("1gbit", "10gbit", "100mbit"): the links Build and Classify cross.
   std::vector<std::string> links = {"loopback"};
   size_t device_cache_bytes = 0;
+  /// --stress: how many sets of how many points (0: no stress run).
+  size_t stress_sets = 0;
+  size_t stress_points = 0;
 };
 
 /// A tc rate "<digits><kbit|mbit|gbit>" in bits per second; 0 when it is not one.
@@ -113,6 +123,11 @@ bool ParseOptions(int argc, char** argv, Options* options) {
       ok = absl::SimpleAtoi(value, &options->cgal_max);
     } else if (name == "--device-cache-bytes") {
       ok = absl::SimpleAtoi(value, &options->device_cache_bytes);
+    } else if (name == "--stress") {
+      const std::vector<std::string> parts = absl::StrSplit(value, 'x');
+      ok = parts.size() == 2 && absl::SimpleAtoi(parts[0], &options->stress_sets) &&
+           absl::SimpleAtoi(parts[1], &options->stress_points) && options->stress_sets > 0 &&
+           options->stress_points > 0;
     } else if (name == "--links") {
       options->links = absl::StrSplit(value, ',');
       for (const std::string& link : options->links) ok = ok && (link == "loopback" || RateBits(link) > 0);
@@ -448,7 +463,144 @@ int MeasurePromotion(const Options& options, const std::vector<Point2>& points, 
   return 0;
 }
 
+/// Used device memory in bytes, 0 without a GPU.
+size_t DeviceBytesInUse() {
+  const absl::StatusOr<DeviceMemory> memory = QueryDeviceMemory();
+  return memory.ok() ? memory->total_bytes - memory->free_bytes : 0;
+}
+
+int RunStress(const Options& options) {
+  const size_t sets = options.stress_sets, n = options.stress_points;
+  auto server = server::GalphaServer::Start(BenchServerOptions(options, "127.0.0.1:0"));
+  if (!server.ok()) {
+    std::fprintf(stderr, "service_bench: %s\n", std::string(server.status().message()).c_str());
+    return 1;
+  }
+  const int port = (*server)->port();
+  // The baseline: after a first build (kernels loaded, pools created) is released and the server's
+  // idle release (2 s) has run.
+  {
+    auto client = Client(port);
+    const std::vector<Point2> warm = gen::Uniform(100000, 99);
+    if (!client->Build(warm).ok() || !client->Release(PointSetHandle(warm)).ok()) return 1;
+  }
+  std::this_thread::sleep_for(std::chrono::seconds(4));
+  const size_t baseline = DeviceBytesInUse();
+  std::vector<std::vector<Point2>> points(sets);
+  {
+    std::vector<std::thread> makers;
+    for (size_t i = 0; i < sets; ++i) makers.emplace_back([&, i] { points[i] = gen::Uniform(n, 1000 + i); });
+    for (std::thread& maker : makers) maker.join();
+  }
+  std::vector<std::string> handles(sets);
+  for (size_t i = 0; i < sets; ++i) handles[i] = PointSetHandle(points[i]);
+  std::atomic<size_t> peak{baseline};
+  std::atomic<bool> sampling{true};
+  std::thread sampler([&] {
+    while (sampling) {
+      size_t now = DeviceBytesInUse(), seen = peak.load();
+      while (now > seen && !peak.compare_exchange_weak(seen, now)) {}
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  std::mutex mutex;
+  std::vector<std::string> failures;
+  const auto fail = [&](const std::string& what, const absl::Status& status) {
+    std::lock_guard<std::mutex> lock(mutex);
+    failures.push_back(absl::StrCat(what, ": ", status.ToString()));
+  };
+  std::vector<double> build_seconds(sets), query_seconds(sets);
+  const auto start = Clock::now();
+  {
+    std::vector<std::thread> clients;
+    for (size_t i = 0; i < sets; ++i) {
+      clients.emplace_back([&, i] {
+        auto client = Client(port);
+        auto begin = Clock::now();
+        const absl::StatusOr<client::BuildResult> built = client->Build(points[i]);
+        build_seconds[i] = SecondsSince(begin);
+        if (!built.ok()) fail(absl::StrCat("build ", i), built.status());
+      });
+    }
+    for (std::thread& c : clients) c.join();
+  }
+  const double builds_wall = SecondsSince(start);
+  {
+    std::vector<std::thread> clients;
+    for (size_t i = 0; i < sets; ++i) {
+      clients.emplace_back([&, i] {
+        auto client = Client(port);
+        const auto begin = Clock::now();
+        for (size_t k = 0; k < sets; ++k) {
+          const size_t j = (i + k) % sets;
+          auto described = client->Describe(handles[j]);
+          if (!described.ok()) {
+            fail(absl::StrCat("client ", i, " Describe of set ", j), described.status());
+            continue;
+          }
+          v1::ClassifyRequest request;
+          request.set_handle(handles[j]);
+          request.set_summary_only(true);
+          request.mutable_threshold()->set_rank(
+              std::max<int64_t>(1, static_cast<int64_t>(described->summary().spectrum_size() / 2)));
+          absl::Status classified =
+              client->Classify(request, [](const v1::ClassifyResponse&) { return absl::OkStatus(); });
+          if (!classified.ok()) fail(absl::StrCat("client ", i, " Classify of set ", j), classified);
+        }
+        query_seconds[i] = SecondsSince(begin);
+      });
+    }
+    for (std::thread& c : clients) c.join();
+  }
+  const double total_wall = SecondsSince(start);
+  const server::FamilyCache::Stats stats = (*server)->service().cache().GetStats();
+  {
+    auto client = Client(port);
+    for (size_t i = 0; i < sets; ++i) {
+      auto released = client->Release(handles[i]);
+      if (!released.ok() && !absl::IsNotFound(released.status())) fail(absl::StrCat("release ", i), released.status());
+    }
+  }
+  const auto released_at = Clock::now();
+  size_t after = DeviceBytesInUse();
+  while (after > baseline + (size_t{64} << 20) && SecondsSince(released_at) < 30) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    after = DeviceBytesInUse();
+  }
+  const double back_after = SecondsSince(released_at);
+  sampling = false;
+  sampler.join();
+  const auto mb = [](size_t bytes) { return static_cast<double>(bytes) / 1e6; };
+  std::printf(
+      "service_bench --stress: %zu clients, %zu distinct sets of %zu points at once, %s backend, %zu build "
+      "slots, host cache %.1f GB, device cache %.1f GB\n\n",
+      sets, sets, n, (*server)->service().backend_name().c_str(), (*server)->service().build_slots(),
+      static_cast<double>(BenchServerOptions(options, "").service.cache_bytes) / 1e9,
+      static_cast<double>(options.device_cache_bytes) / 1e9);
+  std::printf("| what | value |\n|---|---:|\n");
+  std::printf("| failures (builds, queries, releases) | %zu |\n", failures.size());
+  std::printf("| builds, wall s (all %zu at once) | %.2f |\n", sets, builds_wall);
+  std::printf("| one build's RPC s, fastest / slowest | %.2f / %.2f |\n",
+              *std::min_element(build_seconds.begin(), build_seconds.end()),
+              *std::max_element(build_seconds.begin(), build_seconds.end()));
+  std::printf("| queries (Describe + Classify summary of every family, by every client), wall s | %.2f |\n",
+              total_wall - builds_wall);
+  std::printf("| cache: resident entries, demotions, promotions, evictions (both tiers) | %zu, %llu, %llu, %llu |\n",
+              stats.resident.entries, static_cast<unsigned long long>(stats.demotions),
+              static_cast<unsigned long long>(stats.promotions),
+              static_cast<unsigned long long>(stats.resident.evictions + stats.compact.evictions));
+  std::printf("| device memory used MB: baseline / peak / after the releases | %.0f / %.0f / %.0f |\n", mb(baseline),
+              mb(peak.load()), mb(after));
+  const bool back = after <= baseline + (size_t{64} << 20);
+  const std::string back_text = back ? absl::StrCat(std::round(back_after * 10) / 10) : "not within 30 s";
+  std::printf("| back within 64 MB of the baseline after the releases, s | %s |\n", back_text.c_str());
+  for (const std::string& f : failures) std::printf("failure: %s\n", f.c_str());
+  (*server)->Drain();
+  return failures.empty() && back ? 0 : 1;
+}
+
 int Run(const Options& options) {
+  if (options.stress_sets > 0) return RunStress(options);
   // Shaped links first: the namespaces must exist before this process starts any thread.
   std::vector<std::string> links;
   std::unique_ptr<VethLink> veth;
