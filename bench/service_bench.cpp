@@ -482,7 +482,11 @@ int RunStress(const Options& options) {
   {
     auto client = Client(port);
     const std::vector<Point2> warm = gen::Uniform(100000, 99);
-    if (!client->Build(warm).ok() || !client->Release(PointSetHandle(warm)).ok()) return 1;
+    if (!client->Build(warm).ok() || !client->Release(PointSetHandle(warm)).ok()) {
+      std::fprintf(stderr, "service_bench: the warm-up build failed\n");
+      (*server)->Drain();
+      return 1;
+    }
   }
   std::this_thread::sleep_for(std::chrono::seconds(4));
   const size_t baseline = DeviceBytesInUse();
@@ -583,8 +587,10 @@ int RunStress(const Options& options) {
   std::printf("| one build's RPC s, fastest / slowest | %.2f / %.2f |\n",
               *std::min_element(build_seconds.begin(), build_seconds.end()),
               *std::max_element(build_seconds.begin(), build_seconds.end()));
-  std::printf("| queries (Describe + Classify summary of every family, by every client), wall s | %.2f |\n",
-              total_wall - builds_wall);
+  std::printf(
+      "| queries (Describe + Classify summary of every family, by every client), wall s | %.2f (slowest "
+      "client %.2f) |\n",
+      total_wall - builds_wall, *std::max_element(query_seconds.begin(), query_seconds.end()));
   std::printf("| cache: resident entries, demotions, promotions, evictions (both tiers) | %zu, %llu, %llu, %llu |\n",
               stats.resident.entries, static_cast<unsigned long long>(stats.demotions),
               static_cast<unsigned long long>(stats.promotions),

@@ -169,7 +169,7 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
     if (!encoded.ok()) break;
     result.upload_bytes += slot.message.ByteSizeLong();
     open = writer->Write(slot.message);  // serializes the message: the slot is free again after it
-    if (written + window < chunk_count) start(written + window);
+    if (open && written + window < chunk_count) start(written + window);
     const size_t sent = std::min(points.size(), (written + 1) * kPointsPerChunk);
     if (open && options.progress) options.progress(sent);
   }

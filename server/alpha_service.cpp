@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -206,12 +205,14 @@ void AlphaService::SampleDeviceMemory() {
 
 void AlphaService::ReleaseIdleDeviceMemory() {
   if (backend_ != Backend::kCuda || options_.device_idle_release.count() <= 0 || scheduler_ == nullptr) return;
-  const std::optional<std::chrono::steady_clock::time_point> idle = scheduler_->IdleSince();
-  if (!idle || std::chrono::steady_clock::now() - *idle < options_.device_idle_release) return;
-  if (absl::Status released = ReleaseUnusedDeviceMemory(); !released.ok()) {
+  // Under the scheduler, so that no build starts (and captures a graph on a slot's stream) while
+  // the device is waited for. Once a second while idle: after the first pass it only finds what
+  // releases freed since.
+  absl::Status released;
+  scheduler_->RunIfIdleFor(options_.device_idle_release, [&] { released = ReleaseUnusedDeviceMemory(); });
+  if (!released.ok() && !told_release_failure_.exchange(true)) {
     // Not fatal (the memory stays in the pool, as it would without this), but said once.
-    static std::atomic<bool> told{false};
-    if (!told.exchange(true)) std::fprintf(stderr, "galpha_server: %s\n", std::string(released.message()).c_str());
+    std::fprintf(stderr, "galpha_server: %s\n", std::string(released.message()).c_str());
   }
 }
 

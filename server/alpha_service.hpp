@@ -158,6 +158,7 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   ChunkDecodePool decode_pool_;
   UploadWatchdog upload_watchdog_;
   std::atomic<bool> draining_{false};
+  std::atomic<bool> told_release_failure_{false};
   // Last: its workers run builds that use everything above, so it stops first.
   std::unique_ptr<BuildScheduler> scheduler_;
 };

@@ -123,10 +123,11 @@ void BuildScheduler::WorkerLoop(BuildSlot slot) {
   }
 }
 
-std::optional<std::chrono::steady_clock::time_point> BuildScheduler::IdleSince() const {
+bool BuildScheduler::RunIfIdleFor(std::chrono::steady_clock::duration idle, const std::function<void()>& fn) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (running_ > 0 || !queue_.empty()) return std::nullopt;
-  return idle_since_;
+  if (running_ > 0 || !queue_.empty() || std::chrono::steady_clock::now() - idle_since_ < idle) return false;
+  fn();
+  return true;
 }
 
 }  // namespace galpha::server

@@ -12,7 +12,6 @@
 #include <deque>
 #include <functional>
 #include <mutex>
-#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -66,9 +65,9 @@ class BuildScheduler {
   /// finish. Returns at once.
   void Stop();
 
-  /// Since when no job has run or waited (the construction, or the end of the last job); nullopt
-  /// while one runs or waits.
-  std::optional<std::chrono::steady_clock::time_point> IdleSince() const;
+  /// Runs `fn` when no job has run or waited for `idle` (since the construction or the end of the
+  /// last job), with the scheduler held: no job starts while it runs. Returns whether it ran.
+  bool RunIfIdleFor(std::chrono::steady_clock::duration idle, const std::function<void()>& fn);
 
   size_t slots() const { return workers_.size(); }
   size_t max_queue() const { return max_queue_; }

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <new>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -106,24 +107,45 @@ absl::Status BuildStreamDecoder::DecodeFailure() {
 void BuildStreamDecoder::DecodeOnPool(galpha::v1::BuildRequest message, const wire::ChunkPosition& at, uint64_t first) {
   Point2* points = &decoded_.points[first];
   double* weights = decoded_.header.weighted() ? &decoded_.weights[first] : nullptr;
-  {
-    std::lock_guard<std::mutex> lock(decodes_mutex_);
-    ++decoding_;
-  }
   // std::function needs a copyable task: the message travels in a shared_ptr.
   auto owned = std::make_shared<galpha::v1::BuildRequest>(std::move(message));
-  decode_pool_->Submit([this, owned, at, points, weights](wire::PointChunkDecoder& decoder) {
-    const galpha::v1::EncodedPointChunk& chunk = owned->encoded_points();
-    absl::Status decoded =
-        weights != nullptr ? decoder.DecodeWeighted(chunk, at, points, weights) : decoder.Decode(chunk, at, points);
+  {
+    // Back-pressure: a stream has at most this many chunks waiting or decoding, so its encoded
+    // payloads (not counted in the in-flight bytes) stay bounded and one stream cannot fill the
+    // pool's queue ahead of the others; past it the reactor waits, and gRPC's flow control slows
+    // the client, as when the reactor decoded each chunk itself.
+    std::unique_lock<std::mutex> lock(decodes_mutex_);
+    decodes_idle_.wait(lock, [&] { return decoding_ < 2 * decode_pool_->threads(); });
+    ++decoding_;
+  }
+  const auto task = [this, owned, at, points, weights](wire::PointChunkDecoder& decoder) {
+    absl::Status decoded;
+    try {
+      const galpha::v1::EncodedPointChunk& chunk = owned->encoded_points();
+      decoded =
+          weights != nullptr ? decoder.DecodeWeighted(chunk, at, points, weights) : decoder.Decode(chunk, at, points);
+    } catch (const std::bad_alloc&) {
+      decoded =
+          absl::ResourceExhaustedError(absl::StrCat("encoded point chunk ", at.chunk_index, " (from point ",
+                                                    at.first_point, "): the server ran out of memory decoding it"));
+    }
     std::lock_guard<std::mutex> lock(decodes_mutex_);
     if (!decoded.ok() && (!decode_failed_ || at.chunk_index < failed_chunk_)) {
       decode_failed_ = true;
       failed_chunk_ = at.chunk_index;
       decode_failure_ = std::move(decoded);
     }
-    if (--decoding_ == 0) decodes_idle_.notify_all();
-  });
+    --decoding_;
+    decodes_idle_.notify_all();  // WaitForDecodes waits for none, the back-pressure for fewer
+  };
+  try {
+    decode_pool_->Submit(task);
+  } catch (...) {
+    std::lock_guard<std::mutex> lock(decodes_mutex_);
+    --decoding_;
+    decodes_idle_.notify_all();
+    throw;
+  }
 }
 
 void BuildStreamDecoder::ReleasePoints() {
@@ -163,7 +185,7 @@ size_t BuildStreamDecoder::PointBytes() const {
 absl::Status BuildStreamDecoder::Grow(uint64_t count) {
   if (absl::Status s = Reserve(count * PointBytes()); !s.ok()) return s;
   const size_t after = decoded_.points.size() + count;
-  if (after > decoded_.points.capacity()) {
+  if (after > decoded_.points.capacity() || (decoded_.header.weighted() && after > decoded_.weights.capacity())) {
     WaitForDecodes();  // the pool writes into the vectors that are about to move
     // Capacity grows with the bytes that arrived (doubling, as a vector does, but never past an
     // announced count), not with the announcement: an announced 100M points would otherwise
@@ -171,7 +193,9 @@ absl::Status BuildStreamDecoder::Grow(uint64_t count) {
     // is trusted up to kTrustedAnnouncedPoints: the vectors of a stream of up to that many points
     // then never move (each move waits for the chunks decoding into them and copies what arrived:
     // four moves were ~10 ms of a 1M-point upload), and an inflated announcement costs at most
-    // that much address space, untouched (the vectors are not zeroed), so not resident.
+    // that much address space (64 MiB, 96 weighted). The vectors are not zeroed, so only pages
+    // the points fill become resident: what arrived, rounded up to a 2 MiB huge page (HostVector
+    // asks for huge pages from 8 MiB on).
     const uint64_t expected = decoded_.header.expected_points();
     size_t capacity = std::max<size_t>(after, 2 * decoded_.points.capacity());
     if (expected > 0) {
@@ -187,6 +211,16 @@ absl::Status BuildStreamDecoder::Grow(uint64_t count) {
 }
 
 absl::Status BuildStreamDecoder::Add(galpha::v1::BuildRequest message) {
+  absl::Status added = AddMessage(std::move(message));
+  if (added.ok() || decode_pool_ == nullptr) return added;
+  // A chunk still decoding may fail too, and it came before this message: its error is the answer,
+  // as it would be without a pool.
+  WaitForDecodes();
+  if (absl::Status failed = DecodeFailure(); !failed.ok()) return failed;
+  return added;
+}
+
+absl::Status BuildStreamDecoder::AddMessage(galpha::v1::BuildRequest message) {
   if (finished_) return absl::FailedPreconditionError("the build stream already ended");
   if (absl::Status failed = DecodeFailure(); !failed.ok()) return failed;
   switch (message.part_case()) {

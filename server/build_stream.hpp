@@ -1,6 +1,7 @@
 // Decoding of a Build stream (a header, then point chunks) into a point set, with every limit of
-// the service checked as the messages arrive: a bad stream is refused at the first bad message,
-// before the rest is uploaded. Free of gRPC (only the protobuf messages), so the fuzz target and
+// the service checked as the messages arrive: a bad stream is refused at the first bad message
+// (with a decoding pool, what only decompression finds a message or a few later), before the rest
+// is uploaded. Free of gRPC (only the protobuf messages), so the fuzz target and
 // the unit tests drive it directly.
 #pragma once
 
@@ -56,7 +57,7 @@ class InFlightBytes {
 };
 
 /// Points of a header's announced count that the decoder allocates for at the first chunk (64 MiB
-/// of address space; more only as points arrive).
+/// of address space, 96 weighted; more only as points arrive).
 inline constexpr uint64_t kTrustedAnnouncedPoints = uint64_t{1} << 22;
 
 /// Longest BuildHeader.name, in bytes: a label, not a payload (it is kept with the family and sent
@@ -120,6 +121,7 @@ class BuildStreamDecoder {
   /// decoder keeps its reservation until destroyed.
   absl::StatusOr<DecodedBuild*> Finish();
 
+  /// Points of the chunks accepted so far (with a decoding pool, some may still be decoding).
   uint64_t points_received() const { return decoded_.points.size(); }
 
   /// Frees the points (after the chunks still decoding into them) and gives back the bytes reserved
@@ -132,6 +134,8 @@ class BuildStreamDecoder {
   size_t PointBytes() const;
   // The point limits for a stream of `after` points: ResourceExhausted or InvalidArgument.
   absl::Status CheckPointCount(uint64_t after) const;
+  // Add without the rule that a refusal names a failed earlier chunk first.
+  absl::Status AddMessage(galpha::v1::BuildRequest message);
   // `count` more points at the end of decoded_.points, their bytes reserved first. When the
   // vectors must move, the chunks decoding into them finish first.
   absl::Status Grow(uint64_t count);

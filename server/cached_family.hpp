@@ -84,8 +84,8 @@ class CachedFamily {
 };
 
 /// `family` as the cache shares it: its last owner (the cache, or a query still streaming from it
-/// after a release, demotion or eviction) frees hundreds of megabytes, and gives them back to the
-/// system right then.
+/// after a release, demotion or eviction) frees hundreds of megabytes, and asks for them to go back
+/// to the system (server/heap_trim.hpp: soon, on the trimmer's thread).
 std::shared_ptr<const CachedFamily> ShareCachedFamily(AlphaFamily family,
                                                       std::shared_ptr<const CachedFamily::InputFrame> frame);
 std::shared_ptr<const CachedFamily> ShareCachedFamily(ResidentAlphaFamily family,

@@ -13,8 +13,8 @@ namespace galpha::server {
 /// thread, soon; returns at once. Cheap enough to call after every release of a family.
 void ReturnFreedHeapMemory();
 
-/// Blocks until every trim requested before this call has run: for tests that measure the
-/// process, and for shutdown paths that want the memory back before they report.
+/// Blocks until every trim requested before this call has run (for tests that measure the
+/// process).
 void WaitForHeapTrims();
 
 }  // namespace galpha::server

@@ -23,7 +23,8 @@ absl::StatusOr<DeviceMemory> QueryDeviceMemory();
 /// Gives the device memory that CUDA's stream-ordered pool keeps for reuse (freed by builds and by
 /// families that left the device) back to the device; memory still allocated stays. The engine
 /// keeps that memory on purpose (mapping it again costs more than a 1M-point build), so a process
-/// calls this only when it has been idle a while. Unavailable without a CUDA backend or GPU.
+/// calls this only when it has been idle a while, with no build running or starting: it waits for
+/// the whole device first. Unavailable without a CUDA backend or GPU.
 absl::Status ReleaseUnusedDeviceMemory();
 
 /// Non-blocking CUDA streams, owned for the pool's lifetime; stream(i) is a cudaStream_t.

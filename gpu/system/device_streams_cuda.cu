@@ -28,8 +28,9 @@ absl::Status ReleaseUnusedDeviceMemory() {
     return absl::UnavailableError("no CUDA device is visible");
   }
   // Memory freed on a stream after the host last waited on it still counts as in use for the pool
-  // (a build's buffers are freed after its last wait), so the host waits for the device first:
-  // the caller is idle, so only queries' short kernels can be running.
+  // (a build's buffers are freed after its last wait, a resident family's when its stream goes),
+  // so the host waits for the device first. The caller holds builds off; a query capturing a
+  // graph on another thread meanwhile is unaffected (captures are thread-local).
   cudaError_t result = cudaDeviceSynchronize();
   // The pool the engine allocates from (gpu/system/cuda_system.cu configures it).
   cudaMemPool_t pool = nullptr;

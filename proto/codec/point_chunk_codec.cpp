@@ -126,8 +126,9 @@ bool IsPlain(v1::PointTransform transform) {
 }
 
 // Interleaved words (x0, y0, x1, y1, ...; weighted x0, y0, w0, ...: `axes` a point) to the
-// transform's bytes (the proto's PointTransform). Plane by plane, so that every pass reads and
-// writes memory in order (it vectorises).
+// transform's bytes (the proto's PointTransform). The words first become planar (an axis at a
+// time, each pass reading and writing in order), then each word's bytes go to their planes in
+// one pass.
 template <typename Word>
 void TransformWords(const std::vector<Word>& words, size_t axes, v1::PointTransform transform,
                     std::vector<Word>* scratch, std::string* bytes) {

@@ -528,14 +528,16 @@ TEST(BuildSchedulerTest, RefusalsAreTaggedWithTheirReason) {
   EXPECT_EQ(RefusalLabelOf(stopped), "draining");
 }
 
-// IdleSince (what the service waits on before it gives the device's pooled memory back): set
-// from the start, absent while a job runs or waits, and the end of the last job afterwards.
-TEST(BuildSchedulerTest, IdleSinceIsTheEndOfTheLastJob) {
-  using Clock = std::chrono::steady_clock;
-  const Clock::time_point before = Clock::now();
+// RunIfIdleFor (what the service gives the device's pooled memory back under): only after the
+// given idleness since the start or the last job's end, never while a job runs or waits, and with
+// the scheduler held (a job submitted meanwhile starts after it).
+TEST(BuildSchedulerTest, RunIfIdleForWaitsForIdlenessAndHoldsTheScheduler) {
+  using namespace std::chrono_literals;
   BuildScheduler scheduler({nullptr}, /*max_queue=*/4, kNoTenantCap, /*memory_budget_bytes=*/0, nullptr);
-  ASSERT_TRUE(scheduler.IdleSince().has_value()) << "idle from the start";
-  EXPECT_GE(*scheduler.IdleSince(), before);
+  int runs = 0;
+  EXPECT_TRUE(scheduler.RunIfIdleFor(0s, [&] { ++runs; })) << "idle from the start";
+  EXPECT_FALSE(scheduler.RunIfIdleFor(1h, [&] { ++runs; })) << "not idle for an hour yet";
+  EXPECT_EQ(runs, 1);
   Gate started, release, finished;
   ASSERT_THAT(scheduler.Submit("", 1,
                                [&](const BuildSlot&, bool) {
@@ -545,17 +547,31 @@ TEST(BuildSchedulerTest, IdleSinceIsTheEndOfTheLastJob) {
               IsOk());
   ASSERT_THAT(scheduler.Submit("", 1, [&](const BuildSlot&, bool) { finished.Open(); }), IsOk());
   ASSERT_TRUE(started.Wait());
-  EXPECT_FALSE(scheduler.IdleSince().has_value()) << "a job runs and one waits";
-  const Clock::time_point released = Clock::now();
+  EXPECT_FALSE(scheduler.RunIfIdleFor(0s, [&] { ++runs; })) << "a job runs and one waits";
   release.Open();
   ASSERT_TRUE(finished.Wait());
-  // The second job has run; its worker marks the scheduler idle once it has returned.
-  std::optional<Clock::time_point> idle;
-  for (int i = 0; i < 2000 && !(idle = scheduler.IdleSince()).has_value(); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  // The last job's end restarts the idleness.
+  bool ran = false;
+  for (int i = 0; i < 2000 && !(ran = scheduler.RunIfIdleFor(0s, [&] { ++runs; })); ++i) {
+    std::this_thread::sleep_for(1ms);
   }
-  ASSERT_TRUE(idle.has_value());
-  EXPECT_GE(*idle, released);
+  EXPECT_TRUE(ran);
+  EXPECT_FALSE(scheduler.RunIfIdleFor(10s, [&] { ++runs; })) << "a job ended moments ago";
+  EXPECT_EQ(runs, 2);
+  // Held: a job submitted while `fn` runs starts only after it.
+  std::atomic<bool> job_ran{false};
+  bool ran_before_fn_returned = true;
+  std::thread submitter;
+  EXPECT_TRUE(scheduler.RunIfIdleFor(0s, [&] {
+    submitter = std::thread(
+        [&] { EXPECT_THAT(scheduler.Submit("", 1, [&](const BuildSlot&, bool) { job_ran = true; }), IsOk()); });
+    std::this_thread::sleep_for(100ms);
+    ran_before_fn_returned = job_ran.load();
+  }));
+  submitter.join();  // its Submit returned once the scheduler was free again
+  EXPECT_FALSE(ran_before_fn_returned);
+  for (int i = 0; i < 2000 && !job_ran; ++i) std::this_thread::sleep_for(1ms);
+  EXPECT_TRUE(job_ran.load());
 }
 
 }  // namespace

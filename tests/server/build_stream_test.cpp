@@ -4,6 +4,8 @@
 // how the points are split into chunks; and the server-wide bytes in flight, held and given back.
 #include "server/build_stream.hpp"
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <cstdint>
@@ -12,6 +14,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -670,68 +673,6 @@ TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirW
   EXPECT_EQ((*none)->handle, PointSetHandle(std::vector<Point2>{}));
 }
 
-TEST(BuildStreamDecoderTest,
-     WeightedStreamRefusalsNameThePointAndTheWeight){{BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
-EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1})),
-            StatusIs(absl::StatusCode::kInvalidArgument,
-                     ::testing::HasSubstr("4 doubles, not a multiple of 3, after point 0: the header is weighted")));
-}  // namespace
-{
-  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
-  ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1, 0, 2})), IsOk());
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{3, 3, 0.5, 4, 4, nan})),
-              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("point 3 has a NaN weight")));
-  const std::vector<Point2> two = {{5, 5}, {6, 6}};
-  const std::vector<double> infinite = {1.0, -std::numeric_limits<double>::infinity()};
-  wire::PointChunkEncoder encoder;
-  wire::ChunkEncoding float64;
-  v1::BuildRequest encoded;
-  ASSERT_THAT(encoder.Encode(two, infinite, float64, encoded.mutable_encoded_points()), IsOk());
-  EXPECT_THAT(decoder.Add(encoded), StatusIs(absl::StatusCode::kInvalidArgument,
-                                             ::testing::HasSubstr("(from point 2): point 3 has an infinite weight")));
-  EXPECT_EQ(decoder.points_received(), 2u) << "refused chunks add nothing";
-}
-{
-  // An unweighted stream takes no weight scale, and a weighted integer chunk needs one.
-  const std::vector<Point2> two = {{1, 2}, {3, 4}};
-  const std::vector<double> weights = {0.5, 0.25};
-  wire::PointChunkEncoder encoder;
-  wire::ChunkEncoding integers;
-  integers.value_type = v1::POINT_VALUE_TYPE_INT32;
-  integers.x_scale.set_scale(1.0);
-  integers.y_scale.set_scale(1.0);
-  integers.w_scale.set_scale(0.25);
-  v1::BuildRequest weighted_chunk;
-  ASSERT_THAT(encoder.Encode(two, weights, integers, weighted_chunk.mutable_encoded_points()), IsOk());
-  BuildStreamDecoder unweighted(BuildStreamLimits{}, nullptr);
-  ASSERT_THAT(unweighted.Add(Header(0)), IsOk());
-  EXPECT_THAT(unweighted.Add(weighted_chunk),
-              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the stream is not weighted")));
-  v1::BuildRequest no_scale = weighted_chunk;
-  no_scale.mutable_encoded_points()->clear_w_scale();
-  BuildStreamDecoder weighted(BuildStreamLimits{}, nullptr);
-  ASSERT_THAT(weighted.Add(WeightedHeader(0)), IsOk());
-  EXPECT_THAT(weighted.Add(no_scale), StatusIs(absl::StatusCode::kInvalidArgument,
-                                               ::testing::HasSubstr("needs w_scale (the stream is weighted)")));
-  ASSERT_THAT(weighted.Add(weighted_chunk), IsOk());
-  absl::StatusOr<DecodedBuild*> decoded = weighted.Finish();
-  ASSERT_THAT(decoded, IsOk());
-  EXPECT_EQ((*decoded)->weights[1], 0.25);
-}
-#ifdef GALPHA_WITH_PROJ
-{
-  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
-  v1::BuildRequest header = WeightedHeader(0);
-  header.mutable_header()->set_crs("EPSG:4326");
-  EXPECT_THAT(decoder.Add(header),
-              StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("weights need planar coordinates")));
-}
-#endif
-}  // namespace galpha::server
-
 // Chunks decoded on a pool land where they belong: many small encoded chunks, some raw ones between
 // them, with no announced count (so the vectors move several times while chunks are decoding)
 // and with one (allocated at the first chunk), points bit for bit and the handle as for the
@@ -852,6 +793,121 @@ TEST(BuildStreamDecoderTest, ChunksThatFailOnAPoolRefuseTheStreamWithTheEarliest
                          ::testing::HasSubstr("encoded point chunk 4 (from point 1300): its data is not a zstd frame")))
         << "round " << round;
   }
+}
+
+// A refusal found at once (a malformed chunk's shape) while an earlier chunk is still decoding and
+// about to fail: the answer is the earlier chunk's error, as without a pool.
+TEST(BuildStreamDecoderTest, AnEarlierChunkStillDecodingIsTheAnswerToALaterRefusal) {
+  constexpr size_t kThreads = 2;
+  ChunkDecodePool pool(kThreads);
+  const std::vector<Point2> points = gen::Uniform(1000, 49);
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);
+  PoolGate gate(&pool, kThreads);
+  ASSERT_THAT(decoder.Add(Header(0)), IsOk());
+  ASSERT_THAT(decoder.Add(Chunk(points)), IsOk());
+  ASSERT_THAT(decoder.Add(UndecodableChunk(100)), IsOk()) << "queued behind the gate";
+  std::thread opener([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    gate.Open();
+  });
+  v1::BuildRequest shapeless;
+  shapeless.mutable_encoded_points()->set_point_count(0);  // refused before any decoding
+  EXPECT_THAT(decoder.Add(std::move(shapeless)),
+              StatusIs(absl::StatusCode::kInvalidArgument,
+                       ::testing::HasSubstr("encoded point chunk 1 (from point 1000): its data is not a zstd frame")));
+  opener.join();
+}
+
+// Back-pressure: a stream has at most two chunks per pool thread waiting or decoding; the next Add
+// waits for one to finish.
+TEST(BuildStreamDecoderTest, AStreamQueuesAtMostTwoChunksPerPoolThread) {
+  constexpr size_t kThreads = 2;
+  ChunkDecodePool pool(kThreads);
+  const std::vector<Point2> points = gen::Uniform(1200, 50);
+  const auto all = absl::MakeConstSpan(points);
+  BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);
+  ASSERT_THAT(decoder.Add(Header(1200)), IsOk());  // announced: the vectors never move (no waits)
+  std::atomic<size_t> accepted{0};
+  {
+    PoolGate gate(&pool, kThreads);
+    std::thread sender([&] {
+      for (size_t i = 0; i < 12; ++i) {
+        if (decoder.Add(EncodedChunk(all.subspan(100 * i, 100))).ok()) ++accepted;
+      }
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_EQ(accepted.load(), 2 * kThreads) << "chunks accepted while none could decode";
+    gate.Open();
+    sender.join();
+  }
+  EXPECT_EQ(accepted.load(), 12u);
+  absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
+  ASSERT_THAT(decoded, IsOk());
+  EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
+}
+
+TEST(BuildStreamDecoderTest, WeightedStreamRefusalsNameThePointAndTheWeight) {
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
+    EXPECT_THAT(
+        decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1})),
+        StatusIs(absl::StatusCode::kInvalidArgument,
+                 ::testing::HasSubstr("4 doubles, not a multiple of 3, after point 0: the header is weighted")));
+  }
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(decoder.Add(WeightedHeader(0)), IsOk());
+    ASSERT_THAT(decoder.Add(Chunk(std::vector<double>{0, 0, 1, 1, 0, 2})), IsOk());
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THAT(decoder.Add(Chunk(std::vector<double>{3, 3, 0.5, 4, 4, nan})),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("point 3 has a NaN weight")));
+    const std::vector<Point2> two = {{5, 5}, {6, 6}};
+    const std::vector<double> infinite = {1.0, -std::numeric_limits<double>::infinity()};
+    wire::PointChunkEncoder encoder;
+    wire::ChunkEncoding float64;
+    v1::BuildRequest encoded;
+    ASSERT_THAT(encoder.Encode(two, infinite, float64, encoded.mutable_encoded_points()), IsOk());
+    EXPECT_THAT(decoder.Add(encoded), StatusIs(absl::StatusCode::kInvalidArgument,
+                                               ::testing::HasSubstr("(from point 2): point 3 has an infinite weight")));
+    EXPECT_EQ(decoder.points_received(), 2u) << "refused chunks add nothing";
+  }
+  {
+    // An unweighted stream takes no weight scale, and a weighted integer chunk needs one.
+    const std::vector<Point2> two = {{1, 2}, {3, 4}};
+    const std::vector<double> weights = {0.5, 0.25};
+    wire::PointChunkEncoder encoder;
+    wire::ChunkEncoding integers;
+    integers.value_type = v1::POINT_VALUE_TYPE_INT32;
+    integers.x_scale.set_scale(1.0);
+    integers.y_scale.set_scale(1.0);
+    integers.w_scale.set_scale(0.25);
+    v1::BuildRequest weighted_chunk;
+    ASSERT_THAT(encoder.Encode(two, weights, integers, weighted_chunk.mutable_encoded_points()), IsOk());
+    BuildStreamDecoder unweighted(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(unweighted.Add(Header(0)), IsOk());
+    EXPECT_THAT(unweighted.Add(weighted_chunk),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("the stream is not weighted")));
+    v1::BuildRequest no_scale = weighted_chunk;
+    no_scale.mutable_encoded_points()->clear_w_scale();
+    BuildStreamDecoder weighted(BuildStreamLimits{}, nullptr);
+    ASSERT_THAT(weighted.Add(WeightedHeader(0)), IsOk());
+    EXPECT_THAT(weighted.Add(no_scale), StatusIs(absl::StatusCode::kInvalidArgument,
+                                                 ::testing::HasSubstr("needs w_scale (the stream is weighted)")));
+    ASSERT_THAT(weighted.Add(weighted_chunk), IsOk());
+    absl::StatusOr<DecodedBuild*> decoded = weighted.Finish();
+    ASSERT_THAT(decoded, IsOk());
+    EXPECT_EQ((*decoded)->weights[1], 0.25);
+  }
+#ifdef GALPHA_WITH_PROJ
+  {
+    BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
+    v1::BuildRequest header = WeightedHeader(0);
+    header.mutable_header()->set_crs("EPSG:4326");
+    EXPECT_THAT(decoder.Add(header),
+                StatusIs(absl::StatusCode::kInvalidArgument, ::testing::HasSubstr("weights need planar coordinates")));
+  }
+#endif
 }
 
 }  // namespace
