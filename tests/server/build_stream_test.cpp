@@ -71,6 +71,23 @@ uint64_t Bits(double value) {
   return bits;
 }
 
+// Whether `decoded` holds exactly `points` and `weights` (none for an unweighted stream), bit for
+// bit; the first difference otherwise.
+::testing::AssertionResult DecodedBitForBit(const DecodedBuild& decoded, const std::vector<Point2>& points,
+                                            const std::vector<double>& weights = {}) {
+  if (decoded.points.size() != points.size() || decoded.weights.size() != weights.size()) {
+    return ::testing::AssertionFailure() << decoded.points.size() << " points and " << decoded.weights.size()
+                                         << " weights decoded, not " << points.size() << " and " << weights.size();
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (Bits(decoded.points[i].x) != Bits(points[i].x) || Bits(decoded.points[i].y) != Bits(points[i].y) ||
+        (!weights.empty() && Bits(decoded.weights[i]) != Bits(weights[i]))) {
+      return ::testing::AssertionFailure() << "point " << i << " differs";
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
 TEST(BuildStreamDecoderTest, DecodesHeaderAndChunks) {
   const std::vector<Point2> points = gen::Uniform(10, 1);
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr);
@@ -533,11 +550,7 @@ TEST(BuildStreamDecoderTest, EncodedAndRawChunksMixToTheSamePointsAndHandle) {
   ASSERT_THAT(decoder.Add(EncodedChunk(all.subspan(200))), IsOk());
   absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
   ASSERT_THAT(decoded, IsOk());
-  ASSERT_EQ((*decoded)->points.size(), points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
-    ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
-  }
+  ASSERT_TRUE(DecodedBitForBit(**decoded, points));
   EXPECT_EQ((*decoded)->handle, PointSetHandle(points));
 }
 
@@ -656,13 +669,7 @@ TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirW
   EXPECT_EQ(in_flight.held(), 300 * (sizeof(Point2) + sizeof(double))) << "24 bytes a weighted point";
   absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
   ASSERT_THAT(decoded, IsOk());
-  ASSERT_EQ((*decoded)->points.size(), points.size());
-  ASSERT_EQ((*decoded)->weights.size(), points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
-    ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
-    ASSERT_EQ(Bits((*decoded)->weights[i]), Bits(weights[i])) << i;
-  }
+  ASSERT_TRUE(DecodedBitForBit(**decoded, points, weights));
   EXPECT_EQ((*decoded)->handle, WeightedPointSetHandle(points, weights));
   EXPECT_NE((*decoded)->handle, PointSetHandle(points)) << "the handle covers the weights";
   // A weighted stream of no points is the empty set, unweighted: one handle for every empty set.
@@ -707,14 +714,7 @@ TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
       ASSERT_GE(encoded_chunks, 5u);
       absl::StatusOr<DecodedBuild*> decoded = decoder.Finish();
       ASSERT_THAT(decoded, IsOk());
-      ASSERT_EQ((*decoded)->points.size(), points.size());
-      for (size_t i = 0; i < points.size(); ++i) {
-        ASSERT_EQ(Bits((*decoded)->points[i].x), Bits(points[i].x)) << i;
-        ASSERT_EQ(Bits((*decoded)->points[i].y), Bits(points[i].y)) << i;
-        if (weighted) {
-          ASSERT_EQ(Bits((*decoded)->weights[i]), Bits(weights[i])) << i;
-        }
-      }
+      ASSERT_TRUE(DecodedBitForBit(**decoded, points, weighted ? weights : std::vector<double>{}));
       EXPECT_EQ((*decoded)->handle, weighted ? WeightedPointSetHandle(points, weights) : PointSetHandle(points));
       EXPECT_EQ(in_flight.held(), points.size() * (weighted ? 24u : 16u));
     }
