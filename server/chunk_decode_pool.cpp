@@ -46,6 +46,7 @@ void ChunkDecodePool::Work() {
     queue_.pop_front();
     lock.unlock();
     task(decoder);
+    task = nullptr;  // the chunk's message goes now, not under the lock
     lock.lock();
   }
 }
