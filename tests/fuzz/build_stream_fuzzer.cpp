@@ -4,7 +4,10 @@
 // finite, as many as its chunks carried (an encoded chunk: its point_count), its handle is the
 // handle of those points (with their weights, in a weighted stream: BuildHeader.weighted), and no
 // refused chunk holds bytes in flight. Every accepted raw chunk's points (and weights) also go
-// through the encoder in every form it can take and must decode bit for bit.
+// through the encoder in every form it can take and must decode bit for bit. The same messages go
+// through a second decoder that decompresses on a pool of threads (as the server's does): it must
+// end the same way, accepting the same points and handle or refusing with the same status,
+// whichever message or the end of the stream it refuses at.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -16,6 +19,7 @@
 #include "core/io/point_set_handle.hpp"
 #include "proto/codec/point_chunk_codec.hpp"
 #include "server/build_stream.hpp"
+#include "server/chunk_decode_pool.hpp"
 
 namespace {
 
@@ -81,14 +85,38 @@ void CheckEveryEncoding(const v1::PointChunk& raw, bool weighted) {
   }
 }
 
+// Aborts unless the decoder on a pool ended as the one without: both accepted the same points,
+// weights and handle, or both refused with the same status.
+void CheckSameEnd(const absl::StatusOr<galpha::server::DecodedBuild*>& direct,
+                  const absl::StatusOr<galpha::server::DecodedBuild*>& pooled) {
+  if (direct.ok() != pooled.ok()) std::abort();
+  if (!direct.ok()) {
+    if (direct.status() != pooled.status()) std::abort();
+    return;
+  }
+  const galpha::server::DecodedBuild& a = **direct;
+  const galpha::server::DecodedBuild& b = **pooled;
+  if (a.handle != b.handle || a.points.size() != b.points.size() || a.weights.size() != b.weights.size()) std::abort();
+  for (size_t i = 0; i < a.points.size(); ++i) {
+    if (Bits(a.points[i].x) != Bits(b.points[i].x) || Bits(a.points[i].y) != Bits(b.points[i].y)) std::abort();
+  }
+  for (size_t i = 0; i < a.weights.size(); ++i) {
+    if (Bits(a.weights[i]) != Bits(b.weights[i])) std::abort();
+  }
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static galpha::server::ChunkDecodePool pool(2);
   galpha::server::InFlightBytes in_flight(1 << 20);
+  galpha::server::InFlightBytes pooled_in_flight(1 << 20);
   {
     galpha::server::BuildStreamLimits limits;
     limits.max_points = 4096;
     galpha::server::BuildStreamDecoder decoder(limits, &in_flight);
+    galpha::server::BuildStreamDecoder pooled(limits, &pooled_in_flight, "", &pool);
+    absl::Status pooled_refusal;
     size_t position = 0;
     uint64_t carried = 0;
     bool failed = false;
@@ -108,7 +136,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       }
       if (message.has_encoded_points()) carried += message.encoded_points().point_count();
       const uint64_t before = decoder.points_received();
-      failed = !decoder.Add(message).ok();
+      if (pooled_refusal.ok()) pooled_refusal = pooled.Add(message);
+      const absl::Status added = decoder.Add(message);
+      failed = !added.ok();
+      // The pool may refuse later than this message (a chunk still decoding), never earlier.
+      if (!pooled_refusal.ok() && added.ok()) std::abort();
+      if (failed) CheckSameEnd(added, pooled_refusal.ok() ? pooled.Finish().status() : pooled_refusal);
       // A refused chunk adds no points (and, below, holds no bytes once the decoder is gone).
       if (failed && decoder.points_received() != before) std::abort();
       if (!failed && message.has_header()) weighted = message.header().weighted();
@@ -116,6 +149,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     if (!failed) {
       auto decoded = decoder.Finish();
+      if (pooled_refusal.ok()) {
+        CheckSameEnd(decoded, pooled.Finish());
+      } else {
+        CheckSameEnd(decoded, pooled_refusal);
+      }
       if (decoded.ok()) {
         const auto& points = (*decoded)->points;
         const auto& weights = (*decoded)->weights;
@@ -139,6 +177,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   }
   // Every reservation is given back when the decoder goes away.
-  if (in_flight.held() != 0) std::abort();
+  if (in_flight.held() != 0 || pooled_in_flight.held() != 0) std::abort();
   return 0;
 }
