@@ -466,7 +466,7 @@ int MeasurePromotion(const Options& options, const std::vector<Point2>& points, 
 /// Used device memory in bytes, 0 without a GPU.
 size_t DeviceBytesInUse() {
   const absl::StatusOr<DeviceMemory> memory = QueryDeviceMemory();
-  return memory.ok() ? memory->total_bytes - memory->free_bytes : 0;
+  return memory.ok() ? memory->used_bytes() : 0;
 }
 
 int RunStress(const Options& options) {

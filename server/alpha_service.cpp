@@ -2,8 +2,6 @@
 
 #include <unistd.h>
 
-#include <atomic>
-#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -199,7 +197,7 @@ void AlphaService::StartDraining() {
 void AlphaService::SampleDeviceMemory() {
   if (backend_ != Backend::kCuda) return;
   if (auto memory = QueryDeviceMemory(); memory.ok()) {
-    metrics_->SetDeviceMemoryInUse(static_cast<double>(memory->total_bytes - memory->free_bytes));
+    metrics_->SetDeviceMemoryInUse(static_cast<double>(memory->used_bytes()));
   }
 }
 

@@ -93,7 +93,7 @@ class BuildScheduler {
   const size_t max_queue_per_tenant_;
   const size_t memory_budget_;
   SchedulerObserver* const observer_;
-  mutable std::mutex mutex_;
+  std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Pending> queue_;
   size_t running_ = 0;

@@ -15,6 +15,7 @@ namespace galpha {
 struct DeviceMemory {
   size_t free_bytes = 0;
   size_t total_bytes = 0;
+  size_t used_bytes() const { return total_bytes - free_bytes; }
 };
 
 /// Free and total memory of the current device. Unavailable without a CUDA backend or GPU.

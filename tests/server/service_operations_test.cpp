@@ -74,7 +74,7 @@ TEST(ServiceTest, EvictionUnderASmallCacheBudget) {
 /// The device's used memory in bytes (0 without a GPU).
 size_t DeviceBytesInUse() {
   const absl::StatusOr<DeviceMemory> memory = QueryDeviceMemory();
-  return memory.ok() ? memory->total_bytes - memory->free_bytes : 0;
+  return memory.ok() ? memory->used_bytes() : 0;
 }
 
 // On a GPU, the memory CUDA's pool keeps after builds goes back to the device once the server has
