@@ -31,6 +31,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
@@ -52,10 +53,12 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "client/galpha_client.hpp"
+#include "core/io/point_io.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gpu/system/device_streams.hpp"
 #include "server/galpha_server.hpp"
+#include "tests/support/data_files.hpp"
 #include "tests/support/point_generators.hpp"
 
 namespace galpha {
@@ -360,12 +363,59 @@ double TimedBuild(client::AlphaClient& client, const std::vector<Point2>& points
   return seconds;
 }
 
-/// One build and one Classify of every simplex at rank K/2, over one link (best of `repeat`).
-struct LinkMeasure {
-  double build_seconds = 1e30, server_stage_seconds = 1e30, classify_seconds = 1e30;
-  uint64_t bytes_up = 0, bytes_down = 0, simplices = 0;
-  int64_t spectrum_size = 0;
+/// The answer encodings Classify is measured in (ClassifyRequest.simplex_encoding).
+constexpr std::array<v1::SimplexEncoding, 3> kAnswerEncodings = {v1::SIMPLEX_ENCODING_RAW, v1::SIMPLEX_ENCODING_DELTA,
+                                                                 v1::SIMPLEX_ENCODING_DELTA_ZSTD};
+const char* AnswerEncodingName(v1::SimplexEncoding encoding) {
+  return encoding == v1::SIMPLEX_ENCODING_RAW ? "raw" : encoding == v1::SIMPLEX_ENCODING_DELTA ? "delta" : "zstd";
+}
+
+/// One Classify of every simplex at rank K/2 in one answer encoding (best of the repeats):
+/// `wire_bytes` as they crossed the link, `answer_bytes` the raw messages the client decoded them to.
+struct ClassifyMeasure {
+  double seconds = 1e30;
+  uint64_t wire_bytes = 0, answer_bytes = 0, simplices = 0;
 };
+
+/// One build and one Classify of every simplex at rank K/2 per answer encoding, over one link
+/// (best of `repeat`).
+struct LinkMeasure {
+  double build_seconds = 1e30, server_stage_seconds = 1e30;
+  uint64_t bytes_up = 0;
+  int64_t spectrum_size = 0;
+  std::array<ClassifyMeasure, kAnswerEncodings.size()> classify;
+};
+
+std::array<ClassifyMeasure, kAnswerEncodings.size()> MeasureClassify(client::AlphaClient& client,
+                                                                     const std::string& handle, int64_t rank,
+                                                                     int repeat) {
+  std::array<ClassifyMeasure, kAnswerEncodings.size()> measured;
+  for (size_t e = 0; e < kAnswerEncodings.size(); ++e) {
+    v1::ClassifyRequest classify;
+    classify.set_handle(handle);
+    classify.mutable_threshold()->set_rank(rank);
+    classify.set_simplex_encoding(kAnswerEncodings[e]);
+    ClassifyMeasure& m = measured[e];
+    for (int r = 0; r < repeat; ++r) {
+      m.answer_bytes = m.simplices = 0;
+      const auto start = Clock::now();
+      absl::Status status = client.Classify(
+          classify,
+          [&](const v1::ClassifyResponse& message) {
+            m.answer_bytes += message.ByteSizeLong();
+            m.simplices += message.chunk().classes().size();
+            return absl::OkStatus();
+          },
+          &m.wire_bytes);
+      m.seconds = std::min(m.seconds, SecondsSince(start));
+      if (!status.ok()) {
+        std::fprintf(stderr, "classify failed: %s\n", std::string(status.message()).c_str());
+        std::exit(1);
+      }
+    }
+  }
+  return measured;
+}
 
 LinkMeasure MeasureLink(client::AlphaClient& client, const std::vector<Point2>& points, int repeat) {
   LinkMeasure m;
@@ -382,23 +432,7 @@ LinkMeasure MeasureLink(client::AlphaClient& client, const std::vector<Point2>& 
   size_request.set_handle(handle);
   size_request.set_page_size(1);
   m.spectrum_size = client.Spectrum(size_request)->spectrum_size();
-  v1::ClassifyRequest classify;
-  classify.set_handle(handle);
-  classify.mutable_threshold()->set_rank(m.spectrum_size / 2);
-  for (int r = 0; r < repeat; ++r) {
-    m.bytes_down = m.simplices = 0;
-    const auto start = Clock::now();
-    absl::Status status = client.Classify(classify, [&](const v1::ClassifyResponse& message) {
-      m.bytes_down += message.ByteSizeLong();
-      m.simplices += message.chunk().classes().size();
-      return absl::OkStatus();
-    });
-    m.classify_seconds = std::min(m.classify_seconds, SecondsSince(start));
-    if (!status.ok()) {
-      std::fprintf(stderr, "classify failed: %s\n", std::string(status.message()).c_str());
-      std::exit(1);
-    }
-  }
+  m.classify = MeasureClassify(client, handle, m.spectrum_size / 2, repeat);
   return m;
 }
 
@@ -680,7 +714,8 @@ int Run(const Options& options) {
                            : absl::StrCat("Build RPC over a veth pair, tbf ", link, " both ways, ",
                                           veth->rtt_emulated() ? "netem 1 ms RTT" : "RTT not emulated (no netem)");
     std::printf("| %s | %.2f MB | %.2f MB | %.1f | %.2f | %.1f |\n", name.c_str(), Megabytes(m.bytes_up),
-                Megabytes(m.bytes_down), m.build_seconds * 1e3, m.build_seconds / engine, m.classify_seconds * 1e3);
+                Megabytes(m.classify[0].wire_bytes), m.build_seconds * 1e3, m.build_seconds / engine,
+                m.classify[0].seconds * 1e3);
     if (link == "loopback") {
       std::printf("| of which the server's stage times | | | %.1f | | |\n", m.server_stage_seconds * 1e3);
     }
@@ -688,15 +723,58 @@ int Run(const Options& options) {
   if (cgal >= 0) std::printf("| CGAL Alpha_shape_2 EPEC, 1 thread | | | %.1f | %.2f | |\n", cgal * 1e3, cgal / engine);
   std::printf("\n");
 
-  // 2. Classify streaming rate over loopback: every simplex at the middle rank.
+  // 2. Classify of every simplex at the middle rank, per answer encoding and link: the uniform
+  // set above (shuffled input order: the encodings' worst case), LiDAR-like points quantized to
+  // centimetres (also in random order) and the real lidar_autzen file in its own (scan) order.
   const LinkMeasure& loopback = measured["loopback"];
   const std::string handle = PointSetHandle(points);
   const int64_t k = loopback.spectrum_size;
-  std::printf("| Classify, all simplices at rank K/2 | value |\n|---|---:|\n");
-  std::printf("| simplices | %zu |\n| bytes on the wire (messages) | %zu |\n| ms | %.1f |\n| GB/s | %.2f |\n\n",
-              static_cast<size_t>(loopback.simplices), static_cast<size_t>(loopback.bytes_down),
-              loopback.classify_seconds * 1e3,
-              static_cast<double>(loopback.bytes_down) / loopback.classify_seconds / 1e9);
+  struct ClassifySet {
+    std::string name;
+    std::vector<Point2> points;
+  };
+  std::vector<ClassifySet> classify_sets;
+  classify_sets.push_back(
+      {absl::StrCat("lidar_cm ", options.points, " (random order)"), gen::LidarCentimetres(options.points, 1)});
+  if (auto autzen = ReadPointsBin(testdata::DataDir() + "/lidar_autzen.bin"); autzen.ok()) {
+    classify_sets.push_back({absl::StrCat("lidar_autzen ", autzen->size(), " (file order)"), *std::move(autzen)});
+  } else {
+    std::fprintf(stderr, "service_bench: no lidar_autzen (%s); set GALPHA_DATA_DIR\n",
+                 std::string(autzen.status().message()).c_str());
+  }
+  std::printf(
+      "| Classify of every simplex at rank K/2 | link | answer encoding | simplices | MB on the wire | ms | vs raw | "
+      "wire GB/s | answer GB/s (raw bytes / ms) |\n|---|---|---|---:|---:|---:|---:|---:|---:|\n");
+  const auto print_classify = [&](const std::string& set, const std::string& link,
+                                  const std::array<ClassifyMeasure, kAnswerEncodings.size()>& m) {
+    for (size_t e = 0; e < kAnswerEncodings.size(); ++e) {
+      std::printf("| %s | %s | %s | %zu | %.2f | %.1f | %.2f | %.2f | %.2f |\n", set.c_str(), link.c_str(),
+                  AnswerEncodingName(kAnswerEncodings[e]), static_cast<size_t>(m[e].simplices),
+                  Megabytes(m[e].wire_bytes), m[e].seconds * 1e3, m[e].seconds / m[0].seconds,
+                  static_cast<double>(m[e].wire_bytes) / m[e].seconds / 1e9,
+                  static_cast<double>(m[e].answer_bytes) / m[e].seconds / 1e9);
+    }
+  };
+  for (const std::string& link : links) {
+    print_classify(absl::StrCat("uniform ", options.points), link, measured[link].classify);
+  }
+  for (const ClassifySet& set : classify_sets) {
+    for (const std::string& link : links) {
+      if (link != "loopback") {
+        if (absl::Status shaped = veth->Shape(link); !shaped.ok()) {
+          std::fprintf(stderr, "service_bench: %s\n", std::string(shaped.message()).c_str());
+          return 1;
+        }
+      }
+      const auto link_client = link == "loopback" ? Client(port) : Client(veth->target());
+      client::BuildResult built;
+      TimedBuild(*link_client, set.points, &built);
+      const int64_t set_rank = static_cast<int64_t>(built.summary.spectrum_size() / 2);
+      print_classify(set.name, link, MeasureClassify(*link_client, built.handle, set_rank, options.repeat));
+      link_client->Release(built.handle).IgnoreError();
+    }
+  }
+  std::printf("\n");
 
   // 3. Concurrent builds of distinct point sets.
   std::printf(

@@ -134,8 +134,21 @@ absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
   return common;
 }
 
-absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line) {
+absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line, bool remote) {
   ClassifyArgs parsed;
+  if (const std::string* encoding = line.Find("answer-encoding")) {
+    if (!remote) return absl::InvalidArgumentError("--answer-encoding needs --server");
+    if (*encoding == "raw") {
+      parsed.answer_encoding = AnswerEncoding::kRaw;
+    } else if (*encoding == "delta") {
+      parsed.answer_encoding = AnswerEncoding::kDelta;
+    } else if (*encoding == "zstd") {
+      parsed.answer_encoding = AnswerEncoding::kDeltaZstd;
+    } else {
+      return absl::InvalidArgumentError(
+          absl::StrCat("unknown --answer-encoding '", *encoding, "' (expected raw, delta or zstd)"));
+    }
+  }
   auto threshold = ParseThreshold(line);
   if (!threshold.ok()) return threshold.status();
   parsed.threshold = *threshold;

@@ -74,13 +74,19 @@ struct CommonArgs {
 absl::StatusOr<CommonArgs> ParseCommon(absl::string_view command, Args args,
                                        absl::Span<const absl::string_view> allowed);
 
+/// How a server sends classify's simplices (--answer-encoding; the proto's SimplexEncoding).
+enum class AnswerEncoding { kRaw, kDelta, kDeltaZstd };
+
 /// classify's and summary's options after FILE.
 struct ClassifyArgs {
   ThresholdArg threshold;
   ClassifyMode mode = ClassifyMode::kGeneral;
   VertexRule rule = VertexRule::kReport;
+  /// classify --answer-encoding raw|delta|zstd (with --server only; default delta).
+  AnswerEncoding answer_encoding = AnswerEncoding::kDelta;
 };
-absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line);
+/// `remote`: whether --server was given (--answer-encoding needs it).
+absl::StatusOr<ClassifyArgs> ParseClassifyArgs(const CommandLine& line, bool remote = false);
 
 /// persistence's options after FILE: --dimension 0|1 (default both), --min-persistence X >= 0
 /// (alpha_sq units), --format text|csv|json|svg (default text).

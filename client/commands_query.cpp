@@ -23,9 +23,10 @@
 namespace galpha::alphactl {
 
 int RunClassify(Args args) {
-  auto common = ParseCommon("classify", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "vertex-rule"});
+  auto common =
+      ParseCommon("classify", args, {"alpha-sq", "alpha", "rank", "ratio", "mode", "vertex-rule", "answer-encoding"});
   if (!common.ok()) return UsageError(common.status());
-  auto options = ParseClassifyArgs(common->line);
+  auto options = ParseClassifyArgs(common->line, !common->server.empty());
   if (!options.ok()) return UsageError(options.status());
   if (!common->server.empty()) return RemoteClassify(*common, *options);
   size_t input_points = 0;

@@ -244,6 +244,10 @@ int RemoteClassify(const CommonArgs& common, const ClassifyArgs& options) {
   if (!remote.ok()) return Failure(remote.status());
   auto request = ClassifyRequestFor(options, *remote);
   if (!request.ok()) return ArgumentError(request.status());
+  // The client decodes every encoding to the same chunks: the output does not depend on it.
+  request->set_simplex_encoding(options.answer_encoding == AnswerEncoding::kRaw     ? v1::SIMPLEX_ENCODING_RAW
+                                : options.answer_encoding == AnswerEncoding::kDelta ? v1::SIMPLEX_ENCODING_DELTA
+                                                                                    : v1::SIMPLEX_ENCODING_DELTA_ZSTD);
   ChunkedWriter out(stdout);
   absl::Status status = remote->client->Classify(*request, [&](const v1::ClassifyResponse& message) {
     if (!message.has_chunk()) return absl::OkStatus();

@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/point_set_handle.hpp"
 #include "proto/codec/point_chunk_codec.hpp"
+#include "proto/codec/simplex_chunk_codec.hpp"
 
 namespace galpha::client {
 
@@ -275,8 +276,26 @@ absl::Status AlphaClient::ReadStream(
 }
 
 absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
-                                   const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message) {
-  return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Classify, request, on_message);
+                                   const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message,
+                                   uint64_t* wire_bytes) {
+  if (wire_bytes != nullptr) *wire_bytes = 0;
+  wire::SimplexChunkDecoder decoder;
+  v1::ClassifyResponse decoded;
+  uint64_t chunk_index = 0;
+  return ReadStream(
+      request.handle(), &v1::AlphaShapes::Stub::Classify, request,
+      std::function<absl::Status(const v1::ClassifyResponse&)>(
+          [&](const v1::ClassifyResponse& message) -> absl::Status {
+            if (wire_bytes != nullptr) *wire_bytes += message.ByteSizeLong();
+            if (message.has_summary()) return on_message(message);
+            const uint64_t index = chunk_index++;
+            if (!message.has_encoded_chunk()) return on_message(message);
+            if (absl::Status status = decoder.Decode(message.encoded_chunk(), index, decoded.mutable_chunk());
+                !status.ok()) {
+              return status;
+            }
+            return on_message(decoded);
+          }));
 }
 
 absl::Status AlphaClient::MasterList(const v1::MasterListRequest& request,

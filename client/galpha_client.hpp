@@ -103,8 +103,13 @@ class AlphaClient {
 
   /// Server-streamed answers: `on_message` sees each message; an error it returns cancels the
   /// call and is returned.
+  /// Classify's chunks arrive as the request's simplex_encoding asks; `on_message` always sees
+  /// SimplexChunk messages (EncodedSimplexChunks are decoded first, an undecodable one fails the
+  /// call with InvalidArgument naming it), so callers do not depend on the encoding. `wire_bytes`,
+  /// when given, gets the protobuf bytes of the messages as they arrived.
   absl::Status Classify(const galpha::v1::ClassifyRequest& request,
-                        const std::function<absl::Status(const galpha::v1::ClassifyResponse&)>& on_message);
+                        const std::function<absl::Status(const galpha::v1::ClassifyResponse&)>& on_message,
+                        uint64_t* wire_bytes = nullptr);
   absl::Status MasterList(const galpha::v1::MasterListRequest& request,
                           const std::function<absl::Status(const galpha::v1::MasterListResponse&)>& on_message);
   absl::Status Shape(const galpha::v1::ShapeRequest& request,

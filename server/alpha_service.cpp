@@ -13,6 +13,7 @@
 #include "core/io/point_set_handle.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "server/build_reactor.hpp"
+#include "server/encoded_answer.hpp"
 #include "server/grpc_status.hpp"
 #include "server/persistence_answers.hpp"
 #include "server/query_answers.hpp"
@@ -50,7 +51,7 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
     if (source_->Next(&message_)) {
       this->StartWrite(&message_);
     } else {
-      Done(grpc::Status::OK);
+      Done(ToGrpcStatus(source_->status()));
     }
   }
   void Done(const grpc::Status& status) {
@@ -138,7 +139,7 @@ AlphaService::AlphaService(const ServiceOptions& options, ServerMetrics* metrics
     : options_(options),
       metrics_(metrics),
       in_flight_(options.max_in_flight_bytes, options.max_tenant_in_flight_bytes),
-      decode_pool_(std::thread::hardware_concurrency()),
+      codec_pool_(std::thread::hardware_concurrency()),
       upload_watchdog_(options.upload_idle_timeout) {}
 
 AlphaService::~AlphaService() = default;
@@ -308,7 +309,13 @@ grpc::ServerUnaryReactor* AlphaService::Release(grpc::CallbackServerContext* con
 
 grpc::ServerWriteReactor<v1::ClassifyResponse>* AlphaService::Classify(grpc::CallbackServerContext* context,
                                                                        const v1::ClassifyRequest* request) {
-  return AnswerQuery(context, "Classify", *request, MakeClassifySource, StreamedReply<v1::ClassifyResponse>());
+  const auto answer = [this](std::shared_ptr<const CachedFamily> cached, const v1::ClassifyRequest& classify)
+      -> absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> {
+    auto raw = MakeClassifySource(std::move(cached), classify);
+    if (!raw.ok()) return raw.status();
+    return EncodeSimplexChunks(*std::move(raw), classify.simplex_encoding(), &codec_pool_);
+  };
+  return AnswerQuery(context, "Classify", *request, answer, StreamedReply<v1::ClassifyResponse>());
 }
 
 grpc::ServerWriteReactor<v1::MasterListResponse>* AlphaService::MasterList(grpc::CallbackServerContext* context,

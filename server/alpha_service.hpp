@@ -15,7 +15,7 @@
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
 #include "server/build_time_limit.hpp"
-#include "server/chunk_decode_pool.hpp"
+#include "server/chunk_codec_pool.hpp"
 #include "server/exact_comparison_limit.hpp"
 #include "server/family_cache.hpp"
 #include "server/family_promoter.hpp"
@@ -154,8 +154,9 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   std::unique_ptr<FamilyCache> cache_;
   std::unique_ptr<FamilyPromoter> promoter_;  // before scheduler_: its jobs call it
   InFlightBytes in_flight_;
-  /// Decodes the Build streams' encoded chunks, one thread a core (build_stream.hpp).
-  ChunkDecodePool decode_pool_;
+  /// Decodes the Build streams' encoded chunks and encodes compact Classify answers, one thread a
+  /// core (build_stream.hpp, encoded_answer.hpp).
+  ChunkCodecPool codec_pool_;
   UploadWatchdog upload_watchdog_;
   std::atomic<bool> draining_{false};
   std::atomic<bool> told_release_failure_{false};

@@ -32,7 +32,7 @@ BuildReactor::BuildReactor(AlphaService* service, grpc::CallbackServerContext* c
       response_(response),
       record_(service->metrics_, "Build"),
       decoder_(BuildStreamLimits{service->options_.max_points_per_build}, &service->in_flight_,
-               tenant.ok() ? *tenant : std::string(), &service->decode_pool_) {
+               tenant.ok() ? *tenant : std::string(), &service->codec_pool_) {
   if (!tenant.ok()) {
     Respond(tenant.status());
     return;

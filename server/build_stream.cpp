@@ -82,8 +82,8 @@ size_t InFlightBytes::held_by(const std::string& tenant) const {
 }
 
 BuildStreamDecoder::BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant,
-                                       ChunkDecodePool* decode_pool)
-    : limits_(limits), in_flight_(in_flight), tenant_(std::move(tenant)), decode_pool_(decode_pool) {}
+                                       ChunkCodecPool* codec_pool)
+    : limits_(limits), in_flight_(in_flight), tenant_(std::move(tenant)), codec_pool_(codec_pool) {}
 
 BuildStreamDecoder::~BuildStreamDecoder() {
   WaitForDecodes();  // their tasks write into decoded_ and report here
@@ -115,10 +115,11 @@ void BuildStreamDecoder::DecodeOnPool(galpha::v1::BuildRequest message, const wi
     // pool's queue ahead of the others; past it the reactor waits, and gRPC's flow control slows
     // the client, as when the reactor decoded each chunk itself.
     std::unique_lock<std::mutex> lock(decodes_mutex_);
-    decodes_idle_.wait(lock, [&] { return decoding_ < 2 * decode_pool_->threads(); });
+    decodes_idle_.wait(lock, [&] { return decoding_ < 2 * codec_pool_->threads(); });
     ++decoding_;
   }
-  const auto task = [this, owned, at, points, weights](wire::PointChunkDecoder& decoder) {
+  const auto task = [this, owned, at, points, weights](ChunkCodecs& codecs) {
+    wire::PointChunkDecoder& decoder = codecs.point_decoder;
     absl::Status decoded;
     try {
       const galpha::v1::EncodedPointChunk& chunk = owned->encoded_points();
@@ -139,7 +140,7 @@ void BuildStreamDecoder::DecodeOnPool(galpha::v1::BuildRequest message, const wi
     decodes_idle_.notify_all();  // WaitForDecodes waits for none, the back-pressure for fewer
   };
   try {
-    decode_pool_->Submit(task);
+    codec_pool_->Submit(task);
   } catch (...) {
     std::lock_guard<std::mutex> lock(decodes_mutex_);
     --decoding_;
@@ -212,7 +213,7 @@ absl::Status BuildStreamDecoder::Grow(uint64_t count) {
 
 absl::Status BuildStreamDecoder::Add(galpha::v1::BuildRequest message) {
   absl::Status added = AddMessage(std::move(message));
-  if (added.ok() || decode_pool_ == nullptr) return added;
+  if (added.ok() || codec_pool_ == nullptr) return added;
   // A chunk still decoding may fail too, and it came before this message: its error is the answer,
   // as it would be without a pool.
   WaitForDecodes();
@@ -314,7 +315,7 @@ absl::Status BuildStreamDecoder::AddMessage(galpha::v1::BuildRequest message) {
       const uint64_t count = chunk.point_count();
       if (absl::Status s = CheckPointCount(before + count); !s.ok()) return s;
       if (absl::Status s = Grow(count); !s.ok()) return s;
-      if (decode_pool_ != nullptr) {
+      if (codec_pool_ != nullptr) {
         DecodeOnPool(std::move(message), at, before);
         return absl::OkStatus();
       }

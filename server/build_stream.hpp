@@ -21,7 +21,7 @@
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "proto/codec/point_chunk_codec.hpp"
 #include "server/cached_family.hpp"
-#include "server/chunk_decode_pool.hpp"
+#include "server/chunk_codec_pool.hpp"
 
 namespace galpha::server {
 
@@ -89,10 +89,10 @@ class BuildStreamDecoder {
  public:
   /// `in_flight` may be null (no limit on bytes in flight); it must outlive the decoder. `tenant`
   /// is whose bytes these are ("" without authentication: one anonymous tenant). With a
-  /// `decode_pool` (which must outlive the decoder), encoded chunks are decompressed there while
+  /// `codec_pool` (which must outlive the decoder), encoded chunks are decompressed there while
   /// the stream goes on (see Add); without one, in Add.
   BuildStreamDecoder(const BuildStreamLimits& limits, InFlightBytes* in_flight, std::string tenant = "",
-                     ChunkDecodePool* decode_pool = nullptr);
+                     ChunkCodecPool* codec_pool = nullptr);
   /// Waits for the chunks still decoding, then releases the bytes this stream holds in
   /// `in_flight` (also after Finish: the builder keeps the decoder alive while it uses the points).
   ~BuildStreamDecoder();
@@ -109,7 +109,7 @@ class BuildStreamDecoder {
   /// decoded points, 16 bytes each (24 weighted): an encoded chunk's stated count is checked and its decoded bytes
   /// reserved before it is decompressed.
   ///
-  /// With a decode pool, an encoded chunk that passes those checks is decompressed on the pool
+  /// With a codec pool, an encoded chunk that passes those checks is decompressed on the pool
   /// (the message is kept until then), and what only its decoding finds (a malformed payload, a
   /// NaN) is answered by the next Add or by Finish: the stream is refused a message or a few later,
   /// with the error of the earliest chunk that failed, and its points are not taken back. Without
@@ -157,7 +157,7 @@ class BuildStreamDecoder {
   wire::PointChunkDecoder chunk_decoder_;
 
   // Chunks on the pool: how many are still decoding, and the earliest that failed.
-  ChunkDecodePool* const decode_pool_;
+  ChunkCodecPool* const codec_pool_;
   std::mutex decodes_mutex_;
   std::condition_variable decodes_idle_;
   size_t decoding_ = 0;

@@ -373,6 +373,11 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifyS
   if (!mode.ok()) return mode.status();
   const absl::StatusOr<VertexRule> rule = ToVertexRule(request.vertex_rule());
   if (!rule.ok()) return rule.status();
+  if (!v1::SimplexEncoding_IsValid(request.simplex_encoding())) {
+    return absl::InvalidArgumentError(absl::StrCat("simplex_encoding ", static_cast<int>(request.simplex_encoding()),
+                                                   " is not a SimplexEncoding (RAW = 1, DELTA = 2, DELTA_ZSTD = 3; 0 "
+                                                   "means RAW)"));
+  }
   auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
   absl::StatusOr<Classification> classes = family.ClassifyAll(level->level, *mode, *rule);

@@ -45,16 +45,20 @@ absl::StatusOr<VertexRule> ToVertexRule(galpha::v1::VertexRule rule);
 /// Describe's and Build's summary of a cached family, without a name (Build adds its caller's).
 void FillBuildSummary(const CachedFamily& cached, galpha::v1::BuildSummary* summary);
 
-/// A generator of a server-streamed answer: Next fills the next message, false when done.
+/// A generator of a server-streamed answer: Next fills the next message, false when the answer is
+/// complete or has failed; status() then says which.
 template <typename Message>
 class ChunkSource {
  public:
   virtual ~ChunkSource() = default;
   virtual bool Next(Message* message) = 0;
+  /// OK while the answer goes on and once it is complete; the error that ended it otherwise.
+  virtual absl::Status status() const { return absl::OkStatus(); }
 };
 
-/// Classify: the summary, then vertex, edge and triangle chunks in index order. InvalidArgument
-/// for a bad threshold, mode or vertex rule.
+/// Classify: the summary, then vertex, edge and triangle chunks in index order, always raw
+/// (SimplexChunk; the service encodes them as the request asks: encoded_answer.hpp).
+/// InvalidArgument for a bad threshold, mode, vertex rule or simplex encoding.
 absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>>> MakeClassifySource(
     std::shared_ptr<const CachedFamily> cached, const galpha::v1::ClassifyRequest& request);
 

@@ -237,6 +237,39 @@ TEST(AlphactlRemoteTest, RawEncodingSendsDoubles) {
   EXPECT_NE(local_encoding.err.find("--encoding needs --server"), std::string::npos) << local_encoding.err;
 }
 
+// classify's --answer-encoding changes what crosses the wire (the default is delta), never the
+// output; it is refused without --server and with a value it does not know.
+TEST(AlphactlRemoteTest, EveryAnswerEncodingPrintsWhatTheLocalClassifyPrints) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  const std::string file = galpha::testdata::DataDir() + "/lidar_autzen_ground.bin";
+  const char* commands[] = {
+      "classify --rank 2000 --answer-encoding raw",
+      "classify --rank 2000 --answer-encoding delta",
+      "classify --rank 2000 --answer-encoding zstd",
+      "classify --alpha-sq 30 --mode regularized --answer-encoding zstd",
+  };
+  for (const char* command : commands) {
+    SCOPED_TRACE(command);
+    const std::string local_args =
+        absl::StrCat(std::string(command).substr(0, std::string(command).find(" --answer-encoding")), " ", file);
+    const CommandResult local = Alphactl(local_args);
+    const CommandResult remote = Alphactl(absl::StrCat(command, " ", file, " --server ", server.address()));
+    EXPECT_EQ(local.exit_code, 0) << local.err;
+    EXPECT_EQ(remote.exit_code, 0) << remote.err;
+    EXPECT_GT(local.out.size(), 100000u);
+    EXPECT_EQ(remote.out, local.out);
+  }
+  const CommandResult local_only = Alphactl("classify " + file + " --rank 1 --answer-encoding zstd");
+  EXPECT_EQ(local_only.exit_code, 2);
+  EXPECT_NE(local_only.err.find("--answer-encoding needs --server"), std::string::npos) << local_only.err;
+  const CommandResult unknown =
+      Alphactl("classify " + file + " --rank 1 --answer-encoding gzip --server " + server.address());
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown --answer-encoding 'gzip' (expected raw, delta or zstd)"), std::string::npos)
+      << unknown.err;
+}
+
 TEST(AlphactlRemoteTest, ErrorsKeepTheLocalExitCodes) {
   ServerProcess server(GALPHA_SERVER, kServerFlags);
   ASSERT_GT(server.port(), 0) << server.log();

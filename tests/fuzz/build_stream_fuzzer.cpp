@@ -19,7 +19,7 @@
 #include "core/io/point_set_handle.hpp"
 #include "proto/codec/point_chunk_codec.hpp"
 #include "server/build_stream.hpp"
-#include "server/chunk_decode_pool.hpp"
+#include "server/chunk_codec_pool.hpp"
 
 namespace {
 
@@ -108,7 +108,7 @@ void CheckSameEnd(const absl::StatusOr<galpha::server::DecodedBuild*>& direct,
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static galpha::server::ChunkDecodePool pool(2);
+  static galpha::server::ChunkCodecPool pool(2);
   galpha::server::InFlightBytes in_flight(1 << 20);
   galpha::server::InFlightBytes pooled_in_flight(1 << 20);
   {

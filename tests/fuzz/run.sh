@@ -18,8 +18,8 @@ libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthre
 # then run side by side: CI's 2 cores were otherwise half idle in this step.
 # The decoder with the CRS functions that refuse (coordinate_system_no_proj.cpp): a header's crs is
 # then an error, decided without PROJ's database; the fuzzer aims at the decoder.
-clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/chunk_decode_pool.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
-  core/io/coordinate_system_no_proj.cpp proto/codec/point_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
+clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/chunk_codec_pool.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
+  core/io/coordinate_system_no_proj.cpp proto/codec/point_chunk_codec.cpp proto/codec/simplex_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
   $(pkg-config --libs libzstd) &
 builds=($!)
 clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp core/io/las_reader.cpp \

@@ -685,7 +685,7 @@ TEST(BuildStreamDecoderTest, WeightedTriplesRawAndEncodedDecodeToThePointsTheirW
 // and with one (allocated at the first chunk), points bit for bit and the handle as for the
 // points themselves; weighted streams too.
 TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
-  ChunkDecodePool pool(4);
+  ChunkCodecPool pool(4);
   const std::vector<Point2> points = gen::Uniform(20000, 47);
   const std::vector<double> weights = AwkwardWeights(points.size());
   const auto all = absl::MakeConstSpan(points);
@@ -729,9 +729,9 @@ TEST(BuildStreamDecoderTest, ChunksDecodedOnAPoolGiveThePointsBitForBit) {
 // once every held thread has let go of it.
 class PoolGate {
  public:
-  PoolGate(ChunkDecodePool* pool, size_t threads) : held_(threads) {
+  PoolGate(ChunkCodecPool* pool, size_t threads) : held_(threads) {
     for (size_t i = 0; i < threads; ++i) {
-      pool->Submit([this](wire::PointChunkDecoder&) {
+      pool->Submit([this](ChunkCodecs&) {
         std::unique_lock<std::mutex> lock(mutex_);
         changed_.wait(lock, [&] { return open_; });
         --held_;
@@ -759,7 +759,7 @@ class PoolGate {
 
 TEST(BuildStreamDecoderTest, ChunksThatFailOnAPoolRefuseTheStreamWithTheEarliestError) {
   constexpr size_t kThreads = 4;
-  ChunkDecodePool pool(kThreads);
+  ChunkCodecPool pool(kThreads);
   const std::vector<Point2> points = gen::Uniform(1000, 48);
   const auto all = absl::MakeConstSpan(points);
   const std::string expected = "encoded point chunk 3 (from point 300): its data is not a zstd frame";
@@ -799,7 +799,7 @@ TEST(BuildStreamDecoderTest, ChunksThatFailOnAPoolRefuseTheStreamWithTheEarliest
 // about to fail: the answer is the earlier chunk's error, as without a pool.
 TEST(BuildStreamDecoderTest, AnEarlierChunkStillDecodingIsTheAnswerToALaterRefusal) {
   constexpr size_t kThreads = 2;
-  ChunkDecodePool pool(kThreads);
+  ChunkCodecPool pool(kThreads);
   const std::vector<Point2> points = gen::Uniform(1000, 49);
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);
   PoolGate gate(&pool, kThreads);
@@ -822,7 +822,7 @@ TEST(BuildStreamDecoderTest, AnEarlierChunkStillDecodingIsTheAnswerToALaterRefus
 // waits for one to finish.
 TEST(BuildStreamDecoderTest, AStreamQueuesAtMostTwoChunksPerPoolThread) {
   constexpr size_t kThreads = 2;
-  ChunkDecodePool pool(kThreads);
+  ChunkCodecPool pool(kThreads);
   const std::vector<Point2> points = gen::Uniform(1200, 50);
   const auto all = absl::MakeConstSpan(points);
   BuildStreamDecoder decoder(BuildStreamLimits{}, nullptr, "", &pool);

@@ -240,6 +240,21 @@ TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
   EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
 }
 
+TEST(QueryAnswersTest, ClassifyRefusesASimplexEncodingTheEnumDoesNotDefine) {
+  const std::shared_ptr<const CachedFamily>& cached = Families()[0].cached;
+  v1::ClassifyRequest request;
+  *request.mutable_threshold() = Rank(1);
+  for (int encoding : {0, 1, 2, 3}) {
+    request.set_simplex_encoding(static_cast<v1::SimplexEncoding>(encoding));
+    EXPECT_THAT(MakeClassifySource(cached, request).status(), IsOk()) << encoding;
+  }
+  request.set_simplex_encoding(static_cast<v1::SimplexEncoding>(4));
+  const absl::Status refused = MakeClassifySource(cached, request).status();
+  EXPECT_THAT(refused, StatusIs(absl::StatusCode::kInvalidArgument));
+  EXPECT_NE(refused.message().find("simplex_encoding 4 is not a SimplexEncoding"), std::string::npos)
+      << refused.message();
+}
+
 TEST(QueryAnswersTest, ClassifyChunksNeverExceedTheLimit) {
   const std::shared_ptr<const CachedFamily> cached = LargeFamily();
   ASSERT_NE(cached, nullptr);

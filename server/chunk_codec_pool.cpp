@@ -1,17 +1,17 @@
-#include "server/chunk_decode_pool.hpp"
+#include "server/chunk_codec_pool.hpp"
 
 #include <algorithm>
 #include <utility>
 
 namespace galpha::server {
 
-ChunkDecodePool::ChunkDecodePool(size_t threads) {
+ChunkCodecPool::ChunkCodecPool(size_t threads) {
   const size_t count = std::max<size_t>(threads, 1);
   workers_.reserve(count);
   for (size_t i = 0; i < count; ++i) workers_.emplace_back([this] { Work(); });
 }
 
-ChunkDecodePool::~ChunkDecodePool() {
+ChunkCodecPool::~ChunkCodecPool() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stopping_ = true;
@@ -20,7 +20,7 @@ ChunkDecodePool::~ChunkDecodePool() {
   for (std::thread& worker : workers_) worker.join();
 }
 
-void ChunkDecodePool::Submit(Task task) {
+void ChunkCodecPool::Submit(Task task) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     queue_.push_back(std::move(task));
@@ -28,8 +28,8 @@ void ChunkDecodePool::Submit(Task task) {
   wake_.notify_one();
 }
 
-void ChunkDecodePool::Work() {
-  wire::PointChunkDecoder decoder;
+void ChunkCodecPool::Work() {
+  ChunkCodecs codecs;
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     if (queue_.empty() && !stopping_) {
@@ -37,7 +37,7 @@ void ChunkDecodePool::Work() {
       // would hold a chunk's worth per thread for good. Between the chunks of a busy stream it is
       // kept, as a stream's own decoder keeps it.
       lock.unlock();
-      decoder.ReleaseScratch();
+      codecs.point_decoder.ReleaseScratch();
       lock.lock();
     }
     wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
@@ -45,7 +45,7 @@ void ChunkDecodePool::Work() {
     Task task = std::move(queue_.front());
     queue_.pop_front();
     lock.unlock();
-    task(decoder);
+    task(codecs);
     task = nullptr;  // the chunk's message goes now, not under the lock
     lock.lock();
   }

@@ -1,0 +1,76 @@
+// Compact, lossless Classify answers (galpha.v1.EncodedSimplexChunk, defined in
+// proto/galpha/v1/alpha_shapes.proto): the server's encoder and the client's decoder in one module,
+// so that both sides read the format from one place. Free of gRPC (only the protobuf messages), so
+// the fuzz target and the unit tests drive it directly.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "absl/status/status.h"
+#include "absl/types/span.h"
+#include "galpha/v1/alpha_shapes.pb.h"
+
+struct ZSTD_CCtx_s;
+struct ZSTD_DCtx_s;
+
+namespace galpha::wire {
+
+/// Most simplices one EncodedSimplexChunk may state: bounds the decoder's work and memory for one
+/// message (13 MiB of decoded triangles). The server sends 131,072 a chunk.
+inline constexpr uint32_t kMaxSimplicesPerEncodedChunk = uint32_t{1} << 20;
+
+/// Vertex indices a simplex of `kind` has (1, 2, 3); 0 for a kind the format does not define.
+int SimplexArity(galpha::v1::SimplexKind kind);
+
+/// Encodes simplex chunks. Holds a zstd context and a scratch buffer reused from chunk to chunk;
+/// not thread-safe.
+class SimplexChunkEncoder {
+ public:
+  /// `zstd_level`: zstd's compression level for DELTA_ZSTD (1 is the fastest).
+  explicit SimplexChunkEncoder(int zstd_level = 1);
+  ~SimplexChunkEncoder();
+  SimplexChunkEncoder(const SimplexChunkEncoder&) = delete;
+  SimplexChunkEncoder& operator=(const SimplexChunkEncoder&) = delete;
+
+  /// The simplices of `kind` whose indices are `indices` (arity a simplex) and whose classes are
+  /// `classes` (one SimplexClass number, 1..4, a simplex), as `encoding` (DELTA or DELTA_ZSTD).
+  /// InvalidArgument for an unknown kind or encoding, counts that disagree, 0 or more than
+  /// kMaxSimplicesPerEncodedChunk simplices, a class byte outside 1..4, and simplices that are not
+  /// strictly ascending within themselves and across the chunk (the format cannot state them).
+  absl::Status Encode(galpha::v1::SimplexKind kind, absl::Span<const uint32_t> indices, std::string_view classes,
+                      galpha::v1::SimplexEncoding encoding, galpha::v1::EncodedSimplexChunk* out);
+  /// The same from a raw chunk.
+  absl::Status Encode(const galpha::v1::SimplexChunk& chunk, galpha::v1::SimplexEncoding encoding,
+                      galpha::v1::EncodedSimplexChunk* out);
+
+ private:
+  int level_;
+  std::unique_ptr<ZSTD_CCtx_s, void (*)(ZSTD_CCtx_s*)> zstd_;
+  std::string plain_;  // the uncompressed sections, for DELTA_ZSTD
+};
+
+/// Decodes EncodedSimplexChunks. Holds a zstd context and a scratch buffer reused from chunk to
+/// chunk; one per stream, not thread-safe.
+class SimplexChunkDecoder {
+ public:
+  SimplexChunkDecoder();
+  ~SimplexChunkDecoder();
+  SimplexChunkDecoder(const SimplexChunkDecoder&) = delete;
+  SimplexChunkDecoder& operator=(const SimplexChunkDecoder&) = delete;
+
+  /// `chunk` as the SimplexChunk it encodes (`out` is overwritten). InvalidArgument naming the
+  /// chunk (`chunk_index`: its place among the answer's chunks, from 0) for everything the proto
+  /// says a client refuses. Decompression never writes more than the count allows. O(count).
+  absl::Status Decode(const galpha::v1::EncodedSimplexChunk& chunk, uint64_t chunk_index,
+                      galpha::v1::SimplexChunk* out);
+
+ private:
+  std::unique_ptr<ZSTD_DCtx_s, void (*)(ZSTD_DCtx_s*)> zstd_;
+  std::unique_ptr<unsigned char[]> scratch_;  // decompressed sections, never zero-filled first
+  size_t scratch_bytes_ = 0;
+};
+
+}  // namespace galpha::wire

@@ -1,0 +1,116 @@
+#include "server/encoded_answer.hpp"
+
+#include <algorithm>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <new>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+
+namespace galpha::server {
+
+namespace v1 = galpha::v1;
+
+namespace {
+
+// One message of the answer: ready at once (the summary) or once its chunk is encoded.
+struct PendingMessage {
+  std::mutex mutex;
+  std::condition_variable encoded;
+  bool ready = false;
+  absl::Status status;
+  v1::ClassifyResponse message;
+};
+
+class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
+ public:
+  EncodedClassifySource(std::unique_ptr<ChunkSource<v1::ClassifyResponse>> raw, v1::SimplexEncoding encoding,
+                        ChunkCodecPool* pool)
+      : raw_(std::move(raw)), encoding_(encoding), pool_(pool), window_(std::clamp<size_t>(pool->threads(), 1, 8)) {}
+
+  // Tasks still queued or running hold their own PendingMessage and chunk: nothing to wait for.
+  ~EncodedClassifySource() override = default;
+
+  bool Next(v1::ClassifyResponse* message) override {
+    if (!status_.ok()) return false;
+    Refill();
+    if (ahead_.empty()) {
+      status_ = raw_->status();
+      return false;
+    }
+    std::shared_ptr<PendingMessage> front = std::move(ahead_.front());
+    ahead_.pop_front();
+    {
+      std::unique_lock<std::mutex> lock(front->mutex);
+      front->encoded.wait(lock, [&] { return front->ready; });
+    }
+    if (!front->status.ok()) {
+      status_ = front->status;
+      ahead_.clear();  // their tasks finish on their own
+      return false;
+    }
+    message->Swap(&front->message);
+    Refill();  // the next chunk encodes while this one is written
+    return true;
+  }
+
+  absl::Status status() const override { return status_; }
+
+ private:
+  // Takes raw messages until `window_` are ahead (or the raw answer ends), sending each simplex
+  // chunk to the pool.
+  void Refill() {
+    while (ahead_.size() < window_ && !raw_done_) {
+      auto pending = std::make_shared<PendingMessage>();
+      if (!raw_->Next(&pending->message)) {
+        raw_done_ = true;
+        break;
+      }
+      ahead_.push_back(pending);
+      if (!pending->message.has_chunk()) {
+        pending->ready = true;
+        continue;
+      }
+      const uint64_t index = chunk_index_++;
+      pool_->Submit([pending, encoding = encoding_, index](ChunkCodecs& codecs) {
+        absl::Status status;
+        v1::ClassifyResponse encoded;
+        try {
+          status = codecs.simplex_encoder.Encode(pending->message.chunk(), encoding, encoded.mutable_encoded_chunk());
+        } catch (const std::bad_alloc&) {
+          status = absl::ResourceExhaustedError("the server ran out of memory encoding the answer");
+        }
+        if (!status.ok()) {
+          // The raw chunks come from the family's own tables: an encoder refusal is our defect.
+          status = absl::InternalError(absl::StrCat("encoding simplex chunk ", index, ": ", status.message()));
+        }
+        std::lock_guard<std::mutex> lock(pending->mutex);
+        pending->status = std::move(status);
+        pending->message.Swap(&encoded);
+        pending->ready = true;
+        pending->encoded.notify_one();
+      });
+    }
+  }
+
+  std::unique_ptr<ChunkSource<v1::ClassifyResponse>> raw_;
+  v1::SimplexEncoding encoding_;
+  ChunkCodecPool* pool_;
+  size_t window_;
+  std::deque<std::shared_ptr<PendingMessage>> ahead_;
+  bool raw_done_ = false;
+  uint64_t chunk_index_ = 0;
+  absl::Status status_;
+};
+
+}  // namespace
+
+std::unique_ptr<ChunkSource<v1::ClassifyResponse>> EncodeSimplexChunks(
+    std::unique_ptr<ChunkSource<v1::ClassifyResponse>> raw, v1::SimplexEncoding encoding, ChunkCodecPool* pool) {
+  if (encoding != v1::SIMPLEX_ENCODING_DELTA && encoding != v1::SIMPLEX_ENCODING_DELTA_ZSTD) return raw;
+  return std::make_unique<EncodedClassifySource>(std::move(raw), encoding, pool);
+}
+
+}  // namespace galpha::server
