@@ -3,7 +3,10 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <condition_variable>
+#include <deque>
 #include <limits>
+#include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -282,20 +285,70 @@ absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
   wire::SimplexChunkDecoder decoder;
   v1::ClassifyResponse decoded;
   uint64_t chunk_index = 0;
-  return ReadStream(
-      request.handle(), &v1::AlphaShapes::Stub::Classify, request,
-      std::function<absl::Status(const v1::ClassifyResponse&)>(
-          [&](const v1::ClassifyResponse& message) -> absl::Status {
-            if (wire_bytes != nullptr) *wire_bytes += message.ByteSizeLong();
-            if (message.has_summary()) return on_message(message);
-            const uint64_t index = chunk_index++;
-            if (!message.has_encoded_chunk()) return on_message(message);
-            if (absl::Status status = decoder.Decode(message.encoded_chunk(), index, decoded.mutable_chunk());
-                !status.ok()) {
-              return status;
-            }
-            return on_message(decoded);
-          }));
+  // A message as the caller sees it: encoded chunks decoded first.
+  const auto hand_over = [&](const v1::ClassifyResponse& message) -> absl::Status {
+    if (wire_bytes != nullptr) *wire_bytes += message.ByteSizeLong();
+    if (message.has_summary()) return on_message(message);
+    const uint64_t index = chunk_index++;
+    if (!message.has_encoded_chunk()) return on_message(message);
+    if (absl::Status status = decoder.Decode(message.encoded_chunk(), index, decoded.mutable_chunk()); !status.ok()) {
+      return status;
+    }
+    return on_message(decoded);
+  };
+  const v1::SimplexEncoding encoding = request.simplex_encoding();
+  if (encoding != v1::SIMPLEX_ENCODING_DELTA && encoding != v1::SIMPLEX_ENCODING_DELTA_ZSTD) {
+    return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Classify, request,
+                      std::function<absl::Status(const v1::ClassifyResponse&)>(hand_over));
+  }
+
+  // Encoded answers: a thread reads (and parses) the next messages while this one decodes, so
+  // that the decoding is not added to the transfer. At most kAhead messages wait.
+  constexpr size_t kAhead = 4;
+  grpc::ClientContext context;
+  PrepareContext(&context, request.handle());
+  std::unique_ptr<grpc::ClientReader<v1::ClassifyResponse>> reader = stub_->Classify(&context, request);
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::deque<v1::ClassifyResponse> ready;
+  bool ended = false, stopped = false;
+  std::thread read_ahead([&] {
+    v1::ClassifyResponse message;
+    while (reader->Read(&message)) {
+      std::unique_lock<std::mutex> lock(mutex);
+      changed.wait(lock, [&] { return ready.size() < kAhead || stopped; });
+      if (stopped) continue;  // cancelled: read to the end, keep nothing
+      ready.push_back(std::move(message));
+      changed.notify_all();
+    }
+    std::lock_guard<std::mutex> lock(mutex);
+    ended = true;
+    changed.notify_all();
+  });
+  absl::Status consumer_error;
+  for (;;) {
+    v1::ClassifyResponse message;
+    {
+      std::unique_lock<std::mutex> lock(mutex);
+      changed.wait(lock, [&] { return !ready.empty() || ended; });
+      if (ready.empty()) break;
+      message = std::move(ready.front());
+      ready.pop_front();
+      changed.notify_all();
+    }
+    consumer_error = hand_over(message);
+    if (!consumer_error.ok()) {
+      context.TryCancel();
+      std::lock_guard<std::mutex> lock(mutex);
+      stopped = true;
+      ready.clear();
+      changed.notify_all();
+      break;
+    }
+  }
+  read_ahead.join();
+  absl::Status status = FromGrpc(reader->Finish());
+  return consumer_error.ok() ? status : consumer_error;
 }
 
 absl::Status AlphaClient::MasterList(const v1::MasterListRequest& request,

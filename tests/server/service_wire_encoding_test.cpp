@@ -193,6 +193,22 @@ TEST(ServiceWireEncodingTest, EveryAnswerEncodingIsTheRawAnswerInFewerBytes) {
         }
       }
     }
+    // A caller that stops after the summary and one chunk gets its own error back, and the
+    // connection answers the next call in full.
+    v1::ClassifyRequest stopping;
+    stopping.set_handle(built->handle);
+    stopping.mutable_threshold()->set_rank(k / 2);
+    stopping.set_simplex_encoding(v1::SIMPLEX_ENCODING_DELTA_ZSTD);
+    int seen = 0;
+    EXPECT_THAT(client->Classify(stopping,
+                                 [&](const v1::ClassifyResponse&) {
+                                   return ++seen == 2 ? absl::CancelledError("enough") : absl::OkStatus();
+                                 }),
+                StatusIs(absl::StatusCode::kCancelled));
+    EXPECT_EQ(seen, 2);
+    stopping.set_mode(v1::CLASSIFY_MODE_GENERAL);
+    EXPECT_FALSE(ClassifyBytes(*client, stopping).empty());
+
     v1::ClassifyRequest undefined;
     undefined.set_handle(built->handle);
     undefined.mutable_threshold()->set_rank(1);
