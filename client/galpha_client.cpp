@@ -3,15 +3,13 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
-#include <condition_variable>
-#include <deque>
 #include <limits>
-#include <mutex>
 #include <optional>
 #include <thread>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "client/classify_answer_decoder.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "proto/codec/point_chunk_codec.hpp"
 #include "proto/codec/simplex_chunk_codec.hpp"
@@ -282,71 +280,56 @@ absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
                                    const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message,
                                    uint64_t* wire_bytes) {
   if (wire_bytes != nullptr) *wire_bytes = 0;
-  wire::SimplexChunkDecoder decoder;
-  v1::ClassifyResponse decoded;
-  uint64_t chunk_index = 0;
-  // A message as the caller sees it: encoded chunks decoded first.
-  const auto hand_over = [&](const v1::ClassifyResponse& message) -> absl::Status {
-    if (wire_bytes != nullptr) *wire_bytes += message.ByteSizeLong();
-    if (message.has_summary()) return on_message(message);
-    const uint64_t index = chunk_index++;
-    if (!message.has_encoded_chunk()) return on_message(message);
-    if (absl::Status status = decoder.Decode(message.encoded_chunk(), index, decoded.mutable_chunk()); !status.ok()) {
-      return status;
-    }
-    return on_message(decoded);
-  };
   const v1::SimplexEncoding encoding = request.simplex_encoding();
   if (encoding != v1::SIMPLEX_ENCODING_DELTA && encoding != v1::SIMPLEX_ENCODING_DELTA_ZSTD) {
+    // Raw chunks, handed over as they come (an encoded one is decoded all the same).
+    wire::SimplexChunkDecoder decoder;
+    v1::ClassifyResponse decoded;
+    uint64_t chunk_index = 0;
     return ReadStream(request.handle(), &v1::AlphaShapes::Stub::Classify, request,
-                      std::function<absl::Status(const v1::ClassifyResponse&)>(hand_over));
+                      std::function<absl::Status(const v1::ClassifyResponse&)>(
+                          [&](const v1::ClassifyResponse& message) -> absl::Status {
+                            if (wire_bytes != nullptr) *wire_bytes += message.ByteSizeLong();
+                            if (message.has_summary()) return on_message(message);
+                            const uint64_t index = chunk_index++;
+                            if (!message.has_encoded_chunk()) return on_message(message);
+                            absl::Status status =
+                                decoder.Decode(message.encoded_chunk(), index, decoded.mutable_chunk());
+                            return status.ok() ? on_message(decoded) : status;
+                          }));
   }
 
-  // Encoded answers: a thread reads (and parses) the next messages while this one decodes, so
-  // that the decoding is not added to the transfer. At most kAhead messages wait.
-  constexpr size_t kAhead = 4;
+  // Encoded answers: a thread reads (and parses) the next messages while a few others decode the
+  // chunks, so that the decoding is neither added to the transfer nor held to one core; this
+  // thread hands them over in order.
+  const size_t threads = std::clamp<size_t>(std::thread::hardware_concurrency() / 2, 1, 4);
+  ClassifyAnswerDecoder answer(threads, 2 * threads + 2);
   grpc::ClientContext context;
   PrepareContext(&context, request.handle());
   std::unique_ptr<grpc::ClientReader<v1::ClassifyResponse>> reader = stub_->Classify(&context, request);
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::deque<v1::ClassifyResponse> ready;
-  bool ended = false, stopped = false;
+  uint64_t read_bytes = 0;
   std::thread read_ahead([&] {
     v1::ClassifyResponse message;
     while (reader->Read(&message)) {
-      std::unique_lock<std::mutex> lock(mutex);
-      changed.wait(lock, [&] { return ready.size() < kAhead || stopped; });
-      if (stopped) continue;  // cancelled: read to the end, keep nothing
-      ready.push_back(std::move(message));
-      changed.notify_all();
+      read_bytes += message.ByteSizeLong();
+      answer.Push(std::move(message));  // after a Stop: dropped, read on to the end
+      message.Clear();
     }
-    std::lock_guard<std::mutex> lock(mutex);
-    ended = true;
-    changed.notify_all();
+    answer.End();
   });
   absl::Status consumer_error;
   for (;;) {
-    v1::ClassifyResponse message;
-    {
-      std::unique_lock<std::mutex> lock(mutex);
-      changed.wait(lock, [&] { return !ready.empty() || ended; });
-      if (ready.empty()) break;
-      message = std::move(ready.front());
-      ready.pop_front();
-      changed.notify_all();
-    }
-    consumer_error = hand_over(message);
+    absl::StatusOr<const v1::ClassifyResponse*> next = answer.Next();
+    consumer_error = next.ok() ? (*next == nullptr ? absl::OkStatus() : on_message(**next)) : next.status();
+    if (next.ok() && *next == nullptr) break;
     if (!consumer_error.ok()) {
       context.TryCancel();
-      std::lock_guard<std::mutex> lock(mutex);
-      stopped = true;
-      ready.clear();
-      changed.notify_all();
+      answer.Stop();
       break;
     }
   }
   read_ahead.join();
+  if (wire_bytes != nullptr) *wire_bytes = read_bytes;
   absl::Status status = FromGrpc(reader->Finish());
   return consumer_error.ok() ? status : consumer_error;
 }
