@@ -4,6 +4,8 @@
 #include <zstd_errors.h>
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
 #include <cstring>
 
 #include "absl/status/statusor.h"
@@ -89,6 +91,110 @@ absl::StatusOr<size_t> WriteSections(int arity, const uint32_t* indices, const c
     }
   }
   return static_cast<size_t>(p - out);
+}
+
+// The classes section: four 2-bit classes a byte, unpacked through a table of four class bytes
+// per packed byte.
+void UnpackClasses(const unsigned char* packed, size_t count, char* out) {
+  static const std::array<std::array<char, 4>, 256> kTable = [] {
+    std::array<std::array<char, 4>, 256> table{};
+    for (unsigned byte = 0; byte < 256; ++byte) {
+      for (unsigned j = 0; j < 4; ++j) table[byte][j] = static_cast<char>(((byte >> (2 * j)) & 3u) + 1u);
+    }
+    return table;
+  }();
+  const size_t whole = count / 4;
+  for (size_t i = 0; i < whole; ++i) std::memcpy(out + 4 * i, kTable[packed[i]].data(), 4);
+  for (size_t i = 4 * whole; i < count; ++i) out[i] = kTable[packed[i / 4]][i % 4];
+}
+
+// Why the indices section failed, and at which simplex.
+struct IndexFailure {
+  enum Kind { kNone, kTruncated, kOverlong, kOverflow } kind = kNone;
+  size_t simplex = 0;
+};
+
+// One varint at *p with no bound check (the caller knows that kMaxVarintBytes bytes are there);
+// false for a longer one.
+inline bool ReadVarintUnchecked(const unsigned char** p, uint64_t* value) {
+  const unsigned char* q = *p;
+  uint64_t v = q[0];
+  if (v < 0x80) {
+    *p = q + 1;
+    *value = v;
+    return true;
+  }
+  v &= 0x7F;
+  for (int i = 1; i < static_cast<int>(kMaxVarintBytes); ++i) {
+    const uint64_t byte = q[i];
+    v |= (byte & 0x7F) << (7 * i);
+    if (byte < 0x80) {
+      *p = q + i + 1;
+      *value = v;
+      return true;
+    }
+  }
+  return false;
+}
+
+// One varint at *p, checked against `end`.
+inline IndexFailure::Kind ReadVarintChecked(const unsigned char** p, const unsigned char* end, uint64_t* value) {
+  uint64_t v = 0;
+  for (int shift = 0;; shift += 7) {
+    if (*p == end) return IndexFailure::kTruncated;
+    if (shift == 7 * static_cast<int>(kMaxVarintBytes)) return IndexFailure::kOverlong;
+    const unsigned byte = *(*p)++;
+    v |= static_cast<uint64_t>(byte & 0x7Fu) << shift;
+    if ((byte & 0x80u) == 0) break;
+  }
+  *value = v;
+  return IndexFailure::kNone;
+}
+
+// The indices of `count` simplices of A vertices from the varints at *p (proto: EncodedSimplexChunk),
+// into out[0, A * count). Simplices whose varints are surely all there (A * kMaxVarintBytes bytes
+// left) are read without bound checks; the prefix rule is written as selects, not branches.
+template <int A>
+IndexFailure DecodeIndices(const unsigned char** cursor, const unsigned char* end, size_t count, uint32_t* out) {
+  const unsigned char* p = *cursor;
+  for (size_t i = 0; i < count; ++i) {
+    std::array<uint64_t, A> v;
+    if (end - p >= static_cast<std::ptrdiff_t>(A * kMaxVarintBytes)) {
+      for (int k = 0; k < A; ++k) {
+        if (!ReadVarintUnchecked(&p, &v[static_cast<size_t>(k)])) return {IndexFailure::kOverlong, i};
+      }
+    } else {
+      for (int k = 0; k < A; ++k) {
+        const IndexFailure::Kind read = ReadVarintChecked(&p, end, &v[static_cast<size_t>(k)]);
+        if (read != IndexFailure::kNone) return {read, i};
+      }
+    }
+    uint32_t* u = out + i * A;
+    std::array<uint64_t, A> index;
+    if (i == 0) {
+      // The chunk's first simplex: from nothing, each index after the one before it.
+      index[0] = v[0];
+      for (int k = 1; k < A; ++k) index[k] = index[k - 1] + v[k] + 1;
+    } else {
+      const uint32_t* prev = u - A;
+      bool same = true;  // u[0..k-1] == prev[0..k-1]
+      for (int k = 0; k < A; ++k) {
+        const uint64_t last = k + 1 == A ? 1 : 0;
+        const uint64_t from_prev = uint64_t{prev[k]} + v[k] + last;
+        const uint64_t from_before = k == 0 ? 0 : index[k > 0 ? k - 1 : 0] + v[k] + 1;
+        index[k] = same ? from_prev : from_before;
+        same = same && v[k] == 0;
+      }
+    }
+    uint64_t high = 0;
+    for (int k = 0; k < A; ++k) {
+      high |= index[k] >> 32;
+      u[k] = static_cast<uint32_t>(index[k]);
+    }
+    if (high != 0) return {IndexFailure::kOverflow, i};
+  }
+  *cursor = p;
+  return {};
 }
 
 }  // namespace
@@ -224,44 +330,24 @@ absl::Status SimplexChunkDecoder::Decode(const v1::EncodedSimplexChunk& chunk, u
   out->set_kind(chunk.kind());
   std::string* classes = out->mutable_classes();
   classes->resize(count);
-  char* c = classes->data();
-  for (size_t i = 0; i < count; ++i) {
-    c[i] = static_cast<char>(((sections[i / 4] >> (2 * (i % 4))) & 3u) + 1u);
-  }
+  UnpackClasses(sections, count, classes->data());
 
-  const size_t a = static_cast<size_t>(arity);
   auto* indices = out->mutable_vertex_indices();
-  indices->Resize(static_cast<int>(count * a), 0);
-  uint32_t* u = indices->mutable_data();
+  indices->Resize(static_cast<int>(count * static_cast<size_t>(arity)), 0);
   const unsigned char* p = sections + class_bytes;
   const unsigned char* end = sections + size;
-  for (size_t i = 0; i < count; ++i) {
-    uint32_t* cur = u + i * a;
-    const uint32_t* prev = i > 0 ? cur - a : nullptr;
-    bool same = prev != nullptr;
-    for (size_t k = 0; k < a; ++k) {
-      uint64_t value = 0;
-      for (int shift = 0;; shift += 7) {
-        if (p == end) return Refuse(chunk_index, "its varints end inside simplex ", i, " (truncated)");
-        if (shift == 7 * static_cast<int>(kMaxVarintBytes)) {
-          return Refuse(chunk_index, "simplex ", i, " has a varint longer than ", kMaxVarintBytes, " bytes");
-        }
-        const unsigned byte = *p++;
-        value |= static_cast<uint64_t>(byte & 0x7Fu) << shift;
-        if ((byte & 0x80u) == 0) break;
-      }
-      uint64_t index;
-      if (same) {
-        index = uint64_t{prev[k]} + value + (k + 1 == a ? 1 : 0);
-        same = value == 0;
-      } else if (k == 0) {
-        index = value;
-      } else {
-        index = uint64_t{cur[k - 1]} + value + 1;
-      }
-      if (index > UINT32_MAX) return Refuse(chunk_index, "simplex ", i, " has an index over 2^32 - 1");
-      cur[k] = static_cast<uint32_t>(index);
-    }
+  const IndexFailure failure = arity == 1   ? DecodeIndices<1>(&p, end, count, indices->mutable_data())
+                               : arity == 2 ? DecodeIndices<2>(&p, end, count, indices->mutable_data())
+                                            : DecodeIndices<3>(&p, end, count, indices->mutable_data());
+  switch (failure.kind) {
+    case IndexFailure::kNone:
+      break;
+    case IndexFailure::kTruncated:
+      return Refuse(chunk_index, "its varints end inside simplex ", failure.simplex, " (truncated)");
+    case IndexFailure::kOverlong:
+      return Refuse(chunk_index, "simplex ", failure.simplex, " has a varint longer than ", kMaxVarintBytes, " bytes");
+    case IndexFailure::kOverflow:
+      return Refuse(chunk_index, "simplex ", failure.simplex, " has an index over 2^32 - 1");
   }
   if (p != end) return Refuse(chunk_index, "it has ", end - p, " bytes after its ", count, " simplices");
   return absl::OkStatus();
