@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <array>
+#include <atomic>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -26,32 +28,47 @@ namespace v1 = galpha::v1;
 namespace {
 
 /// A server-streamed answer written chunk by chunk as the client takes them (a slow reader slows
-/// the writer; nothing is buffered beyond one message).
+/// the writer). Two messages: while one is written, the source fills the next, so that its work
+/// (classes gathered, chunks encoded) overlaps the transport instead of following each write.
+/// Whichever of the two finishes last, the write (OnWriteDone) or the fill, starts the next cycle;
+/// at most one write is in flight, and nothing is buffered beyond the one message filled ahead.
 template <typename Message>
 class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
  public:
   ChunkWriter(RpcRecord record, std::unique_ptr<ChunkSource<Message>> source)
       : record_(record), source_(std::move(source)) {
-    WriteNext();
+    has_next_ = source_->Next(&messages_[0]);
+    WriteCycles();
   }
   /// An answer that is only an error.
   ChunkWriter(RpcRecord record, const absl::Status& error) : record_(record) { Done(ToGrpcStatus(error)); }
 
   void OnWriteDone(bool ok) override {
-    if (!ok) {
-      Done(grpc::Status(grpc::StatusCode::CANCELLED, "the client stopped reading"));
-      return;
-    }
-    WriteNext();
+    if (!ok) write_failed_ = true;                                       // published by the fetch_add below
+    if (arrivals_.fetch_add(1, std::memory_order_acq_rel) == 0) return;  // the fill goes on
+    WriteCycles();
   }
   void OnDone() override { delete this; }
 
  private:
-  void WriteNext() {
-    if (source_->Next(&message_)) {
-      this->StartWrite(&message_);
-    } else {
-      Done(ToGrpcStatus(source_->status()));
+  // Runs with no write in flight and messages_[next_] filled (if has_next_): starts its write and
+  // fills the other message meanwhile, as long as the write finishes first.
+  void WriteCycles() {
+    for (;;) {
+      if (write_failed_) {
+        Done(grpc::Status(grpc::StatusCode::CANCELLED, "the client stopped reading"));
+        return;
+      }
+      if (!has_next_) {
+        Done(ToGrpcStatus(source_->status()));
+        return;
+      }
+      Message* writing = &messages_[next_];
+      next_ ^= 1;
+      arrivals_.store(0, std::memory_order_relaxed);
+      this->StartWrite(writing);
+      has_next_ = source_->Next(&messages_[next_]);
+      if (arrivals_.fetch_add(1, std::memory_order_acq_rel) == 0) return;  // OnWriteDone goes on
     }
   }
   void Done(const grpc::Status& status) {
@@ -62,7 +79,12 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
 
   RpcRecord record_;
   std::unique_ptr<ChunkSource<Message>> source_;
-  Message message_;
+  std::array<Message, 2> messages_;
+  size_t next_ = 0;        // the message to write next
+  bool has_next_ = false;  // whether it holds one
+  bool write_failed_ = false;
+  // The write's end and the fill's: the second to arrive starts the next cycle.
+  std::atomic<int> arrivals_{0};
 };
 
 /// Finishes a unary RPC with `status`, recorded first.
