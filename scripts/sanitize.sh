@@ -10,7 +10,8 @@
 #         the fuzz targets (tests/fuzz, build_stream_fuzzer), the cache and the upload streams
 #         under TSan below, and all of them in the Release suite.
 #   tsan  ThreadSanitizer on the service's threaded parts (build scheduler, family cache, upload
-#         streams). OpenMP runs one thread there (OMP_NUM_THREADS=1 in the preset): Debian's
+#         streams, compact answers encoded on the codec pool) and the client's parallel decoding
+#         of compact answers. OpenMP runs one thread there (OMP_NUM_THREADS=1 in the preset): Debian's
 #         libgomp is not instrumented, and its own threads would only report its internals.
 # Only these tests, not the whole suite: both builds and runs must fit in CI's budget on 2 cores.
 # Both presets compile at -O1 -g1 (CMAKE_CXX_FLAGS_RELWITHDEBINFO), the level the sanitizers'
@@ -26,7 +27,8 @@ cd "$(dirname "$0")/.."
 
 asan_tests=(predicates_test power_test attachment_test radius_test point_formats_test point_set_handle_test
             alpha_family_test alpha_bruteforce_test)
-tsan_tests=(build_scheduler_test family_cache_test family_promoter_test build_stream_test)
+tsan_tests=(build_scheduler_test family_cache_test family_promoter_test build_stream_test encoded_answer_test
+            classify_answer_decoder_test)
 
 run_preset() {
   local preset=$1

@@ -8,7 +8,7 @@
 #include "absl/status/statusor.h"
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "server/chunk_codec_pool.hpp"
-#include "server/query_answers.hpp"
+#include "server/chunk_source.hpp"
 
 namespace galpha::server {
 

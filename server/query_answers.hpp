@@ -13,6 +13,7 @@
 #include "core/geometry/shape.hpp"
 #include "galpha/v1/alpha_shapes.pb.h"
 #include "server/cached_family.hpp"
+#include "server/chunk_source.hpp"
 
 namespace galpha::server {
 
@@ -44,17 +45,6 @@ absl::StatusOr<VertexRule> ToVertexRule(galpha::v1::VertexRule rule);
 
 /// Describe's and Build's summary of a cached family, without a name (Build adds its caller's).
 void FillBuildSummary(const CachedFamily& cached, galpha::v1::BuildSummary* summary);
-
-/// A generator of a server-streamed answer: Next fills the next message, false when the answer is
-/// complete or has failed; status() then says which.
-template <typename Message>
-class ChunkSource {
- public:
-  virtual ~ChunkSource() = default;
-  virtual bool Next(Message* message) = 0;
-  /// OK while the answer goes on and once it is complete; the error that ended it otherwise.
-  virtual absl::Status status() const { return absl::OkStatus(); }
-};
 
 /// Classify: the summary, then vertex, edge and triangle chunks in index order, always raw
 /// (SimplexChunk; the service encodes them as the request asks: encoded_answer.hpp).

@@ -1,17 +1,19 @@
-// Compact Classify answers on the codec pool (server/encoded_answer.hpp): for every family and
-// request shape, the encoded answer is the raw answer message for message (the summary as it is,
-// each chunk its encoding, decoded by the client's decoder to the same chunk), whatever order the
-// pool's threads finish in; RAW is the raw answer itself; an encoder refusal ends the answer with an
-// internal error that names the chunk, not with a truncated answer that looks complete.
+// Compact Classify answers on the codec pool (server/encoded_answer.hpp), over synthetic raw
+// answers (gRPC-free, and so also in the ThreadSanitizer build): the encoded answer is the raw one
+// message for message, each chunk decoding to the raw chunk, whatever order the pool's threads
+// finish in; RAW is the raw answer itself; an encoder refusal ends the answer with an internal
+// error naming the chunk, not with a truncated answer that looks complete; an answer dropped while
+// its chunks are still encoding leaves the pool working.
 #include "server/encoded_answer.hpp"
 
+#include <gtest/gtest.h>
+
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
-#include "gtest/gtest.h"
 #include "proto/codec/simplex_chunk_codec.hpp"
-#include "tests/server/query_answers_fixture.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
@@ -20,92 +22,95 @@ namespace {
 namespace v1 = galpha::v1;
 using galpha::testing::IsOk;
 using galpha::testing::StatusIs;
-using testing::Drain;
-using testing::Families;
-using testing::LargeFamily;
-using testing::Rank;
 
-std::unique_ptr<ChunkSource<v1::ClassifyResponse>> RawSource(std::shared_ptr<const CachedFamily> family,
-                                                             const v1::ClassifyRequest& request) {
-  auto source = MakeClassifySource(std::move(family), request);
-  EXPECT_THAT(source.status(), IsOk());
-  return source.ok() ? *std::move(source) : nullptr;
+// A summary, then `chunks` chunks of sorted edges or triangles of random sizes (1 to 3,000).
+std::vector<v1::ClassifyResponse> RandomAnswer(int chunks, uint64_t seed) {
+  std::mt19937_64 random(seed);
+  std::vector<v1::ClassifyResponse> messages(1);
+  messages[0].mutable_summary()->set_level(static_cast<int64_t>(seed));
+  for (int c = 0; c < chunks; ++c) {
+    v1::ClassifyResponse message;
+    v1::SimplexChunk* chunk = message.mutable_chunk();
+    const bool triangles = c % 2 == 1;
+    chunk->set_kind(triangles ? v1::SIMPLEX_KIND_TRIANGLE : v1::SIMPLEX_KIND_EDGE);
+    const int n = 1 + static_cast<int>(random() % 3000);
+    uint32_t first = static_cast<uint32_t>(random() % 1000);
+    for (int i = 0; i < n; ++i) {
+      first += static_cast<uint32_t>(random() % 3 == 0);  // runs of equal first vertices
+      chunk->add_vertex_indices(first);
+      chunk->add_vertex_indices(first + 1 + static_cast<uint32_t>(i));
+      if (triangles)
+        chunk->add_vertex_indices(first + 2 + static_cast<uint32_t>(i) + static_cast<uint32_t>(random() % 7));
+      chunk->mutable_classes()->push_back(static_cast<char>(1 + random() % 4));
+    }
+    messages.push_back(std::move(message));
+  }
+  return messages;
 }
 
-TEST(EncodedAnswerTest, EveryEncodedAnswerDecodesToTheRawAnswer) {
-  ChunkCodecPool pool(3);
-  std::vector<std::shared_ptr<const CachedFamily>> families = {LargeFamily()};
-  for (const auto& named : Families()) families.push_back(named.cached);
-  for (const auto& family : families) {
-    const int64_t k = family->reader().max_level();
-    for (int64_t rank : {int64_t{0}, k / 2, k}) {
-      for (bool non_exterior_only : {false, true}) {
-        for (v1::SimplexEncoding encoding : {v1::SIMPLEX_ENCODING_DELTA, v1::SIMPLEX_ENCODING_DELTA_ZSTD}) {
-          SCOPED_TRACE(::testing::Message() << "rank " << rank << " of " << k << ", encoding " << encoding
-                                            << (non_exterior_only ? ", non-exterior only" : ""));
-          v1::ClassifyRequest request;
-          *request.mutable_threshold() = Rank(rank);
-          request.set_non_exterior_only(non_exterior_only);
-          const std::vector<v1::ClassifyResponse> raw = Drain(*RawSource(family, request));
-          auto encoded_source = EncodeSimplexChunks(RawSource(family, request), encoding, &pool);
-          const std::vector<v1::ClassifyResponse> encoded = Drain(*encoded_source);
-          EXPECT_THAT(encoded_source->status(), IsOk());
-          ASSERT_EQ(encoded.size(), raw.size());
-          wire::SimplexChunkDecoder decoder;
-          for (size_t i = 0; i < raw.size(); ++i) {
-            if (raw[i].has_summary()) {
-              EXPECT_EQ(encoded[i].SerializeAsString(), raw[i].SerializeAsString()) << "message " << i;
-              continue;
-            }
-            ASSERT_TRUE(encoded[i].has_encoded_chunk()) << "message " << i;
-            EXPECT_EQ(encoded[i].encoded_chunk().encoding(), encoding);
-            v1::ClassifyResponse decoded;
-            ASSERT_THAT(decoder.Decode(encoded[i].encoded_chunk(), i, decoded.mutable_chunk()), IsOk());
-            EXPECT_EQ(decoded.SerializeAsString(), raw[i].SerializeAsString()) << "message " << i;
-          }
+// Hands out `messages` one by one; then its `status` (OK: the answer is complete).
+class ListSource final : public ChunkSource<v1::ClassifyResponse> {
+ public:
+  explicit ListSource(std::vector<v1::ClassifyResponse> messages, absl::Status status = absl::OkStatus())
+      : messages_(std::move(messages)), status_(std::move(status)) {}
+  bool Next(v1::ClassifyResponse* message) override {
+    if (next_ == messages_.size()) return false;
+    *message = messages_[next_++];
+    return true;
+  }
+  absl::Status status() const override { return next_ == messages_.size() ? status_ : absl::OkStatus(); }
+
+ private:
+  std::vector<v1::ClassifyResponse> messages_;
+  size_t next_ = 0;
+  absl::Status status_;
+};
+
+TEST(EncodedAnswerTest, EncodedAnswersDecodeToTheRawAnswerInOrder) {
+  ChunkCodecPool pool(4);
+  for (uint64_t seed = 1; seed <= 12; ++seed) {
+    for (v1::SimplexEncoding encoding : {v1::SIMPLEX_ENCODING_DELTA, v1::SIMPLEX_ENCODING_DELTA_ZSTD}) {
+      SCOPED_TRACE(::testing::Message() << "seed " << seed << ", encoding " << encoding);
+      const std::vector<v1::ClassifyResponse> raw = RandomAnswer(static_cast<int>(seed * 3), seed);
+      auto encoded = EncodeSimplexChunks(std::make_unique<ListSource>(raw), encoding, &pool);
+      wire::SimplexChunkDecoder decoder;
+      v1::ClassifyResponse message;
+      size_t i = 0;
+      while (encoded->Next(&message)) {
+        ASSERT_LT(i, raw.size());
+        if (i == 0) {
+          EXPECT_EQ(message.SerializeAsString(), raw[0].SerializeAsString());
+        } else {
+          ASSERT_TRUE(message.has_encoded_chunk()) << "message " << i;
+          EXPECT_EQ(message.encoded_chunk().encoding(), encoding);
+          v1::ClassifyResponse decoded;
+          ASSERT_THAT(decoder.Decode(message.encoded_chunk(), i - 1, decoded.mutable_chunk()), IsOk());
+          EXPECT_EQ(decoded.SerializeAsString(), raw[i].SerializeAsString()) << "message " << i;
         }
+        ++i;
       }
+      EXPECT_EQ(i, raw.size());
+      EXPECT_THAT(encoded->status(), IsOk());
     }
   }
 }
 
 TEST(EncodedAnswerTest, RawIsTheRawAnswerItself) {
   ChunkCodecPool pool(1);
-  v1::ClassifyRequest request;
-  *request.mutable_threshold() = Rank(1);
   for (v1::SimplexEncoding encoding : {v1::SIMPLEX_ENCODING_UNSPECIFIED, v1::SIMPLEX_ENCODING_RAW}) {
-    auto raw = RawSource(LargeFamily(), request);
+    auto raw = std::make_unique<ListSource>(RandomAnswer(2, 1));
     const ChunkSource<v1::ClassifyResponse>* address = raw.get();
     EXPECT_EQ(EncodeSimplexChunks(std::move(raw), encoding, &pool).get(), address);
   }
 }
 
-// A summary, two good chunks, one the format cannot state (out of order), one more.
-class ChunksWithADefect final : public ChunkSource<v1::ClassifyResponse> {
- public:
-  bool Next(v1::ClassifyResponse* message) override {
-    message->Clear();
-    if (sent_ == 5) return false;
-    const int n = sent_++;
-    if (n == 0) {
-      message->mutable_summary()->set_level(3);
-      return true;
-    }
-    v1::SimplexChunk* chunk = message->mutable_chunk();
-    chunk->set_kind(v1::SIMPLEX_KIND_EDGE);
-    chunk->add_vertex_indices(n == 3 ? 9 : 1);
-    chunk->add_vertex_indices(n == 3 ? 2 : 2);
-    chunk->set_classes("\x01");
-    return true;
-  }
-
- private:
-  int sent_ = 0;
-};
-
 TEST(EncodedAnswerTest, AnEncoderRefusalEndsTheAnswerWithAnInternalError) {
   ChunkCodecPool pool(2);
-  auto source = EncodeSimplexChunks(std::make_unique<ChunksWithADefect>(), v1::SIMPLEX_ENCODING_DELTA_ZSTD, &pool);
+  std::vector<v1::ClassifyResponse> raw = RandomAnswer(4, 7);
+  // Chunk 2 (message 3) out of order: its first edge reversed.
+  auto* indices = raw[3].mutable_chunk()->mutable_vertex_indices();
+  std::swap((*indices)[0], (*indices)[1]);
+  auto source = EncodeSimplexChunks(std::make_unique<ListSource>(raw), v1::SIMPLEX_ENCODING_DELTA_ZSTD, &pool);
   v1::ClassifyResponse message;
   ASSERT_TRUE(source->Next(&message));
   EXPECT_TRUE(message.has_summary());
@@ -118,6 +123,36 @@ TEST(EncodedAnswerTest, AnEncoderRefusalEndsTheAnswerWithAnInternalError) {
   EXPECT_NE(source->status().message().find("encoding simplex chunk 2: "), std::string::npos)
       << source->status().message();
   EXPECT_FALSE(source->Next(&message)) << "a failed answer stays failed";
+}
+
+TEST(EncodedAnswerTest, TheRawAnswersErrorEndsTheEncodedAnswer) {
+  ChunkCodecPool pool(2);
+  auto source = EncodeSimplexChunks(std::make_unique<ListSource>(RandomAnswer(3, 2), absl::DataLossError("lost")),
+                                    v1::SIMPLEX_ENCODING_DELTA, &pool);
+  v1::ClassifyResponse message;
+  int messages = 0;
+  while (source->Next(&message)) ++messages;
+  EXPECT_EQ(messages, 4);
+  EXPECT_THAT(source->status(), StatusIs(absl::StatusCode::kDataLoss));
+}
+
+TEST(EncodedAnswerTest, AnAnswerDroppedMidwayLeavesThePoolWorking) {
+  ChunkCodecPool pool(3);
+  for (int round = 0; round < 20; ++round) {
+    auto source = EncodeSimplexChunks(std::make_unique<ListSource>(RandomAnswer(30, 100 + round)),
+                                      v1::SIMPLEX_ENCODING_DELTA_ZSTD, &pool);
+    v1::ClassifyResponse message;
+    ASSERT_TRUE(source->Next(&message));  // the summary; chunks are encoding behind it
+    ASSERT_TRUE(source->Next(&message));
+  }
+  // Every dropped answer's tasks still ran or run; a new answer is served in full.
+  auto source =
+      EncodeSimplexChunks(std::make_unique<ListSource>(RandomAnswer(5, 3)), v1::SIMPLEX_ENCODING_DELTA, &pool);
+  v1::ClassifyResponse message;
+  int messages = 0;
+  while (source->Next(&message)) ++messages;
+  EXPECT_EQ(messages, 6);
+  EXPECT_THAT(source->status(), IsOk());
 }
 
 }  // namespace
