@@ -5,7 +5,8 @@
     C++ client (alphactl --server ... bench: the same Build call, after a Release each time);
   * in process: galpha.local().build() vs the engine's own time for the same build in alphactl
     bench (the sum of its stage times, best of --repeat);
-  * classify at one alpha: NumPy arrays per second, both clients;
+  * classify at one alpha: NumPy arrays per second, both clients (the network one in every
+    answer encoding: raw, delta, zstd);
   * the shape at that alpha and at a fifth of it (a fragmented shape: many small polygons,
     singular edges and isolated points) as shapely geometry (mode general), local: Family.shape() (one GEOS call through WKB) vs the same geometry built from
     Family.shape_rings() with shapely's constructors, one object a member (what Family.shape did
@@ -150,7 +151,11 @@ def main() -> int:
                 upload_bytes = remote.summary.upload_bytes
                 net_wall = min(net_wall, wall)
                 net_overhead = min(net_overhead, wall - sum(remote.summary.stage_times.values()))
-            net_classify = classify_rate(remote, alpha)
+            # Classify in every answer encoding (connect's answer_encoding), the same family.
+            net_classify = {}
+            for answer_encoding in ("raw", "delta", "zstd"):
+                with galpha.connect(target, timeout=600, answer_encoding=answer_encoding) as by_encoding:
+                    net_classify[answer_encoding] = classify_rate(by_encoding.family(handle, points), alpha)
             remote.release()
             net.close()
         finally:
@@ -170,7 +175,9 @@ def main() -> int:
     print(f"{'network: galpha.connect().build(), minus stages':52}{ms(net_overhead)}")
     print(f"{'network: Python upload, bytes a point (' + args.encoding + ')':52}{upload_bytes / args.points:10.2f}")
     print(f"{'classify, local: ms / GB/s':52}{ms(local_classify[0])}  {local_classify[1]:.2f} GB/s")
-    print(f"{'classify, network: ms / GB/s':52}{ms(net_classify[0])}  {net_classify[1]:.2f} GB/s")
+    for answer_encoding, (seconds, rate) in net_classify.items():
+        label = f"classify, network, answer_encoding={answer_encoding}: ms / GB/s"
+        print(f"{label:52}{ms(seconds)}  {rate:.2f} GB/s")
     for label, (ours, constructors) in shapes.items():
         print(f"{'shape at ' + label + ', local: Family.shape(), general':52}{ms(ours)}")
         print(f"{'shape at ' + label + ', local: shapely constructors':52}{ms(constructors)}")

@@ -201,3 +201,33 @@ def test_asyncio_client_gives_the_same_answers(server) -> None:
         np.testing.assert_array_equal(master.vertex_indices, family.master_list(k // 3).vertex_indices)
         np.testing.assert_array_equal(curve.components, family.components().components)
         assert optimal == family.optimal(2)
+
+
+def test_every_answer_encoding_gives_the_raw_answer(server) -> None:
+    # Shuffled points with more than one chunk (131,072 simplices) of edges and of triangles, and a
+    # data set in its own order; both modes, and the non-exterior part.
+    sets = [np.random.default_rng(5).random((60000, 2)), read_bin(DATA_SETS[0])]
+    for points in sets:
+        answers = {}
+        for encoding in ("raw", "delta", "zstd"):
+            with galpha.connect(server.address, timeout=60, answer_encoding=encoding) as c:
+                family = c.build(points)
+                k = family.spectrum_size
+                answers[encoding] = [
+                    family.classify(rank=k // 2),
+                    family.classify(rank=k // 3, mode="regularized"),
+                    family.classify(rank=k // 2, non_exterior_only=True),
+                ]
+        for encoding in ("delta", "zstd"):
+            for got, want in zip(answers[encoding], answers["raw"]):
+                for field in ("vertices", "vertex_classes", "edges", "edge_classes", "triangles", "triangle_classes"):
+                    np.testing.assert_array_equal(getattr(got, field), getattr(want, field), err_msg=f"{encoding} {field}")
+                    assert getattr(got, field).dtype == getattr(want, field).dtype
+                assert got.interior_area == want.interior_area and got.holes == want.holes
+
+
+def test_an_unknown_answer_encoding_is_refused() -> None:
+    with pytest.raises(galpha.InvalidInput, match="answer_encoding is 'raw', 'delta' or 'zstd', not 'gzip'"):
+        galpha.connect("localhost:1", answer_encoding="gzip")
+    with pytest.raises(galpha.InvalidInput, match="answer_encoding"):
+        galpha.aio.connect("localhost:1", answer_encoding="lz4")

@@ -118,16 +118,27 @@ class ClassifyAssembler:
     def __init__(self) -> None:
         self.summary: Optional[pb.ClassifySummary] = None
         self.parts: dict = {1: ([], []), 2: ([], []), 3: ([], [])}
+        self.chunks = 0
 
     def add(self, raw: bytes) -> None:
         number, payload = _wire.split_oneof(raw)
         if number == 1:
             self.summary = pb.ClassifySummary.FromString(bytes(payload))
-        elif number == 2:
+            return
+        if number not in (2, 3):
+            return
+        index = self.chunks
+        self.chunks += 1
+        if number == 2:
             kind, indices, classes = _wire.decode_simplex_chunk(payload)
-            if kind in self.parts:
-                self.parts[kind][0].append(indices)
-                self.parts[kind][1].append(classes)
+        else:
+            try:
+                kind, indices, classes = _wire.decode_encoded_simplex_chunk(payload, index)
+            except _wire.EncodedChunkError as e:
+                raise GalphaError(f"the server's Classify answer: {e}", code="DATA_LOSS", code_number=15) from None
+        if kind in self.parts:
+            self.parts[kind][0].append(indices)
+            self.parts[kind][1].append(classes)
 
     def result(self) -> Classification:
         if self.summary is None:
@@ -378,13 +389,31 @@ def _identity(b: bytes) -> bytes:
     return b
 
 
+#: connect()'s answer_encoding values: how Classify's simplices come down (ClassifyRequest.simplex_encoding).
+ANSWER_ENCODINGS = {"raw": 1, "delta": 2, "zstd": 3}
+
+
+def answer_encoding_number(answer_encoding: str) -> int:
+    """The SimplexEncoding number of connect()'s ``answer_encoding``; InvalidInput for another value
+    and for "zstd" without the zstandard module (Debian's python3-zstandard)."""
+    if answer_encoding not in ANSWER_ENCODINGS:
+        raise InvalidInput(f"answer_encoding is 'raw', 'delta' or 'zstd', not {answer_encoding!r}")
+    if answer_encoding == "zstd":
+        try:
+            import zstandard  # noqa: F401
+        except ImportError:
+            raise InvalidInput("answer_encoding='zstd' needs the zstandard module (Debian: python3-zstandard)") from None
+    return ANSWER_ENCODINGS[answer_encoding]
+
+
 class Calls:
     """The service's methods on one channel, with the token and the routing header attached."""
 
-    def __init__(self, channel: Any, token: Optional[str], timeout: Optional[float]) -> None:
+    def __init__(self, channel: Any, token: Optional[str], timeout: Optional[float], answer_encoding: str = "raw") -> None:
         self.channel = channel
         self.token = token
         self.timeout = timeout
+        self.simplex_encoding = answer_encoding_number(answer_encoding)
         def unary(name: str, request_type: Any, response_type: Any) -> Any:
             return channel.unary_unary(
                 SERVICE + name, request_serializer=request_type.SerializeToString, response_deserializer=response_type.FromString
@@ -477,6 +506,7 @@ class NetworkFamilyBackend:
             vertex_rule=_RULES[vertex_rule],
             non_exterior_only=non_exterior_only,
             summary_only=summary_only,
+            simplex_encoding=self._calls.simplex_encoding,
         )
         assembler = ClassifyAssembler()
         for raw in self._stream(self._calls.classify, request):

@@ -145,6 +145,145 @@ def decode_simplex_chunk(payload: memoryview) -> Tuple[int, np.ndarray, np.ndarr
     return kind, _concat(parts_idx, "<u4"), _concat(parts_cls, np.uint8)
 
 
+#: The most simplices one EncodedSimplexChunk may state (the proto's limit).
+MAX_SIMPLICES_PER_ENCODED_CHUNK = 1 << 20
+SIMPLEX_ENCODING_DELTA, SIMPLEX_ENCODING_DELTA_ZSTD = 2, 3
+
+
+class EncodedChunkError(ValueError):
+    """An EncodedSimplexChunk that does not decode; the message names what is wrong."""
+
+
+def _segment_base(starts: np.ndarray, base_at_start: np.ndarray) -> np.ndarray:
+    """For each row, base_at_start of the last row at or before it where ``starts`` is True (row 0
+    always starts)."""
+    last = np.maximum.accumulate(np.where(starts, np.arange(starts.size), 0))
+    return base_at_start[last]
+
+
+def decode_encoded_simplex_chunk(payload: memoryview, chunk_index: int) -> Tuple[int, np.ndarray, np.ndarray]:
+    """EncodedSimplexChunk (proto: the layout; docs/design.md, "Compact Classify answers") as
+    (kind, vertex indices as uint32, classes as uint8), what decode_simplex_chunk gives for the raw
+    chunk, decoded with NumPy (no Python loop over simplices): the varints' 7-bit groups summed per
+    varint, the differences turned into indices by cumulative sums within runs of equal prefixes.
+    EncodedChunkError naming the chunk for everything the proto says a client refuses."""
+    kind = count = encoding = 0
+    data: object = b""
+    for number, _wire, value in fields(payload):
+        if number == 1:
+            kind = int(value)  # type: ignore[arg-type]
+        elif number == 2:
+            count = int(value)  # type: ignore[arg-type]
+        elif number == 3:
+            encoding = int(value)  # type: ignore[arg-type]
+        elif number == 4:
+            data = value
+
+    def refuse(what: str) -> EncodedChunkError:
+        return EncodedChunkError(f"encoded simplex chunk {chunk_index}: {what}")
+
+    arity = {1: 1, 2: 2, 3: 3}.get(kind, 0)
+    if arity == 0:
+        raise refuse(f"its kind {kind} is not a simplex kind")
+    if encoding not in (SIMPLEX_ENCODING_DELTA, SIMPLEX_ENCODING_DELTA_ZSTD):
+        raise refuse(f"its encoding {encoding} is not DELTA (2) or DELTA_ZSTD (3)")
+    if count == 0 or count > MAX_SIMPLICES_PER_ENCODED_CHUNK:
+        raise refuse(f"it states {count} simplices; a chunk holds 1 to {MAX_SIMPLICES_PER_ENCODED_CHUNK}")
+    class_bytes = (count + 3) // 4
+    bound = class_bytes + count * arity * 5
+    if encoding == SIMPLEX_ENCODING_DELTA_ZSTD:
+        import zstandard  # Debian's python3-zstandard; connect() checks for it before asking for zstd
+
+        frame = bytes(data)  # type: ignore[call-overload]
+        too_large = f"its zstd frame decompresses to more than the {bound} bytes {count} simplices can take"
+        try:
+            declared = zstandard.frame_content_size(frame)
+        except zstandard.ZstdError as e:
+            raise refuse(f"its data is not a zstd frame ({e})") from None
+        try:
+            # Never more than `bound` bytes out (no zip bombs): a frame that declares more is refused
+            # unread; one that does not declare its size is first read to at most bound + 1 bytes.
+            if declared > bound:
+                raise refuse(too_large)
+            if declared < 0:
+                reader = zstandard.ZstdDecompressor().stream_reader(frame, read_across_frames=False)
+                if len(reader.read(bound + 1)) > bound:
+                    raise refuse(too_large)
+            stream = zstandard.ZstdDecompressor().decompressobj()
+            sections = stream.decompress(frame)
+        except zstandard.ZstdError as e:
+            raise refuse(f"its zstd frame is corrupt ({e})") from None
+        if not stream.eof:
+            raise refuse("its data ends inside its zstd frame")
+        if stream.unused_data:
+            raise refuse(f"it has {len(stream.unused_data)} bytes after its zstd frame")
+        if len(sections) > bound:
+            raise refuse(too_large)
+    else:
+        sections = bytes(data)  # type: ignore[call-overload]
+        if len(sections) > bound:
+            raise refuse(f"its {len(sections)} bytes are more than the {bound} bytes {count} simplices can take")
+    raw = np.frombuffer(sections, dtype=np.uint8)
+    if raw.size < class_bytes:
+        raise refuse(f"its {raw.size} bytes end before its {class_bytes} bytes of classes")
+    packed = raw[:class_bytes]
+    tail = count % 4
+    if tail and int(packed[-1]) >> (2 * tail):
+        raise refuse("the unused bits of its last class byte are not 0")
+    classes = (np.stack([(packed >> s) & 3 for s in (0, 2, 4, 6)], axis=1).reshape(-1)[:count] + 1).astype(np.uint8)
+
+    varints = raw[class_bytes:]
+    last = varints < 0x80  # the final byte of each varint
+    ends = np.flatnonzero(last)
+    values_needed = count * arity
+    starts = np.empty_like(ends)
+    if ends.size:
+        starts[0] = 0
+        starts[1:] = ends[:-1] + 1
+    lengths = ends - starts + 1
+    # In stream order, as the C++ decoder finds them: a varint over 5 bytes (complete or not),
+    # then the end of the data inside the simplices.
+    unfinished = varints.size - (int(ends[-1]) + 1 if ends.size else 0)
+    too_long = np.flatnonzero(lengths[:values_needed] > 5)
+    if too_long.size:
+        raise refuse(f"simplex {int(too_long[0]) // arity} has a varint longer than 5 bytes")
+    if ends.size < values_needed:
+        if unfinished > 5:
+            raise refuse(f"simplex {ends.size // arity} has a varint longer than 5 bytes")
+        raise refuse(f"its varints end inside simplex {ends.size // arity} (truncated)")
+    if ends.size > values_needed or unfinished:
+        extra = varints.size - 1 - int(ends[values_needed - 1])
+        raise refuse(f"it has {extra} bytes after its {count} simplices")
+    position = np.arange(varints.size) - np.repeat(starts, lengths)
+    groups = (varints & 0x7F).astype(np.int64) << (7 * position).astype(np.int64)
+    v = np.add.reduceat(groups, starts).reshape(count, arity)
+
+    # Index k of simplex i (proto): after the previous simplex's index k where the prefix before k
+    # is the same (plus 1 at the last position), else after index k - 1 of the same simplex plus 1.
+    index = np.empty((count, arity), dtype=np.int64)
+    if arity == 1:
+        steps = v[:, 0] + 1
+        steps[0] = v[0, 0]
+        index[:, 0] = np.cumsum(steps)
+    else:
+        index[:, 0] = np.cumsum(v[:, 0])  # k = 0 is never the last position here
+        same = np.zeros(count, dtype=bool)
+        same[1:] = v[1:, 0] == 0  # the prefix u[0] repeats
+        for k in range(1, arity):
+            is_last = k == arity - 1
+            # Within a run of equal prefixes (started where `same` is False) index k grows by
+            # v + (1 at the last position); the run's first takes index k - 1 + v + 1.
+            steps = v[:, k] + (1 if is_last else 0)
+            total = np.cumsum(steps)
+            first = index[:, k - 1] + v[:, k] + 1
+            base = _segment_base(~same, first - total)
+            index[:, k] = base + total
+            same = same & (v[:, k] == 0)
+    if index.max() > 0xFFFFFFFF:
+        raise refuse(f"simplex {int(np.argmax((index > 0xFFFFFFFF).any(axis=1)))} has an index over 2^32 - 1")
+    return kind, index.astype(np.uint32).reshape(-1), classes
+
+
 def decode_master_list_page(data: bytes) -> Dict[str, np.ndarray]:
     """MasterListResponse: ranks (fixed64), kinds, endpoints (bytes), vertex_indices (fixed32)."""
     parts: Dict[int, List[np.ndarray]] = {1: [], 2: [], 3: [], 4: []}

@@ -163,6 +163,7 @@ class AsyncFamily:
             vertex_rule=_network._RULES[_rule(vertex_rule)],
             non_exterior_only=non_exterior_only,
             summary_only=summary_only,
+            simplex_encoding=self._calls.simplex_encoding,
         )
         assembler = _network.ClassifyAssembler()
         for raw in await self._stream(self._calls.classify, request):
@@ -303,10 +304,20 @@ async def _upload_messages(
 class AsyncClient:
     """A grpc.aio connection to a galpha server (``galpha.aio.connect``)."""
 
-    def __init__(self, target: str, *, token: Optional[str], tls_ca: Optional[str], timeout: Optional[float]) -> None:
+    def __init__(
+        self,
+        target: str,
+        *,
+        token: Optional[str],
+        tls_ca: Optional[str],
+        timeout: Optional[float],
+        answer_encoding: str = "raw",
+    ) -> None:
         self.target = target
+        encoding = _network.answer_encoding_number(answer_encoding)  # before the channel: nothing to close
         self._channel = _aio_channel(target, tls_ca)
         self._calls = _network.Calls(self._channel, token, timeout)
+        self._calls.simplex_encoding = encoding
 
     async def __aenter__(self) -> "AsyncClient":
         return self
@@ -366,9 +377,14 @@ class AsyncClient:
 
 
 def connect(
-    target: str, *, token: Optional[str] = None, tls_ca: Optional[str] = None, timeout: Optional[float] = None
+    target: str,
+    *,
+    token: Optional[str] = None,
+    tls_ca: Optional[str] = None,
+    timeout: Optional[float] = None,
+    answer_encoding: str = "raw",
 ) -> AsyncClient:
     """The asyncio counterpart of :func:`galpha.connect` (create it inside a running event loop)."""
-    return AsyncClient(target, token=token, tls_ca=tls_ca, timeout=timeout)
+    return AsyncClient(target, token=token, tls_ca=tls_ca, timeout=timeout, answer_encoding=answer_encoding)
 
 

@@ -1,0 +1,81 @@
+"""The hand decoder of compact Classify chunks (galpha._wire.decode_encoded_simplex_chunk) on
+chunks written by hand from the proto's text, and every refusal the proto lists, named by chunk.
+That it decodes the server's chunks to the raw answer is test_network.py's
+test_every_answer_encoding_gives_the_raw_answer."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import zstandard
+
+from galpha import _wire
+
+
+def _varint(value: int) -> bytes:
+    return _wire._varint(value)
+
+
+def chunk(kind: int, count: int, data: bytes, encoding: int = 2) -> memoryview:
+    """An EncodedSimplexChunk message: kind (1), simplex_count (2), encoding (3), data (4)."""
+    out = b""
+    for number, value in ((1, kind), (2, count), (3, encoding)):
+        if value:
+            out += _varint(number << 3) + _varint(value)
+    out += _wire._len_field(4, data)
+    return memoryview(out)
+
+
+def test_decodes_the_layout_the_proto_documents() -> None:
+    # Edges (3, 7), (3, 9), (4, 5), classes EXTERIOR, SINGULAR, INTERIOR (the C++ codec test's).
+    kind, indices, classes = _wire.decode_encoded_simplex_chunk(chunk(2, 3, bytes([0x34, 3, 3, 0, 1, 1, 0])), 0)
+    assert kind == 2
+    assert indices.dtype == np.uint32 and indices.tolist() == [3, 7, 3, 9, 4, 5]
+    assert classes.dtype == np.uint8 and classes.tolist() == [1, 2, 4]
+    # Vertices 1 and 300 (a two-byte varint), classes REGULAR then SINGULAR.
+    _, indices, classes = _wire.decode_encoded_simplex_chunk(chunk(1, 2, bytes([0x06, 1, 0xAA, 2])), 0)
+    assert indices.tolist() == [1, 300] and classes.tolist() == [3, 2]
+    # Triangles (1, 2, 5), (1, 2, 6), (1, 3, 4), (2, 3, 4): every prefix rule.
+    data = bytes([0x00, 1, 0, 2, 0, 0, 0, 0, 1, 0, 1, 0, 0])
+    # (1,2,5): 1, 2-1-1=0, 5-2-1=2; (1,2,6): 0, 0, 6-5-1=0; (1,3,4): 0, 3-2=1, 4-3-1=0; (2,3,4): 1, 0, 0.
+    _, indices, _ = _wire.decode_encoded_simplex_chunk(chunk(3, 4, data), 0)
+    assert indices.reshape(-1, 3).tolist() == [[1, 2, 5], [1, 2, 6], [1, 3, 4], [2, 3, 4]]
+    # The same bytes in a zstd frame.
+    framed = zstandard.ZstdCompressor().compress(data)
+    _, again, _ = _wire.decode_encoded_simplex_chunk(chunk(3, 4, framed, encoding=3), 0)
+    np.testing.assert_array_equal(again, indices)
+
+
+@pytest.mark.parametrize(
+    "message, match",
+    [
+        (chunk(0, 1, b"\x00\x05"), "not a simplex kind"),
+        (chunk(1, 1, b"\x00\x05", encoding=1), "not DELTA"),
+        (chunk(1, 0, b""), "states 0 simplices"),
+        (chunk(1, (1 << 20) + 1, b"\x00\x05"), "a chunk holds 1 to"),
+        (chunk(1, 1, b""), "before its 1 bytes of classes"),
+        (chunk(1, 1, b"\x04\x05"), "unused bits"),
+        (chunk(2, 1, b"\x00\x05"), "truncated"),
+        (chunk(1, 1, b"\x00\x85"), "truncated"),
+        (chunk(2, 1, b"\x00\x80\x80\x80\x80\x80\x00"), "longer than 5 bytes"),
+        (chunk(1, 1, b"\x00\x80\x80\x80\x80\x10"), "over 2\\^32 - 1"),
+        (chunk(2, 1, b"\x00\xff\xff\xff\xff\x0f\x00"), "over 2\\^32 - 1"),
+        (chunk(1, 1, b"\x00\x05\x00"), "bytes after"),
+        (chunk(1, 1, b"\x00" * 7), "more than"),
+        (chunk(1, 1, b"\x00\x05", encoding=3), "not a zstd frame"),
+        (chunk(1, 1, zstandard.ZstdCompressor().compress(b"\x00\x05") + b"x", encoding=3), "after its zstd frame"),
+        (chunk(1, 1, zstandard.ZstdCompressor().compress(b"\x00" * 10_000_000), encoding=3), "decompresses to more than"),
+    ],
+)
+def test_malformed_chunks_are_refused_naming_the_chunk(message: memoryview, match: str) -> None:
+    with pytest.raises(_wire.EncodedChunkError, match="^encoded simplex chunk 17: .*" + match):
+        _wire.decode_encoded_simplex_chunk(message, 17)
+
+
+def test_a_frame_without_its_size_is_bounded_too() -> None:
+    # zstd's streaming compressor leaves the content size out of the frame header.
+    stream = zstandard.ZstdCompressor(write_content_size=False).compressobj()
+    bomb = stream.compress(b"\x00" * 1_000_000) + stream.flush()
+    assert zstandard.frame_content_size(bomb) == -1
+    with pytest.raises(_wire.EncodedChunkError, match="decompresses to more than the 6 bytes"):
+        _wire.decode_encoded_simplex_chunk(chunk(1, 1, bomb, encoding=3), 0)
