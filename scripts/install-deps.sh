@@ -36,7 +36,7 @@ test_packages=(
   ccache                 # scripts/test.sh: the image build reuses the CPU build's objects
   pybind11-dev python3-dev python3-numpy python3-pytest  # galpha._engine (GALPHA_BUILD_PYTHON) and its tests
   python3-grpcio python3-protobuf  # the Python package's network client (stubs: protobuf-compiler-grpc above)
-  python3-zstandard      # its compressed point chunks (EncodedPointChunk)
+  python3-zstandard      # its compressed point chunks (EncodedPointChunk) and Classify answers (EncodedSimplexChunk)
   python3-shapely python3-geopandas python3-pyproj python3-tqdm  # its geometry answers, CRSs, progress bars
   python3-matplotlib     # python/examples: the plot of a shape over its points
   python3-pip python3-venv python3-setuptools  # the package's pip install (tested by its tests)
