@@ -3,15 +3,17 @@
 #include <utility>
 
 #include "core/family/canonical_order.hpp"
+#include "core/family/classification_summary.hpp"
 #include "server/heap_trim.hpp"
 
 namespace galpha::server {
 
 namespace {
 
-/// The index orders and ordered vertices (ComputeOrders), charged up front.
+/// The index orders and ordered vertices (ComputeOrders) and the area terms, charged up front.
 size_t OrderBytes(const FamilyReader& reader) {
-  return reader.edges().size() * 3 * sizeof(uint32_t) + reader.triangles().size() * 4 * sizeof(uint32_t);
+  return reader.edges().size() * 3 * sizeof(uint32_t) +
+         reader.triangles().size() * (4 * sizeof(uint32_t) + sizeof(double));
 }
 
 }  // namespace
@@ -66,6 +68,13 @@ const std::vector<uint32_t>& CachedFamily::EdgeVerticesInOrder() const {
 const std::vector<uint32_t>& CachedFamily::TriangleVerticesInOrder() const {
   std::call_once(orders_once_, [this] { ComputeOrders(); });
   return triangle_vertices_;
+}
+
+const std::vector<double>& CachedFamily::TriangleAreaTerms() const {
+  // Apart from the orders: a summary-only Classify needs the terms, not the orders.
+  std::call_once(area_terms_once_,
+                 [this] { triangle_area_terms_ = galpha::TriangleAreaTerms(reader_->points(), reader_->triangles()); });
+  return triangle_area_terms_;
 }
 
 void CachedFamily::ComputeOrders() const {

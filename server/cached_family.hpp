@@ -1,7 +1,8 @@
 // A family as the service holds it, in host memory (AlphaFamily) or resident where it was built
 // (ResidentAlphaFamily: its rank tables in device memory after a CUDA build), read through one
 // interface (server/family_reader.hpp; the report is the build summary a Describe returns), and
-// the index orders Classify streams in (computed on first use, once). No
+// the index orders Classify streams in and the triangles' area terms its summary adds (each computed
+// on first use, once). No
 // name: a BuildHeader.name is the label of one Build call, echoed in that call's answer only
 // (proto: BuildHeader), so the family that any caller of the tenant may reach keeps none.
 #pragma once
@@ -54,8 +55,8 @@ class CachedFamily {
   std::shared_ptr<const InputFrame> Frame() const;
   void AttachFrameIfNone(std::shared_ptr<const InputFrame> frame) const;
   /// Host bytes charged to the cache: the family (of a resident one, what it holds on the host,
-  /// and its tables when the host is where they live), plus the index orders and ordered vertices
-  /// once computed (charged up front so that the charge never changes while cached).
+  /// and its tables when the host is where they live), plus the index orders, ordered vertices and
+  /// area terms once computed (charged up front so that the charge never changes while cached).
   size_t bytes() const { return bytes_; }
   /// Device bytes a resident family's tables hold (0 in host memory or on the CPU backend).
   size_t device_bytes() const { return device_bytes_; }
@@ -67,6 +68,9 @@ class CachedFamily {
   /// that Classify copies index runs instead of gathering them one simplex at a time.
   const std::vector<uint32_t>& EdgeVerticesInOrder() const;
   const std::vector<uint32_t>& TriangleVerticesInOrder() const;
+  /// Each triangle's term of the interior area (core/family/classification_summary.hpp), so that a
+  /// Classify summary adds them in order instead of reading three points at random per triangle.
+  const std::vector<double>& TriangleAreaTerms() const;
 
  private:
   void ComputeOrders() const;
@@ -81,6 +85,8 @@ class CachedFamily {
   mutable std::once_flag orders_once_;
   mutable std::vector<uint32_t> edge_order_, triangle_order_;
   mutable std::vector<uint32_t> edge_vertices_, triangle_vertices_;
+  mutable std::once_flag area_terms_once_;
+  mutable std::vector<double> triangle_area_terms_;
 };
 
 /// `family` as the cache shares it: its last owner (the cache, or a query still streaming from it

@@ -383,7 +383,7 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifyS
   absl::StatusOr<Classification> classes = family.ClassifyAll(level->level, *mode, *rule);
   if (!classes.ok()) return classes.status();
   const ClassificationSummary counts =
-      SummarizeClassification(family.points(), family.representative(), family.triangles(), *classes);
+      SummarizeClassification(family.representative(), cached->TriangleAreaTerms(), *classes);
   const absl::StatusOr<std::vector<TopologyAtLevel>> topology = family.TopologyBetween(level->level, level->level);
   if (!topology.ok()) return topology.status();
   const absl::StatusOr<double> hull_area = family.HullAreaApprox();

@@ -2,7 +2,7 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
+#include <memory>
 
 #include "core/exact/predicates.hpp"
 
@@ -32,11 +32,8 @@ std::array<uint64_t, 4> CountClasses(const SimplexClass* classes, int64_t n, Cou
   return {c0, c1, c2, c3};
 }
 
-}  // namespace
-
-ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const HostVector<uint32_t>& representative,
-                                              const HostVector<std::array<uint32_t, 3>>& mesh_triangles,
-                                              const Classification& classes) {
+// The counts of every kind and class (the area is the callers').
+ClassificationSummary CountAll(const HostVector<uint32_t>& representative, const Classification& classes) {
   ClassificationSummary summary;
   const int64_t nv = static_cast<int64_t>(classes.vertices.size()), ne = static_cast<int64_t>(classes.edges.size()),
                 nt = static_cast<int64_t>(classes.triangles.size());
@@ -44,10 +41,51 @@ ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const
                                   [&](int64_t v) { return representative[v] == static_cast<uint32_t>(v); });
   summary.edges = CountClasses(classes.edges.data(), ne, [](int64_t) { return true; });
   summary.triangles = CountClasses(classes.triangles.data(), nt, [](int64_t) { return true; });
-  // The area is a floating-point sum: in triangle order, one thread, as AssembleShape sums it. Its
-  // terms are computed first on every core (each reads three points at random: most of the pass's
-  // time), then added in order, so the sum is the same double.
+  return summary;
+}
+
+// The interior triangles' terms added in triangle order, one thread, as AssembleShape sums them
+// (terms[t] is read for interior triangles only). A local accumulator: the struct's member,
+// written through memory on every term, tripled this pass's time.
+double InteriorArea(const double* terms, const Classification& classes) {
+  double area = 0.0;
+  const size_t nt = classes.triangles.size();
+  for (size_t t = 0; t < nt; ++t) {
+    if (classes.triangles[t] == SimplexClass::kInterior) area += terms[t];
+  }
+  return area;
+}
+
+}  // namespace
+
+std::vector<double> TriangleAreaTerms(const HostVector<Point2>& p,
+                                      const HostVector<std::array<uint32_t, 3>>& triangles) {
+  const int64_t nt = static_cast<int64_t>(triangles.size());
   std::vector<double> terms(static_cast<size_t>(nt));
+#pragma omp parallel for schedule(static)
+  for (int64_t t = 0; t < nt; ++t) {
+    const auto& tri = triangles[t];
+    terms[static_cast<size_t>(t)] = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
+  }
+  return terms;
+}
+
+ClassificationSummary SummarizeClassification(const HostVector<uint32_t>& representative,
+                                              const std::vector<double>& area_terms, const Classification& classes) {
+  ClassificationSummary summary = CountAll(representative, classes);
+  summary.interior_area = InteriorArea(area_terms.data(), classes);
+  return summary;
+}
+
+ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const HostVector<uint32_t>& representative,
+                                              const HostVector<std::array<uint32_t, 3>>& mesh_triangles,
+                                              const Classification& classes) {
+  ClassificationSummary summary = CountAll(representative, classes);
+  const int64_t nt = static_cast<int64_t>(classes.triangles.size());
+  // The interior triangles' terms first, on every core (each reads three points at random: most of
+  // the pass's time), then added in order. Not zero-filled: only interior terms are written and
+  // read, and the pages are first touched by the threads that fill them.
+  const std::unique_ptr<double[]> terms(new double[static_cast<size_t>(nt)]);
 #pragma omp parallel for schedule(static)
   for (int64_t t = 0; t < nt; ++t) {
     if (classes.triangles[t] == SimplexClass::kInterior) {
@@ -55,13 +93,7 @@ ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const
       terms[static_cast<size_t>(t)] = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
     }
   }
-  // A local accumulator: the struct's member, written through memory on every term, tripled the
-  // pass's time (a store-to-load chain of 2M links at 1M points).
-  double area = 0.0;
-  for (int64_t t = 0; t < nt; ++t) {
-    if (classes.triangles[t] == SimplexClass::kInterior) area += terms[static_cast<size_t>(t)];
-  }
-  summary.interior_area = area;
+  summary.interior_area = InteriorArea(terms.get(), classes);
   return summary;
 }
 

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "core/family/alpha_family.hpp"
 
@@ -18,6 +19,15 @@ struct ClassificationSummary {
 };
 
 ClassificationSummary SummarizeClassification(const AlphaFamily& family, const Classification& classes);
+/// Each triangle's term of the interior area, 0.5 * Orient2dApprox of its vertices, in triangle
+/// order (on every core). A service that summarizes many classifications of one family computes
+/// them once: reading three points at random per triangle is most of a summary's time.
+std::vector<double> TriangleAreaTerms(const HostVector<Point2>& points,
+                                      const HostVector<std::array<uint32_t, 3>>& triangles);
+/// The same summary from those terms (area_terms.size() == classes.triangles.size()): the interior
+/// area adds the interior triangles' terms in triangle order, the same double as the others give.
+ClassificationSummary SummarizeClassification(const HostVector<uint32_t>& representative,
+                                              const std::vector<double>& area_terms, const Classification& classes);
 /// The same from the arrays it reads (a resident family's host arrays).
 ClassificationSummary SummarizeClassification(const HostVector<Point2>& points,
                                               const HostVector<uint32_t>& representative,

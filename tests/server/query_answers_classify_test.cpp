@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/family/classification_summary.hpp"
 #include "core/geometry/shape.hpp"
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
@@ -238,6 +239,27 @@ TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
   EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
   *request.mutable_threshold() = Rank(cached->host_family()->max_level() + 1);
   EXPECT_THAT(MakeClassifySource(cached, request).status(), StatusIs(absl::StatusCode::kInvalidArgument));
+}
+
+// The service sums the cached family's area terms (CachedFamily::TriangleAreaTerms); alphactl
+// gathers the points per classification: the same counts and the same double at every level.
+TEST(QueryAnswersTest, SummaryFromCachedAreaTermsIsTheSameDouble) {
+  for (const NamedFamily& named : Families()) {
+    const AlphaFamily& family = *named.oracle;
+    const std::vector<double>& terms = named.cached->TriangleAreaTerms();
+    ASSERT_EQ(terms.size(), family.triangles().size()) << named.name;
+    for (int64_t level = 0; level <= family.max_level(); level += std::max<int64_t>(1, family.max_level() / 7)) {
+      for (ClassifyMode mode : {ClassifyMode::kGeneral, ClassifyMode::kRegularized}) {
+        const Classification classes = family.ClassifyAll(level, mode, VertexRule::kReport);
+        const ClassificationSummary gathered = SummarizeClassification(family, classes);
+        const ClassificationSummary summed = SummarizeClassification(family.representative(), terms, classes);
+        EXPECT_EQ(summed.interior_area, gathered.interior_area) << named.name << " level " << level;
+        EXPECT_EQ(summed.vertices, gathered.vertices);
+        EXPECT_EQ(summed.edges, gathered.edges);
+        EXPECT_EQ(summed.triangles, gathered.triangles);
+      }
+    }
+  }
 }
 
 TEST(QueryAnswersTest, ClassifyRefusesASimplexEncodingTheEnumDoesNotDefine) {
