@@ -74,25 +74,39 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
         continue;
       }
       const uint64_t index = chunk_index_++;
-      pool_->Submit([pending, encoding = encoding_, index](ChunkCodecs& codecs) {
-        absl::Status status;
-        v1::ClassifyResponse encoded;
-        try {
-          status = codecs.simplex_encoder.Encode(pending->message.chunk(), encoding, encoded.mutable_encoded_chunk());
-        } catch (const std::bad_alloc&) {
-          status = absl::ResourceExhaustedError("the server ran out of memory encoding the answer");
-        }
-        if (!status.ok()) {
-          // The raw chunks come from the family's own tables: an encoder refusal is our defect.
-          status = absl::InternalError(absl::StrCat("encoding simplex chunk ", index, ": ", status.message()));
-        }
-        std::lock_guard<std::mutex> lock(pending->mutex);
-        pending->status = std::move(status);
-        pending->message.Swap(&encoded);
-        pending->ready = true;
-        pending->encoded.notify_one();
-      });
+      try {
+        pool_->Submit([pending, encoding = encoding_, index](ChunkCodecs& codecs) {
+          absl::Status status;
+          v1::ClassifyResponse encoded;
+          try {
+            status = codecs.simplex_encoder.Encode(pending->message.chunk(), encoding, encoded.mutable_encoded_chunk());
+            if (!status.ok()) {
+              // The raw chunks come from the family's own tables: an encoder refusal is our defect.
+              status = absl::InternalError(absl::StrCat("encoding simplex chunk ", index, ": ", status.message()));
+            }
+          } catch (const std::bad_alloc&) {
+            status = OutOfMemory(index);
+          }
+          Finish(*pending, std::move(status), &encoded);
+        });
+      } catch (const std::bad_alloc&) {
+        Finish(*pending, OutOfMemory(index), nullptr);  // never queued: Next must not wait for it
+      }
     }
+  }
+
+  static absl::Status OutOfMemory(uint64_t index) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the server ran out of memory encoding simplex chunk ", index, " of the answer"));
+  }
+
+  // Marks `pending` done with `status` and, when given, its encoded message.
+  static void Finish(PendingMessage& pending, absl::Status status, v1::ClassifyResponse* encoded) {
+    std::lock_guard<std::mutex> lock(pending.mutex);
+    pending.status = std::move(status);
+    if (encoded != nullptr) pending.message.Swap(encoded);
+    pending.ready = true;
+    pending.encoded.notify_one();
   }
 
   std::unique_ptr<ChunkSource<v1::ClassifyResponse>> raw_;
