@@ -318,15 +318,23 @@ absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
     answer.End();
   });
   absl::Status consumer_error;
-  for (;;) {
-    absl::StatusOr<const v1::ClassifyResponse*> next = answer.Next();
-    consumer_error = next.ok() ? (*next == nullptr ? absl::OkStatus() : on_message(**next)) : next.status();
-    if (next.ok() && *next == nullptr) break;
-    if (!consumer_error.ok()) {
-      context.TryCancel();
-      answer.Stop();
-      break;
+  try {
+    for (;;) {
+      absl::StatusOr<const v1::ClassifyResponse*> next = answer.Next();
+      consumer_error = next.ok() ? (*next == nullptr ? absl::OkStatus() : on_message(**next)) : next.status();
+      if (next.ok() && *next == nullptr) break;
+      if (!consumer_error.ok()) {
+        context.TryCancel();
+        answer.Stop();
+        break;
+      }
     }
+  } catch (...) {
+    // A caller's callback that throws: the call ends and the reading thread is joined first.
+    context.TryCancel();
+    answer.Stop();
+    read_ahead.join();
+    throw;
   }
   read_ahead.join();
   if (wire_bytes != nullptr) *wire_bytes = read_bytes;

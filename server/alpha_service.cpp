@@ -37,8 +37,17 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
  public:
   ChunkWriter(RpcRecord record, std::unique_ptr<ChunkSource<Message>> source)
       : record_(record), source_(std::move(source)) {
-    has_next_ = source_->Next(&messages_[0]);
-    WriteCycles();
+    if (!source_->Next(&messages_[0])) {
+      Done(ToGrpcStatus(source_->status()));
+      return;
+    }
+    // gRPC holds a reactor's first write until the handler returns: the second message is filled
+    // after the first is written (by OnWriteDone), so that the first (a Classify summary) is not
+    // held back by the fill (an encoded answer's first chunks).
+    next_ = 1;
+    fill_pending_ = true;
+    arrivals_.store(1, std::memory_order_relaxed);
+    this->StartWrite(&messages_[0]);
   }
   /// An answer that is only an error.
   ChunkWriter(RpcRecord record, const absl::Status& error) : record_(record) { Done(ToGrpcStatus(error)); }
@@ -51,13 +60,18 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
   void OnDone() override { delete this; }
 
  private:
-  // Runs with no write in flight and messages_[next_] filled (if has_next_): starts its write and
-  // fills the other message meanwhile, as long as the write finishes first.
+  // Runs with no write in flight and messages_[next_] filled (if has_next_; fill_pending_: not yet
+  // filled): starts its write and fills the other message meanwhile, as long as the write finishes
+  // first.
   void WriteCycles() {
     for (;;) {
       if (write_failed_) {
         Done(grpc::Status(grpc::StatusCode::CANCELLED, "the client stopped reading"));
         return;
+      }
+      if (fill_pending_) {
+        fill_pending_ = false;
+        has_next_ = source_->Next(&messages_[next_]);
       }
       if (!has_next_) {
         Done(ToGrpcStatus(source_->status()));
@@ -80,8 +94,9 @@ class ChunkWriter final : public grpc::ServerWriteReactor<Message> {
   RpcRecord record_;
   std::unique_ptr<ChunkSource<Message>> source_;
   std::array<Message, 2> messages_;
-  size_t next_ = 0;        // the message to write next
-  bool has_next_ = false;  // whether it holds one
+  size_t next_ = 0;            // the message to write next
+  bool has_next_ = false;      // whether it holds one
+  bool fill_pending_ = false;  // whether it is still to be filled (only before the second write)
   bool write_failed_ = false;
   // The write's end and the fill's: the second to arrive starts the next cycle.
   std::atomic<int> arrivals_{0};

@@ -38,6 +38,7 @@ void ChunkCodecPool::Work() {
       // kept, as a stream's own decoder keeps it.
       lock.unlock();
       codecs.point_decoder.ReleaseScratch();
+      codecs.simplex_encoder.ReleaseScratch();
       lock.lock();
     }
     wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });

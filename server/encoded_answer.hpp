@@ -15,7 +15,7 @@ namespace galpha::server {
 /// `raw` with each SimplexChunk replaced by its EncodedSimplexChunk (same order; the summary as it
 /// is). RAW and UNSPECIFIED return `raw` itself. `pool` must outlive the answer. At most one chunk
 /// a pool thread (and at most 8) is encoded or waiting at once, so an answer holds at most that
-/// many chunks beyond the one being written.
+/// many chunks beyond those its writer holds (the one being written and the one filled ahead).
 std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>> EncodeSimplexChunks(
     std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>> raw, galpha::v1::SimplexEncoding encoding,
     ChunkCodecPool* pool);

@@ -1,7 +1,7 @@
 // Compact, lossless Classify answers (galpha.v1.EncodedSimplexChunk, defined in
 // proto/galpha/v1/alpha_shapes.proto): the server's encoder and the client's decoder in one module,
 // so that both sides read the format from one place. Free of gRPC (only the protobuf messages), so
-// the fuzz target and the unit tests drive it directly.
+// the fuzz target (tests/fuzz/simplex_chunk_fuzzer.cpp) and the unit tests drive it directly.
 #pragma once
 
 #include <cstdint>
@@ -45,6 +45,9 @@ class SimplexChunkEncoder {
   /// The same from a raw chunk.
   absl::Status Encode(const galpha::v1::SimplexChunk& chunk, galpha::v1::SimplexEncoding encoding,
                       galpha::v1::EncodedSimplexChunk* out);
+
+  /// Frees the scratch buffer (it grows to the largest DELTA_ZSTD chunk encoded).
+  void ReleaseScratch() { std::string().swap(plain_); }
 
  private:
   int level_;

@@ -72,6 +72,33 @@ def test_malformed_chunks_are_refused_naming_the_chunk(message: memoryview, matc
         _wire.decode_encoded_simplex_chunk(message, 17)
 
 
+def test_fields_of_the_wrong_wire_type_are_refused() -> None:
+    # Field 4 (data) as a varint of a huge value: refused before anything is allocated for it.
+    message = memoryview(_varint(1 << 3) + _varint(1) + _varint(2 << 3) + _varint(1) + _varint(3 << 3) + _varint(2) + _varint(4 << 3) + _varint(1 << 40))
+    with pytest.raises(_wire.EncodedChunkError, match="field 4\\) has wire type 0"):
+        _wire.decode_encoded_simplex_chunk(message, 3)
+    # The count as bytes.
+    message = memoryview(_varint(1 << 3) + _varint(1) + _wire._len_field(2, b"\x01"))
+    with pytest.raises(_wire.EncodedChunkError, match="field 2 has wire type 2"):
+        _wire.decode_encoded_simplex_chunk(message, 3)
+
+
+def test_a_frame_that_declares_a_small_size_is_bounded_by_its_output() -> None:
+    # A frame whose header declares the chunk's bound but whose blocks hold far more: refused after
+    # at most bound + 1 bytes of output. Built by rewriting the content size of a real frame: zstd
+    # checks it only at the frame's end.
+    plain = b"\x00" * 5_000_000
+    frame = bytearray(zstandard.ZstdCompressor(write_content_size=False, write_checksum=False).compress(plain))
+    # Frame header descriptor: Frame_Content_Size_flag = 2 (a 4-byte size after the window byte).
+    magic, descriptor = bytes(frame[:4]), frame[4]
+    assert descriptor & 0xC0 == 0 and descriptor & 0x20 == 0  # no size, not single-segment: a window byte follows
+    header = magic + bytes([descriptor | 0x80]) + bytes(frame[5:6]) + (6).to_bytes(4, "little")
+    lying = header + bytes(frame[6:])
+    assert zstandard.frame_content_size(lying) == 6
+    with pytest.raises(_wire.EncodedChunkError, match="decompresses to more than the 6 bytes|corrupt"):
+        _wire.decode_encoded_simplex_chunk(chunk(1, 1, lying, encoding=3), 0)
+
+
 def test_a_frame_without_its_size_is_bounded_too() -> None:
     # zstd's streaming compressor leaves the content size out of the frame header.
     stream = zstandard.ZstdCompressor(write_content_size=False).compressobj()

@@ -3,6 +3,7 @@
 #   tests/fuzz/run.sh [SECONDS_PER_TARGET]   (default 20; CI uses the default)
 # Only the sources a target needs are compiled, so the engine (OpenMP, CUDA) is not involved.
 # predicates_fuzzer compares the exact predicates with GMP rationals on arbitrary finite doubles.
+# simplex_chunk_fuzzer decodes arbitrary compact Classify chunks (what a client reads).
 # Corpora start from seeds/ and grow in build/fuzz/corpus (kept between local runs).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -14,7 +15,7 @@ protoc --proto_path=proto --cpp_out="$out/gen" galpha/v1/alpha_shapes.proto
 flags=(-std=c++17 -O1 -g -ffp-contract=off -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined -I. -I"$out/gen")
 libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthread)
 
-# The three targets compile side by side (each clang++ compiles its sources one after another), and
+# The four targets compile side by side (each clang++ compiles its sources one after another), and
 # then run side by side: CI's 2 cores were otherwise half idle in this step.
 # The decoder with the CRS functions that refuse (coordinate_system_no_proj.cpp): a header's crs is
 # then an error, decided without PROJ's database; the fuzzer aims at the decoder.
@@ -28,9 +29,12 @@ builds+=($!)
 clang++ "${flags[@]}" tests/fuzz/predicates_fuzzer.cpp core/io/input_validation.cpp core/io/number_text.cpp \
   -o "$out/predicates_fuzzer" "${libs[@]}" $(pkg-config --libs absl_str_format) -lgmpxx -lgmp &
 builds+=($!)
+clang++ "${flags[@]}" tests/fuzz/simplex_chunk_fuzzer.cpp proto/codec/simplex_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" \
+  -o "$out/simplex_chunk_fuzzer" "${libs[@]}" $(pkg-config --libs libzstd) &
+builds+=($!)
 for pid in "${builds[@]}"; do wait "$pid"; done
 
-targets=(build_stream_fuzzer point_formats_fuzzer predicates_fuzzer)
+targets=(build_stream_fuzzer point_formats_fuzzer predicates_fuzzer simplex_chunk_fuzzer)
 runs=()
 for target in "${targets[@]}"; do
   corpus="$out/corpus/$target"

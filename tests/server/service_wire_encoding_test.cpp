@@ -202,9 +202,9 @@ TEST(ServiceWireEncodingTest, EveryAnswerEncodingIsTheRawAnswerInFewerBytes) {
     int seen = 0;
     EXPECT_THAT(client->Classify(stopping,
                                  [&](const v1::ClassifyResponse&) {
-                                   return ++seen == 2 ? absl::CancelledError("enough") : absl::OkStatus();
+                                   return ++seen == 2 ? absl::AbortedError("enough") : absl::OkStatus();
                                  }),
-                StatusIs(absl::StatusCode::kCancelled));
+                StatusIs(absl::StatusCode::kAborted, "enough"));
     EXPECT_EQ(seen, 2);
     stopping.set_mode(v1::CLASSIFY_MODE_GENERAL);
     EXPECT_FALSE(ClassifyBytes(*client, stopping).empty());

@@ -167,20 +167,31 @@ def decode_encoded_simplex_chunk(payload: memoryview, chunk_index: int) -> Tuple
     chunk, decoded with NumPy (no Python loop over simplices): the varints' 7-bit groups summed per
     varint, the differences turned into indices by cumulative sums within runs of equal prefixes.
     EncodedChunkError naming the chunk for everything the proto says a client refuses."""
-    kind = count = encoding = 0
-    data: object = b""
-    for number, _wire, value in fields(payload):
-        if number == 1:
-            kind = int(value)  # type: ignore[arg-type]
-        elif number == 2:
-            count = int(value)  # type: ignore[arg-type]
-        elif number == 3:
-            encoding = int(value)  # type: ignore[arg-type]
-        elif number == 4:
-            data = value
-
     def refuse(what: str) -> EncodedChunkError:
         return EncodedChunkError(f"encoded simplex chunk {chunk_index}: {what}")
+
+    kind = count = encoding = 0
+    data: object = b""
+    try:
+        parsed = list(fields(payload))
+    except (IndexError, ValueError) as e:
+        raise refuse(f"it is not a well-formed message ({e})") from None
+    for number, wire, value in parsed:
+        if number in (1, 2, 3):
+            if wire != _VARINT:
+                raise refuse(f"its field {number} has wire type {wire}, not a varint")
+            # As the C++ decoder reads them: uint32 and enums keep their low 32 bits.
+            low = int(value) & 0xFFFFFFFF  # type: ignore[arg-type]
+            if number == 1:
+                kind = low
+            elif number == 2:
+                count = low
+            else:
+                encoding = low
+        elif number == 4:
+            if wire != _LEN:
+                raise refuse(f"its data (field 4) has wire type {wire}, not bytes")
+            data = value
 
     arity = {1: 1, 2: 2, 3: 3}.get(kind, 0)
     if arity == 0:
@@ -192,7 +203,10 @@ def decode_encoded_simplex_chunk(payload: memoryview, chunk_index: int) -> Tuple
     class_bytes = (count + 3) // 4
     bound = class_bytes + count * arity * 5
     if encoding == SIMPLEX_ENCODING_DELTA_ZSTD:
-        import zstandard  # Debian's python3-zstandard; connect() checks for it before asking for zstd
+        try:
+            import zstandard  # Debian's python3-zstandard; connect() checks for it before asking for zstd
+        except ImportError:
+            raise refuse("it is zstd-compressed and the zstandard module is missing (python3-zstandard)") from None
 
         frame = bytes(data)  # type: ignore[call-overload]
         too_large = f"its zstd frame decompresses to more than the {bound} bytes {count} simplices can take"
@@ -200,15 +214,17 @@ def decode_encoded_simplex_chunk(payload: memoryview, chunk_index: int) -> Tuple
             declared = zstandard.frame_content_size(frame)
         except zstandard.ZstdError as e:
             raise refuse(f"its data is not a zstd frame ({e})") from None
+        if declared > bound:
+            raise refuse(too_large)
         try:
-            # Never more than `bound` bytes out (no zip bombs): a frame that declares more is refused
-            # unread; one that does not declare its size is first read to at most bound + 1 bytes.
-            if declared > bound:
+            # Never more than bound + 1 bytes out, whatever the frame declares (no zip bombs: a
+            # declared size is checked only at the frame's end): read through a bounded reader
+            # first; only a frame proven small is then decoded whole, for its end and what follows.
+            # One read fills up to its size (or the frame's end); a second one would go on into
+            # what follows the frame.
+            reader = zstandard.ZstdDecompressor().stream_reader(frame, read_across_frames=False)
+            if len(reader.read(bound + 1)) > bound:
                 raise refuse(too_large)
-            if declared < 0:
-                reader = zstandard.ZstdDecompressor().stream_reader(frame, read_across_frames=False)
-                if len(reader.read(bound + 1)) > bound:
-                    raise refuse(too_large)
             stream = zstandard.ZstdDecompressor().decompressobj()
             sections = stream.decompress(frame)
         except zstandard.ZstdError as e:
