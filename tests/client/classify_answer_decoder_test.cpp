@@ -75,7 +75,8 @@ TEST(ClassifyAnswerDecoderTest, MessagesComeOutInOrderDecoded) {
         EXPECT_EQ((*next)->SerializeAsString(), sent[0].SerializeAsString());
       } else {
         ASSERT_TRUE((*next)->has_chunk()) << "message " << received;
-        EXPECT_EQ((*next)->chunk().SerializeAsString(), RawChunk(static_cast<uint32_t>(received - 1)).SerializeAsString())
+        EXPECT_EQ((*next)->chunk().SerializeAsString(),
+                  RawChunk(static_cast<uint32_t>(received - 1)).SerializeAsString())
             << "message " << received;
       }
       ++received;
