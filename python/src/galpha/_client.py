@@ -111,8 +111,7 @@ class NetworkClient:
         self.target = target
         encoding = _network.answer_encoding_number(answer_encoding)  # before the channel: nothing to close
         self._channel = _network.channel_for(target, tls_ca)
-        self._calls = _network.Calls(self._channel, token, timeout)
-        self._calls.simplex_encoding = encoding
+        self._calls = _network.Calls(self._channel, token, timeout, encoding)
 
     def __repr__(self) -> str:
         return f"<galpha.NetworkClient {self.target}>"

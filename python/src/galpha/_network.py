@@ -409,11 +409,11 @@ def answer_encoding_number(answer_encoding: str) -> int:
 class Calls:
     """The service's methods on one channel, with the token and the routing header attached."""
 
-    def __init__(self, channel: Any, token: Optional[str], timeout: Optional[float], answer_encoding: str = "raw") -> None:
+    def __init__(self, channel: Any, token: Optional[str], timeout: Optional[float], simplex_encoding: int = 1) -> None:
         self.channel = channel
         self.token = token
         self.timeout = timeout
-        self.simplex_encoding = answer_encoding_number(answer_encoding)
+        self.simplex_encoding = simplex_encoding  # ClassifyRequest.simplex_encoding (answer_encoding_number)
         def unary(name: str, request_type: Any, response_type: Any) -> Any:
             return channel.unary_unary(
                 SERVICE + name, request_serializer=request_type.SerializeToString, response_deserializer=response_type.FromString

@@ -316,8 +316,7 @@ class AsyncClient:
         self.target = target
         encoding = _network.answer_encoding_number(answer_encoding)  # before the channel: nothing to close
         self._channel = _aio_channel(target, tls_ca)
-        self._calls = _network.Calls(self._channel, token, timeout)
-        self._calls.simplex_encoding = encoding
+        self._calls = _network.Calls(self._channel, token, timeout, encoding)
 
     async def __aenter__(self) -> "AsyncClient":
         return self
