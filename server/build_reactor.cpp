@@ -96,8 +96,20 @@ void BuildReactor::OnReadDone(bool ok) {
   if (ok) {
     Respond(refused);
   } else {
-    EndOfStream();
+    // A read fails both at the end of the stream and when the call broke (the client went away,
+    // gRPC refused a message over --max_message_bytes), and gRPC may report the failed read before
+    // it marks the call cancelled: a cut stream would then be built as if it were whole. A send on
+    // a broken call fails, so the initial metadata decides (OnSendInitialMetadataDone).
+    StartSendInitialMetadata();
   }
+}
+
+void BuildReactor::OnSendInitialMetadataDone(bool ok) {
+  if (!ok || cancelled_) {
+    Respond(absl::CancelledError("the upload was cut: the client went away or gRPC refused one of its messages"));
+    return;
+  }
+  EndOfStream();
 }
 
 void BuildReactor::EndOfStream() {

@@ -32,6 +32,7 @@ class BuildReactor final : public grpc::ServerReadReactor<galpha::v1::BuildReque
                absl::StatusOr<std::string> tenant);
 
   void OnReadDone(bool ok) override;
+  void OnSendInitialMetadataDone(bool ok) override;
   void OnCancel() override { cancelled_ = true; }
   void OnDone() override;
 

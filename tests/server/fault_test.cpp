@@ -189,7 +189,10 @@ TEST(FaultTest, VanishingClientsBurstsAndBadMessagesLeaveTheServerUp) {
     ASSERT_TRUE(done.wait_for(lock, std::chrono::seconds(30), [&] { return finished; }));
   }
   EXPECT_FALSE(garbage_status.ok());  // a grpc::Status
-  {
+  // gRPC reports the refused message's failed read and the call's cancellation in either order:
+  // repeated, a server that takes the failed read for the stream's end builds and caches the empty
+  // set about every other time (ExpectBackToBaseline then finds a resident entry).
+  for (int rep = 0; rep < 50; ++rep) {
     grpc::ClientContext big_context;
     v1::BuildResponse big_response;
     auto writer = client->stub().Build(&big_context, &big_response);
