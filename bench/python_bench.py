@@ -6,7 +6,8 @@
   * in process: galpha.local().build() vs the engine's own time for the same build in alphactl
     bench (the sum of its stage times, best of --repeat);
   * classify at one alpha: NumPy arrays per second, both clients (the network one in every
-    answer encoding: raw, delta, zstd);
+    answer encoding: raw, delta, zstd; the compact two also through the NumPy decoder that
+    installs without the compiled module use);
   * the shape at that alpha and at a fifth of it (a fragmented shape: many small polygons,
     singular edges and isolated points) as shapely geometry (mode general), local: Family.shape() (one GEOS call through WKB) vs the same geometry built from
     Family.shape_rings() with shapely's constructors, one object a member (what Family.shape did
@@ -28,6 +29,7 @@ import argparse
 import pathlib
 import re
 import subprocess
+import threading
 import sys
 import tempfile
 import time
@@ -152,10 +154,21 @@ def main() -> int:
                 net_wall = min(net_wall, wall)
                 net_overhead = min(net_overhead, wall - sum(remote.summary.stage_times.values()))
             # Classify in every answer encoding (connect's answer_encoding), the same family.
+            # The compact ones twice: decoded by the compiled module (what the package does) and by
+            # the NumPy decoder installs without it fall back to (the reader switched off).
             net_classify = {}
-            for answer_encoding in ("raw", "delta", "zstd"):
-                with galpha.connect(target, timeout=600, answer_encoding=answer_encoding) as by_encoding:
-                    net_classify[answer_encoding] = classify_rate(by_encoding.family(handle, points), alpha)
+            for answer_encoding, decoder in (("raw", ""), ("delta", ""), ("zstd", ""), ("delta", "numpy"), ("zstd", "numpy")):
+                native_reader = galpha._wire.native_section_reader
+                if decoder == "numpy":
+                    galpha._wire.native_section_reader = lambda: None
+                galpha._network._decode_thread = threading.local()  # the pool threads take new readers
+                try:
+                    with galpha.connect(target, timeout=600, answer_encoding=answer_encoding) as by_encoding:
+                        label = answer_encoding + (f" ({decoder} decoder)" if decoder else "")
+                        net_classify[label] = classify_rate(by_encoding.family(handle, points), alpha)
+                finally:
+                    galpha._wire.native_section_reader = native_reader
+                    galpha._network._decode_thread = threading.local()
             remote.release()
             net.close()
         finally:
@@ -176,7 +189,7 @@ def main() -> int:
     print(f"{'network: Python upload, bytes a point (' + args.encoding + ')':52}{upload_bytes / args.points:10.2f}")
     print(f"{'classify, local: ms / GB/s':52}{ms(local_classify[0])}  {local_classify[1]:.2f} GB/s")
     for answer_encoding, (seconds, rate) in net_classify.items():
-        label = f"classify, network, answer_encoding={answer_encoding}: ms / GB/s"
+        label = f"classify, network, {answer_encoding}: ms / GB/s"
         print(f"{label:52}{ms(seconds)}  {rate:.2f} GB/s")
     for label, (ours, constructors) in shapes.items():
         print(f"{'shape at ' + label + ', local: Family.shape(), general':52}{ms(ours)}")

@@ -1,7 +1,8 @@
 // Compact, lossless Classify answers (galpha.v1.EncodedSimplexChunk, defined in
 // proto/galpha/v1/alpha_shapes.proto): the server's encoder and the client's decoder in one module,
-// so that both sides read the format from one place. Free of gRPC (only the protobuf messages), so
-// the fuzz target (tests/fuzz/simplex_chunk_fuzzer.cpp) and the unit tests drive it directly.
+// so that both sides read the format from one place (the chunk's data section itself is
+// simplex_sections). Free of gRPC (only the protobuf messages), so the fuzz target
+// (tests/fuzz/simplex_chunk_fuzzer.cpp) and the unit tests drive it directly.
 #pragma once
 
 #include <cstdint>
@@ -12,15 +13,11 @@
 #include "absl/status/status.h"
 #include "absl/types/span.h"
 #include "galpha/v1/alpha_shapes.pb.h"
+#include "proto/sections/simplex_sections.hpp"
 
 struct ZSTD_CCtx_s;
-struct ZSTD_DCtx_s;
 
 namespace galpha::wire {
-
-/// Most simplices one EncodedSimplexChunk may state: bounds the decoder's work and memory for one
-/// message (13 MiB of decoded triangles). The server sends 131,072 a chunk.
-inline constexpr uint32_t kMaxSimplicesPerEncodedChunk = uint32_t{1} << 20;
 
 /// Vertex indices a simplex of `kind` has (1, 2, 3); 0 for a kind the format does not define.
 int SimplexArity(galpha::v1::SimplexKind kind);
@@ -59,11 +56,6 @@ class SimplexChunkEncoder {
 /// chunk; one per stream, not thread-safe.
 class SimplexChunkDecoder {
  public:
-  SimplexChunkDecoder();
-  ~SimplexChunkDecoder();
-  SimplexChunkDecoder(const SimplexChunkDecoder&) = delete;
-  SimplexChunkDecoder& operator=(const SimplexChunkDecoder&) = delete;
-
   /// `chunk` as the SimplexChunk it encodes (`out` is overwritten). InvalidArgument naming the
   /// chunk (`chunk_index`: its place among the answer's chunks, from 0) for everything the proto
   /// says a client refuses. Decompression never writes more than the count allows. O(count).
@@ -71,9 +63,7 @@ class SimplexChunkDecoder {
                       galpha::v1::SimplexChunk* out);
 
  private:
-  std::unique_ptr<ZSTD_DCtx_s, void (*)(ZSTD_DCtx_s*)> zstd_;
-  std::unique_ptr<unsigned char[]> scratch_;  // decompressed sections, never zero-filled first
-  size_t scratch_bytes_ = 0;
+  SimplexSectionReader reader_;
 };
 
 }  // namespace galpha::wire

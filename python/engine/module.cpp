@@ -8,6 +8,7 @@
 #include "python/engine/build_call.hpp"
 #include "python/engine/engine_error.hpp"
 #include "python/engine/family_binding.hpp"
+#include "python/engine/simplex_sections_binding.hpp"
 
 namespace py = pybind11;
 
@@ -15,6 +16,7 @@ PYBIND11_MODULE(_engine, module) {
   module.doc() = "The galpha engine in this process: build(points) -> Family; handle(points).";
   galpha::python::RegisterEngineError(module);
   galpha::python::RegisterFamily(module);
+  galpha::python::RegisterSimplexSectionReader(module);
   module.def(
       "build",
       [](const py::object& points, const std::string& backend, const py::object& progress, const std::string& name,

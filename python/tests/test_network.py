@@ -10,6 +10,8 @@ import re
 import signal
 import socket
 
+import threading
+
 import numpy as np
 import pytest
 from conftest import DATA_SETS, read_bin
@@ -203,30 +205,48 @@ def test_asyncio_client_gives_the_same_answers(server) -> None:
         assert optimal == family.optimal(2)
 
 
-def test_every_answer_encoding_gives_the_raw_answer(server) -> None:
+def test_every_answer_encoding_gives_the_raw_answer(server, monkeypatch) -> None:
     # Shuffled points with more than one chunk (131,072 simplices) of edges and of triangles, and a
-    # data set in its own order; both modes, and the non-exterior part.
+    # data set in its own order; both modes, and the non-exterior part. The compact encodings are
+    # decoded by the compiled module (on the pool) and by the NumPy decoder (the module hidden).
+    from galpha import _network, _wire
+
     sets = [np.random.default_rng(5).random((60000, 2)), read_bin(DATA_SETS[0])]
     for points in sets:
         answers = {}
-        for encoding in ("raw", "delta", "zstd"):
-            with galpha.connect(server.address, timeout=60, answer_encoding=encoding) as c:
-                family = c.build(points)
-                k = family.spectrum_size
-                answers[encoding] = [
-                    family.classify(rank=k // 2),
-                    family.classify(rank=k // 3, mode="regularized"),
-                    family.classify(rank=k // 2, non_exterior_only=True),
-                ]
-        for encoding in ("delta", "zstd"):
+        for encoding, decoder in (("raw", ""), ("delta", ""), ("zstd", ""), ("delta", "numpy"), ("zstd", "numpy")):
+            with monkeypatch.context() as patch:
+                if decoder == "numpy":
+                    patch.setattr(_wire, "native_section_reader", lambda: None)
+                    patch.setattr(_network, "_decode_thread", threading.local())
+                with galpha.connect(server.address, timeout=60, answer_encoding=encoding) as c:
+                    family = c.build(points)
+                    k = family.spectrum_size
+                    answers[encoding + decoder] = [
+                        family.classify(rank=k // 2),
+                        family.classify(rank=k // 3, mode="regularized"),
+                        family.classify(rank=k // 2, non_exterior_only=True),
+                    ]
+            monkeypatch.setattr(_network, "_decode_thread", threading.local())  # readers of the module again
+        for encoding in ("delta", "zstd", "deltanumpy", "zstdnumpy"):
             for got, want in zip(answers[encoding], answers["raw"]):
                 for field in ("vertices", "vertex_classes", "edges", "edge_classes", "triangles", "triangle_classes"):
                     np.testing.assert_array_equal(getattr(got, field), getattr(want, field), err_msg=f"{encoding} {field}")
                     assert getattr(got, field).dtype == getattr(want, field).dtype
 
 
+def test_auto_asks_for_delta_where_the_compiled_module_decodes_it(monkeypatch) -> None:
+    from galpha import _network, _wire
+
+    with galpha.connect("localhost:1") as c:
+        assert c._calls.simplex_encoding == _network.ANSWER_ENCODINGS["delta"]
+    monkeypatch.setattr(_wire, "native_section_reader", lambda: None)
+    with galpha.connect("localhost:1") as c:
+        assert c._calls.simplex_encoding == _network.ANSWER_ENCODINGS["raw"]
+
+
 def test_an_unknown_answer_encoding_is_refused() -> None:
-    with pytest.raises(galpha.InvalidInput, match="answer_encoding is 'raw', 'delta' or 'zstd', not 'gzip'"):
+    with pytest.raises(galpha.InvalidInput, match="answer_encoding is 'auto', 'raw', 'delta' or 'zstd', not 'gzip'"):
         galpha.connect("localhost:1", answer_encoding="gzip")
     with pytest.raises(galpha.InvalidInput, match="answer_encoding"):
         galpha.aio.connect("localhost:1", answer_encoding="lz4")

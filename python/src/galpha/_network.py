@@ -112,40 +112,65 @@ def _counts(c: pb.ClassCounts) -> ClassCounts:
     return ClassCounts(exterior=c.exterior, singular=c.singular, regular=c.regular, interior=c.interior)
 
 
+#: Threads that decode compact Classify chunks (shared by every call of the process): the C++
+#: reader releases the GIL, so chunks decode side by side while the stream is still read.
+_DECODE_THREADS = min(4, os.cpu_count() or 1)
+_decode_pool: Optional[concurrent.futures.ThreadPoolExecutor] = None
+_decode_pool_lock = threading.Lock()
+_decode_thread = threading.local()  # each pool thread's reader (one reuses its zstd context)
+
+
+def _decode_executor() -> concurrent.futures.ThreadPoolExecutor:
+    global _decode_pool
+    with _decode_pool_lock:
+        if _decode_pool is None:
+            _decode_pool = concurrent.futures.ThreadPoolExecutor(_DECODE_THREADS, thread_name_prefix="galpha-decode")
+        return _decode_pool
+
+
+def _decode_encoded(payload: memoryview, index: int) -> Tuple[int, np.ndarray, np.ndarray]:
+    if not hasattr(_decode_thread, "reader"):
+        _decode_thread.reader = _wire.native_section_reader()  # None without the compiled module: NumPy decodes
+    return _wire.decode_encoded_simplex_chunk(payload, index, _decode_thread.reader)
+
+
 class ClassifyAssembler:
-    """Collects a Classify stream (one summary, then chunks by kind) into a Classification."""
+    """Collects a Classify stream (one summary, then chunks by kind) into a Classification. Compact
+    chunks are decoded on a small shared pool as they arrive, and taken in their order."""
 
     def __init__(self) -> None:
         self.summary: Optional[pb.ClassifySummary] = None
-        self.parts: dict = {1: ([], []), 2: ([], []), 3: ([], [])}
-        self.chunks = 0
+        self.chunks: List[Any] = []  # (kind, indices, classes), or a Future of one, in stream order
 
     def add(self, raw: bytes) -> None:
         number, payload = _wire.split_oneof(raw)
         if number == 1:
             self.summary = pb.ClassifySummary.FromString(bytes(payload))
             return
-        if number not in (2, 3):
-            return
-        index = self.chunks
-        self.chunks += 1
         if number == 2:
-            kind, indices, classes = _wire.decode_simplex_chunk(payload)
-        else:
-            try:
-                kind, indices, classes = _wire.decode_encoded_simplex_chunk(payload, index)
-            except _wire.EncodedChunkError as e:
-                raise GalphaError(f"the server's Classify answer: {e}", code="DATA_LOSS", code_number=15) from None
-        if kind in self.parts:
-            self.parts[kind][0].append(indices)
-            self.parts[kind][1].append(classes)
+            self.chunks.append(_wire.decode_simplex_chunk(payload))
+        elif number == 3:
+            self.chunks.append(_decode_executor().submit(_decode_encoded, payload, len(self.chunks)))
 
     def result(self) -> Classification:
+        parts: dict = {1: ([], []), 2: ([], []), 3: ([], [])}
+        try:
+            for chunk in self.chunks:
+                kind, indices, classes = chunk.result() if isinstance(chunk, concurrent.futures.Future) else chunk
+                if kind in parts:
+                    parts[kind][0].append(indices)
+                    parts[kind][1].append(classes)
+        except _wire.EncodedChunkError as e:
+            raise GalphaError(f"the server's Classify answer: {e}", code="DATA_LOSS", code_number=15) from None
+        finally:
+            for chunk in self.chunks:
+                if isinstance(chunk, concurrent.futures.Future):
+                    chunk.cancel()
         if self.summary is None:
             raise GalphaError("the server's Classify answer had no summary", code="DATA_LOSS", code_number=15)
 
         def joined(kind: int, width: int) -> Tuple[np.ndarray, np.ndarray]:
-            idx, cls = self.parts[kind]
+            idx, cls = parts[kind]
             indices = np.concatenate(idx) if idx else np.empty(0, dtype=np.uint32)
             classes = np.concatenate(cls) if cls else np.empty(0, dtype=np.uint8)
             indices = indices.astype(np.uint32, copy=False)
@@ -394,15 +419,23 @@ ANSWER_ENCODINGS = {"raw": 1, "delta": 2, "zstd": 3}
 
 
 def answer_encoding_number(answer_encoding: str) -> int:
-    """The SimplexEncoding number of connect()'s ``answer_encoding``; InvalidInput for another value
-    and for "zstd" without the zstandard module (Debian's python3-zstandard)."""
+    """The SimplexEncoding number of connect()'s ``answer_encoding``: "auto" is "delta" where the
+    compiled module decodes it (as fast as the C++ client), else "raw" (the NumPy decoder takes
+    4-6x raw's time). InvalidInput for another value and for "zstd" with neither galpha's
+    compiled module (which decodes zstd itself) nor the zstandard module (Debian's
+    python3-zstandard)."""
+    if answer_encoding == "auto":
+        return ANSWER_ENCODINGS["delta" if _wire.native_section_reader() is not None else "raw"]
     if answer_encoding not in ANSWER_ENCODINGS:
-        raise InvalidInput(f"answer_encoding is 'raw', 'delta' or 'zstd', not {answer_encoding!r}")
-    if answer_encoding == "zstd":
+        raise InvalidInput(f"answer_encoding is 'auto', 'raw', 'delta' or 'zstd', not {answer_encoding!r}")
+    if answer_encoding == "zstd" and _wire.native_section_reader() is None:
         try:
             import zstandard  # noqa: F401
         except ImportError:
-            raise InvalidInput("answer_encoding='zstd' needs the zstandard module (Debian: python3-zstandard)") from None
+            raise InvalidInput(
+                "answer_encoding='zstd' needs galpha's compiled module (galpha._engine) or the zstandard module "
+                "(Debian: python3-zstandard)"
+            ) from None
     return ANSWER_ENCODINGS[answer_encoding]
 
 

@@ -311,7 +311,7 @@ class AsyncClient:
         token: Optional[str],
         tls_ca: Optional[str],
         timeout: Optional[float],
-        answer_encoding: str = "raw",
+        answer_encoding: str = "auto",
     ) -> None:
         self.target = target
         encoding = _network.answer_encoding_number(answer_encoding)  # before the channel: nothing to close
@@ -381,7 +381,7 @@ def connect(
     token: Optional[str] = None,
     tls_ca: Optional[str] = None,
     timeout: Optional[float] = None,
-    answer_encoding: str = "raw",
+    answer_encoding: str = "auto",
 ) -> AsyncClient:
     """The asyncio counterpart of :func:`galpha.connect` (create it inside a running event loop)."""
     return AsyncClient(target, token=token, tls_ca=tls_ca, timeout=timeout, answer_encoding=answer_encoding)
