@@ -111,8 +111,8 @@ absl::Status SimplexChunkDecoder::Decode(const v1::EncodedSimplexChunk& chunk, u
   classes->resize(count);
   auto* indices = out->mutable_vertex_indices();
   indices->Resize(static_cast<int>(count * static_cast<size_t>(arity)), 0);
-  const absl::Status read = reader_.Read(arity, count, encoding == v1::SIMPLEX_ENCODING_DELTA_ZSTD, chunk.data(),
-                                         chunk_index, indices->mutable_data(), classes->data());
+  absl::Status read = reader_.Read(arity, count, encoding == v1::SIMPLEX_ENCODING_DELTA_ZSTD, chunk.data(), chunk_index,
+                                   indices->mutable_data(), classes->data());
   if (!read.ok()) out->Clear();
   return read;
 }
