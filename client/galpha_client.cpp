@@ -196,6 +196,140 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   return result;
 }
 
+absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch(absl::Span<const BatchSet> sets,
+                                                                                 const BuildBatchCallOptions& options) {
+  constexpr size_t kMaxSets = 100'000;  // the server's (server/build_batch_reactor.hpp)
+  if (sets.size() > kMaxSets) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(sets.size(), " sets; a BuildBatch call carries at most ", kMaxSets, ": split them"));
+  }
+  // The chunks of every set in stream order.
+  struct ChunkRef {
+    size_t set;
+    size_t begin;
+    size_t count;
+  };
+  std::vector<ChunkRef> chunks;
+  std::vector<size_t> first_chunk(sets.size() + 1, 0);
+  for (size_t i = 0; i < sets.size(); ++i) {
+    const BatchSet& set = sets[i];
+    if (!set.weights.empty() && set.weights.size() != set.points.size()) {
+      return absl::InvalidArgumentError(absl::StrCat("set ", i, " ('", set.name, "'): ", set.points.size(),
+                                                     " points need ", set.points.size(), " weights, not ",
+                                                     set.weights.size()));
+    }
+    first_chunk[i] = chunks.size();
+    for (size_t begin = 0; begin < set.points.size(); begin += kPointsPerChunk) {
+      chunks.push_back({i, begin, std::min(kPointsPerChunk, set.points.size() - begin)});
+    }
+  }
+  first_chunk[sets.size()] = chunks.size();
+
+  grpc::ClientContext context;
+  PrepareContext(&context);
+  std::unique_ptr<grpc::ClientReaderWriter<v1::BuildRequest, v1::BuildBatchResponse>> stream =
+      stub_->BuildBatch(&context);
+  // As Build: chunks are encoded ahead of the writes on up to `window` threads, one chunk each,
+  // and written in order; the sets' headers go between them.
+  const size_t window = options.encoding == PointEncoding::kRaw
+                            ? 1
+                            : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads);
+  struct Slot {
+    std::unique_ptr<wire::PointChunkEncoder> encoder;
+    v1::BuildRequest message;
+    absl::Status status;
+    std::thread worker;
+  };
+  std::vector<Slot> slots(window);
+  for (Slot& slot : slots) slot.encoder = std::make_unique<wire::PointChunkEncoder>(options.zstd_level);
+  const auto encode = [&](size_t chunk) {
+    Slot& slot = slots[chunk % window];
+    const ChunkRef& ref = chunks[chunk];
+    const BatchSet& set = sets[ref.set];
+    slot.status = EncodeChunk(set.points.subspan(ref.begin, ref.count),
+                              set.weights.empty() ? set.weights : set.weights.subspan(ref.begin, ref.count),
+                              options.encoding, slot.encoder.get(), &slot.message);
+  };
+  const auto start = [&](size_t chunk) {
+    if (window > 1) slots[chunk % window].worker = std::thread(encode, chunk);
+  };
+  for (size_t chunk = 0; chunk < std::min(window, chunks.size()); ++chunk) start(chunk);
+  bool open = true;
+  absl::Status encoded;
+  std::vector<uint64_t> upload_bytes(sets.size(), 0);
+  for (size_t i = 0; open && encoded.ok() && i < sets.size(); ++i) {
+    v1::BuildRequest header;
+    header.mutable_header()->set_name(sets[i].name);
+    header.mutable_header()->set_expected_points(sets[i].points.size());
+    header.mutable_header()->set_crs(options.crs);
+    header.mutable_header()->set_weighted(!sets[i].weights.empty());
+    open = stream->Write(header);
+    for (size_t chunk = first_chunk[i]; open && chunk < first_chunk[i + 1]; ++chunk) {
+      Slot& slot = slots[chunk % window];
+      if (window > 1) {
+        slot.worker.join();
+      } else {
+        encode(chunk);
+      }
+      encoded = slot.status;
+      if (!encoded.ok()) {
+        encoded = absl::Status(encoded.code(), absl::StrCat("set ", i, " ('", sets[i].name, "'): ", encoded.message()));
+        break;
+      }
+      upload_bytes[i] += slot.message.ByteSizeLong();
+      open = stream->Write(slot.message);
+      if (open && chunk + window < chunks.size()) start(chunk + window);
+    }
+    if (open && encoded.ok() && options.progress) options.progress(i + 1);
+  }
+  for (Slot& slot : slots) {
+    if (slot.worker.joinable()) slot.worker.join();
+  }
+  if (!encoded.ok()) {
+    context.TryCancel();
+    stream->Finish();
+    return encoded;
+  }
+  // A write fails when the server has already answered (an error): Finish returns that answer.
+  if (open) stream->WritesDone();
+  std::vector<absl::StatusOr<BuildResult>> results;
+  results.reserve(sets.size());
+  v1::BuildBatchResponse page;
+  absl::Status malformed;
+  while (stream->Read(&page)) {
+    if (page.first_set() != results.size() || page.set_count() != sets.size() ||
+        results.size() + static_cast<size_t>(page.sets_size()) > sets.size()) {
+      malformed = absl::DataLossError(absl::StrCat("the server's BuildBatch answer is out of order: a page for sets ",
+                                                   page.first_set(), " on of ", page.set_count(), " after ",
+                                                   results.size(), " of ", sets.size()));
+      context.TryCancel();
+      break;
+    }
+    for (v1::BatchedBuild& answer : *page.mutable_sets()) {
+      const size_t i = results.size();
+      if (answer.code() != 0) {
+        results.emplace_back(absl::Status(static_cast<absl::StatusCode>(answer.code()), answer.message()));
+        continue;
+      }
+      BuildResult result;
+      result.handle = answer.result().handle();
+      result.cached = answer.result().cached();
+      result.uploaded = true;
+      result.upload_bytes = upload_bytes[i];
+      result.summary = std::move(*answer.mutable_result()->mutable_summary());
+      results.emplace_back(std::move(result));
+    }
+  }
+  absl::Status status = FromGrpc(stream->Finish());
+  if (!malformed.ok()) return malformed;
+  if (!status.ok()) return status;
+  if (results.size() != sets.size()) {
+    return absl::DataLossError(
+        absl::StrCat("the server's BuildBatch answer ended after ", results.size(), " of ", sets.size(), " sets"));
+  }
+  return results;
+}
+
 absl::StatusOr<v1::DescribeResponse> AlphaClient::Describe(const std::string& handle) {
   grpc::ClientContext context;
   PrepareContext(&context, handle);

@@ -85,6 +85,24 @@ struct BuildCallOptions {
   absl::Span<const double> weights;
 };
 
+/// One set of a BuildBatch call.
+struct BatchSet {
+  /// BuildHeader.name: the set's label (its feature or group id), echoed in its answer.
+  std::string name;
+  absl::Span<const Point2> points;
+  /// Its weights (BuildCallOptions::weights); empty: unweighted.
+  absl::Span<const double> weights;
+};
+
+struct BuildBatchCallOptions {
+  PointEncoding encoding = PointEncoding::kAuto;
+  int zstd_level = 3;
+  /// Every set's BuildHeader.crs (empty: planar).
+  std::string crs;
+  /// Called after each set's points are sent with the number of sets sent.
+  std::function<void(size_t sets_sent)> progress;
+};
+
 /// gRPC status to absl::Status (the codes are the same numbers).
 absl::Status FromGrpc(const grpc::Status& status);
 
@@ -94,6 +112,14 @@ class AlphaClient {
   static absl::StatusOr<std::unique_ptr<AlphaClient>> Connect(const ClientOptions& options);
 
   absl::StatusOr<BuildResult> Build(absl::Span<const Point2> points, const BuildCallOptions& options = {});
+  /// Many sets in one BuildBatch stream (proto: BuildBatch): one answer a set, in their order, each
+  /// the set's BuildResult (handle, cached, summary; uploaded) or the error of its build alone. The
+  /// call's own error (a set the server refused to read, named by its index and name; the
+  /// connection) fails it whole. InvalidArgument, before anything is sent, for weights whose count
+  /// is not their set's points' or more than 100,000 sets. Chunks are encoded on up to
+  /// kMaxEncodingThreads threads ahead of the writes.
+  absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> BuildBatch(absl::Span<const BatchSet> sets,
+                                                                      const BuildBatchCallOptions& options = {});
   absl::StatusOr<galpha::v1::DescribeResponse> Describe(const std::string& handle);
   absl::StatusOr<galpha::v1::SpectrumResponse> Spectrum(const galpha::v1::SpectrumRequest& request);
   absl::StatusOr<galpha::v1::ComponentsResponse> Components(const galpha::v1::ComponentsRequest& request);

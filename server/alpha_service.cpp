@@ -14,6 +14,7 @@
 #include "absl/strings/str_cat.h"
 #include "core/io/point_set_handle.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
+#include "server/build_batch_reactor.hpp"
 #include "server/build_reactor.hpp"
 #include "server/encoded_answer.hpp"
 #include "server/grpc_status.hpp"
@@ -282,6 +283,11 @@ absl::StatusOr<std::shared_ptr<const CachedFamily>> AlphaService::Lookup(grpc::C
 grpc::ServerReadReactor<v1::BuildRequest>* AlphaService::Build(grpc::CallbackServerContext* context,
                                                                v1::BuildResponse* response) {
   return new BuildReactor(this, context, response, Authenticate(context));
+}
+
+grpc::ServerBidiReactor<v1::BuildRequest, v1::BuildBatchResponse>* AlphaService::BuildBatch(
+    grpc::CallbackServerContext* context) {
+  return new BuildBatchReactor(this, context, Authenticate(context));
 }
 
 template <typename Request, typename Answer, typename Reply>

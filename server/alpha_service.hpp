@@ -100,6 +100,8 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
 
   grpc::ServerReadReactor<galpha::v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
                                                            galpha::v1::BuildResponse* response) override;
+  grpc::ServerBidiReactor<galpha::v1::BuildRequest, galpha::v1::BuildBatchResponse>* BuildBatch(
+      grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* Describe(grpc::CallbackServerContext* context, const galpha::v1::DescribeRequest* request,
                                      galpha::v1::DescribeResponse* response) override;
   grpc::ServerWriteReactor<galpha::v1::ClassifyResponse>* Classify(grpc::CallbackServerContext* context,
@@ -125,6 +127,7 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
 
  private:
   friend class BuildReactor;
+  friend class BuildBatchReactor;
   AlphaService(const ServiceOptions& options, ServerMetrics* metrics);
 
   /// The caller's tenant, or Unauthenticated.

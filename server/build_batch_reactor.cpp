@@ -1,0 +1,333 @@
+#include "server/build_batch_reactor.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <thread>
+#include <utility>
+
+#include "absl/strings/cord.h"
+#include "absl/strings/str_cat.h"
+#include "gpu/alpha/alpha_engine.hpp"
+#include "server/alpha_service.hpp"
+#include "server/build_refusal.hpp"
+#include "server/build_time_limit.hpp"
+#include "server/exact_comparison_limit.hpp"
+#include "server/grpc_status.hpp"
+#include "server/heap_trim.hpp"
+#include "server/query_answers.hpp"
+
+namespace galpha::server {
+
+namespace v1 = galpha::v1;
+
+absl::Status NameBatchSet(const absl::Status& status, size_t set, const std::string& name) {
+  absl::Status named(status.code(), absl::StrCat("set ", set, " ('", name, "'): ", status.message()));
+  status.ForEachPayload([&](absl::string_view url, const absl::Cord& payload) { named.SetPayload(url, payload); });
+  return named;
+}
+
+BuildBatchReactor::BuildBatchReactor(AlphaService* service, grpc::CallbackServerContext* context,
+                                     absl::StatusOr<std::string> tenant)
+    : service_(service), context_(context), record_(service->metrics_, "BuildBatch") {
+  if (!tenant.ok()) {
+    Respond(tenant.status());
+    return;
+  }
+  tenant_ = *std::move(tenant);
+  if (service_->draining_) {
+    Respond(TagRefusal(absl::UnavailableError("the server is draining and accepts no new builds"),
+                       BuildRefusal::kDraining));
+    return;
+  }
+  last_activity_ = Clock::now().time_since_epoch().count();
+  uploading_ = true;
+  service_->upload_watchdog_.Watch(this);
+  std::lock_guard<std::mutex> lock(upload_mutex_);
+  if (!upload_over_) StartRead(&request_);  // else the watchdog already ended the call
+}
+
+void BuildBatchReactor::OnDone() {
+  service_->upload_watchdog_.Unwatch(this);
+  delete this;
+}
+
+std::optional<BuildBatchReactor::Clock::time_point> BuildBatchReactor::LastActivity() const {
+  if (!uploading_) return std::nullopt;
+  return Clock::time_point(Clock::duration(last_activity_.load()));
+}
+
+void BuildBatchReactor::TimeOut() {
+  {
+    std::lock_guard<std::mutex> lock(upload_mutex_);
+    if (upload_over_) return;
+    upload_over_ = true;
+    uploading_ = false;
+    sets_.clear();  // the points and their reservations go now
+  }
+  Respond(TagRefusal(absl::DeadlineExceededError(absl::StrCat(
+                         "the batch upload sent nothing for ", service_->upload_watchdog_.idle_timeout().count(),
+                         " ms, the server's idle limit (--upload_idle_timeout_ms): the batch was dropped")),
+                     BuildRefusal::kIdleTimeout));
+}
+
+absl::Status BuildBatchReactor::EndSet() {
+  Set& set = sets_.back();
+  auto decoded = set.decoder->Finish();
+  if (!decoded.ok()) return decoded.status();
+  set.build = *decoded;
+  points_ += set.build->points.size();
+  return absl::OkStatus();
+}
+
+absl::Status BuildBatchReactor::Add(v1::BuildRequest message) {
+  if (message.has_header()) {
+    if (!sets_.empty()) {
+      if (absl::Status ended = EndSet(); !ended.ok()) return NameBatchSet(ended, sets_.size() - 1, sets_.back().name);
+    }
+    if (sets_.size() == kMaxBatchSets) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("a BuildBatch stream carries at most ", kMaxBatchSets, " sets; send the rest in another"));
+    }
+    Set& set = sets_.emplace_back();
+    set.decoder = std::make_unique<BuildStreamDecoder>(BuildStreamLimits{service_->options_.max_points_per_build},
+                                                       &service_->in_flight_, tenant_, &service_->codec_pool_);
+    set.name = message.header().name().substr(0, kMaxBuildNameBytes);  // the decoder refuses a longer one
+    if (absl::Status added = set.decoder->Add(std::move(message)); !added.ok()) {
+      return NameBatchSet(added, sets_.size() - 1, set.name);
+    }
+    return absl::OkStatus();
+  }
+  if (sets_.empty()) {
+    return absl::InvalidArgumentError("a BuildBatch stream starts with a set's header; this one began with points");
+  }
+  Set& set = sets_.back();
+  absl::Status added = set.decoder->Add(std::move(message));
+  // The batch is one build job: its points together are held to the limit of one build.
+  const uint64_t points = points_ + set.decoder->points_received();
+  if (added.ok() && points > service_->options_.max_points_per_build) {
+    added = TagRefusal(absl::ResourceExhaustedError(absl::StrCat(
+                           "the batch's sets hold ", points, " points together, over the server's limit of ",
+                           service_->options_.max_points_per_build, " points a build (--max_points_per_build)")),
+                       BuildRefusal::kPointsPerBuild);
+  }
+  if (!added.ok()) return NameBatchSet(added, sets_.size() - 1, set.name);
+  return absl::OkStatus();
+}
+
+void BuildBatchReactor::OnReadDone(bool ok) {
+  absl::Status refused;
+  {
+    std::lock_guard<std::mutex> lock(upload_mutex_);
+    if (upload_over_) return;  // the watchdog ended the call
+    if (ok) {
+      last_activity_ = Clock::now().time_since_epoch().count();
+      refused = Add(std::move(request_));
+      if (refused.ok()) {
+        StartRead(&request_);
+        return;
+      }
+    }
+    upload_over_ = true;
+    uploading_ = false;
+  }
+  if (ok) {
+    Respond(refused);
+  } else {
+    // As in BuildReactor::OnReadDone: a failed read is the stream's end only if the call still
+    // takes a send.
+    StartSendInitialMetadata();
+  }
+}
+
+void BuildBatchReactor::OnSendInitialMetadataDone(bool ok) {
+  if (!ok || cancelled_) {
+    Respond(absl::CancelledError("the upload was cut: the client went away or gRPC refused one of its messages"));
+    return;
+  }
+  EndOfStream();
+}
+
+void BuildBatchReactor::EndOfStream() {
+  if (CallerGone()) {
+    Respond(absl::CancelledError("the client cancelled the batch during the upload"));
+    return;
+  }
+  if (sets_.empty()) {
+    Respond(absl::InvalidArgumentError("the BuildBatch stream carried no set: it needs a header, then points, a set"));
+    return;
+  }
+  if (absl::Status ended = EndSet(); !ended.ok()) {
+    Respond(NameBatchSet(ended, sets_.size() - 1, sets_.back().name));
+    return;
+  }
+  // Cached sets answer now; the others are built one after the other by one job, whose working
+  // memory is the largest set's (every set's points are already reserved as in flight).
+  size_t need = 0;
+  for (size_t i = 0; i < sets_.size(); ++i) {
+    Set& set = sets_[i];
+    const FamilyCache::Found found = service_->cache_->Lookup(tenant_, set.build->handle);
+    if (found.resident != nullptr) {
+      if (set.build->frame != nullptr) found.resident->AttachFrameIfNone(set.build->frame);
+      Answer(i, *found.resident, /*was_cached=*/true);
+      set.decoder.reset();
+      continue;
+    }
+    if (found.compact != nullptr && set.build->frame == nullptr) set.build->frame = found.compact->frame();
+    need = std::max(need, set.build->points.size() * (kBuildBytesPerPoint + sizeof(Point2)) +
+                              set.build->weights.size() * kBuildBytesPerWeight);
+    to_build_.push_back(i);
+  }
+  if (to_build_.empty()) {
+    WriteNextPage();
+    return;
+  }
+  absl::Status submitted = service_->scheduler_->Submit(
+      tenant_, need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
+  if (!submitted.ok()) Respond(submitted);
+}
+
+void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
+  if (draining) {
+    Respond(TagRefusal(absl::UnavailableError("the server is shutting down; the batch had not started"),
+                       BuildRefusal::kDraining));
+    return;
+  }
+  if (CallerGone()) {
+    Respond(absl::CancelledError("the client went away while the batch was queued"));
+    return;
+  }
+  uint64_t points = 0;
+  for (size_t i : to_build_) points += sets_[i].build->points.size();
+  const bool cuda = service_->backend_name_ == "cuda";
+  const unsigned cores = std::thread::hardware_concurrency();
+  const auto one_build = BuildTimeLimit(points, cuda, cores, service_->options_.build_time);
+  const bool limited = one_build.count() > 0;
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(one_build) +
+                        kBatchBuildTimePerSet * static_cast<int64_t>(to_build_.size());
+  for (size_t i : to_build_) {
+    if (CallerGone()) break;
+    BuildSet(i, slot, limited, deadline);
+  }
+  ReturnFreedHeapMemory();  // the engine's working memory and the points
+  if (CallerGone()) {
+    Respond(absl::CancelledError("the client went away during the batch; the sets built so far stay cached"));
+    return;
+  }
+  WriteNextPage();
+}
+
+void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline) {
+  Set& set = sets_[index];
+  const DecodedBuild& build = *set.build;
+  // An earlier set of this batch with the same points (or another call) may have built it since.
+  if (const FamilyCache::Found found = service_->cache_->Lookup(tenant_, build.handle); found.resident != nullptr) {
+    if (build.frame != nullptr) found.resident->AttachFrameIfNone(build.frame);
+    Answer(index, *found.resident, /*was_cached=*/true);
+    set.decoder.reset();
+    return;
+  }
+  const size_t points = build.points.size();
+  const bool cuda = service_->backend_name_ == "cuda";
+  const unsigned cores = std::thread::hardware_concurrency();
+  BuildOptions options;
+  options.backend = service_->backend_;
+  options.cuda_stream = slot.cuda_stream;
+  options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
+  options.max_exact_comparisons = ExactComparisonLimit(points, service_->options_.exact_comparisons);
+  const auto start = Clock::now();
+  absl::StatusOr<std::shared_ptr<const CachedFamily>> family =
+      BuildCachedFamily(build.points, build.weights, build.header.weighted(), options,
+                        service_->resident_families_ && service_->cache_->FitsDeviceTier(points), build.frame);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (!family.ok()) {
+    if (absl::IsCancelled(family.status()) && !cancelled_ && limited && Clock::now() > deadline) {
+      AnswerError(index, TagRefusal(absl::DeadlineExceededError(absl::StrCat(
+                                        "the batch ran past its time limit (",
+                                        BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time),
+                                        "; a batch has the limit of one build of all its points plus ",
+                                        kBatchBuildTimePerSet.count(), " ms a set)")),
+                                    BuildRefusal::kBuildTime));
+    } else if (IsExactComparisonLimit(family.status())) {
+      AnswerError(index, TagRefusal(absl::ResourceExhaustedError(
+                                        ExactComparisonLimitMessage(points, service_->options_.exact_comparisons)),
+                                    BuildRefusal::kExactComparisons));
+    } else {
+      AnswerError(index, family.status());
+    }
+    set.decoder.reset();  // its points and their reservation
+    return;
+  }
+  service_->metrics_->RecordBuild((*family)->reader().report(), seconds);
+  auto inserted = service_->cache_->Insert(tenant_, build.handle, *std::move(family));
+  if (!inserted.ok()) {
+    AnswerError(index, absl::IsResourceExhausted(inserted.status())
+                           ? TagRefusal(inserted.status(), BuildRefusal::kCacheBytes)
+                           : inserted.status());
+  } else {
+    Answer(index, **inserted, /*was_cached=*/false);
+  }
+  set.decoder.reset();
+}
+
+void BuildBatchReactor::Answer(size_t index, const CachedFamily& family, bool was_cached) {
+  Set& set = sets_[index];
+  v1::BuildResponse* result = set.answer.mutable_result();
+  result->set_handle(set.build->handle);
+  result->set_cached(was_cached);
+  FillBuildSummary(family, result->mutable_summary());
+  result->mutable_summary()->set_name(set.build->header.name());
+  set.answered = true;
+}
+
+void BuildBatchReactor::AnswerError(size_t index, const absl::Status& status) {
+  if (const std::string reason = RefusalLabelOf(status); !reason.empty()) {
+    service_->metrics_->RecordRejectedBuild(reason);
+  }
+  Set& set = sets_[index];
+  set.answer.Clear();
+  set.answer.set_code(static_cast<int32_t>(status.code()));
+  set.answer.set_message(std::string(status.message()));
+  set.answered = true;
+}
+
+void BuildBatchReactor::WriteNextPage() {
+  if (next_page_set_ >= sets_.size()) {
+    Respond(absl::OkStatus());
+    return;
+  }
+  page_.Clear();
+  page_.set_first_set(next_page_set_);
+  page_.set_set_count(sets_.size());
+  const size_t end = std::min(sets_.size(), next_page_set_ + kBatchSetsPerPage);
+  for (size_t i = next_page_set_; i < end; ++i) {
+    Set& set = sets_[i];
+    if (!set.answered) {
+      // Only a cancelled batch leaves sets unanswered, and it does not write.
+      set.answer.set_code(static_cast<int32_t>(absl::StatusCode::kCancelled));
+      set.answer.set_message("the batch ended before this set was built");
+    }
+    *page_.add_sets() = std::move(set.answer);
+  }
+  next_page_set_ = end;
+  StartWrite(&page_);
+}
+
+void BuildBatchReactor::OnWriteDone(bool ok) {
+  if (!ok) {
+    Respond(absl::CancelledError("the client went away while the batch's answer was written"));
+    return;
+  }
+  WriteNextPage();
+}
+
+void BuildBatchReactor::Respond(const absl::Status& status) {
+  if (const std::string reason = RefusalLabelOf(status); !reason.empty()) {
+    service_->metrics_->RecordRejectedBuild(reason);
+  }
+  const grpc::Status result = ToGrpcStatus(status);
+  record_.Done(result);
+  Finish(result);
+}
+
+}  // namespace galpha::server

@@ -1,0 +1,111 @@
+// The BuildBatch RPC (issue "Speak GIS and molecules", item 3: one hull per feature): many point
+// sets in one client stream, each as a Build stream would carry it (a header, then its chunks),
+// read through one decoder a set; then one job on the build scheduler builds the sets that are
+// not cached, one after the other on its slot, and the answer goes back in pages of
+// kBatchSetsPerPage. A bad stream fails the whole call, naming the set; a set whose build alone
+// fails answers its own status and the others go on.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "galpha/v1/alpha_shapes.grpc.pb.h"
+#include "server/build_scheduler.hpp"
+#include "server/build_stream.hpp"
+#include "server/rpc_record.hpp"
+#include "server/upload_watchdog.hpp"
+
+namespace galpha::server {
+
+class AlphaService;
+
+/// Most sets one BuildBatch stream may carry (INVALID_ARGUMENT past it): bounds the per-set state
+/// a stream can make the server hold, whatever its points.
+inline constexpr size_t kMaxBatchSets = 100'000;
+/// Sets a BuildBatchResponse page answers.
+inline constexpr size_t kBatchSetsPerPage = 1000;
+/// Build time a batch is given a set, beyond the limit of one build of all its points: each set
+/// costs the engine a fixed start whatever its size.
+inline constexpr std::chrono::milliseconds kBatchBuildTimePerSet{100};
+
+/// `status` with its message prefixed by the set it concerns ("set 3 ('parcel-17'): ..."), its
+/// code and payloads (a refusal's tag) kept.
+absl::Status NameBatchSet(const absl::Status& status, size_t set, const std::string& name);
+
+class BuildBatchReactor final
+    : public grpc::ServerBidiReactor<galpha::v1::BuildRequest, galpha::v1::BuildBatchResponse>,
+      private UploadWatchdog::Upload {
+ public:
+  /// `tenant` is the caller's, or the authentication's error (the call then fails at once).
+  BuildBatchReactor(AlphaService* service, grpc::CallbackServerContext* context, absl::StatusOr<std::string> tenant);
+
+  void OnReadDone(bool ok) override;
+  void OnSendInitialMetadataDone(bool ok) override;
+  void OnWriteDone(bool ok) override;
+  void OnCancel() override { cancelled_ = true; }
+  void OnDone() override;
+
+ private:
+  using Clock = UploadWatchdog::Clock;
+
+  // One set of the stream: its decoder (which holds its points' reservation until the set is
+  // built), the decoded set once its stream part ended, and its answer.
+  struct Set {
+    std::string name;  // its header's (what errors name it by)
+    std::unique_ptr<BuildStreamDecoder> decoder;
+    DecodedBuild* build = nullptr;
+    galpha::v1::BatchedBuild answer;
+    bool answered = false;
+  };
+
+  // UploadWatchdog::Upload
+  std::optional<Clock::time_point> LastActivity() const override;
+  void TimeOut() override;
+
+  // Whether the call was cancelled: the client went away, or gRPC refused one of its messages.
+  bool CallerGone() const { return cancelled_ || context_->IsCancelled(); }
+  // One message: a header starts the next set (ending the one before), a chunk goes to the
+  // current set. Errors name the set.
+  absl::Status Add(galpha::v1::BuildRequest message);
+  // Ends the current set's part of the stream: its decoder's Finish.
+  absl::Status EndSet();
+  void EndOfStream();
+  void Run(const BuildSlot& slot, bool draining);
+  // Builds set `index` on `slot` (before `deadline` when `limited`) and caches its family.
+  void BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline);
+  // `family` as set `index`'s answer.
+  void Answer(size_t index, const CachedFamily& family, bool was_cached);
+  // Set `index`'s answer as a failure (counted as a refusal when it is one).
+  void AnswerError(size_t index, const absl::Status& status);
+  // Writes the next page of answers, or finishes the call after the last.
+  void WriteNextPage();
+  // The last thing any path does: after Finish, gRPC may delete this at any moment.
+  void Respond(const absl::Status& status);
+
+  AlphaService* const service_;
+  grpc::CallbackServerContext* const context_;
+  RpcRecord record_;
+  std::string tenant_;
+  galpha::v1::BuildRequest request_;
+  std::vector<Set> sets_;
+  uint64_t points_ = 0;  // of the sets whose part of the stream ended
+  std::vector<size_t> to_build_;
+  galpha::v1::BuildBatchResponse page_;
+  size_t next_page_set_ = 0;
+  std::atomic<bool> cancelled_{false};
+  // As BuildReactor's: the upload ends once, by its refusal, its end or the watchdog.
+  std::mutex upload_mutex_;
+  bool upload_over_ = false;  // guarded by upload_mutex_
+  std::atomic<bool> uploading_{false};
+  std::atomic<Clock::rep> last_activity_{0};
+};
+
+}  // namespace galpha::server
