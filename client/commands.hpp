@@ -21,6 +21,7 @@
 #include "core/base/point.hpp"
 #include "core/family/alpha_family.hpp"
 #include "core/family/threshold.hpp"
+#include "core/geometry/shape.hpp"
 #include "core/io/coordinate_system.hpp"
 #include "nlohmann/json.hpp"
 
@@ -174,9 +175,9 @@ absl::Status CheckThresholdRank(int64_t rank, int64_t k);
 absl::Status CheckMasterListRank(int64_t rank, int64_t k);
 
 /// shape --group-by COLUMN: one regularized shape per group of FILE's points (their values of a
-/// GeoJSON property or a GDAL layer's field), each built on its own, in the order the groups first
-/// appear: a GeoJSON FeatureCollection (one MultiPolygon feature per group, properties group,
-/// points, level, alpha_sq, area) or, for wkt, one line per group: the value, a tab, the WKT.
+/// GeoJSON property or a GDAL layer's field), each built on its own (with --server: all in one
+/// BuildBatch call), in the order the groups first appear: a GeoJSON FeatureCollection (one MultiPolygon feature per
+/// group, properties group, points, level, alpha_sq, area) or, for wkt, one line per group: the value, a tab, the WKT.
 int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, const std::string& format,
                     double min_hole_area);
 
@@ -192,5 +193,19 @@ int RemoteOptimal(const CommonArgs& common, int64_t components, std::optional<in
 int RemoteBench(const CommonArgs& common, int64_t repeat);
 int RemotePersistence(const CommonArgs& common, const PersistenceArgs& options);
 int RemoteHoles(const CommonArgs& common, const HolesArgs& options);
+
+/// One set's regularized shape at a threshold, as the server answers it.
+struct RemoteSetShape {
+  int64_t level = 0;
+  double alpha_sq = 0;
+  ShapeGeometry shape;
+};
+/// shape --group-by --server: the sets (a name and the computed points each) built in one
+/// BuildBatch call, then each one's level, squared alpha and regularized shape (holes smaller than
+/// `min_hole_area` filled) at `threshold`. An error names the set by `names`' entry.
+absl::StatusOr<std::vector<RemoteSetShape>> RemoteSetShapes(const CommonArgs& common,
+                                                            const std::vector<std::string>& names,
+                                                            const std::vector<absl::Span<const Point2>>& sets,
+                                                            const ThresholdArg& threshold, double min_hole_area);
 
 }  // namespace galpha::alphactl

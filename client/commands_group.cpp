@@ -1,6 +1,7 @@
 // alphactl shape --group-by: one shape per group of points (issue "Speak GIS": a hull per feature
 // class, cluster or region). Each group is framed (its own local projection for a geographic
-// CRS), built and shaped on its own.
+// CRS), built and shaped on its own, here or, with --server, by the server from one BuildBatch
+// call.
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -37,10 +38,6 @@ std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> Groups
 
 int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, const std::string& format,
                     double min_hole_area) {
-  if (!common.server.empty()) {
-    return UsageError(
-        absl::InvalidArgumentError("--group-by builds each group here; it does not combine with --server"));
-  }
   if (common.input.weights != InputOptions::Weights::kNone) {
     return UsageError(absl::InvalidArgumentError(
         "--group-by reads groups without weights: build a weighted set's shape without --group-by"));
@@ -56,40 +53,66 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
   } catch (const std::exception& e) {
     return Failure(absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what())));
   }
-  ChunkedWriter out(stdout);
-  nlohmann::ordered_json features = nlohmann::ordered_json::array();
-  for (const auto& [group, indices] : GroupsOf(read.groups)) {
-    const std::string name = group ? absl::StrCat("group '", *group, "'") : std::string("the group without a value");
+  // Each group framed on its own (its own local projection for a geographic CRS).
+  const auto groups = GroupsOf(read.groups);
+  std::vector<std::string> names;
+  std::vector<FramedPoints> frames;
+  for (const auto& [group, indices] : groups) {
+    names.push_back(group ? absl::StrCat("group '", *group, "'") : std::string("the group without a value"));
     std::vector<Point2> subset;
     subset.reserve(indices.size());
     for (uint32_t i : indices) subset.push_back(read.points[i]);
     auto frame = FramePoints(common, std::move(subset), read.crs);
     if (!frame.ok())
-      return Failure(absl::Status(frame.status().code(), absl::StrCat(name, ": ", frame.status().message())));
-    auto family = BuildFamily(common, frame->Computed(), /*weights=*/{});
-    if (!family.ok())
-      return Failure(absl::Status(family.status().code(), absl::StrCat(name, ": ", family.status().message())));
-    auto level = ResolveThreshold(*family, threshold);
-    if (!level.ok())
-      return ArgumentError(absl::Status(level.status().code(), absl::StrCat(name, ": ", level.status().message())));
-    auto shape = AssembleShape(family->ComplexAt(level->level, ClassifyMode::kRegularized));
-    if (!shape.ok()) return Failure(shape.status());
-    // Areas in the computation's units (square metres for a geographic CRS).
-    if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family->points(), min_hole_area);
-    auto points = OutputPoints(*frame, format == "geojson");
+      return Failure(absl::Status(frame.status().code(), absl::StrCat(names.back(), ": ", frame.status().message())));
+    frames.push_back(*std::move(frame));
+  }
+  // Each group's level, squared alpha and shape: built here one by one, or by the server in one
+  // BuildBatch call.
+  std::vector<RemoteSetShape> shapes;
+  if (!common.server.empty()) {
+    std::vector<absl::Span<const Point2>> sets;
+    for (const FramedPoints& frame : frames) sets.push_back(frame.Computed());
+    auto remote = RemoteSetShapes(common, names, sets, threshold, min_hole_area);
+    if (!remote.ok()) {
+      return absl::IsInvalidArgument(remote.status()) ? ArgumentError(remote.status()) : Failure(remote.status());
+    }
+    shapes = *std::move(remote);
+  } else {
+    for (size_t g = 0; g < groups.size(); ++g) {
+      const std::string& name = names[g];
+      auto family = BuildFamily(common, frames[g].Computed(), /*weights=*/{});
+      if (!family.ok())
+        return Failure(absl::Status(family.status().code(), absl::StrCat(name, ": ", family.status().message())));
+      auto level = ResolveThreshold(*family, threshold);
+      if (!level.ok())
+        return ArgumentError(absl::Status(level.status().code(), absl::StrCat(name, ": ", level.status().message())));
+      auto shape = AssembleShape(family->ComplexAt(level->level, ClassifyMode::kRegularized));
+      if (!shape.ok()) return Failure(shape.status());
+      // Areas in the computation's units (square metres for a geographic CRS).
+      if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family->points(), min_hole_area);
+      shapes.push_back({level->level, level->alpha_sq, *std::move(shape)});
+    }
+  }
+  ChunkedWriter out(stdout);
+  nlohmann::ordered_json features = nlohmann::ordered_json::array();
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const auto& [group, indices] = groups[g];
+    const RemoteSetShape& shape = shapes[g];
+    auto points = OutputPoints(frames[g], format == "geojson");
     if (!points.ok()) return Failure(points.status());
     if (format == "wkt") {
-      out.Append(absl::StrCat(group.value_or(""), "\t", ShapeToWkt(*shape, *points), "\n"));
+      out.Append(absl::StrCat(group.value_or(""), "\t", ShapeToWkt(shape.shape, *points), "\n"));
       continue;
     }
     nlohmann::ordered_json properties = {{"group", group ? nlohmann::ordered_json(*group) : nlohmann::ordered_json()},
                                          {"points", indices.size()},
-                                         {"level", level->level},
-                                         {"alpha_sq", level->alpha_sq},
-                                         {"area", shape->area}};
+                                         {"level", shape.level},
+                                         {"alpha_sq", shape.alpha_sq},
+                                         {"area", shape.shape.area}};
     features.push_back({{"type", "Feature"},
                         {"properties", std::move(properties)},
-                        {"geometry", ShapePolygonsGeoJson(*shape, *points)}});
+                        {"geometry", ShapePolygonsGeoJson(shape.shape, *points)}});
   }
   if (format == "geojson") {
     out.Append(JsonText({{"type", "FeatureCollection"}, {"features", std::move(features)}}));

@@ -113,9 +113,9 @@ absl::StatusOr<RemoteFamily> OpenRemote(const CommonArgs& common, bool skip_uplo
 
 /// The proto threshold of a command-line threshold; a rank outside 0..K gives the local
 /// command's error message (the summary knows K).
-absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, const RemoteFamily& remote) {
+absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, uint64_t spectrum_size) {
   v1::Threshold out;
-  const int64_t k = static_cast<int64_t>(remote.build.summary.spectrum_size());
+  const int64_t k = static_cast<int64_t>(spectrum_size);
   switch (threshold.kind) {
     case ThresholdArg::Kind::kRank:
       if (absl::Status s = CheckThresholdRank(threshold.rank, k); !s.ok()) return s;
@@ -132,6 +132,10 @@ absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, const R
       break;
   }
   return out;
+}
+
+absl::StatusOr<v1::Threshold> ToThreshold(const ThresholdArg& threshold, const RemoteFamily& remote) {
+  return ToThreshold(threshold, remote.build.summary.spectrum_size());
 }
 
 v1::ClassifyMode ToProto(ClassifyMode mode) {
@@ -314,17 +318,16 @@ int RemoteSummary(const CommonArgs& common, const ClassifyArgs& options) {
   return kExitOk;
 }
 
-/// The shape a rings-format ShapeRequest answers, every index checked against FILE's points.
-absl::StatusOr<ShapeGeometry> RingsOfShape(RemoteFamily& remote, const v1::ShapeRequest& request) {
+/// The shape a rings-format ShapeRequest answers, every index checked against the `n` points.
+absl::StatusOr<ShapeGeometry> RingsOfShape(client::AlphaClient& client, size_t n, const v1::ShapeRequest& request) {
   ShapeGeometry shape;
-  const size_t n = remote.frame.input.size();
   auto checked = [n](const auto& indices) -> absl::Status {
     for (uint32_t v : indices) {
       if (v >= n) return absl::DataLossError("shape: the server named a vertex beyond FILE's");
     }
     return absl::OkStatus();
   };
-  GALPHA_RETURN_IF_ERROR(remote.client->Shape(request, [&](const v1::ShapeResponse& m) -> absl::Status {
+  GALPHA_RETURN_IF_ERROR(client.Shape(request, [&](const v1::ShapeResponse& m) -> absl::Status {
     const v1::ShapeRings& rings = m.rings();
     for (const v1::ShapePolygon& polygon : rings.polygons()) {
       GALPHA_RETURN_IF_ERROR(checked(polygon.outer()));
@@ -367,7 +370,7 @@ int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, Cla
     // The server holds the computed (projected) points: the geometry is written here, in the
     // coordinates of the format (docs/design.md, "Coordinate reference systems").
     request.set_format(v1::SHAPE_FORMAT_RINGS);
-    auto shape = RingsOfShape(*remote, request);
+    auto shape = RingsOfShape(*remote->client, remote->frame.input.size(), request);
     if (!shape.ok()) return QueryError(common, shape.status());
     auto points = OutputPoints(remote->frame, format == "geojson");
     if (!points.ok()) return Failure(points.status());
@@ -393,6 +396,52 @@ int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, Cla
   if (!status.ok()) return QueryError(common, status);
   if (!any || last != '\n') out.Append('\n');
   return FinishOutput(out);
+}
+
+absl::StatusOr<std::vector<RemoteSetShape>> RemoteSetShapes(const CommonArgs& common,
+                                                            const std::vector<std::string>& names,
+                                                            const std::vector<absl::Span<const Point2>>& sets,
+                                                            const ThresholdArg& threshold, double min_hole_area) {
+  GALPHA_ASSIGN_OR_RETURN(std::unique_ptr<client::AlphaClient> client, ConnectTo(common));
+  std::vector<client::BatchSet> batch;
+  batch.reserve(sets.size());
+  for (size_t i = 0; i < sets.size(); ++i) batch.push_back({names[i], sets[i], {}});
+  client::BuildBatchCallOptions options;
+  if (common.raw_upload) options.encoding = client::PointEncoding::kRaw;
+  GALPHA_ASSIGN_OR_RETURN(std::vector<absl::StatusOr<client::BuildResult>> built, client->BuildBatch(batch, options));
+  const auto named = [&](size_t i, const absl::Status& status) {
+    return absl::Status(status.code(), absl::StrCat(names[i], ": ", status.message()));
+  };
+  std::vector<RemoteSetShape> shapes(sets.size());
+  for (size_t i = 0; i < sets.size(); ++i) {
+    if (!built[i].ok()) return named(i, built[i].status());
+    auto at = ToThreshold(threshold, built[i]->summary.spectrum_size());
+    if (!at.ok()) return named(i, at.status());
+    // The level and squared alpha the threshold resolves to, as the local command prints them.
+    v1::ClassifyRequest classify;
+    classify.set_handle(built[i]->handle);
+    *classify.mutable_threshold() = *at;
+    classify.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+    classify.set_summary_only(true);
+    absl::Status status = client->Classify(classify, [&](const v1::ClassifyResponse& message) {
+      if (message.has_summary()) {
+        shapes[i].level = message.summary().level();
+        shapes[i].alpha_sq = message.summary().alpha_sq();
+      }
+      return absl::OkStatus();
+    });
+    if (!status.ok()) return named(i, status);
+    v1::ShapeRequest request;
+    request.set_handle(built[i]->handle);
+    *request.mutable_threshold() = *at;
+    request.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+    request.set_format(v1::SHAPE_FORMAT_RINGS);
+    request.set_min_hole_area(min_hole_area);
+    auto shape = RingsOfShape(*client, sets[i].size(), request);
+    if (!shape.ok()) return named(i, shape.status());
+    shapes[i].shape = *std::move(shape);
+  }
+  return shapes;
 }
 
 int RemoteMasterList(const CommonArgs& common, int64_t rank) {

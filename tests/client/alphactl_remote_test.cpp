@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <random>
 #include <string>
 #include <thread>
 
@@ -117,6 +118,55 @@ TEST(AlphactlRemoteTest, GeographicInputAnswersAsLocally) {
   ExpectRemotePrintsAsLocal(server, file, commands, " --crs EPSG:4326");
 }
 #endif
+
+/// A GeoJSON FeatureCollection of `per_group` points around each of three centres, the property
+/// "kind" naming the group ("b", "a", and none for the third), `spread` wide.
+std::string GroupedGeoJson(double x0, double y0, double spread, int per_group) {
+  std::mt19937_64 random(11);
+  std::normal_distribution<double> normal(0.0, spread);
+  const double centres[3][2] = {{x0, y0}, {x0 + 20 * spread, y0 + 5 * spread}, {x0 - 10 * spread, y0 + 15 * spread}};
+  const char* kinds[3] = {R"({"kind":"b"})", R"({"kind":"a"})", R"({"other":1})"};
+  std::string features;
+  for (int i = 0; i < 3 * per_group; ++i) {
+    const int g = i % 3;
+    char point[96];
+    std::snprintf(point, sizeof point, "[%.17g,%.17g]", centres[g][0] + normal(random), centres[g][1] + normal(random));
+    features += absl::StrCat(i ? "," : "", R"({"type":"Feature","properties":)", kinds[g],
+                             R"(,"geometry":{"type":"Point","coordinates":)", point, "}}");
+  }
+  return absl::StrCat(R"({"type":"FeatureCollection","features":[)", features, "]}");
+}
+
+// shape --group-by --server builds the groups in one BuildBatch call and prints what the local
+// command prints, group for group.
+TEST(AlphactlRemoteTest, GroupedShapesAnswerAsLocally) {
+  ServerProcess server(GALPHA_SERVER, kServerFlags);
+  ASSERT_GT(server.port(), 0) << server.log();
+  const std::string file =
+      std::filesystem::temp_directory_path() / ("alphactl_groups_" + std::to_string(getpid()) + ".geojson");
+  std::ofstream(file) << GroupedGeoJson(0, 0, 1.0, 150);
+  const char* commands[] = {
+      "shape --ratio 0.7 --group-by kind --format geojson",
+      "shape --ratio 0.7 --group-by kind --format wkt",
+      "shape --rank 40 --group-by kind --format geojson --min-hole-area 0.5",
+  };
+  ExpectRemotePrintsAsLocal(server, file, commands, " --crs none");
+  // A threshold one group cannot take is refused naming the group, with the local exit code.
+  const CommandResult local = Alphactl("shape " + file + " --rank 100000 --group-by kind --format wkt --crs none");
+  const CommandResult remote =
+      Alphactl("shape " + file + " --rank 100000 --group-by kind --format wkt --crs none --server " + server.address());
+  EXPECT_EQ(local.exit_code, 2) << local.err;
+  EXPECT_EQ(remote.exit_code, local.exit_code) << remote.err;
+  EXPECT_NE(remote.err.find("group 'b'"), std::string::npos) << remote.err;
+#ifdef GALPHA_WITH_PROJ
+  // Longitudes and latitudes (GeoJSON's own CRS): each group in its own local projection.
+  std::ofstream(file) << GroupedGeoJson(14.1, 45.4, 0.001, 120);
+  const char* geographic[] = {"shape --ratio 0.6 --group-by kind --format geojson",
+                              "shape --alpha 30 --group-by kind --format wkt"};
+  ExpectRemotePrintsAsLocal(server, file, geographic);
+#endif
+  std::filesystem::remove(file);
+}
 
 // Weighted points go up as (x, y, w) (BuildHeader.weighted), encoded or raw, and every answer is
 // the local weighted family's: hidden points included, which the remote summary lists from the
