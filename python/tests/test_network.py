@@ -250,3 +250,53 @@ def test_an_unknown_answer_encoding_is_refused() -> None:
         galpha.connect("localhost:1", answer_encoding="gzip")
     with pytest.raises(galpha.InvalidInput, match="answer_encoding"):
         galpha.aio.connect("localhost:1", answer_encoding="lz4")
+
+
+def test_build_batch_gives_each_set_its_own_family(server) -> None:
+    # Sets of a layer's kind, an empty one and a repeated one among them; the oracle is each set
+    # built alone, in this process.
+    rng = np.random.default_rng(31)
+    sets = {
+        "uniform": rng.random((800, 2)),
+        "grid": np.array([[i, j] for i in range(20) for j in range(15)], dtype=np.float64),
+        "line": np.column_stack([np.arange(50.0), np.zeros(50)]),
+        "empty": np.empty((0, 2)),
+    }
+    sets["again"] = sets["uniform"].copy()
+    with galpha.connect(server.address, timeout=60) as c:
+        families = c.build_batch(sets)
+        assert [f.summary.name for f in families] == list(sets)
+        for (name, points), family in zip(sets.items(), families):
+            local = galpha.local("cpu").build(points)
+            assert family.handle == galpha.point_set_handle(points), name
+            assert family.spectrum_size == local.spectrum_size, name
+            assert family.summary.triangles == local.summary.triangles, name
+            if family.spectrum_size:
+                k = family.spectrum_size // 2
+                got, want = family.classify(rank=k), local.classify(rank=k)
+                np.testing.assert_array_equal(got.triangles, want.triangles)
+                np.testing.assert_array_equal(got.triangle_classes, want.triangle_classes)
+        assert families[-1].summary.cached  # the repeat of "uniform"
+        # Pairs work too, and a second call finds every family.
+        again = c.build_batch(list(sets.items())[:2], encoding="raw")
+        assert [f.handle for f in again] == [f.handle for f in families[:2]]
+        assert all(f.summary.cached for f in again)
+
+
+def test_build_batch_errors_name_the_set(start_server) -> None:
+    # A cache too small for the large set: its build alone fails; the small ones are built.
+    s = start_server("--cache_bytes", "200000")
+    small, large = np.random.default_rng(1).random((40, 2)), np.random.default_rng(2).random((20000, 2))
+    with galpha.connect(s.address, timeout=60) as c:
+        with pytest.raises(galpha.ResourceExhausted, match="set 'large': .*cache"):
+            c.build_batch([("small", small), ("large", large)])
+        results = c.build_batch([("small", small), ("large", large)], return_exceptions=True)
+        assert isinstance(results[0], galpha.Family) and results[0].summary.cached
+        assert isinstance(results[1], galpha.ResourceExhausted)
+        with pytest.raises(galpha.InvalidInput, match="a mapping of name to points"):
+            c.build_batch([small])
+        # A set with a NaN fails the whole call, naming the set by its index and name.
+        bad = small.copy()
+        bad[3, 0] = np.nan
+        with pytest.raises(galpha.InvalidInput, match="set 1 \\('bad'\\)"):
+            c.build_batch([("fine", small), ("bad", bad)], encoding="raw")

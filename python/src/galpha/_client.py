@@ -3,14 +3,14 @@ embedded engine in this process, CUDA when there is a GPU, else the CPU's cores)
 
 from __future__ import annotations
 
-from typing import Any, Callable, Optional, Protocol, Union
+from typing import Any, Callable, List, Optional, Protocol, Union
 
 import numpy as np
 
 
 from ._encoding import check_encoding
 from ._crs import frame_of
-from ._errors import InvalidInput
+from ._errors import InvalidInput, error_for_code
 from ._family import Family, weighted_rows
 from ._points import as_points
 
@@ -159,6 +159,49 @@ class NetworkClient:
             if close is not None:
                 close()
         return Family(backend, array, frame, weight_array)
+
+    def build_batch(
+        self,
+        sets: Any,
+        *,
+        encoding: str = "auto",
+        crs: Any = None,
+        return_exceptions: bool = False,
+    ) -> List[Any]:
+        """Builds many point sets in one call (a GIS layer's features, a group-by's groups): the
+        server reads them from one stream and builds them one after the other, each cached under
+        its own handle as :meth:`build` would cache it. ``sets``: a mapping of name to points, or
+        a sequence of (name, points) pairs, each points argument as :meth:`build` takes it (the
+        name labels the set, as :meth:`build`'s ``name``). ``crs`` applies to every set (by
+        default each one's own, as :meth:`build`); geographic sets are each projected on their own.
+
+        Returns the families in the sets' order. A set whose build alone fails (a limit of the
+        server's, say) raises its error, naming the set, after the others were built (they stay
+        cached: build them again to get them); with ``return_exceptions=True`` its place in the
+        list holds the error instead. A set the server cannot read fails the whole call.
+        """
+        encoding = check_encoding(encoding)
+        items = list(sets.items()) if hasattr(sets, "items") else list(sets)
+        prepared = []
+        uploads = []
+        for item in items:
+            if not isinstance(item, tuple) or len(item) != 2 or not isinstance(item[0], str):
+                raise InvalidInput("build_batch takes a mapping of name to points, or (name, points) pairs")
+            name, points = item
+            array, data_crs = as_points(points)
+            frame = frame_of(array, crs, data_crs)
+            prepared.append((name, array, frame))
+            uploads.append((name, frame.computed))
+        backends = self._network.build_batch_on_server(self._calls, uploads, encoding)
+        out: List[Any] = []
+        for (name, array, frame), backend in zip(prepared, backends):
+            if isinstance(backend, Exception):
+                if not return_exceptions:
+                    raise error_for_code(backend.code_number, f"set {name!r}: {backend.message}") from None
+                out.append(backend)
+            else:
+                out.append(Family(backend, array, frame))
+        return out
 
     def family(self, handle: str, points: Any, *, crs: Any = None, weights: Any = None) -> Family:
         """The family the server holds under ``handle`` for these points (NotFound if it holds

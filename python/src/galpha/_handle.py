@@ -34,7 +34,8 @@ def point_set_handle(points: np.ndarray) -> str:
     (x, y, w), as the server computes it."""
     array = np.ascontiguousarray(points, dtype="<f8")
     tag = _WEIGHTED_TAG if array.ndim == 2 and array.shape[1] == 3 else _TAG
-    data = memoryview(array).cast("B")
+    # Flat bytes (memoryview cannot cast an array with a zero in its shape: the empty set has no leaves).
+    data = memoryview(array.reshape(-1)).cast("B") if array.size else memoryview(b"")
     total = len(data)
     leaves = [data[i : i + LEAF_BYTES] for i in range(0, total, LEAF_BYTES)]
     if len(leaves) > 1:

@@ -464,6 +464,9 @@ class Calls:
             SERVICE + "Spectrum", request_serializer=pb.SpectrumRequest.SerializeToString, response_deserializer=_identity
         )
         self.build = channel.stream_unary(SERVICE + "Build", request_serializer=_identity, response_deserializer=pb.BuildResponse.FromString)
+        self.build_batch = channel.stream_stream(
+            SERVICE + "BuildBatch", request_serializer=_identity, response_deserializer=pb.BuildBatchResponse.FromString
+        )
         self.classify = channel.unary_stream(
             SERVICE + "Classify", request_serializer=pb.ClassifyRequest.SerializeToString, response_deserializer=_identity
         )
@@ -749,6 +752,50 @@ def build_on_server(
         building(True)
     summary = dataclasses.replace(summary_from(answer.summary, cached=answer.cached), upload_bytes=counter.bytes)
     return NetworkFamilyBackend(calls, answer.handle, summary)
+
+
+#: Most sets one BuildBatch call carries (the server's limit, server/build_batch_reactor.hpp).
+MAX_BATCH_SETS = 100_000
+
+
+def build_batch_on_server(calls: Calls, sets: List[Tuple[str, np.ndarray]], encoding: str = "auto") -> List[Any]:
+    """Uploads every set in one BuildBatch stream (each as a Build stream carries it, its chunks
+    encoded on other threads) and returns, in their order, a NetworkFamilyBackend per set or the
+    GalphaError of a set whose build alone failed. A stream the server refuses raises, naming the
+    set; so does a KeyboardInterrupt, after cancelling the call."""
+    if len(sets) > MAX_BATCH_SETS:
+        raise InvalidInput(f"{len(sets)} sets; a batch carries at most {MAX_BATCH_SETS:,}: split them")
+    counters = [UploadCounter() for _ in sets]
+
+    def messages() -> Iterator[bytes]:
+        for (name, points), counter in zip(sets, counters):
+            yield from upload_messages(name, points, None, encoding, counter)
+
+    results: List[Any] = []
+    answers = calls.build_batch(messages(), timeout=calls.timeout, metadata=calls.metadata())
+    try:
+        for page in answers:
+            if page.first_set != len(results) or page.set_count != len(sets) or len(results) + len(page.sets) > len(sets):
+                raise GalphaError("the server's BuildBatch answer is out of order", code="DATA_LOSS", code_number=15)
+            for answer in page.sets:
+                index = len(results)
+                if answer.code != 0:
+                    results.append(error_for_code(answer.code, answer.message))
+                    continue
+                summary = dataclasses.replace(
+                    summary_from(answer.result.summary, cached=answer.result.cached), upload_bytes=counters[index].bytes
+                )
+                results.append(NetworkFamilyBackend(calls, answer.result.handle, summary))
+    except grpc.RpcError as e:
+        raise raise_from_rpc(e) from None
+    except BaseException:
+        answers.cancel()
+        raise
+    if len(results) != len(sets):
+        raise GalphaError(
+            f"the server's BuildBatch answer ended after {len(results)} of {len(sets)} sets", code="DATA_LOSS", code_number=15
+        )
+    return results
 
 
 def wait_for_server(calls: Calls, deadline_s: float) -> None:
