@@ -12,6 +12,8 @@
 // --device-cache-bytes gives the server a device budget for resident families (CUDA builds keep
 // their tables on the GPU and answer from there: server/README.md, "Cache"); 0 (the default):
 // CUDA families are downloaded into host memory, as the CPU backend's are.
+// --batch=SETSxPOINTS (e.g. 10000x1000) runs only the batch scenario of issue 20: the sets in one
+// BuildBatch call, against one Build a set and one Build of all their points (RunBatch).
 // --stress=SETSxPOINTS (e.g. 8x20000000) runs only the stress scenario of issue 16: SETS clients
 // build SETS distinct point sets at once, then each queries every family (Describe and a Classify
 // summary; a family the cache pushed out is rebuilt by the query), then every family is released;
@@ -82,6 +84,9 @@ struct Options {
   /// --stress: how many sets of how many points (0: no stress run).
   size_t stress_sets = 0;
   size_t stress_points = 0;
+  /// --batch: how many sets of how many points go up in one BuildBatch call (0: no batch run).
+  size_t batch_sets = 0;
+  size_t batch_points = 0;
 };
 
 /// A tc rate "<digits><kbit|mbit|gbit>" in bits per second; 0 when it is not one.
@@ -131,6 +136,10 @@ bool ParseOptions(int argc, char** argv, Options* options) {
       ok = parts.size() == 2 && absl::SimpleAtoi(parts[0], &options->stress_sets) &&
            absl::SimpleAtoi(parts[1], &options->stress_points) && options->stress_sets > 0 &&
            options->stress_points > 0;
+    } else if (name == "--batch") {
+      const std::vector<std::string> parts = absl::StrSplit(value, 'x');
+      ok = parts.size() == 2 && absl::SimpleAtoi(parts[0], &options->batch_sets) &&
+           absl::SimpleAtoi(parts[1], &options->batch_points) && options->batch_sets > 0 && options->batch_points > 0;
     } else if (name == "--links") {
       options->links = absl::StrSplit(value, ',');
       for (const std::string& link : options->links) ok = ok && (link == "loopback" || RateBits(link) > 0);
@@ -646,8 +655,81 @@ int RunStress(const Options& options) {
   return failures.empty() && back ? 0 : 1;
 }
 
+/// --batch: SETS sets of POINTS uniform points each (each in its own unit square, seeds apart) as
+/// one BuildBatch call, against the same sets as SETS Build calls one after the other (what a
+/// client did before BuildBatch) and against one Build of all their points together (issue 20's
+/// reference: a batch should take under 10x that). Each after a fresh server start, so that
+/// nothing is cached; best of --repeat.
+int RunBatch(const Options& options) {
+  const size_t sets = options.batch_sets, n = options.batch_points;
+  std::vector<std::vector<Point2>> points;
+  std::vector<Point2> all;
+  points.reserve(sets);
+  all.reserve(sets * n);
+  for (size_t i = 0; i < sets; ++i) {
+    points.push_back(gen::Uniform(n, 5000 + i));
+    for (Point2 p : points.back())
+      all.push_back({p.x + static_cast<double>(i % 1000) * 2.0, p.y + static_cast<double>(i / 1000) * 2.0});
+  }
+  std::vector<client::BatchSet> batch;
+  for (size_t i = 0; i < sets; ++i) batch.push_back({absl::StrCat("set-", i), points[i], {}});
+  double batch_s = 1e300, single_s = 1e300, whole_s = 1e300;
+  std::string backend;
+  for (int r = 0; r < options.repeat; ++r) {
+    for (int which = 0; which < 3; ++which) {
+      auto server = server::GalphaServer::Start(BenchServerOptions(options, "127.0.0.1:0"));
+      if (!server.ok()) {
+        std::fprintf(stderr, "service_bench: %s\n", std::string(server.status().message()).c_str());
+        return 1;
+      }
+      backend = (*server)->service().backend_name();
+      auto client = Client((*server)->port());
+      const auto start = Clock::now();
+      absl::Status status;
+      if (which == 0) {
+        auto answers = client->BuildBatch(batch);
+        status = answers.status();
+        if (answers.ok()) {
+          for (const auto& answer : *answers) {
+            if (!answer.ok()) status = answer.status();
+          }
+        }
+        if (status.ok()) batch_s = std::min(batch_s, SecondsSince(start));
+      } else if (which == 1) {
+        client::BuildCallOptions call;
+        call.skip_upload_if_cached = false;
+        for (size_t i = 0; i < sets && status.ok(); ++i) status = client->Build(points[i], call).status();
+        if (status.ok()) single_s = std::min(single_s, SecondsSince(start));
+      } else {
+        client::BuildCallOptions call;
+        call.skip_upload_if_cached = false;
+        status = client->Build(all, call).status();
+        if (status.ok()) whole_s = std::min(whole_s, SecondsSince(start));
+      }
+      (*server)->Drain();
+      if (!status.ok()) {
+        std::fprintf(stderr, "service_bench --batch: %s\n", std::string(status.message()).c_str());
+        return 1;
+      }
+    }
+  }
+  std::printf("service_bench --batch: %zu sets of %zu uniform points, %s backend, loopback, best of %d\n", sets, n,
+              backend.c_str(), options.repeat);
+  std::printf("| call | ms | ms a set | / one Build of all points |\n|---|---:|---:|---:|\n");
+  const auto row = [&](const char* what, double seconds) {
+    std::printf("| %s | %.1f | %.3f | %.2f |\n", what, seconds * 1e3, seconds * 1e3 / static_cast<double>(sets),
+                seconds / whole_s);
+  };
+  row("BuildBatch, one call", batch_s);
+  row("Build, one call a set", single_s);
+  row("Build of all the points as one set", whole_s);
+  std::printf("ratio BuildBatch / one Build a set: %.2f\n", batch_s / single_s);
+  return 0;
+}
+
 int Run(const Options& options) {
   if (options.stress_sets > 0) return RunStress(options);
+  if (options.batch_sets > 0) return RunBatch(options);
   // Shaped links first: the namespaces must exist before this process starts any thread.
   std::vector<std::string> links;
   std::unique_ptr<VethLink> veth;
