@@ -93,6 +93,19 @@ absl::Status EncodeChunk(absl::Span<const Point2> points, absl::Span<const doubl
   return encoder->Encode(points, weights, chunk, message->mutable_encoded_points());
 }
 
+// A Build stream's message as the BuildBatch stream's message it is (the same parts).
+v1::BuildBatchRequest AsBatchMessage(v1::BuildRequest message) {
+  v1::BuildBatchRequest out;
+  if (message.has_points()) {
+    *out.mutable_points() = std::move(*message.mutable_points());
+  } else if (message.has_encoded_points()) {
+    *out.mutable_encoded_points() = std::move(*message.mutable_encoded_points());
+  } else if (message.has_header()) {
+    *out.mutable_header() = std::move(*message.mutable_header());
+  }
+  return out;
+}
+
 }  // namespace
 
 absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, const BuildCallOptions& options) {
@@ -227,7 +240,7 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
 
   grpc::ClientContext context;
   PrepareContext(&context);
-  std::unique_ptr<grpc::ClientReaderWriter<v1::BuildRequest, v1::BuildBatchResponse>> stream =
+  std::unique_ptr<grpc::ClientReaderWriter<v1::BuildBatchRequest, v1::BuildBatchResponse>> stream =
       stub_->BuildBatch(&context);
   // As Build: chunks are encoded ahead of the writes on up to `window` threads, one chunk each,
   // and written in order; the sets' headers go between them.
@@ -258,7 +271,7 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
   absl::Status encoded;
   std::vector<uint64_t> upload_bytes(sets.size(), 0);
   for (size_t i = 0; open && encoded.ok() && i < sets.size(); ++i) {
-    v1::BuildRequest header;
+    v1::BuildBatchRequest header;
     header.mutable_header()->set_name(sets[i].name);
     header.mutable_header()->set_expected_points(sets[i].points.size());
     header.mutable_header()->set_crs(options.crs);
@@ -277,7 +290,7 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
         break;
       }
       upload_bytes[i] += slot.message.ByteSizeLong();
-      open = stream->Write(slot.message);
+      open = stream->Write(AsBatchMessage(std::move(slot.message)));
       if (open && chunk + window < chunks.size()) start(chunk + window);
     }
     if (open && encoded.ok() && options.progress) options.progress(i + 1);

@@ -285,7 +285,7 @@ grpc::ServerReadReactor<v1::BuildRequest>* AlphaService::Build(grpc::CallbackSer
   return new BuildReactor(this, context, response, Authenticate(context));
 }
 
-grpc::ServerBidiReactor<v1::BuildRequest, v1::BuildBatchResponse>* AlphaService::BuildBatch(
+grpc::ServerBidiReactor<v1::BuildBatchRequest, v1::BuildBatchResponse>* AlphaService::BuildBatch(
     grpc::CallbackServerContext* context) {
   return new BuildBatchReactor(this, context, Authenticate(context));
 }

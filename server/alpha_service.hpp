@@ -100,7 +100,7 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
 
   grpc::ServerReadReactor<galpha::v1::BuildRequest>* Build(grpc::CallbackServerContext* context,
                                                            galpha::v1::BuildResponse* response) override;
-  grpc::ServerBidiReactor<galpha::v1::BuildRequest, galpha::v1::BuildBatchResponse>* BuildBatch(
+  grpc::ServerBidiReactor<galpha::v1::BuildBatchRequest, galpha::v1::BuildBatchResponse>* BuildBatch(
       grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* Describe(grpc::CallbackServerContext* context, const galpha::v1::DescribeRequest* request,
                                      galpha::v1::DescribeResponse* response) override;

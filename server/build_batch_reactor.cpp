@@ -21,6 +21,24 @@ namespace galpha::server {
 
 namespace v1 = galpha::v1;
 
+v1::BuildRequest AsBuildRequest(v1::BuildBatchRequest message) {
+  v1::BuildRequest out;
+  switch (message.part_case()) {
+    case v1::BuildBatchRequest::kHeader:
+      *out.mutable_header() = std::move(*message.mutable_header());
+      break;
+    case v1::BuildBatchRequest::kPoints:
+      *out.mutable_points() = std::move(*message.mutable_points());
+      break;
+    case v1::BuildBatchRequest::kEncodedPoints:
+      *out.mutable_encoded_points() = std::move(*message.mutable_encoded_points());
+      break;
+    case v1::BuildBatchRequest::PART_NOT_SET:
+      break;  // the decoder refuses a message of no kind
+  }
+  return out;
+}
+
 absl::Status NameBatchSet(const absl::Status& status, size_t set, const std::string& name) {
   absl::Status named(status.code(), absl::StrCat("set ", set, " ('", name, "'): ", status.message()));
   status.ForEachPayload([&](absl::string_view url, const absl::Cord& payload) { named.SetPayload(url, payload); });
@@ -80,7 +98,8 @@ absl::Status BuildBatchReactor::EndSet() {
   return absl::OkStatus();
 }
 
-absl::Status BuildBatchReactor::Add(v1::BuildRequest message) {
+absl::Status BuildBatchReactor::Add(v1::BuildBatchRequest batch_message) {
+  v1::BuildRequest message = AsBuildRequest(std::move(batch_message));
   if (message.has_header()) {
     if (!sets_.empty()) {
       if (absl::Status ended = EndSet(); !ended.ok()) return NameBatchSet(ended, sets_.size() - 1, sets_.back().name);

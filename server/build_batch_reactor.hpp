@@ -36,12 +36,15 @@ inline constexpr size_t kBatchSetsPerPage = 1000;
 /// costs the engine a fixed start whatever its size.
 inline constexpr std::chrono::milliseconds kBatchBuildTimePerSet{100};
 
+/// A BuildBatch stream's message as the Build stream's message it is (the same parts).
+galpha::v1::BuildRequest AsBuildRequest(galpha::v1::BuildBatchRequest message);
+
 /// `status` with its message prefixed by the set it concerns ("set 3 ('parcel-17'): ..."), its
 /// code and payloads (a refusal's tag) kept.
 absl::Status NameBatchSet(const absl::Status& status, size_t set, const std::string& name);
 
 class BuildBatchReactor final
-    : public grpc::ServerBidiReactor<galpha::v1::BuildRequest, galpha::v1::BuildBatchResponse>,
+    : public grpc::ServerBidiReactor<galpha::v1::BuildBatchRequest, galpha::v1::BuildBatchResponse>,
       private UploadWatchdog::Upload {
  public:
   /// `tenant` is the caller's, or the authentication's error (the call then fails at once).
@@ -74,7 +77,7 @@ class BuildBatchReactor final
   bool CallerGone() const { return cancelled_ || context_->IsCancelled(); }
   // One message: a header starts the next set (ending the one before), a chunk goes to the
   // current set. Errors name the set.
-  absl::Status Add(galpha::v1::BuildRequest message);
+  absl::Status Add(galpha::v1::BuildBatchRequest message);
   // Ends the current set's part of the stream: its decoder's Finish.
   absl::Status EndSet();
   void EndOfStream();
@@ -94,7 +97,7 @@ class BuildBatchReactor final
   grpc::CallbackServerContext* const context_;
   RpcRecord record_;
   std::string tenant_;
-  galpha::v1::BuildRequest request_;
+  galpha::v1::BuildBatchRequest request_;
   std::vector<Set> sets_;
   uint64_t points_ = 0;  // of the sets whose part of the stream ended
   std::vector<size_t> to_build_;

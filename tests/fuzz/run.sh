@@ -20,7 +20,7 @@ libs=($(pkg-config --libs protobuf absl_statusor absl_strings libcrypto) -lpthre
 # The decoder with the CRS functions that refuse (coordinate_system_no_proj.cpp): a header's crs is
 # then an error, decided without PROJ's database; the fuzzer aims at the decoder.
 clang++ "${flags[@]}" tests/fuzz/build_stream_fuzzer.cpp server/build_stream.cpp server/chunk_codec_pool.cpp server/build_refusal.cpp core/io/point_set_handle.cpp \
-  core/io/coordinate_system_no_proj.cpp proto/codec/point_chunk_codec.cpp proto/codec/simplex_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
+  core/io/coordinate_system_no_proj.cpp proto/codec/point_chunk_codec.cpp proto/codec/simplex_chunk_codec.cpp proto/sections/simplex_sections.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" -o "$out/build_stream_fuzzer" "${libs[@]}" \
   $(pkg-config --libs libzstd) &
 builds=($!)
 clang++ "${flags[@]}" tests/fuzz/point_formats_fuzzer.cpp core/io/point_formats.cpp core/io/point_io.cpp core/io/las_reader.cpp \
@@ -29,7 +29,7 @@ builds+=($!)
 clang++ "${flags[@]}" tests/fuzz/predicates_fuzzer.cpp core/io/input_validation.cpp core/io/number_text.cpp \
   -o "$out/predicates_fuzzer" "${libs[@]}" $(pkg-config --libs absl_str_format) -lgmpxx -lgmp &
 builds+=($!)
-clang++ "${flags[@]}" tests/fuzz/simplex_chunk_fuzzer.cpp proto/codec/simplex_chunk_codec.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" \
+clang++ "${flags[@]}" tests/fuzz/simplex_chunk_fuzzer.cpp proto/codec/simplex_chunk_codec.cpp proto/sections/simplex_sections.cpp "$out/gen/galpha/v1/alpha_shapes.pb.cc" \
   -o "$out/simplex_chunk_fuzzer" "${libs[@]}" $(pkg-config --libs libzstd) &
 builds+=($!)
 for pid in "${builds[@]}"; do wait "$pid"; done

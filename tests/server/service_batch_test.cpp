@@ -64,6 +64,13 @@ std::vector<client::BatchSet> Batch(const std::vector<NamedSet>& sets) {
   return batch;
 }
 
+/// A Build stream's message as a BuildBatch stream's: the same bytes (proto: BuildBatchRequest).
+v1::BuildBatchRequest AsBatch(const v1::BuildRequest& message) {
+  v1::BuildBatchRequest out;
+  EXPECT_TRUE(out.ParseFromString(message.SerializeAsString()));
+  return out;
+}
+
 /// Streams `messages` as one BuildBatch call: its status, and its answers' sets in `answers`.
 absl::Status RawBatch(client::AlphaClient& client, const std::vector<v1::BuildRequest>& messages,
                       std::vector<v1::BatchedBuild>* answers = nullptr) {
@@ -71,7 +78,7 @@ absl::Status RawBatch(client::AlphaClient& client, const std::vector<v1::BuildRe
   client.PrepareContext(&context);
   auto stream = client.stub().BuildBatch(&context);
   for (const v1::BuildRequest& message : messages) {
-    if (!stream->Write(message)) break;
+    if (!stream->Write(AsBatch(message))) break;
   }
   stream->WritesDone();
   v1::BuildBatchResponse page;
@@ -223,7 +230,7 @@ TEST(ServiceBatchTest, AnswersComeInPagesOfAThousandSets) {
   grpc::ClientContext context;
   client->PrepareContext(&context);
   auto stream = client->stub().BuildBatch(&context);
-  for (const v1::BuildRequest& message : messages) ASSERT_TRUE(stream->Write(message));
+  for (const v1::BuildRequest& message : messages) ASSERT_TRUE(stream->Write(AsBatch(message)));
   stream->WritesDone();
   std::vector<uint64_t> firsts;
   size_t sets = 0;
