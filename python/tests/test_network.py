@@ -300,3 +300,18 @@ def test_build_batch_errors_name_the_set(start_server) -> None:
         bad[3, 0] = np.nan
         with pytest.raises(galpha.InvalidInput, match="set 1 \\('bad'\\)"):
             c.build_batch([("fine", small), ("bad", bad)], encoding="raw")
+
+
+def test_asyncio_build_batch_gives_the_families_of_the_sync_one(server) -> None:
+    sets = [("a", np.random.default_rng(41).random((300, 2))), ("b", np.random.default_rng(42).random((500, 2)))]
+
+    async def run() -> list:
+        async with galpha.aio.connect(server.address, timeout=60) as c:
+            families = await c.build_batch(sets)
+            return [(f.handle, f.summary.name, (await f.classify(rank=f.summary.spectrum_size // 2)).triangles) for f in families]
+
+    got = asyncio.run(run())
+    with galpha.connect(server.address, timeout=60) as c:
+        for (handle, name, triangles), family, (set_name, _) in zip(got, c.build_batch(sets), sets):
+            assert handle == family.handle and name == set_name
+            np.testing.assert_array_equal(triangles, family.classify(rank=family.spectrum_size // 2).triangles)

@@ -55,6 +55,35 @@ def checked_weights(weights: Any, array: np.ndarray, frame: Any) -> Optional[np.
     return weight_array
 
 
+def batch_sets(sets: Any, crs: Any) -> List[Any]:
+    """build_batch's ``sets`` as (name, points array, frame) triples, each framed on its own."""
+    items = list(sets.items()) if hasattr(sets, "items") else list(sets)
+    prepared = []
+    for item in items:
+        if not isinstance(item, tuple) or len(item) != 2 or not isinstance(item[0], str):
+            raise InvalidInput("build_batch takes a mapping of name to points, or (name, points) pairs")
+        name, points = item
+        array, data_crs = as_points(points)
+        prepared.append((name, array, frame_of(array, crs, data_crs)))
+    return prepared
+
+
+def batch_results(prepared: List[Any], answers: List[Any], make: Callable[..., Any], return_exceptions: bool) -> List[Any]:
+    """build_batch's answer: make(answer, array, frame) per built set; a failed set's error raised
+    naming the set, or kept in its place with ``return_exceptions``."""
+    from ._errors import GalphaError
+
+    out: List[Any] = []
+    for (name, array, frame), answer in zip(prepared, answers):
+        if isinstance(answer, GalphaError):
+            if not return_exceptions:
+                raise error_for_code(answer.code_number, f"set {name!r}: {answer.message}") from None
+            out.append(answer)
+        else:
+            out.append(make(answer, array, frame))
+    return out
+
+
 class _TqdmStages:
     """A tqdm bar per stage, fed fractions."""
 
@@ -181,27 +210,9 @@ class NetworkClient:
         list holds the error instead. A set the server cannot read fails the whole call.
         """
         encoding = check_encoding(encoding)
-        items = list(sets.items()) if hasattr(sets, "items") else list(sets)
-        prepared = []
-        uploads = []
-        for item in items:
-            if not isinstance(item, tuple) or len(item) != 2 or not isinstance(item[0], str):
-                raise InvalidInput("build_batch takes a mapping of name to points, or (name, points) pairs")
-            name, points = item
-            array, data_crs = as_points(points)
-            frame = frame_of(array, crs, data_crs)
-            prepared.append((name, array, frame))
-            uploads.append((name, frame.computed))
-        backends = self._network.build_batch_on_server(self._calls, uploads, encoding)
-        out: List[Any] = []
-        for (name, array, frame), backend in zip(prepared, backends):
-            if isinstance(backend, Exception):
-                if not return_exceptions:
-                    raise error_for_code(backend.code_number, f"set {name!r}: {backend.message}") from None
-                out.append(backend)
-            else:
-                out.append(Family(backend, array, frame))
-        return out
+        prepared = batch_sets(sets, crs)
+        backends = self._network.build_batch_on_server(self._calls, [(n, f.computed) for n, _, f in prepared], encoding)
+        return batch_results(prepared, backends, lambda backend, array, frame: Family(backend, array, frame), return_exceptions)
 
     def family(self, handle: str, points: Any, *, crs: Any = None, weights: Any = None) -> Family:
         """The family the server holds under ``handle`` for these points (NotFound if it holds

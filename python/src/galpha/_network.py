@@ -758,44 +758,63 @@ def build_on_server(
 MAX_BATCH_SETS = 100_000
 
 
+class BatchAnswers:
+    """Collects BuildBatch's answer pages: per set (handle, BuildSummary) or its GalphaError, in
+    the stream's order; `counters` hold each set's upload bytes."""
+
+    def __init__(self, counters: List[UploadCounter]) -> None:
+        self.counters = counters
+        self.sets: List[Any] = []
+
+    def add(self, page: pb.BuildBatchResponse) -> None:
+        count = len(self.counters)
+        if page.first_set != len(self.sets) or page.set_count != count or len(self.sets) + len(page.sets) > count:
+            raise GalphaError("the server's BuildBatch answer is out of order", code="DATA_LOSS", code_number=15)
+        for answer in page.sets:
+            if answer.code != 0:
+                self.sets.append(error_for_code(answer.code, answer.message))
+                continue
+            summary = summary_from(answer.result.summary, cached=answer.result.cached)
+            summary = dataclasses.replace(summary, upload_bytes=self.counters[len(self.sets)].bytes)
+            self.sets.append((answer.result.handle, summary))
+
+    def result(self) -> List[Any]:
+        if len(self.sets) != len(self.counters):
+            raise GalphaError(
+                f"the server's BuildBatch answer ended after {len(self.sets)} of {len(self.counters)} sets",
+                code="DATA_LOSS",
+                code_number=15,
+            )
+        return self.sets
+
+
 def build_batch_on_server(calls: Calls, sets: List[Tuple[str, np.ndarray]], encoding: str = "auto") -> List[Any]:
     """Uploads every set in one BuildBatch stream (each as a Build stream carries it, its chunks
     encoded on other threads) and returns, in their order, a NetworkFamilyBackend per set or the
     GalphaError of a set whose build alone failed. A stream the server refuses raises, naming the
     set; so does a KeyboardInterrupt, after cancelling the call."""
-    if len(sets) > MAX_BATCH_SETS:
-        raise InvalidInput(f"{len(sets)} sets; a batch carries at most {MAX_BATCH_SETS:,}: split them")
-    counters = [UploadCounter() for _ in sets]
+    check_batch_size(len(sets))
+    answers = BatchAnswers([UploadCounter() for _ in sets])
 
     def messages() -> Iterator[bytes]:
-        for (name, points), counter in zip(sets, counters):
+        for (name, points), counter in zip(sets, answers.counters):
             yield from upload_messages(name, points, None, encoding, counter)
 
-    results: List[Any] = []
-    answers = calls.build_batch(messages(), timeout=calls.timeout, metadata=calls.metadata())
+    call = calls.build_batch(messages(), timeout=calls.timeout, metadata=calls.metadata())
     try:
-        for page in answers:
-            if page.first_set != len(results) or page.set_count != len(sets) or len(results) + len(page.sets) > len(sets):
-                raise GalphaError("the server's BuildBatch answer is out of order", code="DATA_LOSS", code_number=15)
-            for answer in page.sets:
-                index = len(results)
-                if answer.code != 0:
-                    results.append(error_for_code(answer.code, answer.message))
-                    continue
-                summary = dataclasses.replace(
-                    summary_from(answer.result.summary, cached=answer.result.cached), upload_bytes=counters[index].bytes
-                )
-                results.append(NetworkFamilyBackend(calls, answer.result.handle, summary))
+        for page in call:
+            answers.add(page)
     except grpc.RpcError as e:
         raise raise_from_rpc(e) from None
     except BaseException:
-        answers.cancel()
+        call.cancel()
         raise
-    if len(results) != len(sets):
-        raise GalphaError(
-            f"the server's BuildBatch answer ended after {len(results)} of {len(sets)} sets", code="DATA_LOSS", code_number=15
-        )
-    return results
+    return [a if isinstance(a, GalphaError) else NetworkFamilyBackend(calls, a[0], a[1]) for a in answers.result()]
+
+
+def check_batch_size(count: int) -> None:
+    if count > MAX_BATCH_SETS:
+        raise InvalidInput(f"{count} sets; a batch carries at most {MAX_BATCH_SETS:,}: split them")
 
 
 def wait_for_server(calls: Calls, deadline_s: float) -> None:

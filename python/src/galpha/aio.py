@@ -15,7 +15,7 @@ import grpc
 import numpy as np
 
 from . import _network, _wire
-from ._client import Progress, checked_weights, progress_callback
+from ._client import Progress, batch_results, batch_sets, checked_weights, progress_callback
 from ._crs import Frame, frame_of
 from ._encoding import check_encoding
 from ._errors import InvalidInput
@@ -326,6 +326,40 @@ class AsyncClient:
 
     async def close(self) -> None:
         await self._channel.close()
+
+    async def build_batch(
+        self,
+        sets: Any,
+        *,
+        encoding: str = "auto",
+        crs: Any = None,
+        return_exceptions: bool = False,
+    ) -> List[Any]:
+        """Many point sets in one call, as :meth:`galpha.NetworkClient.build_batch` takes and
+        answers them (a list of AsyncFamily, or errors with ``return_exceptions``); the chunks are
+        encoded off the event loop. Cancelling the task cancels the call."""
+        encoding = check_encoding(encoding)
+        prepared = batch_sets(sets, crs)
+        _network.check_batch_size(len(prepared))
+        answers = _network.BatchAnswers([_network.UploadCounter() for _ in prepared])
+
+        async def messages() -> AsyncIterator[bytes]:
+            for (name, _, frame), counter in zip(prepared, answers.counters):
+                async for message in _upload_messages(name, frame.computed, None, encoding, counter):
+                    yield message
+
+        call = self._calls.build_batch(messages(), timeout=self._calls.timeout, metadata=self._calls.metadata())
+        try:
+            async for page in call:
+                answers.add(page)
+        except grpc.RpcError as e:
+            raise _network.raise_from_rpc(e) from None
+        return batch_results(
+            prepared,
+            answers.result(),
+            lambda answer, array, frame: AsyncFamily(self._calls, answer[0], answer[1], array, frame, frame.computed),
+            return_exceptions,
+        )
 
     async def build(
         self,
