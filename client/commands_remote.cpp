@@ -398,48 +398,68 @@ int RemoteShape(const CommonArgs& common, const ThresholdArg& threshold_arg, Cla
   return FinishOutput(out);
 }
 
+namespace {
+
+/// At most `bytes` of `text`, cut at a UTF-8 character boundary.
+std::string Utf8Prefix(const std::string& text, size_t bytes) {
+  if (text.size() <= bytes) return text;
+  size_t end = bytes;
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+  return text.substr(0, end);
+}
+
+}  // namespace
+
 absl::StatusOr<std::vector<RemoteSetShape>> RemoteSetShapes(const CommonArgs& common,
                                                             const std::vector<std::string>& names,
                                                             const std::vector<absl::Span<const Point2>>& sets,
                                                             const ThresholdArg& threshold, double min_hole_area) {
+  // Batches of this many sets, each queried before the next goes up, so that a server whose cache
+  // cannot hold every group's family at once still answers each while it holds it.
+  constexpr size_t kSetsPerCall = 10000;
+  constexpr size_t kMaxLabelBytes = 256;  // BuildHeader.name's limit
   GALPHA_ASSIGN_OR_RETURN(std::unique_ptr<client::AlphaClient> client, ConnectTo(common));
-  std::vector<client::BatchSet> batch;
-  batch.reserve(sets.size());
-  for (size_t i = 0; i < sets.size(); ++i) batch.push_back({names[i], sets[i], {}});
   client::BuildBatchCallOptions options;
   if (common.raw_upload) options.encoding = client::PointEncoding::kRaw;
-  GALPHA_ASSIGN_OR_RETURN(std::vector<absl::StatusOr<client::BuildResult>> built, client->BuildBatch(batch, options));
   const auto named = [&](size_t i, const absl::Status& status) {
     return absl::Status(status.code(), absl::StrCat(names[i], ": ", status.message()));
   };
   std::vector<RemoteSetShape> shapes(sets.size());
-  for (size_t i = 0; i < sets.size(); ++i) {
-    if (!built[i].ok()) return named(i, built[i].status());
-    auto at = ToThreshold(threshold, built[i]->summary.spectrum_size());
-    if (!at.ok()) return named(i, at.status());
-    // The level and squared alpha the threshold resolves to, as the local command prints them.
-    v1::ClassifyRequest classify;
-    classify.set_handle(built[i]->handle);
-    *classify.mutable_threshold() = *at;
-    classify.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
-    classify.set_summary_only(true);
-    absl::Status status = client->Classify(classify, [&](const v1::ClassifyResponse& message) {
-      if (message.has_summary()) {
-        shapes[i].level = message.summary().level();
-        shapes[i].alpha_sq = message.summary().alpha_sq();
-      }
-      return absl::OkStatus();
-    });
-    if (!status.ok()) return named(i, status);
-    v1::ShapeRequest request;
-    request.set_handle(built[i]->handle);
-    *request.mutable_threshold() = *at;
-    request.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
-    request.set_format(v1::SHAPE_FORMAT_RINGS);
-    request.set_min_hole_area(min_hole_area);
-    auto shape = RingsOfShape(*client, sets[i].size(), request);
-    if (!shape.ok()) return named(i, shape.status());
-    shapes[i].shape = *std::move(shape);
+  for (size_t first = 0; first < sets.size(); first += kSetsPerCall) {
+    const size_t end = std::min(sets.size(), first + kSetsPerCall);
+    std::vector<client::BatchSet> batch;
+    batch.reserve(end - first);
+    for (size_t i = first; i < end; ++i) batch.push_back({Utf8Prefix(names[i], kMaxLabelBytes), sets[i], {}});
+    GALPHA_ASSIGN_OR_RETURN(std::vector<absl::StatusOr<client::BuildResult>> built, client->BuildBatch(batch, options));
+    for (size_t i = first; i < end; ++i) {
+      const absl::StatusOr<client::BuildResult>& set = built[i - first];
+      if (!set.ok()) return named(i, set.status());
+      auto at = ToThreshold(threshold, set->summary.spectrum_size());
+      if (!at.ok()) return named(i, at.status());
+      // The level and squared alpha the threshold resolves to, as the local command prints them.
+      v1::ClassifyRequest classify;
+      classify.set_handle(set->handle);
+      *classify.mutable_threshold() = *at;
+      classify.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+      classify.set_summary_only(true);
+      absl::Status status = client->Classify(classify, [&](const v1::ClassifyResponse& message) {
+        if (message.has_summary()) {
+          shapes[i].level = message.summary().level();
+          shapes[i].alpha_sq = message.summary().alpha_sq();
+        }
+        return absl::OkStatus();
+      });
+      if (!status.ok()) return named(i, status);
+      v1::ShapeRequest request;
+      request.set_handle(set->handle);
+      *request.mutable_threshold() = *at;
+      request.set_mode(v1::CLASSIFY_MODE_REGULARIZED);
+      request.set_format(v1::SHAPE_FORMAT_RINGS);
+      request.set_min_hole_area(min_hole_area);
+      auto shape = RingsOfShape(*client, sets[i].size(), request);
+      if (!shape.ok()) return named(i, shape.status());
+      shapes[i].shape = *std::move(shape);
+    }
   }
   return shapes;
 }

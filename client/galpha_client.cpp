@@ -216,6 +216,7 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
     return absl::InvalidArgumentError(
         absl::StrCat(sets.size(), " sets; a BuildBatch call carries at most ", kMaxSets, ": split them"));
   }
+  if (sets.empty()) return std::vector<absl::StatusOr<BuildResult>>();
   // The chunks of every set in stream order.
   struct ChunkRef {
     size_t set;
@@ -324,6 +325,12 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
         results.emplace_back(absl::Status(static_cast<absl::StatusCode>(answer.code()), answer.message()));
         continue;
       }
+      if (answer.result().handle().empty()) {
+        malformed =
+            absl::DataLossError(absl::StrCat("the server's BuildBatch answer has set ", i, " built without a handle"));
+        context.TryCancel();
+        break;
+      }
       BuildResult result;
       result.handle = answer.result().handle();
       result.cached = answer.result().cached();
@@ -332,6 +339,7 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
       result.summary = std::move(*answer.mutable_result()->mutable_summary());
       results.emplace_back(std::move(result));
     }
+    if (!malformed.ok()) break;
   }
   absl::Status status = FromGrpc(stream->Finish());
   if (!malformed.ok()) return malformed;

@@ -182,7 +182,8 @@ void BuildBatchReactor::EndOfStream() {
   }
   // Cached sets answer now; the others are built one after the other by one job, whose working
   // memory is the largest set's (every set's points are already reserved as in flight).
-  size_t need = 0;
+  size_t largest = 0;  // the largest set's working memory
+  size_t held = 0;     // every set's points and weights, held until the set is built
   for (size_t i = 0; i < sets_.size(); ++i) {
     Set& set = sets_[i];
     const FamilyCache::Found found = service_->cache_->Lookup(tenant_, set.build->handle);
@@ -193,10 +194,12 @@ void BuildBatchReactor::EndOfStream() {
       continue;
     }
     if (found.compact != nullptr && set.build->frame == nullptr) set.build->frame = found.compact->frame();
-    need = std::max(need, set.build->points.size() * (kBuildBytesPerPoint + sizeof(Point2)) +
-                              set.build->weights.size() * kBuildBytesPerWeight);
+    largest = std::max(
+        largest, set.build->points.size() * kBuildBytesPerPoint + set.build->weights.size() * kBuildBytesPerWeight);
+    held += set.build->points.size() * sizeof(Point2) + set.build->weights.size() * sizeof(double);
     to_build_.push_back(i);
   }
+  const size_t need = largest + held;
   if (to_build_.empty()) {
     WriteNextPage();
     return;
@@ -224,9 +227,25 @@ void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
   const bool limited = one_build.count() > 0;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(one_build) +
                         kBatchBuildTimePerSet * static_cast<int64_t>(to_build_.size());
-  for (size_t i : to_build_) {
+  for (size_t k = 0; k < to_build_.size(); ++k) {
     if (CallerGone()) break;
-    BuildSet(i, slot, limited, deadline);
+    if (limited && Clock::now() > deadline) {
+      // The rest is not started: one refusal for the batch, the same answer for every set left.
+      const absl::Status late = TagRefusal(
+          absl::DeadlineExceededError(absl::StrCat(
+              "the batch ran past its time limit before this set was built (a batch may take the limit of one build "
+              "of all its ",
+              points, " points plus ", kBatchBuildTimePerSet.count(),
+              " ms a set: ", BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time), ")")),
+          BuildRefusal::kBuildTime);
+      service_->metrics_->RecordRejectedBuild(RefusalLabelOf(late));
+      for (; k < to_build_.size(); ++k) {
+        AnswerError(to_build_[k], late, /*count_refusal=*/false);
+        sets_[to_build_[k]].decoder.reset();
+      }
+      break;
+    }
+    BuildSet(to_build_[k], slot, limited, deadline, points);
   }
   ReturnFreedHeapMemory();  // the engine's working memory and the points
   if (CallerGone()) {
@@ -236,7 +255,8 @@ void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
   WriteNextPage();
 }
 
-void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline) {
+void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline,
+                                 uint64_t batch_points) {
   Set& set = sets_[index];
   const DecodedBuild& build = *set.build;
   // An earlier set of this batch with the same points (or another call) may have built it since.
@@ -261,12 +281,13 @@ void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limit
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (!family.ok()) {
     if (absl::IsCancelled(family.status()) && !cancelled_ && limited && Clock::now() > deadline) {
-      AnswerError(index, TagRefusal(absl::DeadlineExceededError(absl::StrCat(
-                                        "the batch ran past its time limit (",
-                                        BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time),
-                                        "; a batch has the limit of one build of all its points plus ",
-                                        kBatchBuildTimePerSet.count(), " ms a set)")),
-                                    BuildRefusal::kBuildTime));
+      AnswerError(index,
+                  TagRefusal(absl::DeadlineExceededError(absl::StrCat(
+                                 "the batch ran past its time limit during this set's build (a batch may take "
+                                 "the limit of one build of all its ",
+                                 batch_points, " points plus ", kBatchBuildTimePerSet.count(), " ms a set: ",
+                                 BuildTimeLimitMessage(batch_points, cuda, cores, service_->options_.build_time), ")")),
+                             BuildRefusal::kBuildTime));
     } else if (IsExactComparisonLimit(family.status())) {
       AnswerError(index, TagRefusal(absl::ResourceExhaustedError(
                                         ExactComparisonLimitMessage(points, service_->options_.exact_comparisons)),
@@ -299,8 +320,8 @@ void BuildBatchReactor::Answer(size_t index, const CachedFamily& family, bool wa
   set.answered = true;
 }
 
-void BuildBatchReactor::AnswerError(size_t index, const absl::Status& status) {
-  if (const std::string reason = RefusalLabelOf(status); !reason.empty()) {
+void BuildBatchReactor::AnswerError(size_t index, const absl::Status& status, bool count_refusal) {
+  if (const std::string reason = RefusalLabelOf(status); count_refusal && !reason.empty()) {
     service_->metrics_->RecordRejectedBuild(reason);
   }
   Set& set = sets_[index];

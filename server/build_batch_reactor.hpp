@@ -82,12 +82,13 @@ class BuildBatchReactor final
   absl::Status EndSet();
   void EndOfStream();
   void Run(const BuildSlot& slot, bool draining);
-  // Builds set `index` on `slot` (before `deadline` when `limited`) and caches its family.
-  void BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline);
+  // Builds set `index` on `slot` (before `deadline` when `limited`; `batch_points`: the points of
+  // the sets the batch builds, for the limit's message) and caches its family.
+  void BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline, uint64_t batch_points);
   // `family` as set `index`'s answer.
   void Answer(size_t index, const CachedFamily& family, bool was_cached);
-  // Set `index`'s answer as a failure (counted as a refusal when it is one).
-  void AnswerError(size_t index, const absl::Status& status);
+  // Set `index`'s answer as a failure (counted as a refusal when it is one and `count_refusal`).
+  void AnswerError(size_t index, const absl::Status& status, bool count_refusal = true);
   // Writes the next page of answers, or finishes the call after the last.
   void WriteNextPage();
   // The last thing any path does: after Finish, gRPC may delete this at any moment.

@@ -272,12 +272,15 @@ absl::Status CheckEncodedChunkShape(const v1::EncodedPointChunk& chunk, const Ch
   return CheckAxisScale(chunk, chunk.w_scale(), chunk.has_w_scale(), "w_scale (the stream is weighted)", at);
 }
 
-PointChunkDecoder::PointChunkDecoder()
-    : zstd_(ZSTD_createDCtx(), [](ZSTD_DCtx_s* context) { ZSTD_freeDCtx(context); }) {}
+// The zstd context (about 95 KB) is made at the first compressed chunk and freed with the scratch:
+// a stream of raw chunks, and a finished stream waiting for its build (a BuildBatch holds one
+// decoder a set), keep none.
+PointChunkDecoder::PointChunkDecoder() : zstd_(nullptr, [](ZSTD_DCtx_s* context) { ZSTD_freeDCtx(context); }) {}
 
 PointChunkDecoder::~PointChunkDecoder() = default;
 
 void PointChunkDecoder::ReleaseScratch() {
+  zstd_.reset();
   scratch_.reset();
   scratch_bytes_ = 0;
   std::vector<uint64_t>().swap(words64_);
@@ -330,6 +333,10 @@ absl::Status PointChunkDecoder::DecodeValues(const v1::EncodedPointChunk& chunk,
     }
     // The output is bounded by the stated size: a frame that would write more fails here, having
     // written at most `expected` bytes (no zip bombs).
+    if (zstd_ == nullptr) {
+      zstd_.reset(ZSTD_createDCtx());
+      if (zstd_ == nullptr) return absl::ResourceExhaustedError("zstd: no memory for a decompression context");
+    }
     const size_t decoded = ZSTD_decompressDCtx(zstd_.get(), scratch_.get(), expected, data.data(), data.size());
     if (ZSTD_isError(decoded)) {
       if (ZSTD_getErrorCode(decoded) == ZSTD_error_dstSize_tooSmall) {

@@ -60,7 +60,8 @@ class PointChunkDecoder {
   absl::Status DecodeWeighted(const galpha::v1::EncodedPointChunk& chunk, const ChunkPosition& at, Point2* out,
                               double* weights);
 
-  /// Frees the scratch buffers (they grow to the largest chunk decoded); decoding again regrows them.
+  /// Frees the scratch buffers (they grow to the largest chunk decoded) and the zstd context;
+  /// decoding again makes them again.
   void ReleaseScratch();
 
  private:

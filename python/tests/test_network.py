@@ -293,6 +293,7 @@ def test_build_batch_errors_name_the_set(start_server) -> None:
         results = c.build_batch([("small", small), ("large", large)], return_exceptions=True)
         assert isinstance(results[0], galpha.Family) and results[0].summary.cached
         assert isinstance(results[1], galpha.ResourceExhausted)
+        assert c.build_batch({}) == []
         with pytest.raises(galpha.InvalidInput, match="a mapping of name to points"):
             c.build_batch([small])
         # A set with a NaN fails the whole call, naming the set by its index and name.

@@ -174,6 +174,10 @@ TEST(ServiceBatchTest, AMalformedSetFailsTheWholeBatchNamingIt) {
   odd.mutable_points()->add_coordinates(1.0);
   status = RawBatch(*client, {NamedHeader("odd", 0), odd});
   EXPECT_THAT(status, StatusIs(absl::StatusCode::kInvalidArgument, HasSubstr("set 0 ('odd')")));
+  // The client answers an empty batch itself, without a call.
+  auto none = client->BuildBatch({});
+  ASSERT_THAT(none, IsOk());
+  EXPECT_TRUE(none->empty());
   // Points before any header, and no set at all.
   EXPECT_THAT(RawBatch(*client, {PointsOf(a)}),
               StatusIs(absl::StatusCode::kInvalidArgument, HasSubstr("began with points")));

@@ -774,6 +774,12 @@ class BatchAnswers:
             if answer.code != 0:
                 self.sets.append(error_for_code(answer.code, answer.message))
                 continue
+            if not answer.result.handle:
+                raise GalphaError(
+                    f"the server's BuildBatch answer has set {len(self.sets)} built without a handle",
+                    code="DATA_LOSS",
+                    code_number=15,
+                )
             summary = summary_from(answer.result.summary, cached=answer.result.cached)
             summary = dataclasses.replace(summary, upload_bytes=self.counters[len(self.sets)].bytes)
             self.sets.append((answer.result.handle, summary))
@@ -794,6 +800,8 @@ def build_batch_on_server(calls: Calls, sets: List[Tuple[str, np.ndarray]], enco
     GalphaError of a set whose build alone failed. A stream the server refuses raises, naming the
     set; so does a KeyboardInterrupt, after cancelling the call."""
     check_batch_size(len(sets))
+    if not sets:
+        return []
     answers = BatchAnswers([UploadCounter() for _ in sets])
 
     def messages() -> Iterator[bytes]:

@@ -340,6 +340,8 @@ class AsyncClient:
         encoded off the event loop. Cancelling the task cancels the call."""
         encoding = check_encoding(encoding)
         prepared = batch_sets(sets, crs)
+        if not prepared:
+            return []
         _network.check_batch_size(len(prepared))
         answers = _network.BatchAnswers([_network.UploadCounter() for _ in prepared])
 
@@ -354,6 +356,9 @@ class AsyncClient:
                 answers.add(page)
         except grpc.RpcError as e:
             raise _network.raise_from_rpc(e) from None
+        except BaseException:
+            call.cancel()
+            raise
         return batch_results(
             prepared,
             answers.result(),
