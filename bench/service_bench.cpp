@@ -669,7 +669,7 @@ int RunBatch(const Options& options) {
   for (size_t i = 0; i < sets; ++i) {
     points.push_back(gen::Uniform(n, 5000 + i));
     for (Point2 p : points.back())
-      all.push_back({p.x + static_cast<double>(i % 1000) * 2.0, p.y + static_cast<double>(i / 1000) * 2.0});
+      all.push_back({p.x + static_cast<double>(i % 1000) * 2.0, p.y + static_cast<double>(i / 1000 * 2)});
   }
   std::vector<client::BatchSet> batch;
   for (size_t i = 0; i < sets; ++i) batch.push_back({absl::StrCat("set-", i), points[i], {}});

@@ -72,7 +72,8 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
   std::vector<RemoteSetShape> shapes;
   if (!common.server.empty()) {
     std::vector<absl::Span<const Point2>> sets;
-    for (const FramedPoints& frame : frames) sets.push_back(frame.Computed());
+    sets.reserve(frames.size());
+    for (const FramedPoints& frame : frames) sets.emplace_back(frame.Computed());
     auto remote = RemoteSetShapes(common, names, sets, threshold, min_hole_area);
     if (!remote.ok()) {
       return absl::IsInvalidArgument(remote.status()) ? ArgumentError(remote.status()) : Failure(remote.status());

@@ -32,6 +32,9 @@ class AlphaService;
 inline constexpr size_t kMaxBatchSets = 100'000;
 /// Sets a BuildBatchResponse page answers.
 inline constexpr size_t kBatchSetsPerPage = 1000;
+/// Sets of at most this many points are built on the host's cores, one set a core at a time,
+/// whatever the service's backend; larger ones on the build's slot.
+inline constexpr size_t kHostBatchSetPoints = 20000;
 /// Build time a batch is given a set, beyond the limit of one build of all its points: each set
 /// costs the engine a fixed start whatever its size.
 inline constexpr std::chrono::milliseconds kBatchBuildTimePerSet{100};
@@ -84,7 +87,9 @@ class BuildBatchReactor final
   void Run(const BuildSlot& slot, bool draining);
   // Builds set `index` on `slot` (before `deadline` when `limited`; `batch_points`: the points of
   // the sets the batch builds, for the limit's message) and caches its family.
-  void BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline, uint64_t batch_points);
+  // `on_host`: on the CPU backend, in host memory, whatever the service's backend.
+  void BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline, uint64_t batch_points,
+                bool on_host);
   // `family` as set `index`'s answer.
   void Answer(size_t index, const CachedFamily& family, bool was_cached);
   // Set `index`'s answer as a failure (counted as a refusal when it is one and `count_refusal`).

@@ -38,7 +38,7 @@ struct NamedSet {
   std::vector<double> weights;
 };
 
-/// Small sets of every kind a GIS layer holds, degenerate ones and an empty one included.
+/// Sets of every kind a GIS layer holds, degenerate ones and an empty one included.
 std::vector<NamedSet> Sets() {
   std::vector<NamedSet> sets = {
       {"uniform", gen::Uniform(1000, 1), {}},
@@ -49,6 +49,9 @@ std::vector<NamedSet> Sets() {
       {"circle", gen::Circle(300, 5), {}},
       {"one", {{0.5, 0.5}}, {}},
       {"uniform-again", gen::Uniform(1000, 1), {}},
+      // Over BuildBatchReactor's host-core size: built on the slot while the others are built on
+      // the host's cores.
+      {"large", gen::Uniform(30000, 8), {}},
   };
   NamedSet weighted{"weighted", gen::Uniform(400, 6), {}};
   std::mt19937_64 random(7);
@@ -60,6 +63,7 @@ std::vector<NamedSet> Sets() {
 
 std::vector<client::BatchSet> Batch(const std::vector<NamedSet>& sets) {
   std::vector<client::BatchSet> batch;
+  batch.reserve(sets.size());
   for (const NamedSet& set : sets) batch.push_back({set.name, set.points, set.weights});
   return batch;
 }
