@@ -3,9 +3,11 @@
 #include <grpcpp/grpcpp.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -93,6 +95,76 @@ absl::Status EncodeChunk(absl::Span<const Point2> points, absl::Span<const doubl
   return encoder->Encode(points, weights, chunk, message->mutable_encoded_points());
 }
 
+// Point chunks encoded ahead of the writes, one thread a chunk, up to `window` at once, and handed
+// over in order as each is ready: encoding costs 2-16 ms a 1 MiB chunk on one core (zstd and the
+// trial encodings), as much as sending it over 1 Gb/s, so the writes of the first chunks overlap
+// the encoding of the next ones instead of waiting for a whole batch. Build and BuildBatch use it.
+class ChunksEncodedAhead {
+ public:
+  // Chunk `chunk`'s points and weights (empty: unweighted).
+  using ChunkPoints = std::function<std::pair<absl::Span<const Point2>, absl::Span<const double>>(size_t chunk)>;
+
+  ChunksEncodedAhead(size_t chunk_count, PointEncoding encoding, int zstd_level, ChunkPoints points)
+      : chunk_count_(chunk_count),
+        encoding_(encoding),
+        window_(encoding == PointEncoding::kRaw
+                    ? 1
+                    : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads)),
+        points_(std::move(points)),
+        slots_(window_) {
+    for (Slot& slot : slots_) slot.encoder = std::make_unique<wire::PointChunkEncoder>(zstd_level);
+    for (size_t chunk = 0; chunk < std::min(window_, chunk_count_); ++chunk) Start(chunk);
+  }
+  // After a failure (a bad chunk, or the server's answer ending the stream) the chunks still being
+  // encoded are waited for, then dropped.
+  ~ChunksEncodedAhead() {
+    for (Slot& slot : slots_) {
+      if (slot.worker.joinable()) slot.worker.join();
+    }
+  }
+  ChunksEncodedAhead(const ChunksEncodedAhead&) = delete;
+  ChunksEncodedAhead& operator=(const ChunksEncodedAhead&) = delete;
+
+  // The next chunk's message, in order, or its encoding's error; valid until the next call (the
+  // caller writes it in between: its slot then takes the chunk `window` ahead).
+  absl::StatusOr<v1::BuildRequest*> Next() {
+    if (next_ > 0 && next_ - 1 + window_ < chunk_count_) Start(next_ - 1 + window_);
+    Slot& slot = slots_[next_ % window_];
+    if (window_ > 1) {
+      slot.worker.join();
+    } else {
+      Encode(next_);  // with one slot there is nothing to overlap: each chunk is encoded here
+    }
+    ++next_;
+    if (!slot.status.ok()) return slot.status;
+    return &slot.message;
+  }
+
+ private:
+  struct Slot {
+    std::unique_ptr<wire::PointChunkEncoder> encoder;
+    v1::BuildRequest message;
+    absl::Status status;
+    std::thread worker;
+  };
+
+  void Encode(size_t chunk) {
+    Slot& slot = slots_[chunk % window_];
+    const auto [points, weights] = points_(chunk);
+    slot.status = EncodeChunk(points, weights, encoding_, slot.encoder.get(), &slot.message);
+  }
+  void Start(size_t chunk) {
+    if (window_ > 1) slots_[chunk % window_].worker = std::thread([this, chunk] { Encode(chunk); });
+  }
+
+  const size_t chunk_count_;
+  const PointEncoding encoding_;
+  const size_t window_;
+  const ChunkPoints points_;
+  std::vector<Slot> slots_;
+  size_t next_ = 0;
+};
+
 // A Build stream's message as the BuildBatch stream's message it is (the same parts).
 v1::BuildBatchRequest AsBatchMessage(v1::BuildRequest message) {
   v1::BuildBatchRequest out;
@@ -143,55 +215,25 @@ absl::StatusOr<BuildResult> AlphaClient::Build(absl::Span<const Point2> points, 
   message.mutable_header()->set_crs(options.crs);
   message.mutable_header()->set_weighted(weighted);
   bool open = writer->Write(message);
-  // Chunks are encoded ahead of the writes, one thread a chunk, up to `window` at once, and
-  // written in order as each is ready: encoding costs 2-16 ms a 1 MiB chunk on one core (zstd and
-  // the trial encodings), as much as sending it over 1 Gb/s, so the writes of the first chunks
-  // overlap the encoding of the next ones instead of waiting for a whole batch.
-  const size_t window = options.encoding == PointEncoding::kRaw
-                            ? 1
-                            : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads);
   const size_t chunk_count = (points.size() + kPointsPerChunk - 1) / kPointsPerChunk;
-  struct Slot {
-    std::unique_ptr<wire::PointChunkEncoder> encoder;
-    v1::BuildRequest message;
-    absl::Status status;
-    std::thread worker;
-  };
-  std::vector<Slot> slots(window);
-  for (Slot& slot : slots) slot.encoder = std::make_unique<wire::PointChunkEncoder>(options.zstd_level);
-  const auto encode = [&](size_t chunk) {
-    Slot& slot = slots[chunk % window];
-    const size_t begin = chunk * kPointsPerChunk;
-    const size_t count = std::min(kPointsPerChunk, points.size() - begin);
-    slot.status = EncodeChunk(points.subspan(begin, count), weighted ? weights.subspan(begin, count) : weights,
-                              options.encoding, slot.encoder.get(), &slot.message);
-  };
-  // With one slot there is nothing to overlap: each chunk is encoded on this thread.
-  const auto start = [&](size_t chunk) {
-    if (window > 1) slots[chunk % window].worker = std::thread(encode, chunk);
-  };
-  for (size_t chunk = 0; chunk < std::min(window, chunk_count); ++chunk) start(chunk);
   absl::Status encoded;
-  size_t written = 0;  // chunks written; the ones after it up to written + window may be encoding
-  for (; open && encoded.ok() && written < chunk_count; ++written) {
-    Slot& slot = slots[written % window];
-    if (window > 1) {
-      slot.worker.join();
-    } else {
-      encode(written);
+  {
+    ChunksEncodedAhead chunks(chunk_count, options.encoding, options.zstd_level, [&](size_t chunk) {
+      const size_t begin = chunk * kPointsPerChunk;
+      const size_t count = std::min(kPointsPerChunk, points.size() - begin);
+      return std::make_pair(points.subspan(begin, count), weighted ? weights.subspan(begin, count) : weights);
+    });
+    for (size_t written = 0; open && written < chunk_count; ++written) {
+      absl::StatusOr<v1::BuildRequest*> message = chunks.Next();
+      if (!message.ok()) {
+        encoded = message.status();
+        break;
+      }
+      result.upload_bytes += (*message)->ByteSizeLong();
+      open = writer->Write(**message);
+      const size_t sent = std::min(points.size(), (written + 1) * kPointsPerChunk);
+      if (open && options.progress) options.progress(sent);
     }
-    encoded = slot.status;
-    if (!encoded.ok()) break;
-    result.upload_bytes += slot.message.ByteSizeLong();
-    open = writer->Write(slot.message);  // serializes the message: the slot is free again after it
-    if (open && written + window < chunk_count) start(written + window);
-    const size_t sent = std::min(points.size(), (written + 1) * kPointsPerChunk);
-    if (open && options.progress) options.progress(sent);
-  }
-  // After a failure (a bad chunk, or the server's answer ending the stream) the chunks still being
-  // encoded are waited for, then dropped.
-  for (Slot& slot : slots) {
-    if (slot.worker.joinable()) slot.worker.join();
   }
   if (!encoded.ok()) {
     context.TryCancel();
@@ -243,61 +285,36 @@ absl::StatusOr<std::vector<absl::StatusOr<BuildResult>>> AlphaClient::BuildBatch
   PrepareContext(&context);
   std::unique_ptr<grpc::ClientReaderWriter<v1::BuildBatchRequest, v1::BuildBatchResponse>> stream =
       stub_->BuildBatch(&context);
-  // As Build: chunks are encoded ahead of the writes on up to `window` threads, one chunk each,
-  // and written in order; the sets' headers go between them.
-  const size_t window = options.encoding == PointEncoding::kRaw
-                            ? 1
-                            : std::clamp<size_t>(std::thread::hardware_concurrency(), 1, kMaxEncodingThreads);
-  struct Slot {
-    std::unique_ptr<wire::PointChunkEncoder> encoder;
-    v1::BuildRequest message;
-    absl::Status status;
-    std::thread worker;
-  };
-  std::vector<Slot> slots(window);
-  for (Slot& slot : slots) slot.encoder = std::make_unique<wire::PointChunkEncoder>(options.zstd_level);
-  const auto encode = [&](size_t chunk) {
-    Slot& slot = slots[chunk % window];
-    const ChunkRef& ref = chunks[chunk];
-    const BatchSet& set = sets[ref.set];
-    slot.status = EncodeChunk(set.points.subspan(ref.begin, ref.count),
-                              set.weights.empty() ? set.weights : set.weights.subspan(ref.begin, ref.count),
-                              options.encoding, slot.encoder.get(), &slot.message);
-  };
-  const auto start = [&](size_t chunk) {
-    if (window > 1) slots[chunk % window].worker = std::thread(encode, chunk);
-  };
-  for (size_t chunk = 0; chunk < std::min(window, chunks.size()); ++chunk) start(chunk);
   bool open = true;
   absl::Status encoded;
   std::vector<uint64_t> upload_bytes(sets.size(), 0);
-  for (size_t i = 0; open && encoded.ok() && i < sets.size(); ++i) {
-    v1::BuildBatchRequest header;
-    header.mutable_header()->set_name(sets[i].name);
-    header.mutable_header()->set_expected_points(sets[i].points.size());
-    header.mutable_header()->set_crs(options.crs);
-    header.mutable_header()->set_weighted(!sets[i].weights.empty());
-    open = stream->Write(header);
-    for (size_t chunk = first_chunk[i]; open && chunk < first_chunk[i + 1]; ++chunk) {
-      Slot& slot = slots[chunk % window];
-      if (window > 1) {
-        slot.worker.join();
-      } else {
-        encode(chunk);
+  {
+    // As Build's, the sets' headers written between their chunks.
+    ChunksEncodedAhead ahead(chunks.size(), options.encoding, options.zstd_level, [&](size_t chunk) {
+      const ChunkRef& ref = chunks[chunk];
+      const BatchSet& set = sets[ref.set];
+      return std::make_pair(set.points.subspan(ref.begin, ref.count),
+                            set.weights.empty() ? set.weights : set.weights.subspan(ref.begin, ref.count));
+    });
+    for (size_t i = 0; open && encoded.ok() && i < sets.size(); ++i) {
+      v1::BuildBatchRequest header;
+      header.mutable_header()->set_name(sets[i].name);
+      header.mutable_header()->set_expected_points(sets[i].points.size());
+      header.mutable_header()->set_crs(options.crs);
+      header.mutable_header()->set_weighted(!sets[i].weights.empty());
+      open = stream->Write(header);
+      for (size_t chunk = first_chunk[i]; open && chunk < first_chunk[i + 1]; ++chunk) {
+        absl::StatusOr<v1::BuildRequest*> message = ahead.Next();
+        if (!message.ok()) {
+          encoded = absl::Status(message.status().code(),
+                                 absl::StrCat("set ", i, " ('", sets[i].name, "'): ", message.status().message()));
+          break;
+        }
+        upload_bytes[i] += (*message)->ByteSizeLong();
+        open = stream->Write(AsBatchMessage(std::move(**message)));
       }
-      encoded = slot.status;
-      if (!encoded.ok()) {
-        encoded = absl::Status(encoded.code(), absl::StrCat("set ", i, " ('", sets[i].name, "'): ", encoded.message()));
-        break;
-      }
-      upload_bytes[i] += slot.message.ByteSizeLong();
-      open = stream->Write(AsBatchMessage(std::move(slot.message)));
-      if (open && chunk + window < chunks.size()) start(chunk + window);
+      if (open && encoded.ok() && options.progress) options.progress(i + 1);
     }
-    if (open && encoded.ok() && options.progress) options.progress(i + 1);
-  }
-  for (Slot& slot : slots) {
-    if (slot.worker.joinable()) slot.worker.join();
   }
   if (!encoded.ok()) {
     context.TryCancel();
