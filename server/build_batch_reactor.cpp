@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <memory>
 #include <thread>
 #include <utility>
@@ -189,9 +190,16 @@ void BuildBatchReactor::EndOfStream() {
   size_t largest = 0;        // the largest set's working memory
   size_t largest_small = 0;  // the same of the sets built on host cores, several at once
   size_t small = 0;
-  size_t held = 0;  // every set's points and weights, held until the set is built
+  size_t held = 0;                         // every set's points and weights, held until the set is built
+  std::map<std::string, size_t> first_of;  // handle -> the first set to build with it
   for (size_t i = 0; i < sets_.size(); ++i) {
     Set& set = sets_[i];
+    // A set repeated in the batch is built once (the sets are built side by side, so the cache
+    // would not yet hold it for the repeat) and answered as a cache hit after it.
+    if (auto first = first_of.find(set.build->handle); first != first_of.end()) {
+      repeats_.emplace_back(i, first->second);
+      continue;
+    }
     const FamilyCache::Found found = service_->cache_->Lookup(tenant_, set.build->handle);
     if (found.resident != nullptr) {
       if (set.build->frame != nullptr) found.resident->AttachFrameIfNone(set.build->frame);
@@ -208,11 +216,13 @@ void BuildBatchReactor::EndOfStream() {
       ++small;
     }
     held += set.build->points.size() * sizeof(Point2) + set.build->weights.size() * sizeof(double);
+    first_of.emplace(set.build->handle, i);
     to_build_.push_back(i);
   }
   const size_t host_threads = std::min<size_t>(std::max(std::thread::hardware_concurrency(), 1u), small);
   const size_t need = largest + host_threads * largest_small + held;
   if (to_build_.empty()) {
+    AnswerRepeats();
     WriteNextPage();
     return;
   }
@@ -280,6 +290,7 @@ void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
   build_all(large, &next_large, /*on_host=*/false);
   for (std::thread& worker : workers) worker.join();
   if (any_late) service_->metrics_->RecordRejectedBuild(RefusalLabelOf(late));
+  AnswerRepeats();
   ReturnFreedHeapMemory();  // the engine's working memory and the points
   if (CallerGone()) {
     Respond(absl::CancelledError("the client went away during the batch; the sets built so far stay cached"));
@@ -351,6 +362,19 @@ void BuildBatchReactor::Answer(size_t index, const CachedFamily& family, bool wa
   FillBuildSummary(family, result->mutable_summary());
   result->mutable_summary()->set_name(set.build->header.name());
   set.answered = true;
+}
+
+void BuildBatchReactor::AnswerRepeats() {
+  for (const auto& [index, first] : repeats_) {
+    Set& set = sets_[index];
+    set.answer = sets_[first].answer;
+    if (set.answer.code() == 0) {
+      set.answer.mutable_result()->set_cached(true);
+      set.answer.mutable_result()->mutable_summary()->set_name(set.build->header.name());
+    }
+    set.answered = true;
+    set.decoder.reset();
+  }
 }
 
 void BuildBatchReactor::AnswerError(size_t index, const absl::Status& status, bool count_refusal) {

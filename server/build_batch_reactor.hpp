@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -94,6 +95,8 @@ class BuildBatchReactor final
   void Answer(size_t index, const CachedFamily& family, bool was_cached);
   // Set `index`'s answer as a failure (counted as a refusal when it is one and `count_refusal`).
   void AnswerError(size_t index, const absl::Status& status, bool count_refusal = true);
+  // The repeats' answers: their first set's, as a cache hit under their own name.
+  void AnswerRepeats();
   // Writes the next page of answers, or finishes the call after the last.
   void WriteNextPage();
   // The last thing any path does: after Finish, gRPC may delete this at any moment.
@@ -107,6 +110,7 @@ class BuildBatchReactor final
   std::vector<Set> sets_;
   uint64_t points_ = 0;  // of the sets whose part of the stream ended
   std::vector<size_t> to_build_;
+  std::vector<std::pair<size_t, size_t>> repeats_;  // (set, the earlier set of the same points)
   galpha::v1::BuildBatchResponse page_;
   size_t next_page_set_ = 0;
   std::atomic<bool> cancelled_{false};
