@@ -6,6 +6,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <random>
 #include <string>
 #include <vector>
@@ -222,6 +223,36 @@ TEST(ServiceBatchTest, ASetThatFailsAloneLeavesTheOthersBuilt) {
   EXPECT_THAT(client->Describe(PointSetHandle(small)), IsOk());
   EXPECT_THAT(client->Describe(PointSetHandle(large)).status(), StatusIs(absl::StatusCode::kNotFound));
   EXPECT_EQ(ScrapeMetric(*server, "galpha_builds_rejected_total{reason=\"cache_bytes\"}"), 1.0);
+}
+
+TEST(ServiceBatchTest, SetsPastTheBatchDeadlineAreNotStarted) {
+  // A time limit of about 1 ms plus 100 ms a set: the first large set (built on the slot, for a
+  // second or more) runs past it and stops at a phase boundary; the two after it are
+  // answered without being started. Two refusals: the set stopped, and the batch's unstarted rest.
+  auto options = TestServerOptions();
+  options.service.build_time.multiple = 1e-9;
+  options.service.build_time.floor = std::chrono::milliseconds(1);
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  std::vector<std::vector<Point2>> points;
+  std::vector<client::BatchSet> batch;
+  // Sets whose build takes a second or more on the test's backend (a GPU builds 200,000 points
+  // in milliseconds).
+  const size_t n = testing::TestBackend() == "cuda" ? 20'000'000 : 200'000;
+  for (uint64_t i = 0; i < 3; ++i) points.push_back(gen::Uniform(n, 50 + i));
+  for (size_t i = 0; i < 3; ++i) batch.push_back({"large-" + std::to_string(i), points[i], {}});
+  auto answers = client->BuildBatch(batch);
+  ASSERT_THAT(answers, IsOk());
+  ASSERT_EQ(answers->size(), 3u);
+  EXPECT_THAT((*answers)[0].status(),
+              StatusIs(absl::StatusCode::kDeadlineExceeded, HasSubstr("during this set's build")));
+  for (size_t i = 1; i < 3; ++i) {
+    EXPECT_THAT((*answers)[i].status(),
+                StatusIs(absl::StatusCode::kDeadlineExceeded, HasSubstr("before this set was built")));
+    EXPECT_THAT(client->Describe(PointSetHandle(points[i])).status(), StatusIs(absl::StatusCode::kNotFound));
+  }
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_builds_rejected_total{reason=\"build_time\"}"), 2.0);
 }
 
 TEST(ServiceBatchTest, AnswersComeInPagesOfAThousandSets) {
