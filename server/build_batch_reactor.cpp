@@ -51,46 +51,18 @@ absl::Status NameBatchSet(const absl::Status& status, size_t set, const std::str
 
 BuildBatchReactor::BuildBatchReactor(AlphaService* service, grpc::CallbackServerContext* context,
                                      absl::StatusOr<std::string> tenant)
-    : service_(service), context_(context), record_(service->metrics_, "BuildBatch") {
+    : UploadReactor(&service->upload_watchdog_, context, "the batch upload", "the batch"),
+      service_(service),
+      record_(service->metrics_, "BuildBatch") {
   if (!tenant.ok()) {
-    Respond(tenant.status());
+    BeginUpload(tenant.status());
     return;
   }
   tenant_ = *std::move(tenant);
-  if (service_->draining_) {
-    Respond(TagRefusal(absl::UnavailableError("the server is draining and accepts no new builds"),
-                       BuildRefusal::kDraining));
-    return;
-  }
-  last_activity_ = Clock::now().time_since_epoch().count();
-  uploading_ = true;
-  service_->upload_watchdog_.Watch(this);
-  std::lock_guard<std::mutex> lock(upload_mutex_);
-  if (!upload_over_) StartRead(&request_);  // else the watchdog already ended the call
-}
-
-void BuildBatchReactor::OnDone() {
-  service_->upload_watchdog_.Unwatch(this);
-  delete this;
-}
-
-std::optional<BuildBatchReactor::Clock::time_point> BuildBatchReactor::LastActivity() const {
-  if (!uploading_) return std::nullopt;
-  return Clock::time_point(Clock::duration(last_activity_.load()));
-}
-
-void BuildBatchReactor::TimeOut() {
-  {
-    std::lock_guard<std::mutex> lock(upload_mutex_);
-    if (upload_over_) return;
-    upload_over_ = true;
-    uploading_ = false;
-    sets_.clear();  // the points and their reservations go now
-  }
-  Respond(TagRefusal(absl::DeadlineExceededError(absl::StrCat(
-                         "the batch upload sent nothing for ", service_->upload_watchdog_.idle_timeout().count(),
-                         " ms, the server's idle limit (--upload_idle_timeout_ms): the batch was dropped")),
-                     BuildRefusal::kIdleTimeout));
+  BeginUpload(service_->draining_
+                  ? TagRefusal(absl::UnavailableError("the server is draining and accepts no new builds"),
+                               BuildRefusal::kDraining)
+                  : absl::OkStatus());
 }
 
 absl::Status BuildBatchReactor::EndSet() {
@@ -102,7 +74,7 @@ absl::Status BuildBatchReactor::EndSet() {
   return absl::OkStatus();
 }
 
-absl::Status BuildBatchReactor::Add(v1::BuildBatchRequest batch_message) {
+absl::Status BuildBatchReactor::AddMessage(v1::BuildBatchRequest batch_message) {
   v1::BuildRequest message = AsBuildRequest(std::move(batch_message));
   if (message.has_header()) {
     if (!sets_.empty()) {
@@ -136,39 +108,6 @@ absl::Status BuildBatchReactor::Add(v1::BuildBatchRequest batch_message) {
   }
   if (!added.ok()) return NameBatchSet(added, sets_.size() - 1, set.name);
   return absl::OkStatus();
-}
-
-void BuildBatchReactor::OnReadDone(bool ok) {
-  absl::Status refused;
-  {
-    std::lock_guard<std::mutex> lock(upload_mutex_);
-    if (upload_over_) return;  // the watchdog ended the call
-    if (ok) {
-      last_activity_ = Clock::now().time_since_epoch().count();
-      refused = Add(std::move(request_));
-      if (refused.ok()) {
-        StartRead(&request_);
-        return;
-      }
-    }
-    upload_over_ = true;
-    uploading_ = false;
-  }
-  if (ok) {
-    Respond(refused);
-  } else {
-    // As in BuildReactor::OnReadDone: a failed read is the stream's end only if the call still
-    // takes a send.
-    StartSendInitialMetadata();
-  }
-}
-
-void BuildBatchReactor::OnSendInitialMetadataDone(bool ok) {
-  if (!ok || cancelled_) {
-    Respond(absl::CancelledError("the upload was cut: the client went away or gRPC refused one of its messages"));
-    return;
-  }
-  EndOfStream();
 }
 
 void BuildBatchReactor::EndOfStream() {

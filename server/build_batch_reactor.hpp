@@ -22,7 +22,7 @@
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
 #include "server/rpc_record.hpp"
-#include "server/upload_watchdog.hpp"
+#include "server/upload_reactor.hpp"
 
 namespace galpha::server {
 
@@ -48,21 +48,15 @@ galpha::v1::BuildRequest AsBuildRequest(galpha::v1::BuildBatchRequest message);
 absl::Status NameBatchSet(const absl::Status& status, size_t set, const std::string& name);
 
 class BuildBatchReactor final
-    : public grpc::ServerBidiReactor<galpha::v1::BuildBatchRequest, galpha::v1::BuildBatchResponse>,
-      private UploadWatchdog::Upload {
+    : public UploadReactor<grpc::ServerBidiReactor<galpha::v1::BuildBatchRequest, galpha::v1::BuildBatchResponse>,
+                           galpha::v1::BuildBatchRequest> {
  public:
   /// `tenant` is the caller's, or the authentication's error (the call then fails at once).
   BuildBatchReactor(AlphaService* service, grpc::CallbackServerContext* context, absl::StatusOr<std::string> tenant);
 
-  void OnReadDone(bool ok) override;
-  void OnSendInitialMetadataDone(bool ok) override;
   void OnWriteDone(bool ok) override;
-  void OnCancel() override { cancelled_ = true; }
-  void OnDone() override;
 
  private:
-  using Clock = UploadWatchdog::Clock;
-
   // One set of the stream: its decoder (which holds its points' reservation until the set is
   // built), the decoded set once its stream part ended, and its answer.
   struct Set {
@@ -73,18 +67,15 @@ class BuildBatchReactor final
     bool answered = false;
   };
 
-  // UploadWatchdog::Upload
-  std::optional<Clock::time_point> LastActivity() const override;
-  void TimeOut() override;
+  // UploadReactor. A header starts the next set (ending the one before), a chunk goes to the
+  // current set; errors name the set.
+  absl::Status AddMessage(galpha::v1::BuildBatchRequest message) override;
+  void DropUpload() override { sets_.clear(); }  // the points and their reservations
+  void EndOfStream() override;
+  void Respond(const absl::Status& status) override;
 
-  // Whether the call was cancelled: the client went away, or gRPC refused one of its messages.
-  bool CallerGone() const { return cancelled_ || context_->IsCancelled(); }
-  // One message: a header starts the next set (ending the one before), a chunk goes to the
-  // current set. Errors name the set.
-  absl::Status Add(galpha::v1::BuildBatchRequest message);
   // Ends the current set's part of the stream: its decoder's Finish.
   absl::Status EndSet();
-  void EndOfStream();
   void Run(const BuildSlot& slot, bool draining);
   // Builds set `index` on `slot` (before `deadline` when `limited`; `batch_points`: the points of
   // the sets the batch builds, for the limit's message) and caches its family.
@@ -99,26 +90,16 @@ class BuildBatchReactor final
   void AnswerRepeats();
   // Writes the next page of answers, or finishes the call after the last.
   void WriteNextPage();
-  // The last thing any path does: after Finish, gRPC may delete this at any moment.
-  void Respond(const absl::Status& status);
 
   AlphaService* const service_;
-  grpc::CallbackServerContext* const context_;
   RpcRecord record_;
   std::string tenant_;
-  galpha::v1::BuildBatchRequest request_;
   std::vector<Set> sets_;
   uint64_t points_ = 0;  // of the sets whose part of the stream ended
   std::vector<size_t> to_build_;
   std::vector<std::pair<size_t, size_t>> repeats_;  // (set, the earlier set of the same points)
   galpha::v1::BuildBatchResponse page_;
   size_t next_page_set_ = 0;
-  std::atomic<bool> cancelled_{false};
-  // As BuildReactor's: the upload ends once, by its refusal, its end or the watchdog.
-  std::mutex upload_mutex_;
-  bool upload_over_ = false;  // guarded by upload_mutex_
-  std::atomic<bool> uploading_{false};
-  std::atomic<Clock::rep> last_activity_{0};
 };
 
 }  // namespace galpha::server

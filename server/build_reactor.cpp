@@ -27,93 +27,25 @@ using Clock = std::chrono::steady_clock;
 
 BuildReactor::BuildReactor(AlphaService* service, grpc::CallbackServerContext* context, v1::BuildResponse* response,
                            absl::StatusOr<std::string> tenant)
-    : service_(service),
-      context_(context),
+    : UploadReactor(&service->upload_watchdog_, context, "the upload", "the build"),
+      service_(service),
       response_(response),
       record_(service->metrics_, "Build"),
       decoder_(BuildStreamLimits{service->options_.max_points_per_build}, &service->in_flight_,
                tenant.ok() ? *tenant : std::string(), &service->codec_pool_) {
   if (!tenant.ok()) {
-    Respond(tenant.status());
+    BeginUpload(tenant.status());
     return;
   }
   tenant_ = *std::move(tenant);
-  if (service_->draining_) {
-    Respond(TagRefusal(absl::UnavailableError("the server is draining and accepts no new builds"),
-                       BuildRefusal::kDraining));
-    return;
-  }
-  last_activity_ = Clock::now().time_since_epoch().count();
-  uploading_ = true;
-  service_->upload_watchdog_.Watch(this);
-  std::lock_guard<std::mutex> lock(upload_mutex_);
-  if (!upload_over_) StartRead(&request_);  // else the watchdog already ended the call
-}
-
-void BuildReactor::OnDone() {
-  // After this the watchdog never calls this reactor again.
-  service_->upload_watchdog_.Unwatch(this);
-  delete this;
-}
-
-std::optional<BuildReactor::Clock::time_point> BuildReactor::LastActivity() const {
-  if (!uploading_) return std::nullopt;
-  return Clock::time_point(Clock::duration(last_activity_.load()));
-}
-
-void BuildReactor::TimeOut() {
-  {
-    std::lock_guard<std::mutex> lock(upload_mutex_);
-    if (upload_over_) return;
-    upload_over_ = true;
-    uploading_ = false;
-    // The points and their reservation go now, not when gRPC is done with the call.
-    decoder_.ReleasePoints();
-  }
-  // The read still pending completes (not ok) after Finish; OnReadDone then sees upload_over_.
-  Respond(TagRefusal(absl::DeadlineExceededError(absl::StrCat(
-                         "the upload sent nothing for ", service_->upload_watchdog_.idle_timeout().count(),
-                         " ms, the server's idle limit (--upload_idle_timeout_ms): the build was dropped")),
-                     BuildRefusal::kIdleTimeout));
-}
-
-void BuildReactor::OnReadDone(bool ok) {
-  absl::Status refused;
-  {
-    std::lock_guard<std::mutex> lock(upload_mutex_);
-    if (upload_over_) return;  // the watchdog ended the call
-    if (ok) {
-      last_activity_ = Clock::now().time_since_epoch().count();
-      refused = decoder_.Add(std::move(request_));
-      if (refused.ok()) {
-        StartRead(&request_);
-        return;
-      }
-    }
-    upload_over_ = true;
-    uploading_ = false;
-  }
-  if (ok) {
-    Respond(refused);
-  } else {
-    // A read fails both at the end of the stream and when the call broke (the client went away,
-    // gRPC refused a message over --max_message_bytes), and gRPC may report the failed read before
-    // it marks the call cancelled: a cut stream would then be built as if it were whole. A send on
-    // a broken call fails, so the initial metadata decides (OnSendInitialMetadataDone).
-    StartSendInitialMetadata();
-  }
-}
-
-void BuildReactor::OnSendInitialMetadataDone(bool ok) {
-  if (!ok || cancelled_) {
-    Respond(absl::CancelledError("the upload was cut: the client went away or gRPC refused one of its messages"));
-    return;
-  }
-  EndOfStream();
+  BeginUpload(service_->draining_
+                  ? TagRefusal(absl::UnavailableError("the server is draining and accepts no new builds"),
+                               BuildRefusal::kDraining)
+                  : absl::OkStatus());
 }
 
 void BuildReactor::EndOfStream() {
-  if (context_->IsCancelled() || cancelled_) {
+  if (CallerGone()) {
     Respond(absl::CancelledError("the client cancelled the build during the upload"));
     return;
   }
@@ -145,7 +77,7 @@ void BuildReactor::Run(const BuildSlot& slot, bool draining) {
                        BuildRefusal::kDraining));
     return;
   }
-  if (cancelled_) {
+  if (CallerGone()) {
     Respond(absl::CancelledError("the client went away while the build was queued"));
     return;
   }
