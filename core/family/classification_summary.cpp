@@ -1,8 +1,12 @@
 #include "core/family/classification_summary.hpp"
 
+#include <omp.h>
+
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "core/exact/predicates.hpp"
 
@@ -44,14 +48,36 @@ ClassificationSummary CountAll(const HostVector<uint32_t>& representative, const
   return summary;
 }
 
-// The interior triangles' terms added in triangle order, one thread, as AssembleShape sums them
-// (terms[t] is read for interior triangles only). A local accumulator: the struct's member,
-// written through memory on every term, tripled this pass's time.
+// The interior triangles' terms added in triangle order, one addition at a time, as AssembleShape
+// sums them: `for t: if interior(t): area += terms[t]`, the same double. Done that way, the branch
+// mispredicts about every other triangle at a middle level (most of a 1M-point summary's time,
+// ~10 ms). Here each core first packs the interior terms of its block of triangles without a branch
+// (every term is written, the next position advances only past an interior one), then one thread
+// adds the packed terms block after block: the same additions in the same order.
 double InteriorArea(const double* terms, const Classification& classes) {
+  const int64_t nt = static_cast<int64_t>(classes.triangles.size());
+  if (nt == 0) return 0.0;
+  const int64_t blocks = std::min<int64_t>(nt, 4 * static_cast<int64_t>(omp_get_max_threads()));
+  // Block b packs into [its first triangle, packed_end[b]): never past its own triangles.
+  const std::unique_ptr<double[]> packed(new double[static_cast<size_t>(nt)]);
+  std::vector<int64_t> packed_end(static_cast<size_t>(blocks));
+  const auto block_begin = [&](int64_t b) { return nt * b / blocks; };
+  const SimplexClass* cls = classes.triangles.data();
+#pragma omp parallel for schedule(static, 1)
+  for (int64_t b = 0; b < blocks; ++b) {
+    int64_t k = block_begin(b);
+    const int64_t end = block_begin(b + 1);
+    for (int64_t t = block_begin(b); t < end; ++t) {
+      packed[static_cast<size_t>(k)] = terms[t];
+      k += static_cast<int64_t>(cls[t] == SimplexClass::kInterior);
+    }
+    packed_end[static_cast<size_t>(b)] = k;
+  }
   double area = 0.0;
-  const size_t nt = classes.triangles.size();
-  for (size_t t = 0; t < nt; ++t) {
-    if (classes.triangles[t] == SimplexClass::kInterior) area += terms[t];
+  for (int64_t b = 0; b < blocks; ++b) {
+    const double* term = packed.get() + block_begin(b);
+    const double* const end = packed.get() + packed_end[static_cast<size_t>(b)];
+    for (; term != end; ++term) area += *term;
   }
   return area;
 }
@@ -83,15 +109,17 @@ ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const
   ClassificationSummary summary = CountAll(representative, classes);
   const int64_t nt = static_cast<int64_t>(classes.triangles.size());
   // The interior triangles' terms first, on every core (each reads three points at random: most of
-  // the pass's time), then added in order. Not zero-filled: only interior terms are written and
-  // read, and the pages are first touched by the threads that fill them.
+  // the pass's time), then added in order; the others' are 0 (written, since the packing reads
+  // every term, and first touched by the threads that fill them).
   const std::unique_ptr<double[]> terms(new double[static_cast<size_t>(nt)]);
 #pragma omp parallel for schedule(static)
   for (int64_t t = 0; t < nt; ++t) {
+    double term = 0.0;
     if (classes.triangles[t] == SimplexClass::kInterior) {
       const auto& tri = mesh_triangles[t];
-      terms[static_cast<size_t>(t)] = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
+      term = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
     }
+    terms[static_cast<size_t>(t)] = term;
   }
   summary.interior_area = InteriorArea(terms.get(), classes);
   return summary;

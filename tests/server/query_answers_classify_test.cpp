@@ -3,6 +3,8 @@
 // components and area; non-exterior-only and summary-only requests; bad thresholds refused.
 #include "server/query_answers.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -258,6 +260,32 @@ TEST(QueryAnswersTest, SummaryFromCachedAreaTermsIsTheSameDouble) {
         EXPECT_EQ(summed.edges, gathered.edges);
         EXPECT_EQ(summed.triangles, gathered.triangles);
       }
+    }
+  }
+}
+
+// The summary packs the interior terms on every core before one thread adds them: the sum must
+// still be the interior terms added one at a time in triangle order (what AssembleShape gives), on
+// any number of threads (the blocks follow the thread count).
+TEST(QueryAnswersTest, SummaryAreaAddsTheInteriorTermsInTriangleOrderOnAnyThreadCount) {
+  const int threads_before = omp_get_max_threads();
+  for (const NamedFamily& named : Families()) {
+    const AlphaFamily& family = *named.oracle;
+    const std::vector<double>& terms = named.cached->TriangleAreaTerms();
+    for (int64_t level = 0; level <= family.max_level(); level += std::max<int64_t>(1, family.max_level() / 5)) {
+      const Classification classes = family.ClassifyAll(level, ClassifyMode::kRegularized, VertexRule::kReport);
+      double in_order = 0.0;
+      for (size_t t = 0; t < classes.triangles.size(); ++t) {
+        if (classes.triangles[t] == SimplexClass::kInterior) in_order += terms[t];
+      }
+      for (int threads : {1, 2, 3, 7, 16}) {
+        omp_set_num_threads(threads);
+        EXPECT_EQ(SummarizeClassification(family.representative(), terms, classes).interior_area, in_order)
+            << named.name << " level " << level << ", " << threads << " threads";
+        EXPECT_EQ(SummarizeClassification(family, classes).interior_area, in_order)
+            << named.name << " level " << level << ", " << threads << " threads";
+      }
+      omp_set_num_threads(threads_before);
     }
   }
 }
