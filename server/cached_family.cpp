@@ -1,5 +1,6 @@
 #include "server/cached_family.hpp"
 
+#include <iterator>
 #include <utility>
 
 #include "core/family/canonical_order.hpp"
@@ -48,6 +49,28 @@ std::shared_ptr<const CachedFamily::InputFrame> CachedFamily::Frame() const {
 void CachedFamily::AttachFrameIfNone(std::shared_ptr<const InputFrame> frame) const {
   absl::MutexLock lock(&frame_mutex_);
   if (frame_ == nullptr) frame_ = std::move(frame);
+}
+
+absl::StatusOr<std::shared_ptr<const Classification>> CachedFamily::SharedClassification(int64_t level,
+                                                                                         ClassifyMode mode,
+                                                                                         VertexRule rule) const {
+  std::shared_ptr<PendingClassification> pending;
+  {
+    absl::MutexLock lock(&shared_mutex_);
+    for (auto it = shared_classifications_.begin(); it != shared_classifications_.end();) {
+      it = it->second.expired() ? shared_classifications_.erase(it) : std::next(it);
+    }
+    std::weak_ptr<PendingClassification>& slot = shared_classifications_[ClassificationKey{level, mode, rule}];
+    pending = slot.lock();
+    if (pending == nullptr) {
+      pending = std::make_shared<PendingClassification>();
+      slot = pending;
+    }
+  }
+  std::call_once(pending->once, [&] { pending->classes = reader_->ClassifyAll(level, mode, rule); });
+  if (!pending->classes.ok()) return pending->classes.status();
+  // Shares the entry's life: the map's weak reference holds while any caller streams from it.
+  return std::shared_ptr<const Classification>(pending, &*pending->classes);
 }
 
 const std::vector<uint32_t>& CachedFamily::EdgeOrder() const {

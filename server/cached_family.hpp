@@ -8,12 +8,15 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "absl/base/thread_annotations.h"
+#include "absl/status/statusor.h"
 #include "absl/synchronization/mutex.h"
 #include "core/family/alpha_family.hpp"
 #include "core/io/coordinate_system.hpp"
@@ -72,8 +75,22 @@ class CachedFamily {
   /// Classify summary adds them in order instead of reading three points at random per triangle.
   const std::vector<double>& TriangleAreaTerms() const;
 
+  /// reader().ClassifyAll(level, mode, rule), shared by the calls that ask for the same one while
+  /// any of them still holds it: the parts of one Classify answer read over several calls at once
+  /// (ClassifyRequest.part_count) classify the family once, not once a part. Computed by the first
+  /// caller; the others wait for it. An error is not kept: the next caller tries again.
+  absl::StatusOr<std::shared_ptr<const Classification>> SharedClassification(int64_t level, ClassifyMode mode,
+                                                                             VertexRule rule) const;
+
  private:
   void ComputeOrders() const;
+
+  /// One classification, computed once by whichever of its callers comes first.
+  struct PendingClassification {
+    std::once_flag once;
+    absl::StatusOr<Classification> classes;
+  };
+  using ClassificationKey = std::tuple<int64_t, ClassifyMode, VertexRule>;
 
   std::shared_ptr<const AlphaFamily> host_;
   std::shared_ptr<const ResidentAlphaFamily> resident_;
@@ -87,6 +104,10 @@ class CachedFamily {
   mutable std::vector<uint32_t> edge_vertices_, triangle_vertices_;
   mutable std::once_flag area_terms_once_;
   mutable std::vector<double> triangle_area_terms_;
+  mutable absl::Mutex shared_mutex_;
+  // Expired entries are dropped on the next lookup: at most a few keys are ever in use at once.
+  mutable std::map<ClassificationKey, std::weak_ptr<PendingClassification>> shared_classifications_
+      ABSL_GUARDED_BY(shared_mutex_);
 };
 
 /// `family` as the cache shares it: its last owner (the cache, or a query still streaming from it

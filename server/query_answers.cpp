@@ -32,9 +32,11 @@ char ClassByte(SimplexClass c) { return static_cast<char>(static_cast<int>(c) + 
 
 class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
  public:
-  ClassifySource(std::shared_ptr<const CachedFamily> cached, Classification classes, ClassificationSummary counts,
-                 ResolvedLevel level, TopologyAtLevel topology, double hull_area, ClassifyMode mode,
-                 bool non_exterior_only, bool summary_only)
+  /// The chunks numbered part, part + parts, ... of the answer (all of them with parts 1); the
+  /// summary first in part 0 only (`counts`, `topology` and `hull_area` are not read in the others).
+  ClassifySource(std::shared_ptr<const CachedFamily> cached, std::shared_ptr<const Classification> classes,
+                 ClassificationSummary counts, ResolvedLevel level, TopologyAtLevel topology, double hull_area,
+                 ClassifyMode mode, bool non_exterior_only, bool summary_only, uint32_t part, uint32_t parts)
       : cached_(std::move(cached)),
         classes_(std::move(classes)),
         counts_(counts),
@@ -43,7 +45,11 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
         hull_area_(hull_area),
         mode_(mode),
         non_exterior_only_(non_exterior_only),
-        phase_(summary_only ? Phase::kLastSummary : Phase::kSummary) {}
+        part_(part),
+        parts_(parts),
+        phase_(summary_only ? Phase::kLastSummary
+               : part == 0  ? Phase::kSummary
+                            : Phase::kVertices) {}
 
   bool Next(v1::ClassifyResponse* message) override {
     message->Clear();
@@ -60,25 +66,28 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
                 if (family.representative()[v] != v)
                   return std::pair<SimplexClass, bool>{SimplexClass::kExterior, false};
                 out[0] = static_cast<uint32_t>(v);
-                return Emit(classes_.vertices[v]);
+                return Emit(classes_->vertices[v]);
               })) {
-            return true;
+            if (ChunkIsMine()) return true;
+            break;
           }
           phase_ = Phase::kEdges;
           position_ = 0;
           break;
         case Phase::kEdges:
           if (FillOrdered(message, v1::SIMPLEX_KIND_EDGE, 2, cached_->EdgeVerticesInOrder(), cached_->EdgeOrder(),
-                          classes_.edges)) {
-            return true;
+                          classes_->edges)) {
+            if (ChunkIsMine()) return true;
+            break;
           }
           phase_ = Phase::kTriangles;
           position_ = 0;
           break;
         case Phase::kTriangles:
           if (FillOrdered(message, v1::SIMPLEX_KIND_TRIANGLE, 3, cached_->TriangleVerticesInOrder(),
-                          cached_->TriangleOrder(), classes_.triangles)) {
-            return true;
+                          cached_->TriangleOrder(), classes_->triangles)) {
+            if (ChunkIsMine()) return true;
+            break;
           }
           phase_ = Phase::kDone;
           break;
@@ -90,6 +99,11 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
 
  private:
   enum class Phase { kSummary, kLastSummary, kVertices, kEdges, kTriangles, kDone };
+
+  // Whether the chunk just passed belongs to this part (it was filled, else only skipped), counting it.
+  bool ChunkIsMine() { return chunk_++ % parts_ == part_; }
+  // Whether the next chunk is another part's: it is then skipped (its simplices passed, not copied).
+  bool SkipNext() const { return chunk_ % parts_ != part_; }
 
   // What a simplex contributes: its class, and whether it is sent.
   std::pair<SimplexClass, bool> Emit(SimplexClass c) const {
@@ -123,6 +137,10 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
     }
     if (position_ >= count) return false;
     const size_t n = std::min<size_t>(kSimplicesPerChunk, count - position_);
+    if (SkipNext()) {
+      position_ += n;
+      return true;
+    }
     const size_t a = static_cast<size_t>(arity);
     v1::SimplexChunk* chunk = message->mutable_chunk();
     chunk->set_kind(kind);
@@ -142,6 +160,15 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
   // indices and returns (class, sent). Returns whether the chunk holds anything.
   template <typename Item>
   bool FillChunk(v1::ClassifyResponse* message, v1::SimplexKind kind, int arity, size_t count, Item item) {
+    if (SkipNext()) {
+      // Another part's chunk: its simplices are passed, counting those it sends, into a scratch.
+      std::array<uint32_t, 3> scratch{};
+      size_t sent = 0;
+      for (; position_ < count && sent < kSimplicesPerChunk; ++position_) {
+        if (item(position_, scratch.data()).second) ++sent;
+      }
+      return sent > 0;
+    }
     v1::SimplexChunk* chunk = message->mutable_chunk();
     chunk->set_kind(kind);
     auto* indices = chunk->mutable_vertex_indices();
@@ -167,15 +194,17 @@ class ClassifySource final : public ChunkSource<v1::ClassifyResponse> {
   }
 
   std::shared_ptr<const CachedFamily> cached_;
-  Classification classes_;
+  std::shared_ptr<const Classification> classes_;
   ClassificationSummary counts_;
   ResolvedLevel level_;
   TopologyAtLevel topology_;
   double hull_area_;
   ClassifyMode mode_;
   bool non_exterior_only_;
+  uint32_t part_, parts_;
   Phase phase_;
   size_t position_ = 0;
+  uint64_t chunk_ = 0;  // chunks of the whole answer passed so far (sent by this part or skipped)
 };
 
 class MasterListSource final : public ChunkSource<v1::MasterListResponse> {
@@ -378,18 +407,40 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ClassifyResponse>>> MakeClassifyS
                                                    " is not a SimplexEncoding (RAW = 1, DELTA = 2, DELTA_ZSTD = 3; 0 "
                                                    "means RAW)"));
   }
+  const uint32_t parts = std::max<uint32_t>(request.part_count(), 1);
+  if (parts > kMaxClassifyParts) {
+    return absl::InvalidArgumentError(absl::StrCat("part_count ", request.part_count(), " is over ", kMaxClassifyParts,
+                                                   ", the most parts an answer is split into"));
+  }
+  if (request.part_index() >= parts) {
+    return absl::InvalidArgumentError(absl::StrCat("part_index ", request.part_index(), " is not below part_count ",
+                                                   parts, request.part_count() == 0 ? " (0: the whole answer)" : ""));
+  }
+  if (parts > 1 && request.summary_only()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("a summary_only answer has no chunks to split into ", parts, " parts: ask for part_count 0"));
+  }
   auto level = ResolveLevel(family, request.threshold());
   if (!level.ok()) return level.status();
-  absl::StatusOr<Classification> classes = family.ClassifyAll(level->level, *mode, *rule);
+  // Shared with the other parts of a split answer (and any identical Classify at the same time).
+  absl::StatusOr<std::shared_ptr<const Classification>> classes =
+      cached->SharedClassification(level->level, *mode, *rule);
   if (!classes.ok()) return classes.status();
-  const ClassificationSummary counts =
-      SummarizeClassification(family.representative(), cached->TriangleAreaTerms(), *classes);
-  const absl::StatusOr<std::vector<TopologyAtLevel>> topology = family.TopologyBetween(level->level, level->level);
-  if (!topology.ok()) return topology.status();
-  const absl::StatusOr<double> hull_area = family.HullAreaApprox();
-  if (!hull_area.ok()) return hull_area.status();
-  return std::make_unique<ClassifySource>(std::move(cached), *std::move(classes), counts, *level, topology->front(),
-                                          *hull_area, *mode, request.non_exterior_only(), request.summary_only());
+  ClassificationSummary counts;
+  TopologyAtLevel topology;
+  double hull_area = 0.0;
+  if (request.part_index() == 0) {  // the part that sends the summary
+    counts = SummarizeClassification(family.representative(), cached->TriangleAreaTerms(), **classes);
+    const absl::StatusOr<std::vector<TopologyAtLevel>> topologies = family.TopologyBetween(level->level, level->level);
+    if (!topologies.ok()) return topologies.status();
+    topology = topologies->front();
+    const absl::StatusOr<double> hull = family.HullAreaApprox();
+    if (!hull.ok()) return hull.status();
+    hull_area = *hull;
+  }
+  return std::make_unique<ClassifySource>(std::move(cached), *std::move(classes), counts, *level, topology, hull_area,
+                                          *mode, request.non_exterior_only(), request.summary_only(),
+                                          request.part_index(), parts);
 }
 
 absl::StatusOr<std::unique_ptr<ChunkSource<v1::MasterListResponse>>> MakeMasterListSource(

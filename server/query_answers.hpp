@@ -19,6 +19,8 @@ namespace galpha::server {
 
 /// Simplices per Classify chunk (at most 13 bytes each: well under gRPC's 4 MiB message limit).
 inline constexpr uint32_t kSimplicesPerChunk = 1u << 17;
+/// The most parts a Classify answer is split into (ClassifyRequest.part_count).
+inline constexpr uint32_t kMaxClassifyParts = 64;
 /// Master-list entries per MasterList message.
 inline constexpr uint32_t kMasterEntriesPerChunk = 1u << 17;
 /// Bytes of text per Shape message; indices per ShapeRings message (about).
@@ -47,8 +49,10 @@ absl::StatusOr<VertexRule> ToVertexRule(galpha::v1::VertexRule rule);
 void FillBuildSummary(const CachedFamily& cached, galpha::v1::BuildSummary* summary);
 
 /// Classify: the summary, then vertex, edge and triangle chunks in index order, always raw
-/// (SimplexChunk; the service encodes them as the request asks: encoded_answer.hpp).
-/// InvalidArgument for a bad threshold, mode, vertex rule or simplex encoding.
+/// (SimplexChunk; the service encodes them as the request asks: encoded_answer.hpp); of a split
+/// answer (part_count > 1), the part's chunks only, after the summary in part 0. The classification
+/// is shared with the other parts (CachedFamily::SharedClassification). InvalidArgument for a bad
+/// threshold, mode, vertex rule, simplex encoding or part.
 absl::StatusOr<std::unique_ptr<ChunkSource<galpha::v1::ClassifyResponse>>> MakeClassifySource(
     std::shared_ptr<const CachedFamily> cached, const galpha::v1::ClassifyRequest& request);
 

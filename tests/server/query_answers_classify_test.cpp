@@ -9,15 +9,19 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "core/family/classification_summary.hpp"
 #include "core/geometry/shape.hpp"
+#include "gmock/gmock.h"
 #include "gtest/gtest.h"
 #include "server/cached_family.hpp"
+#include "tests/server/cached_family_fixture.hpp"
 #include "tests/server/query_answers_fixture.hpp"
+#include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha::server {
@@ -28,7 +32,9 @@ using galpha::testing::IsOk;
 using galpha::testing::StatusIs;
 using testing::Drain;
 using testing::Families;
+using ::testing::HasSubstr;
 using testing::LargeFamily;
+using testing::MakeCachedFamily;
 using testing::NamedFamily;
 using testing::Rank;
 using testing::ResolveOn;
@@ -232,6 +238,97 @@ TEST(QueryAnswersTest, ClassifySummaryOnlySendsOneMessage) {
       CheckClassify(f.cached, *f.oracle, request);
     }
   }
+}
+
+// A split answer: part k sends the chunks numbered k, k + P, ... of the whole answer, the summary
+// in part 0 only; dealt back round-robin, the parts are the whole answer, message for message.
+// 300,000 points: every kind spans several chunks (kSimplicesPerChunk), so that parts skip chunks
+// within a kind, the filtered ones too.
+TEST(QueryAnswersTest, ClassifyPartsDealtRoundRobinAreTheWholeAnswer) {
+  const std::shared_ptr<const CachedFamily> cached = MakeCachedFamily(gen::Uniform(300000, 9), "uniform_300000");
+  for (const bool non_exterior_only : {false, true}) {
+    v1::ClassifyRequest request;
+    *request.mutable_threshold() = Rank(cached->reader().max_level() / 2);
+    request.set_non_exterior_only(non_exterior_only);
+    auto whole_source = MakeClassifySource(cached, request);
+    ASSERT_THAT(whole_source, IsOk());
+    const std::vector<v1::ClassifyResponse> whole = Drain(**whole_source);
+    ASSERT_GT(whole.size(), 8u) << "the test needs an answer of several chunks";
+    for (const uint32_t parts : {2u, 3u, 5u, 64u}) {
+      std::vector<std::vector<v1::ClassifyResponse>> answers(parts);
+      for (uint32_t part = 0; part < parts; ++part) {
+        request.set_part_index(part);
+        request.set_part_count(parts);
+        auto source = MakeClassifySource(cached, request);
+        ASSERT_THAT(source, IsOk());
+        answers[part] = Drain(**source);
+        for (size_t m = 0; m < answers[part].size(); ++m) {
+          EXPECT_EQ(answers[part][m].has_summary(), part == 0 && m == 0) << "part " << part << " message " << m;
+        }
+      }
+      ASSERT_FALSE(answers[0].empty());
+      std::vector<v1::ClassifyResponse> merged = {answers[0][0]};
+      std::vector<size_t> next(parts, 0);
+      next[0] = 1;
+      for (uint64_t chunk = 0;; ++chunk) {
+        const uint32_t part = static_cast<uint32_t>(chunk % parts);
+        if (next[part] == answers[part].size()) break;
+        merged.push_back(answers[part][next[part]++]);
+      }
+      for (uint32_t part = 0; part < parts; ++part) {
+        EXPECT_EQ(next[part], answers[part].size()) << parts << " parts: part " << part << " sent chunks past the end";
+      }
+      ASSERT_EQ(merged.size(), whole.size()) << parts << " parts";
+      for (size_t m = 0; m < whole.size(); ++m) {
+        EXPECT_EQ(merged[m].SerializeAsString(), whole[m].SerializeAsString()) << parts << " parts, message " << m;
+      }
+    }
+  }
+}
+
+TEST(QueryAnswersTest, ClassifyRefusesPartsItCannotSplit) {
+  const std::shared_ptr<const CachedFamily>& cached = Families()[0].cached;
+  v1::ClassifyRequest request;
+  *request.mutable_threshold() = Rank(1);
+  const auto refused = [&](uint32_t index, uint32_t count, bool summary_only, const std::string& says) {
+    request.set_part_index(index);
+    request.set_part_count(count);
+    request.set_summary_only(summary_only);
+    EXPECT_THAT(MakeClassifySource(cached, request).status(),
+                StatusIs(absl::StatusCode::kInvalidArgument, HasSubstr(says)))
+        << index << " of " << count;
+  };
+  refused(0, kMaxClassifyParts + 1, false, "part_count 65 is over 64");
+  refused(3, 3, false, "part_index 3 is not below part_count 3");
+  refused(1, 0, false, "part_index 1 is not below part_count 1 (0: the whole answer)");
+  refused(0, 2, true, "summary_only");
+  request.set_part_index(kMaxClassifyParts - 1);
+  request.set_part_count(kMaxClassifyParts);
+  request.set_summary_only(false);
+  EXPECT_THAT(MakeClassifySource(cached, request), IsOk());
+}
+
+// The parts of one answer share one classification while any of them holds it.
+TEST(QueryAnswersTest, SharedClassificationIsComputedOnceWhileHeld) {
+  const std::shared_ptr<const CachedFamily> cached = LargeFamily();
+  const int64_t level = cached->reader().max_level() / 2;
+  auto first = cached->SharedClassification(level, ClassifyMode::kGeneral, VertexRule::kReport);
+  auto second = cached->SharedClassification(level, ClassifyMode::kGeneral, VertexRule::kReport);
+  auto other = cached->SharedClassification(level, ClassifyMode::kRegularized, VertexRule::kReport);
+  ASSERT_THAT(first, IsOk());
+  ASSERT_THAT(second, IsOk());
+  ASSERT_THAT(other, IsOk());
+  EXPECT_EQ(first->get(), second->get());
+  EXPECT_NE(first->get(), other->get());
+  const Classification expected =
+      cached->host_family()->ClassifyAll(level, ClassifyMode::kGeneral, VertexRule::kReport);
+  EXPECT_EQ((*first)->vertices, expected.vertices);
+  EXPECT_EQ((*first)->edges, expected.edges);
+  EXPECT_EQ((*first)->triangles, expected.triangles);
+  const std::weak_ptr<const Classification> released = *first;
+  first->reset();
+  second->reset();
+  EXPECT_TRUE(released.expired()) << "no caller holds it: the family keeps no classification";
 }
 
 TEST(QueryAnswersTest, ClassifyRefusesBadThresholds) {
