@@ -8,7 +8,9 @@
 //
 //   service_bench [--backend=auto|cpu|cuda] [--points=N] [--clients=1,2,4,8] [--repeat=R]
 //                 [--query-seconds=S] [--query-clients=Q] [--build-slots=K] [--cgal-max=N]
-//                 [--links=loopback,1gbit,10gbit] [--device-cache-bytes=N]
+//                 [--links=loopback,1gbit,10gbit] [--device-cache-bytes=N] [--classify-parts=1,2,4,8]
+// --classify-parts lists the part counts (ClientOptions::classify_parts) the parts table reads the
+// uniform set's Classify in; the other tables read it in one call.
 // --device-cache-bytes gives the server a device budget for resident families (CUDA builds keep
 // their tables on the GPU and answer from there: server/README.md, "Cache"); 0 (the default):
 // CUDA families are downloaded into host memory, as the CPU backend's are.
@@ -80,6 +82,8 @@ struct Options {
   size_t cgal_max = 1000000;
   /// "loopback" and tc rates ("1gbit", "10gbit", "100mbit"): the links Build and Classify cross.
   std::vector<std::string> links = {"loopback"};
+  /// The part counts the parts table reads the uniform set's Classify in (ClientOptions::classify_parts).
+  std::vector<uint32_t> classify_parts = {1, 2, 4, 8};
   size_t device_cache_bytes = 0;
   /// --stress: how many sets of how many points (0: no stress run).
   size_t stress_sets = 0;
@@ -140,6 +144,13 @@ bool ParseOptions(int argc, char** argv, Options* options) {
       const std::vector<std::string> parts = absl::StrSplit(value, 'x');
       ok = parts.size() == 2 && absl::SimpleAtoi(parts[0], &options->batch_sets) &&
            absl::SimpleAtoi(parts[1], &options->batch_points) && options->batch_sets > 0 && options->batch_points > 0;
+    } else if (name == "--classify-parts") {
+      options->classify_parts.clear();
+      for (const absl::string_view part : absl::StrSplit(value, ',')) {
+        uint32_t count = 0;
+        ok = ok && absl::SimpleAtoi(part, &count) && count >= 1 && count <= client::kMaxClassifyParts;
+        options->classify_parts.push_back(count);
+      }
     } else if (name == "--links") {
       options->links = absl::StrSplit(value, ',');
       for (const std::string& link : options->links) ok = ok && (link == "loopback" || RateBits(link) > 0);
@@ -345,13 +356,18 @@ double Percentile(std::vector<double> values, double q) {
   return values[std::min(values.size() - 1, static_cast<size_t>(q * static_cast<double>(values.size())))];
 }
 
-std::unique_ptr<client::AlphaClient> Client(const std::string& target) {
+/// A client whose Classify answers come in `classify_parts` calls (1: one call, so that the first
+/// tables compare with earlier runs; the parts table sets its own).
+std::unique_ptr<client::AlphaClient> Client(const std::string& target, uint32_t classify_parts = 1) {
   client::ClientOptions options;
   options.target = target;
+  options.classify_parts = classify_parts;
   return *client::AlphaClient::Connect(options);
 }
 
-std::unique_ptr<client::AlphaClient> Client(int port) { return Client("127.0.0.1:" + std::to_string(port)); }
+std::unique_ptr<client::AlphaClient> Client(int port, uint32_t classify_parts = 1) {
+  return Client("127.0.0.1:" + std::to_string(port), classify_parts);
+}
 
 /// Releases, then uploads and builds `points`; the RPC's wall time.
 double TimedBuild(client::AlphaClient& client, const std::vector<Point2>& points, client::BuildResult* result) {
@@ -849,6 +865,12 @@ int Run(const Options& options) {
   for (const std::string& link : links) {
     print_classify(absl::StrCat("uniform ", options.points), link, measured[link].classify);
   }
+  // The same answer read in P parts at once (ClassifyRequest.part_count), each on a connection of
+  // its own, merged back in order by the client library.
+  std::vector<std::pair<std::string, std::array<ClassifyMeasure, kAnswerEncodings.size()>>> by_parts;
+  for (const uint32_t parts : options.classify_parts) {
+    by_parts.emplace_back(absl::StrCat(parts), MeasureClassify(*Client(port, parts), handle, k / 2, options.repeat));
+  }
   for (const ClassifySet& set : classify_sets) {
     for (const std::string& link : links) {
       if (link != "loopback") {
@@ -863,6 +885,19 @@ int Run(const Options& options) {
       const int64_t set_rank = static_cast<int64_t>(built.summary.spectrum_size() / 2);
       print_classify(set.name, link, MeasureClassify(*link_client, built.handle, set_rank, options.repeat));
       link_client->Release(built.handle).IgnoreError();
+    }
+  }
+  std::printf("\n");
+  std::printf(
+      "| Classify of every simplex of uniform %zu at rank K/2, loopback, in parts | parts | answer encoding | ms | of "
+      "which before the summary | vs one call | answer GB/s (raw bytes / ms) |\n|---|---:|---|---:|---:|---:|---:|\n",
+      options.points);
+  for (const auto& [parts, m] : by_parts) {
+    for (size_t e = 0; e < kAnswerEncodings.size(); ++e) {
+      const double one_call = loopback.classify[e].seconds;  // the first table's one call
+      std::printf("| | %s | %s | %.1f | %.1f | %.2f | %.2f |\n", parts.c_str(), AnswerEncodingName(kAnswerEncodings[e]),
+                  m[e].seconds * 1e3, m[e].first_message_seconds * 1e3, m[e].seconds / one_call,
+                  static_cast<double>(m[e].answer_bytes) / m[e].seconds / 1e9);
     }
   }
   std::printf("\n");

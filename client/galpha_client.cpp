@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "client/classify_answer_decoder.hpp"
+#include "client/classify_parts_merger.hpp"
 #include "core/io/point_set_handle.hpp"
 #include "proto/codec/point_chunk_codec.hpp"
 #include "proto/codec/simplex_chunk_codec.hpp"
@@ -42,8 +43,16 @@ absl::StatusOr<std::unique_ptr<AlphaClient>> AlphaClient::Connect(const ClientOp
   // to the same server, and the concurrent uploads of tens of megabytes of several clients would
   // share that connection's flow control.
   arguments.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+  if (options.classify_parts < 1 || options.classify_parts > kMaxClassifyParts) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("classify_parts ", options.classify_parts, " is outside 1..", kMaxClassifyParts));
+  }
   client->channel_ = grpc::CreateCustomChannel(options.target, credentials, arguments);
   client->stub_ = v1::AlphaShapes::NewStub(client->channel_);
+  for (uint32_t part = 1; part < options.classify_parts; ++part) {
+    client->part_channels_.push_back(grpc::CreateCustomChannel(options.target, credentials, arguments));
+    client->part_stubs_.push_back(v1::AlphaShapes::NewStub(client->part_channels_.back()));
+  }
   return client;
 }
 
@@ -452,6 +461,9 @@ absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
                                    const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message,
                                    uint64_t* wire_bytes) {
   if (wire_bytes != nullptr) *wire_bytes = 0;
+  if (!part_stubs_.empty() && !request.summary_only() && request.part_count() == 0) {
+    return ClassifyInParts(request, on_message, wire_bytes);
+  }
   const v1::SimplexEncoding encoding = request.simplex_encoding();
   if (encoding != v1::SIMPLEX_ENCODING_DELTA && encoding != v1::SIMPLEX_ENCODING_DELTA_ZSTD) {
     // Raw chunks, handed over as they come (an encoded one is decoded all the same).
@@ -512,6 +524,94 @@ absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
   if (wire_bytes != nullptr) *wire_bytes = read_bytes;
   absl::Status status = FromGrpc(reader->Finish());
   return consumer_error.ok() ? status : consumer_error;
+}
+
+absl::Status AlphaClient::ClassifyInParts(const v1::ClassifyRequest& request,
+                                          const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message,
+                                          uint64_t* wire_bytes) {
+  const size_t parts = part_stubs_.size() + 1;
+  // A few messages a part ahead of the caller: enough to keep each connection busy, and the
+  // memory held is a few chunks a part (at most about 1.7 MB each).
+  ClassifyPartsMerger merger(parts, 4);
+  std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
+  for (size_t part = 0; part < parts; ++part) {
+    contexts.push_back(std::make_unique<grpc::ClientContext>());
+    PrepareContext(contexts.back().get(), request.handle());
+  }
+  std::vector<uint64_t> read_bytes(parts, 0);
+  std::vector<std::thread> readers;
+  readers.reserve(parts);
+  for (size_t part = 0; part < parts; ++part) {
+    v1::ClassifyRequest part_request = request;
+    part_request.set_part_index(static_cast<uint32_t>(part));
+    part_request.set_part_count(static_cast<uint32_t>(parts));
+    v1::AlphaShapes::Stub& stub = part == 0 ? *stub_ : *part_stubs_[part - 1];
+    // Each part's chunks are decoded on its own reader's thread: P parts, P decoders.
+    readers.emplace_back([&, part, part_request = std::move(part_request)] {
+      grpc::ClientContext& context = *contexts[part];
+      std::unique_ptr<grpc::ClientReader<v1::ClassifyResponse>> reader = stub.Classify(&context, part_request);
+      wire::SimplexChunkDecoder decoder;
+      v1::ClassifyResponse message, decoded;
+      uint64_t chunks = 0;  // this part's, so far: chunk `chunks` of this part is the answer's part + parts * chunks
+      absl::Status failed;
+      while (reader->Read(&message)) {
+        read_bytes[part] += message.ByteSizeLong();
+        if (!failed.ok()) continue;  // read on to the end after a failure
+        if (message.has_encoded_chunk()) {
+          failed = decoder.Decode(message.encoded_chunk(), part + parts * chunks, decoded.mutable_chunk());
+          if (!failed.ok()) {
+            context.TryCancel();
+            continue;
+          }
+          message.Swap(&decoded);
+        }
+        if (!message.has_summary()) ++chunks;
+        merger.Push(part, std::move(message));  // refused once the merger stopped reading this part: read on
+        message.Clear();
+        decoded.Clear();
+      }
+      const absl::Status status = FromGrpc(reader->Finish());
+      merger.End(part, failed.ok() ? status : failed);
+    });
+  }
+  const auto stop_all = [&] {
+    merger.Stop();
+    for (auto& context : contexts) context->TryCancel();
+  };
+  absl::Status result;
+  bool others_cancelled = false;
+  try {
+    for (;;) {
+      absl::StatusOr<const v1::ClassifyResponse*> next = merger.Next();
+      if (!next.ok()) {
+        result = next.status();
+        stop_all();
+        break;
+      }
+      if (*next == nullptr) break;
+      if (!others_cancelled && merger.whole_from_part_zero()) {
+        // The server answered every part whole: part 0 alone is read.
+        for (size_t part = 1; part < parts; ++part) contexts[part]->TryCancel();
+        others_cancelled = true;
+      }
+      result = on_message(**next);
+      if (!result.ok()) {
+        stop_all();
+        break;
+      }
+    }
+  } catch (...) {
+    // A caller's callback that throws: the calls end and the readers are joined first.
+    stop_all();
+    for (std::thread& reader : readers) reader.join();
+    throw;
+  }
+  for (std::thread& reader : readers) reader.join();
+  if (wire_bytes != nullptr) {
+    *wire_bytes = 0;
+    for (uint64_t bytes : read_bytes) *wire_bytes += bytes;
+  }
+  return result;
 }
 
 absl::Status AlphaClient::MasterList(const v1::MasterListRequest& request,

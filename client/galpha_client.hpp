@@ -26,6 +26,11 @@ struct ClientOptions {
   std::string bearer_token;
   /// Per-call deadline; zero: none.
   std::chrono::milliseconds deadline{0};
+  /// Classify reads an answer as this many parts at once (ClassifyRequest.part_count), each call on
+  /// a connection of its own, and hands it over in the order of one call: one stream carries about
+  /// 1 GB/s on loopback, several about that each (bench/README.md). 1: one call. 1..64; summary-only
+  /// requests, and requests that name a part themselves, are one call.
+  uint32_t classify_parts = 4;
 };
 
 /// The request header a gRPC-aware load balancer hashes on (deploy/k8s/envoy.yaml), so that a
@@ -34,6 +39,10 @@ inline constexpr char kHandleHeader[] = "x-galpha-handle";
 
 /// Points per Build chunk: 1 MiB of doubles, well under gRPC's 4 MiB message limit.
 inline constexpr size_t kPointsPerChunk = 65536;
+
+/// The most parts a Classify answer is read in (ClientOptions::classify_parts; the server refuses
+/// a part_count above it).
+inline constexpr uint32_t kMaxClassifyParts = 64;
 
 /// Most threads Build encodes chunks on at once (one chunk each).
 inline constexpr size_t kMaxEncodingThreads = 8;
@@ -133,6 +142,9 @@ class AlphaClient {
   /// SimplexChunk messages (EncodedSimplexChunks are decoded first, an undecodable one fails the
   /// call with InvalidArgument naming it), so callers do not depend on the encoding. `wire_bytes`,
   /// when given, gets the protobuf bytes of the messages as they arrived.
+  /// With ClientOptions::classify_parts above 1, the answer is read in that many parts at once and
+  /// handed over in the same order and messages (client/classify_parts_merger.hpp); from a server
+  /// that does not split answers, as one call's.
   absl::Status Classify(const galpha::v1::ClassifyRequest& request,
                         const std::function<absl::Status(const galpha::v1::ClassifyResponse&)>& on_message,
                         uint64_t* wire_bytes = nullptr);
@@ -156,9 +168,17 @@ class AlphaClient {
                               grpc::ClientContext*, const Request&),
                           const Request& request, const std::function<absl::Status(const Response&)>& on_message);
 
+  absl::Status ClassifyInParts(const galpha::v1::ClassifyRequest& request,
+                               const std::function<absl::Status(const galpha::v1::ClassifyResponse&)>& on_message,
+                               uint64_t* wire_bytes);
+
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<galpha::v1::AlphaShapes::Stub> stub_;
+  /// Parts 1.. of a split Classify answer (part 0 takes stub_), each channel a connection of its
+  /// own (connected on first use).
+  std::vector<std::shared_ptr<grpc::Channel>> part_channels_;
+  std::vector<std::unique_ptr<galpha::v1::AlphaShapes::Stub>> part_stubs_;
 };
 
 }  // namespace galpha::client

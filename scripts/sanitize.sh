@@ -28,7 +28,7 @@ cd "$(dirname "$0")/.."
 asan_tests=(predicates_test power_test attachment_test radius_test point_formats_test point_set_handle_test
             alpha_family_test alpha_bruteforce_test)
 tsan_tests=(build_scheduler_test family_cache_test family_promoter_test build_stream_test encoded_answer_test
-            classify_answer_decoder_test)
+            classify_answer_decoder_test classify_parts_merger_test)
 
 run_preset() {
   local preset=$1

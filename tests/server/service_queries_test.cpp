@@ -252,6 +252,70 @@ TEST(ServiceTest, EveryQueryMatchesTheLocalEngine) {
   ExpectServiceMatchesLocal(*client, GpsTracks(), "gps tracks");
 }
 
+// A Classify answer read in parts (ClientOptions::classify_parts, ClassifyRequest.part_count) is
+// handed over as one call's, message for message, in every encoding, filtered or not. 300,000
+// points: every kind spans several chunks. (Every other test reads in the default 4 parts, and
+// compares the rows with the local engine.)
+TEST(ServiceTest, ClassifyReadInPartsIsTheSameAnswer) {
+  auto server = StartServer(TestServerOptions());
+  ASSERT_NE(server, nullptr);
+  const std::vector<Point2> points = gen::Uniform(300000, 21);
+  std::vector<std::unique_ptr<client::AlphaClient>> clients;
+  for (const uint32_t parts : {1u, 2u, 5u, 64u}) {
+    client::ClientOptions options;
+    options.target = "127.0.0.1:" + std::to_string(server->port());
+    options.classify_parts = parts;
+    auto connected = client::AlphaClient::Connect(options);
+    ASSERT_THAT(connected, IsOk());
+    clients.push_back(*std::move(connected));
+  }
+  auto built = clients[0]->Build(points);
+  ASSERT_THAT(built, IsOk());
+  const auto messages_of = [&](client::AlphaClient& client, const v1::ClassifyRequest& request) {
+    std::vector<std::string> messages;
+    EXPECT_THAT(client.Classify(request,
+                                [&](const v1::ClassifyResponse& message) {
+                                  messages.push_back(message.SerializeAsString());
+                                  return absl::OkStatus();
+                                }),
+                IsOk());
+    return messages;
+  };
+  for (const auto encoding : {v1::SIMPLEX_ENCODING_RAW, v1::SIMPLEX_ENCODING_DELTA, v1::SIMPLEX_ENCODING_DELTA_ZSTD}) {
+    for (const bool non_exterior_only : {false, true}) {
+      v1::ClassifyRequest request;
+      request.set_handle(built->handle);
+      request.mutable_threshold()->set_rank(static_cast<int64_t>(built->summary.spectrum_size() / 2));
+      request.set_simplex_encoding(encoding);
+      request.set_non_exterior_only(non_exterior_only);
+      const std::vector<std::string> whole = messages_of(*clients[0], request);
+      ASSERT_GT(whole.size(), 8u) << "the test needs an answer of several chunks";
+      for (size_t c = 1; c < clients.size(); ++c) {
+        EXPECT_EQ(messages_of(*clients[c], request), whole)
+            << "encoding " << encoding << ", non_exterior_only " << non_exterior_only << ", client " << c;
+      }
+    }
+  }
+  // A caller's error stops every part and is returned.
+  v1::ClassifyRequest request;
+  request.set_handle(built->handle);
+  request.mutable_threshold()->set_rank(1);
+  int seen = 0;
+  EXPECT_THAT(clients[2]->Classify(request,
+                                   [&](const v1::ClassifyResponse&) {
+                                     return ++seen == 3 ? absl::AbortedError("enough") : absl::OkStatus();
+                                   }),
+              StatusIs(absl::StatusCode::kAborted));
+  EXPECT_EQ(seen, 3);
+  // Bad options are refused before any call.
+  client::ClientOptions bad;
+  bad.target = "127.0.0.1:" + std::to_string(server->port());
+  bad.classify_parts = 0;
+  EXPECT_THAT(client::AlphaClient::Connect(bad), StatusIs(absl::StatusCode::kInvalidArgument));
+  bad.classify_parts = client::kMaxClassifyParts + 1;
+  EXPECT_THAT(client::AlphaClient::Connect(bad), StatusIs(absl::StatusCode::kInvalidArgument));
+}
+
 TEST(ServiceTest, DescribeReleaseAndTheCache) {
   auto server = StartServer(TestServerOptions());
   ASSERT_NE(server, nullptr);
