@@ -43,13 +43,17 @@ absl::StatusOr<std::unique_ptr<AlphaClient>> AlphaClient::Connect(const ClientOp
   // to the same server, and the concurrent uploads of tens of megabytes of several clients would
   // share that connection's flow control.
   arguments.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
-  if (options.classify_parts < 1 || options.classify_parts > kMaxClassifyParts) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("classify_parts ", options.classify_parts, " is outside 1..", kMaxClassifyParts));
+  if (options.classify_parts > kMaxClassifyParts) {
+    return absl::InvalidArgumentError(absl::StrCat("classify_parts ", options.classify_parts, " is over ",
+                                                   kMaxClassifyParts, " (0: half this machine's cores, at most ",
+                                                   kMaxDefaultClassifyParts, ")"));
   }
+  const uint32_t parts = options.classify_parts > 0 ? options.classify_parts
+                                                    : std::clamp<uint32_t>(std::thread::hardware_concurrency() / 2, 1,
+                                                                           kMaxDefaultClassifyParts);
   client->channel_ = grpc::CreateCustomChannel(options.target, credentials, arguments);
   client->stub_ = v1::AlphaShapes::NewStub(client->channel_);
-  for (uint32_t part = 1; part < options.classify_parts; ++part) {
+  for (uint32_t part = 1; part < parts; ++part) {
     client->part_channels_.push_back(grpc::CreateCustomChannel(options.target, credentials, arguments));
     client->part_stubs_.push_back(v1::AlphaShapes::NewStub(client->part_channels_.back()));
   }

@@ -20,6 +20,7 @@ struct PendingMessage {
   std::mutex mutex;
   std::condition_variable encoded;
   bool ready = false;
+  bool summary = false;  // set when queued, never changed: readable without the lock
   absl::Status status;
   v1::ClassifyResponse message;
 };
@@ -35,7 +36,11 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
 
   bool Next(v1::ClassifyResponse* message) override {
     if (!status_.ok()) return false;
-    Refill();
+    // The summary goes out at once: the chunks after it are taken from the raw answer (copies of
+    // a few megabytes) and sent to the pool on the next call, while it is written. Other messages
+    // wait for their encoding with the window full behind them.
+    if (ahead_.empty()) Refill(1);
+    if (!ahead_.empty() && !ahead_.front()->summary) Refill(window_);
     if (ahead_.empty()) {
       status_ = raw_->status();
       return false;
@@ -52,17 +57,17 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
       return false;
     }
     message->Swap(&front->message);
-    Refill();  // the next chunk encodes while this one is written
+    if (!front->summary) Refill(window_);  // the next chunks encode while this one is written
     return true;
   }
 
   absl::Status status() const override { return status_; }
 
  private:
-  // Takes raw messages until `window_` are ahead (or the raw answer ends), sending each simplex
+  // Takes raw messages until `count` are ahead (or the raw answer ends), sending each simplex
   // chunk to the pool.
-  void Refill() {
-    while (ahead_.size() < window_ && !raw_done_) {
+  void Refill(size_t count) {
+    while (ahead_.size() < count && !raw_done_) {
       auto pending = std::make_shared<PendingMessage>();
       if (!raw_->Next(&pending->message)) {
         raw_done_ = true;
@@ -70,6 +75,7 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
       }
       ahead_.push_back(pending);
       if (!pending->message.has_chunk()) {
+        pending->summary = true;
         pending->ready = true;
         continue;
       }

@@ -59,6 +59,8 @@ class ListSource final : public ChunkSource<v1::ClassifyResponse> {
     return true;
   }
   absl::Status status() const override { return next_ == messages_.size() ? status_ : absl::OkStatus(); }
+  /// How many messages were taken so far.
+  size_t taken() const { return next_; }
 
  private:
   std::vector<v1::ClassifyResponse> messages_;
@@ -93,6 +95,38 @@ TEST(EncodedAnswerTest, EncodedAnswersDecodeToTheRawAnswerInOrder) {
       EXPECT_THAT(encoded->status(), IsOk());
     }
   }
+}
+
+// The summary is handed over before any chunk is taken from the raw answer (the copies of the
+// next chunks would hold it back); a part of a split answer, chunks only, encodes in order too.
+TEST(EncodedAnswerTest, TheSummaryGoesOutBeforeTheChunksAreTaken) {
+  ChunkCodecPool pool(4);
+  const std::vector<v1::ClassifyResponse> raw = RandomAnswer(20, 77);
+  auto list = std::make_unique<ListSource>(raw);
+  const ListSource* source = list.get();
+  auto encoded = EncodeSimplexChunks(std::move(list), v1::SIMPLEX_ENCODING_DELTA, &pool);
+  v1::ClassifyResponse message;
+  ASSERT_TRUE(encoded->Next(&message));
+  EXPECT_TRUE(message.has_summary());
+  EXPECT_EQ(source->taken(), 1u) << "chunks were taken before the summary was handed over";
+  ASSERT_TRUE(encoded->Next(&message));
+  EXPECT_TRUE(message.has_encoded_chunk());
+  EXPECT_GT(source->taken(), 2u) << "with a chunk at the front, the window fills behind it";
+
+  const std::vector<v1::ClassifyResponse> part(raw.begin() + 1, raw.end());  // no summary
+  auto chunks_only = EncodeSimplexChunks(std::make_unique<ListSource>(part), v1::SIMPLEX_ENCODING_DELTA_ZSTD, &pool);
+  wire::SimplexChunkDecoder decoder;
+  size_t i = 0;
+  while (chunks_only->Next(&message)) {
+    ASSERT_LT(i, part.size());
+    ASSERT_TRUE(message.has_encoded_chunk()) << "message " << i;
+    v1::ClassifyResponse decoded;
+    ASSERT_THAT(decoder.Decode(message.encoded_chunk(), i, decoded.mutable_chunk()), IsOk());
+    EXPECT_EQ(decoded.SerializeAsString(), part[i].SerializeAsString()) << "message " << i;
+    ++i;
+  }
+  EXPECT_EQ(i, part.size());
+  EXPECT_THAT(chunks_only->status(), IsOk());
 }
 
 TEST(EncodedAnswerTest, RawIsTheRawAnswerItself) {
