@@ -252,6 +252,67 @@ def test_an_unknown_answer_encoding_is_refused() -> None:
         galpha.aio.connect("localhost:1", answer_encoding="lz4")
 
 
+def test_classify_read_in_parts_is_the_one_call_answer(server) -> None:
+    # Shuffled points with several chunks of every kind (131,072 simplices a chunk), in parts dealt
+    # round-robin by the server and merged back by the client, sync and asyncio, raw and delta.
+    points = np.random.default_rng(7).random((160000, 2))
+    fields = ("vertices", "vertex_classes", "edges", "edge_classes", "triangles", "triangle_classes")
+
+    def answers(c) -> list:
+        family = c.build(points)
+        k = family.spectrum_size
+        return [family.classify(rank=k // 2), family.classify(rank=k // 3, non_exterior_only=True)]
+
+    async def answers_aio(parts: int, encoding: str) -> list:
+        async with galpha.aio.connect(server.address, timeout=60, classify_parts=parts, answer_encoding=encoding) as c:
+            family = await c.build(points)
+            k = family.summary.spectrum_size
+            return [await family.classify(rank=k // 2), await family.classify(rank=k // 3, non_exterior_only=True)]
+
+    with galpha.connect(server.address, timeout=60, classify_parts=1, answer_encoding="raw") as c:
+        want = answers(c)
+    for parts in (2, 5, 64, 0):
+        for encoding in ("raw", "delta"):
+            with galpha.connect(server.address, timeout=60, classify_parts=parts, answer_encoding=encoding) as c:
+                got = answers(c)
+            got_aio = asyncio.run(answers_aio(parts, encoding))
+            for g, a, w in zip(got, got_aio, want):
+                assert (g.level, g.interior_area, g.components) == (w.level, w.interior_area, w.components)
+                for field in fields:
+                    np.testing.assert_array_equal(getattr(g, field), getattr(w, field), err_msg=f"{parts} parts {field}")
+                    np.testing.assert_array_equal(getattr(a, field), getattr(w, field), err_msg=f"aio {parts} {field}")
+
+
+def test_merge_parts_deals_chunks_back_and_refuses_what_does_not_fit() -> None:
+    from galpha import _network
+    from galpha.v1 import alpha_shapes_pb2 as pb
+
+    summary = pb.ClassifyResponse(summary=pb.ClassifySummary(level=3)).SerializeToString()
+    chunks = [
+        pb.ClassifyResponse(chunk=pb.SimplexChunk(kind=pb.SIMPLEX_KIND_VERTEX, vertex_indices=[c], classes=b"\x01")).SerializeToString()
+        for c in range(7)
+    ]
+    whole = [summary] + chunks
+    for count in (2, 3, 8):
+        parts = [([summary] if p == 0 else []) + chunks[p::count] for p in range(count)]
+        assert _network.merge_parts(parts) == whole
+    # A server that ignores part_count answers every part whole: part 0 is the answer.
+    assert _network.merge_parts([whole, whole, whole]) == whole
+    assert _network.merge_parts([[summary], [summary]]) == [summary]
+    with pytest.raises(galpha.GalphaError, match="part 1 of 2 of the server's Classify answer sent chunks past"):
+        _network.merge_parts([[summary, chunks[0]], [chunks[1], chunks[3]]])
+    with pytest.raises(galpha.GalphaError, match="did not start with the summary"):
+        _network.merge_parts([[chunks[0]], [chunks[1]]])
+
+
+def test_classify_parts_out_of_range_are_refused() -> None:
+    for bad in (-1, 65, "4", True, 2.0):
+        with pytest.raises(galpha.InvalidInput, match="classify_parts is a number of parts from 1 to 64"):
+            galpha.connect("localhost:1", classify_parts=bad)
+        with pytest.raises(galpha.InvalidInput, match="classify_parts"):
+            galpha.aio.connect("localhost:1", classify_parts=bad)
+
+
 def test_build_batch_gives_each_set_its_own_family(server) -> None:
     # Sets of a layer's kind, an empty one and a repeated one among them; the oracle is each set
     # built alone, in this process.

@@ -65,8 +65,72 @@ def raise_from_rpc(error: grpc.RpcError) -> GalphaError:
     return error_for_code(code.value[0], details or code.name)
 
 
+#: The most parts a Classify answer is read in (the server refuses a part_count above it), and the
+#: most connect()'s default picks.
+MAX_CLASSIFY_PARTS = 64
+MAX_DEFAULT_CLASSIFY_PARTS = 8
+
+#: Each channel a connection of its own: gRPC otherwise shares one connection among a process's
+#: channels to one server, and the parts of a Classify answer would share its single stream's pace.
+CHANNEL_OPTIONS = [("grpc.max_receive_message_length", MAX_RECEIVE_BYTES), ("grpc.use_local_subchannel_pool", 1)]
+
+
+def classify_parts_count(classify_parts: int) -> int:
+    """The number of parts connect()'s ``classify_parts`` reads a Classify answer in: as given
+    (1..64), or for 0 half this machine's cores, at least 1 and at most 8."""
+    if isinstance(classify_parts, bool) or not isinstance(classify_parts, int) or not 0 <= classify_parts <= MAX_CLASSIFY_PARTS:
+        raise InvalidInput(
+            f"classify_parts is a number of parts from 1 to {MAX_CLASSIFY_PARTS}, or 0 for half this machine's "
+            f"cores (at most {MAX_DEFAULT_CLASSIFY_PARTS}), not {classify_parts!r}"
+        )
+    if classify_parts > 0:
+        return classify_parts
+    return max(1, min(MAX_DEFAULT_CLASSIFY_PARTS, (os.cpu_count() or 1) // 2))
+
+
+def part_requests(request: pb.ClassifyRequest, parts: int) -> List[pb.ClassifyRequest]:
+    """The requests for the ``parts`` parts of one Classify answer (ClassifyRequest.part_count)."""
+    out = []
+    for index in range(parts):
+        part = pb.ClassifyRequest()
+        part.CopyFrom(request)
+        part.part_index = index
+        part.part_count = parts
+        out.append(part)
+    return out
+
+
+def merge_parts(parts: Sequence[Sequence[bytes]]) -> List[bytes]:
+    """The messages of one Classify answer from its parts, in the order one call sends them: part
+    0's summary, then chunk c from part c % P (the server deals them round-robin). A server older
+    than part_count answers every part whole (part 1 then starts with a summary): part 0 is the
+    answer."""
+    count = len(parts)
+    data_loss = dict(code="DATA_LOSS", code_number=15)
+    if count > 1 and parts[1] and _wire.split_oneof(parts[1][0])[0] == 1:
+        return list(parts[0])
+    if not parts[0] or _wire.split_oneof(parts[0][0])[0] != 1:
+        raise GalphaError("part 0 of the server's Classify answer did not start with the summary", **data_loss)
+    merged = [parts[0][0]]
+    taken = [1] + [0] * (count - 1)
+    chunk = 0
+    while True:
+        part = chunk % count
+        if taken[part] == len(parts[part]):
+            break  # chunk `chunk` does not exist: neither does any later one
+        merged.append(parts[part][taken[part]])
+        taken[part] += 1
+        chunk += 1
+    for part in range(count):
+        if taken[part] != len(parts[part]):
+            raise GalphaError(
+                f"part {part} of {count} of the server's Classify answer sent chunks past the answer's end", **data_loss
+            )
+    return merged
+
+
 def channel_for(target: str, tls_ca: Optional[str]) -> grpc.Channel:
-    options = [("grpc.max_receive_message_length", MAX_RECEIVE_BYTES)]
+    options = CHANNEL_OPTIONS
     if tls_ca is None:
         return grpc.insecure_channel(target, options=options)
     with open(tls_ca, "rb") as f:
@@ -442,11 +506,23 @@ def answer_encoding_number(answer_encoding: str) -> int:
 class Calls:
     """The service's methods on one channel, with the token and the routing header attached."""
 
-    def __init__(self, channel: Any, token: Optional[str], timeout: Optional[float], simplex_encoding: int = 1) -> None:
+    def __init__(
+        self,
+        channel: Any,
+        token: Optional[str],
+        timeout: Optional[float],
+        simplex_encoding: int = 1,
+        part_channels: Sequence[Any] = (),
+    ) -> None:
         self.channel = channel
         self.token = token
         self.timeout = timeout
         self.simplex_encoding = simplex_encoding  # ClassifyRequest.simplex_encoding (answer_encoding_number)
+        # Classify on parts 1.. of a split answer (part 0 takes `classify`): a channel each.
+        self.part_classify = [
+            c.unary_stream(SERVICE + "Classify", request_serializer=pb.ClassifyRequest.SerializeToString, response_deserializer=_identity)
+            for c in part_channels
+        ]
         def unary(name: str, request_type: Any, response_type: Any) -> Any:
             return channel.unary_unary(
                 SERVICE + name, request_serializer=request_type.SerializeToString, response_deserializer=response_type.FromString
@@ -545,9 +621,19 @@ class NetworkFamilyBackend:
             simplex_encoding=self._calls.simplex_encoding,
         )
         assembler = ClassifyAssembler()
-        for raw in self._stream(self._calls.classify, request):
+        for raw in self._classify_messages(request):
             assembler.add(raw)
         return assembler.result()
+
+    def _classify_messages(self, request: pb.ClassifyRequest) -> List[bytes]:
+        methods = [self._calls.classify] + self._calls.part_classify
+        if len(methods) == 1 or request.summary_only:
+            return self._stream(self._calls.classify, request)
+        # The parts at once, a thread and a connection each (their waits release the GIL).
+        requests = part_requests(request, len(methods))
+        with concurrent.futures.ThreadPoolExecutor(len(methods)) as pool:
+            futures = [pool.submit(self._stream, m, r) for m, r in zip(methods, requests)]
+            return merge_parts([f.result() for f in futures])
 
     def shape_rings(self, threshold: Threshold, mode: Mode, min_hole_area: float = 0.0) -> ShapeRings:
         request = shape_request(self._handle, threshold, mode, min_hole_area)

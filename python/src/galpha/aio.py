@@ -52,7 +52,7 @@ __all__ = ["connect", "AsyncClient", "AsyncFamily"]
 
 
 def _aio_channel(target: str, tls_ca: Optional[str]) -> grpc.aio.Channel:
-    options = [("grpc.max_receive_message_length", _network.MAX_RECEIVE_BYTES)]
+    options = _network.CHANNEL_OPTIONS
     if tls_ca is None:
         return grpc.aio.insecure_channel(target, options=options)
     with open(tls_ca, "rb") as f:
@@ -165,8 +165,16 @@ class AsyncFamily:
             summary_only=summary_only,
             simplex_encoding=self._calls.simplex_encoding,
         )
+        methods = [self._calls.classify] + self._calls.part_classify
+        if len(methods) == 1 or summary_only:
+            messages = await self._stream(self._calls.classify, request)
+        else:
+            # The parts at once, a connection each.
+            requests = _network.part_requests(request, len(methods))
+            parts = await asyncio.gather(*(self._stream(m, r) for m, r in zip(methods, requests)))
+            messages = _network.merge_parts(parts)
         assembler = _network.ClassifyAssembler()
-        for raw in await self._stream(self._calls.classify, request):
+        for raw in messages:
             assembler.add(raw)
         return assembler.result()
 
@@ -312,11 +320,15 @@ class AsyncClient:
         tls_ca: Optional[str],
         timeout: Optional[float],
         answer_encoding: str = "auto",
+        classify_parts: int = 0,
     ) -> None:
         self.target = target
-        encoding = _network.answer_encoding_number(answer_encoding)  # before the channel: nothing to close
+        # Checked before the channels: nothing to close.
+        encoding = _network.answer_encoding_number(answer_encoding)
+        parts = _network.classify_parts_count(classify_parts)
         self._channel = _aio_channel(target, tls_ca)
-        self._calls = _network.Calls(self._channel, token, timeout, encoding)
+        self._part_channels = [_aio_channel(target, tls_ca) for _ in range(parts - 1)]
+        self._calls = _network.Calls(self._channel, token, timeout, encoding, self._part_channels)
 
     async def __aenter__(self) -> "AsyncClient":
         return self
@@ -326,6 +338,8 @@ class AsyncClient:
 
     async def close(self) -> None:
         await self._channel.close()
+        for channel in self._part_channels:
+            await channel.close()
 
     async def build_batch(
         self,
@@ -421,8 +435,11 @@ def connect(
     tls_ca: Optional[str] = None,
     timeout: Optional[float] = None,
     answer_encoding: str = "auto",
+    classify_parts: int = 0,
 ) -> AsyncClient:
     """The asyncio counterpart of :func:`galpha.connect` (create it inside a running event loop)."""
-    return AsyncClient(target, token=token, tls_ca=tls_ca, timeout=timeout, answer_encoding=answer_encoding)
+    return AsyncClient(
+        target, token=token, tls_ca=tls_ca, timeout=timeout, answer_encoding=answer_encoding, classify_parts=classify_parts
+    )
 
 
