@@ -114,12 +114,6 @@ absl::StatusOr<ResolvedThreshold> ResidentFamilyReader::Resolve(const Threshold&
   return resolved;
 }
 
-absl::StatusOr<ShapeComplex> ResidentFamilyReader::ComplexAt(int64_t level, ClassifyMode mode) const {
-  GALPHA_ASSIGN_OR_RETURN(const Classification classes, family_->ClassifyAll(level, mode, VertexRule::kReport));
-  return ComplexFromClasses(family_->points(), family_->representative(), family_->triangles(), family_->edges(),
-                            classes, mode);
-}
-
 absl::StatusOr<PersistenceDiagram> HostFamilyReader::Persistence(absl::Span<const uint32_t> edge_order,
                                                                  absl::Span<const uint32_t> triangle_order) const {
   return PersistenceDiagramOf(*family_, edge_order, triangle_order);

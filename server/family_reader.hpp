@@ -16,6 +16,7 @@
 #include "core/family/alpha_family.hpp"
 #include "core/family/persistence_pair.hpp"
 #include "core/family/threshold.hpp"
+#include "core/geometry/shape.hpp"
 #include "gpu/alpha/resident_family.hpp"
 
 namespace galpha::server {
@@ -41,8 +42,9 @@ class FamilyReader {
   virtual absl::StatusOr<ResolvedThreshold> Resolve(const Threshold& threshold) const = 0;
   virtual absl::StatusOr<int64_t> RankLowerBound(double alpha_sq) const = 0;
   virtual absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const = 0;
-  /// AlphaFamily::ComplexAt (a resident family's from its classes: ComplexFromClasses).
-  virtual absl::StatusOr<ShapeComplex> ComplexAt(int64_t level, ClassifyMode mode) const = 0;
+  /// AssembleShape(AlphaFamily::ComplexAt(level, mode)); a resident family's found where its
+  /// tables live, the same ShapeGeometry (ResidentAlphaFamily::ShapeAt).
+  virtual absl::StatusOr<ShapeGeometry> ShapeAt(int64_t level, ClassifyMode mode) const = 0;
   virtual absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const = 0;
   virtual absl::StatusOr<double> HullAreaApprox() const = 0;
   virtual absl::StatusOr<double> PublishedAlphaSq(int64_t level) const = 0;
@@ -97,8 +99,8 @@ class HostFamilyReader final : public FamilyReaderOf<AlphaFamily> {
   absl::StatusOr<ResolvedThreshold> Resolve(const Threshold& threshold) const override;
   absl::StatusOr<int64_t> RankLowerBound(double alpha_sq) const override;
   absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const override;
-  absl::StatusOr<ShapeComplex> ComplexAt(int64_t level, ClassifyMode mode) const override {
-    return family_->ComplexAt(level, mode);
+  absl::StatusOr<ShapeGeometry> ShapeAt(int64_t level, ClassifyMode mode) const override {
+    return AssembleShape(family_->ComplexAt(level, mode));
   }
   absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const override;
   absl::StatusOr<double> HullAreaApprox() const override;
@@ -125,7 +127,9 @@ class ResidentFamilyReader final : public FamilyReaderOf<ResidentAlphaFamily> {
   absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const override {
     return family_->ClassifyAll(level, mode, rule);
   }
-  absl::StatusOr<ShapeComplex> ComplexAt(int64_t level, ClassifyMode mode) const override;
+  absl::StatusOr<ShapeGeometry> ShapeAt(int64_t level, ClassifyMode mode) const override {
+    return family_->ShapeAt(level, mode);
+  }
   absl::StatusOr<std::vector<TopologyAtLevel>> TopologyBetween(int64_t first, int64_t last) const override {
     return family_->TopologyBetween(first, last);
   }

@@ -486,10 +486,8 @@ absl::StatusOr<std::unique_ptr<ChunkSource<v1::ShapeResponse>>> MakeShapeSource(
     return absl::InvalidArgumentError(
         absl::StrCat("min_hole_area ", min_hole_area, " is not an area: give 0 (keep every hole) or more"));
   }
-  // The complex from the classes (a resident family's computed where its tables live).
-  absl::StatusOr<ShapeComplex> complex = family.ComplexAt(level->level, *mode);
-  if (!complex.ok()) return complex.status();
-  auto shape = AssembleShape(*complex);
+  // A resident family's boundary is found where its tables live.
+  absl::StatusOr<ShapeGeometry> shape = family.ShapeAt(level->level, *mode);
   if (!shape.ok()) return shape.status();
   // Areas in the family's units (metres for a projected geographic set).
   if (min_hole_area > 0) FillHolesSmallerThan(&*shape, family.points(), min_hole_area);

@@ -48,28 +48,28 @@ ClassificationSummary CountAll(const HostVector<uint32_t>& representative, const
   return summary;
 }
 
-// The interior triangles' terms added in triangle order, one addition at a time, as AssembleShape
-// sums them: `for t: if interior(t): area += terms[t]`, the same double. Done that way, the branch
-// mispredicts about every other triangle at a middle level (most of a 1M-point summary's time,
-// ~10 ms). Here each core first packs the interior terms of its block of triangles without a branch
-// (every term is written, the next position advances only past an interior one), then one thread
-// adds the packed terms block after block: the same additions in the same order.
-double InteriorArea(const double* terms, const Classification& classes) {
-  const int64_t nt = static_cast<int64_t>(classes.triangles.size());
+// The terms of the triangles t with interior(t) added in triangle order, one addition at a time,
+// as AssembleShape sums them: `for t: if interior(t): area += terms[t]`, the same double. Done that
+// way, the branch mispredicts about every other triangle at a middle level (most of a 1M-point
+// summary's time, ~10 ms). Here each core first packs the interior terms of its block of triangles
+// without a branch (every term is written, the next position advances only past an interior
+// one), then one thread adds the packed terms block after block: the same additions in the same
+// order.
+template <typename Interior>
+double AddInteriorTermsInOrder(const double* terms, int64_t nt, Interior interior) {
   if (nt == 0) return 0.0;
   const int64_t blocks = std::min<int64_t>(nt, 4 * static_cast<int64_t>(omp_get_max_threads()));
   // Block b packs into [its first triangle, packed_end[b]): never past its own triangles.
   const std::unique_ptr<double[]> packed(new double[static_cast<size_t>(nt)]);
   std::vector<int64_t> packed_end(static_cast<size_t>(blocks));
   const auto block_begin = [&](int64_t b) { return nt * b / blocks; };
-  const SimplexClass* cls = classes.triangles.data();
 #pragma omp parallel for schedule(static, 1)
   for (int64_t b = 0; b < blocks; ++b) {
     int64_t k = block_begin(b);
     const int64_t end = block_begin(b + 1);
     for (int64_t t = block_begin(b); t < end; ++t) {
       packed[static_cast<size_t>(k)] = terms[t];
-      k += static_cast<int64_t>(cls[t] == SimplexClass::kInterior);
+      k += static_cast<int64_t>(interior(t));
     }
     packed_end[static_cast<size_t>(b)] = k;
   }
@@ -80,6 +80,12 @@ double InteriorArea(const double* terms, const Classification& classes) {
     for (; term != end; ++term) area += *term;
   }
   return area;
+}
+
+double InteriorArea(const double* terms, const Classification& classes) {
+  const SimplexClass* cls = classes.triangles.data();
+  return AddInteriorTermsInOrder(terms, static_cast<int64_t>(classes.triangles.size()),
+                                 [cls](int64_t t) { return cls[t] == SimplexClass::kInterior; });
 }
 
 }  // namespace
@@ -123,6 +129,23 @@ ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const
   }
   summary.interior_area = InteriorArea(terms.get(), classes);
   return summary;
+}
+
+double InteriorAreaOfFlagged(const HostVector<Point2>& p, const HostVector<std::array<uint32_t, 3>>& triangles,
+                             const std::vector<uint8_t>& in_complex) {
+  const int64_t nt = static_cast<int64_t>(triangles.size());
+  const std::unique_ptr<double[]> terms(new double[static_cast<size_t>(nt)]);
+#pragma omp parallel for schedule(static)
+  for (int64_t t = 0; t < nt; ++t) {
+    double term = 0.0;
+    if (in_complex[static_cast<size_t>(t)] != 0) {
+      const auto& tri = triangles[t];
+      term = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
+    }
+    terms[static_cast<size_t>(t)] = term;
+  }
+  const uint8_t* in = in_complex.data();
+  return AddInteriorTermsInOrder(terms.get(), nt, [in](int64_t t) { return in[t] != 0; });
 }
 
 }  // namespace galpha

@@ -34,4 +34,10 @@ ClassificationSummary SummarizeClassification(const HostVector<Point2>& points,
                                               const HostVector<std::array<uint32_t, 3>>& triangles,
                                               const Classification& classes);
 
+/// The same interior area from per-triangle flags (1: in the complex), in triangle order: what a
+/// resident family's shape adds (gpu/alpha/resident_family.hpp, ShapeAt), so that its area is
+/// AssembleShape's double.
+double InteriorAreaOfFlagged(const HostVector<Point2>& points, const HostVector<std::array<uint32_t, 3>>& triangles,
+                             const std::vector<uint8_t>& in_complex);
+
 }  // namespace galpha

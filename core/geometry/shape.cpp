@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <unordered_map>
 #include <utility>
 
 #include "absl/status/status.h"
@@ -104,11 +105,7 @@ struct TriangleSide {
 };
 
 // A boundary edge: its twin is not in the set, so its piece lies on its left only.
-struct BoundaryEdge {
-  uint32_t from;
-  uint32_t to;
-  uint32_t piece;
-};
+using BoundaryEdge = ShapeBoundarySide;
 
 // Whether, around `v` and counter-clockwise from the direction of `ref` (excluded), the direction
 // of `a` comes before that of `b`. Exact: the half-plane left of v->ref (the direction opposite
@@ -301,9 +298,19 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
     }
     i = end;
   }
-  std::vector<BoundaryEdge> boundary;  // sorted by (from, to) below, as TraceRings needs
+  std::vector<BoundaryEdge> boundary;
   boundary.reserve(lone_sides.size());
   for (size_t i : lone_sides) boundary.push_back({sides[i].from(), sides[i].to(), pieces.Find(sides[i].triangle)});
+  return ShapeFromBoundary(points, std::move(boundary), shape.area, complex.singular_edges, complex.isolated_points);
+}
+
+absl::StatusOr<ShapeGeometry> ShapeFromBoundary(absl::Span<const Point2> points,
+                                                std::vector<ShapeBoundarySide> boundary, double area,
+                                                absl::Span<const std::array<uint32_t, 2>> singular_edges,
+                                                absl::Span<const uint32_t> isolated_points) {
+  ShapeGeometry shape;
+  shape.area = area;
+  // Sorted by (from, to), as TraceRings needs.
   std::sort(boundary.begin(), boundary.end(), [](const BoundaryEdge& a, const BoundaryEdge& b) {
     return a.from < b.from || (a.from == b.from && a.to < b.to);
   });
@@ -312,8 +319,8 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
 
   // Each piece has exactly one counter-clockwise ring (around the unbounded complement region) and
   // one clockwise ring per bounded complement region (its holes). Anything else means overlap.
-  constexpr uint32_t kNoPolygon = UINT32_MAX;
-  std::vector<uint32_t> polygon_of_piece(triangles.size(), kNoPolygon);
+  // Polygons by piece label (labels are any numbers: a map, not an array as long as the triangles).
+  std::unordered_map<uint32_t, uint32_t> polygon_of_piece;
   std::vector<int> orientation(rings.size());
   for (size_t r = 0; r < rings.size(); ++r) {
     Ring& ring = rings[r];
@@ -322,21 +329,20 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
       return OverlapError(absl::StrCat("a boundary ring doubles back near point ", ring.vertices[0]));
     }
     if (orientation[r] < 0) continue;
-    if (polygon_of_piece[ring.piece] != kNoPolygon) {
+    if (!polygon_of_piece.emplace(ring.piece, static_cast<uint32_t>(shape.polygons.size())).second) {
       return OverlapError(absl::StrCat("the piece of triangle ", ring.piece, " has two outer rings"));
     }
-    polygon_of_piece[ring.piece] = static_cast<uint32_t>(shape.polygons.size());
     RotateToSmallest(ring.vertices);
     shape.polygons.push_back({std::move(ring.vertices), {}});
   }
   for (size_t r = 0; r < rings.size(); ++r) {
     if (orientation[r] > 0) continue;
-    const uint32_t polygon = polygon_of_piece[rings[r].piece];
-    if (polygon == kNoPolygon) {
+    const auto polygon = polygon_of_piece.find(rings[r].piece);
+    if (polygon == polygon_of_piece.end()) {
       return OverlapError(absl::StrCat("the piece of triangle ", rings[r].piece, " has no outer ring"));
     }
     RotateToSmallest(rings[r].vertices);
-    shape.polygons[polygon].holes.push_back(std::move(rings[r].vertices));
+    shape.polygons[polygon->second].holes.push_back(std::move(rings[r].vertices));
   }
   for (ShapePolygon& polygon : shape.polygons) {
     std::sort(polygon.holes.begin(), polygon.holes.end());
@@ -344,13 +350,13 @@ absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex) {
   std::sort(shape.polygons.begin(), shape.polygons.end(),
             [](const ShapePolygon& a, const ShapePolygon& b) { return a.outer < b.outer; });
 
-  for (const auto& edge : complex.singular_edges) {
+  for (const auto& edge : singular_edges) {
     shape.singular_edges.push_back({std::min(edge[0], edge[1]), std::max(edge[0], edge[1])});
   }
   std::sort(shape.singular_edges.begin(), shape.singular_edges.end());
   shape.singular_edges.erase(std::unique(shape.singular_edges.begin(), shape.singular_edges.end()),
                              shape.singular_edges.end());
-  shape.isolated_points = complex.isolated_points;
+  shape.isolated_points.assign(isolated_points.begin(), isolated_points.end());
   std::sort(shape.isolated_points.begin(), shape.isolated_points.end());
   shape.isolated_points.erase(std::unique(shape.isolated_points.begin(), shape.isolated_points.end()),
                               shape.isolated_points.end());

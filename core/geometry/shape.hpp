@@ -76,6 +76,26 @@ struct ShapeGeometry {
 /// not close into simple rings) — none of which a subset of one triangulation has.
 absl::StatusOr<ShapeGeometry> AssembleShape(const ShapeComplex& complex);
 
+/// One side of a shape's boundary: an edge of a complex triangle whose other side is not in the
+/// complex, directed as that triangle runs along it (counter-clockwise), and its piece: any label
+/// shared by exactly the triangles of one edge-connected piece.
+struct ShapeBoundarySide {
+  uint32_t from;
+  uint32_t to;
+  uint32_t piece;
+};
+
+/// The second half of AssembleShape, for callers that found the boundary elsewhere (a resident
+/// family finds it where its tables live: gpu/alpha/resident_family.hpp): the rings traced from
+/// `boundary` (any order), grouped into polygons by piece, with `area` (AssembleShape's: the
+/// complex's triangle areas added in triangle order), and the singular edges and isolated points in
+/// canonical order. The same ShapeGeometry as AssembleShape of the same complex; its overlap errors
+/// as well.
+absl::StatusOr<ShapeGeometry> ShapeFromBoundary(absl::Span<const Point2> points,
+                                                std::vector<ShapeBoundarySide> boundary, double area,
+                                                absl::Span<const std::array<uint32_t, 2>> singular_edges,
+                                                absl::Span<const uint32_t> isolated_points);
+
 // The writers print coordinates as their shortest decimal that reads back as the same double
 // (core/io/number_text.hpp: "0.1", not %.17g's "0.10000000000000001"). They require every index of
 // `shape` to be < points.size() (true of AssembleShape's result for the same points).

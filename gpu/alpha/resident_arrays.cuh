@@ -56,6 +56,140 @@ struct ClassifyEverySimplex {
   }
 };
 
+// ---- The shape's boundary at one level (ResidentTables::ShapeBoundaryAt) ----------------------------
+
+/// Whether each triangle is in the shape's complex at `level` (INTERIOR, in either mode).
+struct TriangleInComplex {
+  const uint32_t* tri_rank;
+  int64_t level;
+  uint8_t* in;
+  GALPHA_HD void operator()(uint32_t t) const {
+    in[t] = TriangleClassAt(tri_rank[t], level) == SimplexClass::kInterior ? 1 : 0;
+  }
+};
+
+// Relaxed atomic loads, stores and compare-and-swap on both backends (CUDA; GCC builtins on the
+// host), for the pieces' union-find, whose threads read and write the same parents.
+GALPHA_HD inline uint32_t LoadRelaxed(const uint32_t* p) {
+#if defined(__CUDA_ARCH__)
+  return *static_cast<const volatile uint32_t*>(p);
+#else
+  return __atomic_load_n(p, __ATOMIC_RELAXED);
+#endif
+}
+GALPHA_HD inline void StoreRelaxed(uint32_t* p, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  *static_cast<volatile uint32_t*>(p) = v;
+#else
+  __atomic_store_n(p, v, __ATOMIC_RELAXED);
+#endif
+}
+GALPHA_HD inline bool CompareAndSwap(uint32_t* p, uint32_t expected, uint32_t desired) {
+#if defined(__CUDA_ARCH__)
+  return atomicCAS(p, expected, desired) == expected;
+#else
+  return __atomic_compare_exchange_n(p, &expected, desired, false, __ATOMIC_RELAXED, __ATOMIC_RELAXED);
+#endif
+}
+
+/// The root of x's tree in `parent`, halving the path on the way. Concurrent unions only ever
+/// point a root at another root and a non-root at one of its ancestors, so a read that another
+/// thread has since changed still leads to the root.
+GALPHA_HD inline uint32_t FindPieceRoot(uint32_t* parent, uint32_t x) {
+  for (;;) {
+    const uint32_t p = LoadRelaxed(parent + x);
+    if (p == x) return x;
+    const uint32_t grand = LoadRelaxed(parent + p);
+    if (grand != p) StoreRelaxed(parent + x, grand);
+    x = grand;
+  }
+}
+
+/// Joins the pieces of triangles a and b: the larger root is hooked under the smaller (retried
+/// when another thread hooked it first), so every root is its piece's smallest triangle id, and
+/// the labels do not depend on the threads' order.
+GALPHA_HD inline void UnitePieces(uint32_t* parent, uint32_t a, uint32_t b) {
+  for (;;) {
+    a = FindPieceRoot(parent, a);
+    b = FindPieceRoot(parent, b);
+    if (a == b) return;
+    const uint32_t low = a < b ? a : b, high = a < b ? b : a;
+    if (CompareAndSwap(parent + high, high, low)) return;
+  }
+}
+
+/// Joins the two complex triangles of each edge between two of them (an edge of one piece).
+struct JoinPiecesAcrossEdge {
+  const EdgeTris* edge_triangles;
+  const uint8_t* in;
+  uint32_t* parent;
+  GALPHA_HD void operator()(uint32_t e) const {
+    const EdgeTris et = edge_triangles[e];
+    if (et.t[0] >= 0 && et.t[1] >= 0 && in[et.t[0]] != 0 && in[et.t[1]] != 0) {
+      UnitePieces(parent, static_cast<uint32_t>(et.t[0]), static_cast<uint32_t>(et.t[1]));
+    }
+  }
+};
+
+/// Each triangle's parent set to its piece's root (its smallest triangle id).
+struct LabelPiece {
+  uint32_t* parent;
+  GALPHA_HD void operator()(uint32_t t) const { StoreRelaxed(parent + t, FindPieceRoot(parent, t)); }
+};
+
+/// An edge with a complex triangle on exactly one side (none: the hull's outside).
+struct IsBoundaryEdge {
+  const EdgeTris* edge_triangles;
+  const uint8_t* in;
+  GALPHA_HD bool operator()(uint32_t e) const {
+    const EdgeTris et = edge_triangles[e];
+    const bool in0 = et.t[0] >= 0 && in[et.t[0]] != 0, in1 = et.t[1] >= 0 && in[et.t[1]] != 0;
+    return in0 != in1;
+  }
+};
+
+/// A boundary edge's complex triangle and that triangle's piece.
+struct BoundaryEdgeSide {
+  const EdgeTris* edge_triangles;
+  const uint8_t* in;
+  const uint32_t* piece;
+  const uint32_t* edges;  // the boundary edges' ids
+  uint32_t* inside;
+  uint32_t* inside_piece;
+  GALPHA_HD void operator()(uint32_t i) const {
+    const EdgeTris et = edge_triangles[edges[i]];
+    const uint32_t t = static_cast<uint32_t>(et.t[0] >= 0 && in[et.t[0]] != 0 ? et.t[0] : et.t[1]);
+    inside[i] = t;
+    inside_piece[i] = piece[t];
+  }
+};
+
+/// SINGULAR edges at a level (GENERAL mode: edges of the complex without a triangle of it).
+struct IsSingularEdge {
+  const uint32_t* edge_rho_rank;
+  const uint32_t* edge_mu_low;
+  const uint32_t* edge_mu_high;
+  int64_t level;
+  GALPHA_HD bool operator()(uint32_t e) const {
+    return EdgeClassAt(edge_rho_rank[e], edge_mu_low[e], edge_mu_high[e], level, ClassifyMode::kGeneral) ==
+           SimplexClass::kSingular;
+  }
+};
+
+/// SINGULAR input points at a level (GENERAL mode, VertexRule::kReport: isolated points of the
+/// complex; duplicates are the caller's to drop).
+struct IsSingularVertex {
+  const uint32_t* vertex_mu_low;
+  const uint32_t* vertex_mu_high;
+  const uint32_t* vertex_tri_low;
+  const uint8_t* hidden;  // per input point; null when unweighted
+  int64_t level;
+  GALPHA_HD bool operator()(uint32_t v) const {
+    return VertexClassAt(hidden != nullptr && hidden[v] != 0, vertex_mu_low[v], vertex_mu_high[v], vertex_tri_low[v],
+                         level, ClassifyMode::kGeneral, VertexRule::kReport) == SimplexClass::kSingular;
+  }
+};
+
 /// Whether a level's curve values are within the limits (b null: only a's).
 struct CurvesWithin {
   const uint32_t* a;
@@ -159,6 +293,60 @@ class ResidentTablesOn final : public ResidentTables {
     sys.Download({{vertices, classes.data(), size_t{sizes_.n}},
                   {edges, classes.data() + sizes_.n, size_t{sizes_.num_edges}},
                   {triangles, classes.data() + sizes_.n + sizes_.num_edges, size_t{sizes_.num_tri}}});
+  }
+
+  ShapeBoundary ShapeBoundaryAt(int64_t level, ClassifyMode mode) override {
+    System& sys = *system_;
+    const ResidentTableBuffers<System>& t = tables_;
+    const uint32_t num_tri = sizes_.num_tri, num_edges = sizes_.num_edges, n = sizes_.n;
+    const thrust::counting_iterator<uint32_t> zero(0);
+    ShapeBoundary out;
+    Buffer<uint8_t, System> in(sys, num_tri);
+    thrust::for_each_n(sys.policy(), zero, num_tri, TriangleInComplex{t.tri_rank.data(), level, in.data()});
+    // The pieces: the complex's triangles joined across the edges between two of them.
+    Buffer<uint32_t, System> piece(sys, num_tri);
+    thrust::sequence(sys.policy(), piece.data(), piece.data() + num_tri);
+    thrust::for_each_n(sys.policy(), zero, num_edges,
+                       JoinPiecesAcrossEdge{t.edge_triangles.data(), in.data(), piece.data()});
+    thrust::for_each_n(sys.policy(), zero, num_tri, LabelPiece{piece.data()});
+    Buffer<uint32_t, System> edges(sys, num_edges);
+    const auto boundary = static_cast<size_t>(thrust::copy_if(sys.policy(), zero, zero + num_edges, edges.data(),
+                                                              IsBoundaryEdge{t.edge_triangles.data(), in.data()}) -
+                                              edges.data());
+    Buffer<uint32_t, System> inside(sys, boundary), inside_piece(sys, boundary);
+    thrust::for_each_n(sys.policy(), zero, boundary,
+                       BoundaryEdgeSide{t.edge_triangles.data(), in.data(), piece.data(), edges.data(), inside.data(),
+                                        inside_piece.data()});
+    out.edges.resize(boundary);
+    out.inside.resize(boundary);
+    out.piece.resize(boundary);
+    out.triangle_in_complex.resize(num_tri);
+    std::vector<HostCopy> parts = {{out.edges.data(), edges.data(), boundary * sizeof(uint32_t)},
+                                   {out.inside.data(), inside.data(), boundary * sizeof(uint32_t)},
+                                   {out.piece.data(), inside_piece.data(), boundary * sizeof(uint32_t)},
+                                   {out.triangle_in_complex.data(), in.data(), size_t{num_tri}}};
+    Buffer<uint32_t, System> singular_edges(sys, mode == ClassifyMode::kGeneral ? num_edges : 0);
+    Buffer<uint32_t, System> singular_vertices(sys, mode == ClassifyMode::kGeneral ? n : 0);
+    if (mode == ClassifyMode::kGeneral) {
+      const auto edge_count = static_cast<size_t>(
+          thrust::copy_if(sys.policy(), zero, zero + num_edges, singular_edges.data(),
+                          IsSingularEdge{t.edge_rho_rank.data(), t.edge_mu_low.data(), t.edge_mu_high.data(), level}) -
+          singular_edges.data());
+      const auto vertex_count = static_cast<size_t>(
+          thrust::copy_if(sys.policy(), zero, zero + n, singular_vertices.data(),
+                          IsSingularVertex{t.vertex_mu_low.data(), t.vertex_mu_high.data(), t.vertex_tri_low.data(),
+                                           t.hidden.size() > 0 ? t.hidden.data() : nullptr, level}) -
+          singular_vertices.data());
+      out.singular_edges.resize(edge_count);
+      out.singular_vertices.resize(vertex_count);
+      parts.push_back({out.singular_edges.data(), singular_edges.data(), edge_count * sizeof(uint32_t)});
+      parts.push_back({out.singular_vertices.data(), singular_vertices.data(), vertex_count * sizeof(uint32_t)});
+    }
+    // Nothing to copy for empty parts (their vectors may have no storage).
+    parts.erase(std::remove_if(parts.begin(), parts.end(), [](const HostCopy& c) { return c.bytes == 0; }),
+                parts.end());
+    if (!parts.empty()) sys.Download(parts);
+    return out;
   }
 
   CurveValues CurvesAt(int64_t level) override {

@@ -24,6 +24,18 @@ struct CurveValues {
   uint64_t area_units = 0;
 };
 
+/// The boundary of the shape at one level (ResidentTables::ShapeBoundaryAt), by ids: what the
+/// host needs to trace the shape's rings (core/geometry/shape.hpp, ShapeFromBoundary).
+struct ShapeBoundary {
+  /// Each edge with a complex triangle on exactly one side: the edge, that triangle, and the
+  /// triangle's piece (the smallest triangle id of its edge-connected piece), in edge order.
+  std::vector<uint32_t> edges, inside, piece;
+  /// Per triangle, 1 when it is in the complex (INTERIOR): the shape's area adds those.
+  std::vector<uint8_t> triangle_in_complex;
+  /// GENERAL mode: the SINGULAR edges, and the SINGULAR input points (duplicates among them).
+  std::vector<uint32_t> singular_edges, singular_vertices;
+};
+
 struct PersistenceIn;
 struct PersistenceOut;
 
@@ -47,6 +59,9 @@ class ResidentTables {
   /// n, #edges and #triangles entries (SimplexClass values).
   virtual void Classify(int64_t level, ClassifyMode mode, VertexRule rule, SimplexClass* vertices, SimplexClass* edges,
                         SimplexClass* triangles) = 0;
+  /// The shape's boundary at `level` (-1..K) in `mode`, found where the tables live: only the
+  /// boundary, the complex's triangle flags and the singular simplices come back, not every class.
+  virtual ShapeBoundary ShapeBoundaryAt(int64_t level, ClassifyMode mode) = 0;
   /// The curves at `level` (0..K).
   virtual CurveValues CurvesAt(int64_t level) = 0;
   /// The curves at levels first..last (within 0..K), one entry a level.

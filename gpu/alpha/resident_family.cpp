@@ -1,15 +1,18 @@
 #include "gpu/alpha/resident_family.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cfloat>
 #include <cmath>
 #include <string>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "absl/strings/str_cat.h"
 #include "core/base/status_macros.hpp"
 #include "core/family/area_ratio.hpp"
+#include "core/family/classification_summary.hpp"
 #include "core/family/simplex_threshold.hpp"
 #include "gpu/alpha/alpha_build_parts.hpp"
 #include "gpu/alpha/persistence_pairs.cuh"
@@ -123,6 +126,33 @@ absl::StatusOr<Classification> ResidentAlphaFamily::ClassifyAll(int64_t level, C
     tables_->Classify(level, mode, rule, c.vertices.data(), c.edges.data(), c.triangles.data());
   }));
   return c;
+}
+
+absl::StatusOr<ShapeGeometry> ResidentAlphaFamily::ShapeAt(int64_t level, ClassifyMode mode) const {
+  detail::ShapeBoundary found;
+  GALPHA_RETURN_IF_ERROR(OnTables(*mutex_, absl::StrCat("finding the shape's boundary at level ", level),
+                                  [&] { found = tables_->ShapeBoundaryAt(level, mode); }));
+  // Each boundary edge directed as its complex triangle (counter-clockwise) runs along it.
+  std::vector<ShapeBoundarySide> sides(found.edges.size());
+  const int64_t count = static_cast<int64_t>(sides.size());
+#pragma omp parallel for schedule(static)
+  for (int64_t i = 0; i < count; ++i) {
+    const std::array<uint32_t, 2>& edge = host_.edges[found.edges[static_cast<size_t>(i)]];
+    const std::array<uint32_t, 3>& tri = host_.triangles[found.inside[static_cast<size_t>(i)]];
+    const int k = tri[0] == edge[0] ? 0 : tri[1] == edge[0] ? 1 : 2;
+    const bool along = tri[static_cast<size_t>((k + 1) % 3)] == edge[1];
+    sides[static_cast<size_t>(i)] = {along ? edge[0] : edge[1], along ? edge[1] : edge[0],
+                                     found.piece[static_cast<size_t>(i)]};
+  }
+  std::vector<std::array<uint32_t, 2>> singular_edges;
+  singular_edges.reserve(found.singular_edges.size());
+  for (const uint32_t e : found.singular_edges) singular_edges.push_back(host_.edges[e]);
+  std::vector<uint32_t> isolated;  // distinct points only, as ComplexFromClasses keeps them
+  for (const uint32_t v : found.singular_vertices) {
+    if (host_.representative[v] == v) isolated.push_back(v);
+  }
+  const double area = InteriorAreaOfFlagged(host_.points, host_.triangles, found.triangle_in_complex);
+  return ShapeFromBoundary(host_.points, std::move(sides), area, singular_edges, isolated);
 }
 
 absl::StatusOr<TopologyAtLevel> ResidentAlphaFamily::TopologyAt(int64_t level) const {

@@ -18,6 +18,7 @@
 #include "absl/synchronization/mutex.h"
 #include "absl/types/span.h"
 #include "core/family/alpha_family.hpp"
+#include "core/geometry/shape.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 
 namespace galpha {
@@ -72,6 +73,11 @@ class ResidentAlphaFamily {
 
   /// AlphaFamily::ClassifyAll, computed where the tables live.
   absl::StatusOr<Classification> ClassifyAll(int64_t level, ClassifyMode mode, VertexRule rule) const;
+  /// AssembleShape(ComplexAt(level, mode)) of the host family, the same ShapeGeometry: the
+  /// boundary, the pieces and the singular simplices are found where the tables live, and only
+  /// they and the complex's triangle flags come back; the host traces the rings from the boundary
+  /// (core/geometry/shape.hpp, ShapeFromBoundary) and adds the area in triangle order.
+  absl::StatusOr<ShapeGeometry> ShapeAt(int64_t level, ClassifyMode mode) const;
   /// The curves at `level` (below 0: all zero; above K: K's).
   absl::StatusOr<TopologyAtLevel> TopologyAt(int64_t level) const;
   /// The same at every level of first..last, in one download.

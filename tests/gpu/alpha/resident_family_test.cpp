@@ -168,6 +168,20 @@ class ResidentFamilyTest : public testing::BackendTest {
             EXPECT_EQ(from_classes.triangles, expected.triangles) << "level " << level;
             EXPECT_EQ(from_classes.singular_edges, expected.singular_edges) << "level " << level;
             EXPECT_EQ(from_classes.isolated_points, expected.isolated_points) << "level " << level;
+            // The shape from the boundary found where the tables live is AssembleShape's, to the
+            // area's last bit.
+            const absl::StatusOr<ShapeGeometry> shape = resident.ShapeAt(level, mode);
+            const absl::StatusOr<ShapeGeometry> assembled = AssembleShape(expected);
+            ASSERT_THAT(shape, IsOk());
+            ASSERT_THAT(assembled, IsOk());
+            ASSERT_EQ(shape->polygons.size(), assembled->polygons.size()) << "level " << level;
+            for (size_t p = 0; p < shape->polygons.size(); ++p) {
+              EXPECT_EQ(shape->polygons[p].outer, assembled->polygons[p].outer) << "level " << level;
+              EXPECT_EQ(shape->polygons[p].holes, assembled->polygons[p].holes) << "level " << level;
+            }
+            EXPECT_EQ(shape->singular_edges, assembled->singular_edges) << "level " << level;
+            EXPECT_EQ(shape->isolated_points, assembled->isolated_points) << "level " << level;
+            EXPECT_EQ(shape->area, assembled->area) << "level " << level;
           }
         }
       }
