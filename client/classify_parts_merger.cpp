@@ -41,20 +41,24 @@ bool ClassifyPartsMerger::Take(std::unique_lock<std::mutex>& lock, size_t p) {
 }
 
 absl::Status ClassifyPartsMerger::FinishAll(std::unique_lock<std::mutex>& lock) {
+  // Whether a part holds more than it may after the answer's end. A server that does not split
+  // answers sent such a part whole: only a summary, as part 0's answer had no chunk.
+  const auto past_the_end = [](const Part& part) {
+    if (part.dropped || part.queue.empty()) return false;
+    return !(part.first && part.queue.size() == 1 && part.queue.front().has_summary());
+  };
+  // Not waiting for a part with chunks past the end: its reader may wait for room and never end.
   changed_.wait(lock, [&] {
-    return std::all_of(parts_.begin(), parts_.end(), [](const Part& p) { return p.ended || p.dropped; });
+    return std::all_of(parts_.begin(), parts_.end(),
+                       [&](const Part& p) { return p.ended || p.dropped || past_the_end(p); });
   });
   for (size_t p = 0; p < parts_.size(); ++p) {
     const Part& part = parts_[p];
-    if (part.dropped) continue;
-    if (!part.status.ok()) return part.status;
-    // A server that does not split answers sent this part whole: only a summary, as part 0's
-    // answer had no chunk.
-    if (part.first && part.queue.size() == 1 && part.queue.front().has_summary()) continue;
-    if (!part.queue.empty()) {
+    if (past_the_end(part)) {
       return absl::InternalError(
           absl::StrCat("part ", p, " of ", parts_.size(), " of the Classify answer sent chunks past the answer's end"));
     }
+    if (!part.dropped && !part.status.ok()) return part.status;
   }
   return absl::OkStatus();
 }

@@ -465,7 +465,8 @@ absl::Status AlphaClient::Classify(const v1::ClassifyRequest& request,
                                    const std::function<absl::Status(const v1::ClassifyResponse&)>& on_message,
                                    uint64_t* wire_bytes) {
   if (wire_bytes != nullptr) *wire_bytes = 0;
-  if (!part_stubs_.empty() && !request.summary_only() && request.part_count() == 0) {
+  // A request that names a part itself goes as it is (the server checks it).
+  if (!part_stubs_.empty() && !request.summary_only() && request.part_count() == 0 && request.part_index() == 0) {
     return ClassifyInParts(request, on_message, wire_bytes);
   }
   const v1::SimplexEncoding encoding = request.simplex_encoding();
@@ -543,24 +544,19 @@ absl::Status AlphaClient::ClassifyInParts(const v1::ClassifyRequest& request,
     PrepareContext(contexts.back().get(), request.handle());
   }
   std::vector<uint64_t> read_bytes(parts, 0);
-  std::vector<std::thread> readers;
-  readers.reserve(parts);
-  for (size_t part = 0; part < parts; ++part) {
-    v1::ClassifyRequest part_request = request;
-    part_request.set_part_index(static_cast<uint32_t>(part));
-    part_request.set_part_count(static_cast<uint32_t>(parts));
+  // Part `part`'s call, read on its own thread; its chunks decoded there (P parts, P decoders).
+  const auto read_part = [&](size_t part, const v1::ClassifyRequest& part_request) {
+    grpc::ClientContext& context = *contexts[part];
     v1::AlphaShapes::Stub& stub = part == 0 ? *stub_ : *part_stubs_[part - 1];
-    // Each part's chunks are decoded on its own reader's thread: P parts, P decoders.
-    readers.emplace_back([&, part, part_request = std::move(part_request)] {
-      grpc::ClientContext& context = *contexts[part];
-      std::unique_ptr<grpc::ClientReader<v1::ClassifyResponse>> reader = stub.Classify(&context, part_request);
-      wire::SimplexChunkDecoder decoder;
-      v1::ClassifyResponse message, decoded;
-      uint64_t chunks = 0;  // this part's, so far: chunk `chunks` of this part is the answer's part + parts * chunks
-      absl::Status failed;
-      while (reader->Read(&message)) {
-        read_bytes[part] += message.ByteSizeLong();
-        if (!failed.ok()) continue;  // read on to the end after a failure
+    std::unique_ptr<grpc::ClientReader<v1::ClassifyResponse>> reader = stub.Classify(&context, part_request);
+    wire::SimplexChunkDecoder decoder;
+    v1::ClassifyResponse message, decoded;
+    uint64_t chunks = 0;  // this part's, so far: chunk `chunks` of this part is the answer's part + parts * chunks
+    absl::Status failed;
+    while (reader->Read(&message)) {
+      read_bytes[part] += message.ByteSizeLong();
+      if (!failed.ok()) continue;  // read on to the end after a failure
+      try {
         if (message.has_encoded_chunk()) {
           failed = decoder.Decode(message.encoded_chunk(), part + parts * chunks, decoded.mutable_chunk());
           if (!failed.ok()) {
@@ -571,20 +567,32 @@ absl::Status AlphaClient::ClassifyInParts(const v1::ClassifyRequest& request,
         }
         if (!message.has_summary()) ++chunks;
         merger.Push(part, std::move(message));  // refused once the merger stopped reading this part: read on
-        message.Clear();
-        decoded.Clear();
+      } catch (const std::exception& e) {       // out of memory: this part fails, and the answer with it
+        failed = absl::ResourceExhaustedError(
+            absl::StrCat("reading part ", part, " of ", parts, " of the Classify answer: ", e.what()));
+        context.TryCancel();
       }
-      const absl::Status status = FromGrpc(reader->Finish());
-      merger.End(part, failed.ok() ? status : failed);
-    });
-  }
+      message.Clear();
+      decoded.Clear();
+    }
+    const absl::Status status = FromGrpc(reader->Finish());
+    merger.End(part, failed.ok() ? status : failed);
+  };
   const auto stop_all = [&] {
     merger.Stop();
     for (auto& context : contexts) context->TryCancel();
   };
+  std::vector<std::thread> readers;
+  readers.reserve(parts);
   absl::Status result;
   bool others_cancelled = false;
   try {
+    for (size_t part = 0; part < parts; ++part) {
+      v1::ClassifyRequest part_request = request;
+      part_request.set_part_index(static_cast<uint32_t>(part));
+      part_request.set_part_count(static_cast<uint32_t>(parts));
+      readers.emplace_back(read_part, part, std::move(part_request));
+    }
     for (;;) {
       absl::StatusOr<const v1::ClassifyResponse*> next = merger.Next();
       if (!next.ok()) {
@@ -605,7 +613,8 @@ absl::Status AlphaClient::ClassifyInParts(const v1::ClassifyRequest& request,
       }
     }
   } catch (...) {
-    // A caller's callback that throws: the calls end and the readers are joined first.
+    // A thread that could not start, or a caller's callback that throws: the calls end and the
+    // started readers are joined first.
     stop_all();
     for (std::thread& reader : readers) reader.join();
     throw;

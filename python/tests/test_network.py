@@ -252,7 +252,9 @@ def test_an_unknown_answer_encoding_is_refused() -> None:
         galpha.aio.connect("localhost:1", answer_encoding="lz4")
 
 
-def test_classify_read_in_parts_is_the_one_call_answer(server) -> None:
+def test_classify_read_in_parts_is_the_one_call_answer(server, monkeypatch) -> None:
+    from galpha import _network
+
     # Shuffled points with several chunks of every kind (131,072 simplices a chunk), in parts dealt
     # round-robin by the server and merged back by the client, sync and asyncio, raw and delta.
     points = np.random.default_rng(7).random((160000, 2))
@@ -271,6 +273,10 @@ def test_classify_read_in_parts_is_the_one_call_answer(server) -> None:
 
     with galpha.connect(server.address, timeout=60, classify_parts=1, answer_encoding="raw") as c:
         want = answers(c)
+    # Every split answer goes through merge_parts: none was read whole from each part.
+    merged = []
+    real_merge = _network.merge_parts
+    monkeypatch.setattr(_network, "merge_parts", lambda parts: merged.append(len(parts)) or real_merge(parts))
     for parts in (2, 5, 64, 0):
         for encoding in ("raw", "delta"):
             with galpha.connect(server.address, timeout=60, classify_parts=parts, answer_encoding=encoding) as c:
@@ -281,6 +287,33 @@ def test_classify_read_in_parts_is_the_one_call_answer(server) -> None:
                 for field in fields:
                     np.testing.assert_array_equal(getattr(g, field), getattr(w, field), err_msg=f"{parts} parts {field}")
                     np.testing.assert_array_equal(getattr(a, field), getattr(w, field), err_msg=f"aio {parts} {field}")
+    # Two answers, sync and asyncio, two encodings: 8 merges a part count (0 on 2 cores is one call).
+    assert len(merged) == sum(8 for parts in (2, 5, 64, 0) if _network.classify_parts_count(parts) > 1)
+
+
+def test_classify_in_parts_from_a_server_that_does_not_split(server, monkeypatch) -> None:
+    # A server older than part_count answers every part whole (simulated: the requests go without
+    # the part fields). The client keeps part 0's answer and cancels the others.
+    from galpha import _network
+
+    points = np.random.default_rng(8).random((60000, 2))
+    with galpha.connect(server.address, timeout=60, classify_parts=1) as c:
+        family = c.build(points)
+        k = family.spectrum_size
+        want = family.classify(rank=k // 2)
+    monkeypatch.setattr(_network, "part_requests", lambda request, parts: [request] * parts)
+    monkeypatch.setattr(_network, "merge_parts", lambda parts: pytest.fail("the whole answers were merged"))
+
+    async def aio_answer():
+        async with galpha.aio.connect(server.address, timeout=60, classify_parts=4) as c:
+            return await (await c.build(points)).classify(rank=k // 2)
+
+    with galpha.connect(server.address, timeout=60, classify_parts=4) as c:
+        got = c.build(points).classify(rank=k // 2)
+    got_aio = asyncio.run(aio_answer())
+    for field in ("vertices", "vertex_classes", "edges", "edge_classes", "triangles", "triangle_classes"):
+        np.testing.assert_array_equal(getattr(got, field), getattr(want, field), err_msg=field)
+        np.testing.assert_array_equal(getattr(got_aio, field), getattr(want, field), err_msg=field)
 
 
 def test_merge_parts_deals_chunks_back_and_refuses_what_does_not_fit() -> None:

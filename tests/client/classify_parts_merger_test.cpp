@@ -157,6 +157,19 @@ TEST(ClassifyPartsMergerTest, ChunksPastTheAnswersEndAreAnError) {
   for (std::thread& reader : readers) reader.join();
   EXPECT_THAT(error, StatusIs(absl::StatusCode::kInternal));
   EXPECT_NE(error.message().find("part 1 of 2"), std::string::npos) << error;
+
+  // More chunks past the end than the part may queue: its reader waits for room, and the merger
+  // must not wait for its end.
+  const std::vector<v1::ClassifyResponse> longer = WholeAnswer(40);
+  std::vector<std::vector<v1::ClassifyResponse>> many = {PartOf(longer, 0, 2), PartOf(longer, 1, 2)};
+  many[0].resize(2);  // the answer ends at chunk 2; part 1 goes on to chunk 39
+  ClassifyPartsMerger small(2, 1);
+  std::vector<std::thread> more = StartReaders(&small, many, ends, 10);
+  absl::Status stuck;
+  Drain(small, &stuck);
+  small.Stop();  // releases the reader waiting for room, as the client does after an error
+  for (std::thread& reader : more) reader.join();
+  EXPECT_THAT(stuck, StatusIs(absl::StatusCode::kInternal));
 }
 
 TEST(ClassifyPartsMergerTest, PartZeroMustStartWithTheSummary) {

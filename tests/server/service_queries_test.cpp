@@ -254,8 +254,8 @@ TEST(ServiceTest, EveryQueryMatchesTheLocalEngine) {
 
 // A Classify answer read in parts (ClientOptions::classify_parts, ClassifyRequest.part_count) is
 // handed over as one call's, message for message, in every encoding, filtered or not. 300,000
-// points: every kind spans several chunks. (Every other test reads in the default parts, and
-// compares the rows with the local engine.)
+// points: every kind spans several chunks. (The other tests read in the default parts: half the
+// machine's cores, so one part on 2 cores.)
 TEST(ServiceTest, ClassifyReadInPartsIsTheSameAnswer) {
   auto server = StartServer(TestServerOptions());
   ASSERT_NE(server, nullptr);
@@ -271,13 +271,18 @@ TEST(ServiceTest, ClassifyReadInPartsIsTheSameAnswer) {
   }
   auto built = clients[0]->Build(points);
   ASSERT_THAT(built, IsOk());
-  const auto messages_of = [&](client::AlphaClient& client, const v1::ClassifyRequest& request) {
+  // The messages handed over, and the bytes that came down. A real split brings down the one
+  // call's bytes exactly (the same messages); a server that ignored part_count, read in parts by
+  // the client, would bring down P whole answers: the byte count tells the two apart.
+  const auto messages_of = [&](client::AlphaClient& client, const v1::ClassifyRequest& request, uint64_t* bytes) {
     std::vector<std::string> messages;
-    EXPECT_THAT(client.Classify(request,
-                                [&](const v1::ClassifyResponse& message) {
-                                  messages.push_back(message.SerializeAsString());
-                                  return absl::OkStatus();
-                                }),
+    EXPECT_THAT(client.Classify(
+                    request,
+                    [&](const v1::ClassifyResponse& message) {
+                      messages.push_back(message.SerializeAsString());
+                      return absl::OkStatus();
+                    },
+                    bytes),
                 IsOk());
     return messages;
   };
@@ -288,11 +293,14 @@ TEST(ServiceTest, ClassifyReadInPartsIsTheSameAnswer) {
       request.mutable_threshold()->set_rank(static_cast<int64_t>(built->summary.spectrum_size() / 2));
       request.set_simplex_encoding(encoding);
       request.set_non_exterior_only(non_exterior_only);
-      const std::vector<std::string> whole = messages_of(*clients[0], request);
+      uint64_t whole_bytes = 0;
+      const std::vector<std::string> whole = messages_of(*clients[0], request, &whole_bytes);
       ASSERT_GT(whole.size(), 8u) << "the test needs an answer of several chunks";
       for (size_t c = 1; c < clients.size(); ++c) {
-        EXPECT_EQ(messages_of(*clients[c], request), whole)
+        uint64_t bytes = 0;
+        EXPECT_EQ(messages_of(*clients[c], request, &bytes), whole)
             << "encoding " << encoding << ", non_exterior_only " << non_exterior_only << ", client " << c;
+        EXPECT_EQ(bytes, whole_bytes) << "client " << c << ": the server did not split the answer";
       }
     }
   }

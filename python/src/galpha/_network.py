@@ -627,13 +627,49 @@ class NetworkFamilyBackend:
 
     def _classify_messages(self, request: pb.ClassifyRequest) -> List[bytes]:
         methods = [self._calls.classify] + self._calls.part_classify
-        if len(methods) == 1 or request.summary_only:
+        if len(methods) == 1 or request.summary_only or request.part_count or request.part_index:
             return self._stream(self._calls.classify, request)
-        # The parts at once, a thread and a connection each (their waits release the GIL).
-        requests = part_requests(request, len(methods))
-        with concurrent.futures.ThreadPoolExecutor(len(methods)) as pool:
-            futures = [pool.submit(self._stream, m, r) for m, r in zip(methods, requests)]
-            return merge_parts([f.result() for f in futures])
+        # The parts at once, a thread and a connection each (their waits release the GIL). The
+        # first failure cancels the others; so does a server that answers every part whole.
+        metadata = self._calls.metadata(self._handle)
+        calls = [m(r, timeout=self._calls.timeout, metadata=metadata) for m, r in zip(methods, part_requests(request, len(methods)))]
+        older_server = threading.Event()
+
+        def read(part: int) -> List[bytes]:
+            messages: List[bytes] = []
+            try:
+                for raw in calls[part]:
+                    if part > 0 and not messages and _wire.split_oneof(raw)[0] == 1:
+                        older_server.set()  # a summary outside part 0: part 0 is the whole answer
+                        for call in calls[1:]:
+                            call.cancel()
+                        return messages
+                    messages.append(raw)
+            except grpc.RpcError:
+                if part > 0 and older_server.is_set():
+                    return messages  # cancelled here
+                raise
+            return messages
+
+        with concurrent.futures.ThreadPoolExecutor(len(calls)) as pool:
+            futures = [pool.submit(read, part) for part in range(len(calls))]
+            try:
+                concurrent.futures.wait(futures, return_when=concurrent.futures.FIRST_EXCEPTION)
+            except BaseException:  # Ctrl-C: the calls end before the pool is left
+                for call in calls:
+                    call.cancel()
+                raise
+            failed = [f.exception() for f in futures if f.done() and f.exception() is not None]
+            if failed:
+                for call in calls:
+                    call.cancel()
+        if failed:
+            error = failed[0]
+            if isinstance(error, grpc.RpcError):
+                raise raise_from_rpc(error) from None
+            raise error
+        parts = [f.result() for f in futures]
+        return parts[0] if older_server.is_set() else merge_parts(parts)
 
     def shape_rings(self, threshold: Threshold, mode: Mode, min_hole_area: float = 0.0) -> ShapeRings:
         request = shape_request(self._handle, threshold, mode, min_hole_area)

@@ -169,14 +169,56 @@ class AsyncFamily:
         if len(methods) == 1 or summary_only:
             messages = await self._stream(self._calls.classify, request)
         else:
-            # The parts at once, a connection each.
-            requests = _network.part_requests(request, len(methods))
-            parts = await asyncio.gather(*(self._stream(m, r) for m, r in zip(methods, requests)))
-            messages = _network.merge_parts(parts)
+            messages = await self._classify_in_parts(methods, request)
         assembler = _network.ClassifyAssembler()
         for raw in messages:
             assembler.add(raw)
         return assembler.result()
+
+    async def _classify_in_parts(self, methods: List[Any], request: pb.ClassifyRequest) -> List[bytes]:
+        """The parts of one Classify answer at once, a connection each, merged in order. The first
+        failure cancels the others; so does a server that answers every part whole."""
+        metadata = self._metadata()
+        calls = [
+            m(r, timeout=self._calls.timeout, metadata=metadata)
+            for m, r in zip(methods, _network.part_requests(request, len(methods)))
+        ]
+        older_server = False
+
+        async def read(part: int) -> List[bytes]:
+            nonlocal older_server
+            messages: List[bytes] = []
+            try:
+                async for raw in calls[part]:
+                    if part > 0 and not messages and _wire.split_oneof(raw)[0] == 1:
+                        older_server = True  # a summary outside part 0: part 0 is the whole answer
+                        for call in calls[1:]:
+                            call.cancel()
+                        return messages
+                    messages.append(raw)
+            except (grpc.RpcError, asyncio.CancelledError):
+                if part > 0 and older_server:
+                    return messages  # cancelled here
+                raise
+            return messages
+
+        tasks = [asyncio.ensure_future(read(part)) for part in range(len(calls))]
+        try:
+            done, _ = await asyncio.wait(tasks, return_when=asyncio.FIRST_EXCEPTION)
+            failed = [t.exception() for t in tasks if t.done() and not t.cancelled() and t.exception() is not None]
+            if failed:
+                raise failed[0]
+            parts = await asyncio.gather(*tasks)
+        except grpc.RpcError as e:
+            raise _network.raise_from_rpc(e) from None
+        finally:
+            if not all(t.done() for t in tasks):  # a failure, or the caller cancelled: the calls end
+                for call in calls:
+                    call.cancel()
+                for task in tasks:
+                    task.cancel()
+                await asyncio.gather(*tasks, return_exceptions=True)
+        return parts[0] if older_server else _network.merge_parts(parts)
 
     async def shape_rings(
         self,
