@@ -5,9 +5,10 @@
 //                  [--dists=NAME,...(default: every generator)] [--seed=1] [--data FILE.bin]...
 // Per input, best of --repeat: the whole in-process call (points in host memory -> family
 // usable) of each form and their ratio; the host form's "download" stage and the resident one's
-// "keep_resident"; ClassifyAll at the middle level from each form; ToHostFamily (the download done
-// later, when asked); bytes per input point that each form holds (resident: where the tables live,
-// and on the host), and each build's engine working-memory peak. Every answer of the resident
+// "keep_resident"; ClassifyAll at the middle level from each form; the regularized shape there
+// from each form (AssembleShape of the host family's complex, ResidentAlphaFamily::ShapeAt);
+// ToHostFamily (the download done later, when asked); bytes per input point that each form holds
+// (resident: where the tables live, and on the host), and each build's engine working-memory peak. Every answer of the resident
 // family at the middle level is checked against the host family's (the bench fails on a
 // difference).
 #include <algorithm>
@@ -20,6 +21,7 @@
 
 #include "bench/bench_options.hpp"
 #include "core/family/alpha_family.hpp"
+#include "core/geometry/shape.hpp"
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gpu/alpha/resident_family.hpp"
 
@@ -50,6 +52,9 @@ struct ResidentResult {
   double host_call_ms = kNone, resident_call_ms = kNone;
   double download_ms = 0, keep_ms = 0;  // of the fastest calls
   double host_classify_ms = kNone, resident_classify_ms = kNone;
+  // The regularized shape at the middle level: AssembleShape of the host family's complex against
+  // the resident family's ShapeAt (its boundary found where the tables live).
+  double host_shape_ms = kNone, resident_shape_ms = kNone;
   double to_host_ms = kNone;
   double host_bytes_per_point = 0, resident_device_per_point = 0, resident_host_per_point = 0;
   // The engine's working-memory peak (its ledger: device memory on CUDA, host memory on the CPU).
@@ -118,6 +123,25 @@ ResidentResult RunOne(const std::string& name, const std::vector<Point2>& points
         at.ok() && at->components == host->Components(level) && at->holes == host->Holes(level, ClassifyMode::kGeneral);
 
     start = std::chrono::steady_clock::now();
+    const absl::StatusOr<ShapeGeometry> host_shape = AssembleShape(host->ComplexAt(level, ClassifyMode::kRegularized));
+    r.host_shape_ms = std::min(r.host_shape_ms, MillisecondsSince(start));
+    start = std::chrono::steady_clock::now();
+    const absl::StatusOr<ShapeGeometry> resident_shape = resident->ShapeAt(level, ClassifyMode::kRegularized);
+    r.resident_shape_ms = std::min(r.resident_shape_ms, MillisecondsSince(start));
+    if (!host_shape.ok() || !resident_shape.ok()) {
+      r.error = (host_shape.ok() ? resident_shape.status() : host_shape.status()).ToString();
+      break;
+    }
+    r.same &= resident_shape->area == host_shape->area &&
+              resident_shape->polygons.size() == host_shape->polygons.size() &&
+              resident_shape->singular_edges == host_shape->singular_edges &&
+              resident_shape->isolated_points == host_shape->isolated_points;
+    for (size_t p = 0; r.same && p < host_shape->polygons.size(); ++p) {
+      r.same &= resident_shape->polygons[p].outer == host_shape->polygons[p].outer &&
+                resident_shape->polygons[p].holes == host_shape->polygons[p].holes;
+    }
+
+    start = std::chrono::steady_clock::now();
     const absl::StatusOr<AlphaFamily> downloaded = resident->ToHostFamily();
     r.to_host_ms = std::min(r.to_host_ms, MillisecondsSince(start));
     if (!downloaded.ok()) {
@@ -135,12 +159,12 @@ void PrintRow(const ResidentResult& r) {
     return;
   }
   std::printf(
-      "| %s | %zu | %s | %.1f | %.1f | %.2fx | %.1f | %.1f | %.2f | %.2f | %.1f | %.0f | %.0f + %.0f | %.0f / %.0f | "
-      "%s |\n",
+      "| %s | %zu | %s | %.1f | %.1f | %.2fx | %.1f | %.1f | %.2f | %.2f | %.1f / %.1f | %.1f | %.0f | %.0f + %.0f | "
+      "%.0f / %.0f | %s |\n",
       r.name.c_str(), r.n, r.backend.c_str(), r.host_call_ms, r.resident_call_ms, r.host_call_ms / r.resident_call_ms,
-      r.download_ms, r.keep_ms, r.host_classify_ms, r.resident_classify_ms, r.to_host_ms, r.host_bytes_per_point,
-      r.resident_device_per_point, r.resident_host_per_point, r.host_peak_per_point, r.resident_peak_per_point,
-      r.same ? "same" : "DIFFERENT");
+      r.download_ms, r.keep_ms, r.host_classify_ms, r.resident_classify_ms, r.host_shape_ms, r.resident_shape_ms,
+      r.to_host_ms, r.host_bytes_per_point, r.resident_device_per_point, r.resident_host_per_point,
+      r.host_peak_per_point, r.resident_peak_per_point, r.same ? "same" : "DIFFERENT");
   std::fflush(stdout);
 }
 
@@ -163,9 +187,10 @@ int Main(int argc, char** argv) {
   std::printf(
       "| input | n | backend | host family: whole call ms | resident family: whole call ms | host / resident | "
       "host's download stage ms | resident's keep stage ms | ClassifyAll from the host family ms | "
-      "ClassifyAll from the resident family ms | ToHostFamily ms | host family B/pt | resident B/pt (tables + host) | "
-      "engine peak B/pt (host / resident build) | answers |\n"
-      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
+      "ClassifyAll from the resident family ms | regularized shape ms (host AssembleShape / resident ShapeAt) | "
+      "ToHostFamily ms | host family B/pt | resident B/pt (tables + host) | engine peak B/pt (host / resident build) | "
+      "answers |\n"
+      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");
   bool failed = false;
   auto run = [&](const std::string& name, const std::vector<Point2>& points) {
     std::fprintf(stderr, "running %s n=%zu\n", name.c_str(), points.size());
