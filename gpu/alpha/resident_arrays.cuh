@@ -131,10 +131,13 @@ struct JoinPiecesAcrossEdge {
   }
 };
 
-/// Each triangle's parent set to its piece's root (its smallest triangle id).
+/// Each triangle's piece: its root (the piece's smallest triangle id), into an array of its own.
+/// Not into `parent`: another thread's path halving may store an older ancestor over a root
+/// written there, while every label here is final.
 struct LabelPiece {
   uint32_t* parent;
-  GALPHA_HD void operator()(uint32_t t) const { StoreRelaxed(parent + t, FindPieceRoot(parent, t)); }
+  uint32_t* piece;
+  GALPHA_HD void operator()(uint32_t t) const { piece[t] = FindPieceRoot(parent, t); }
 };
 
 /// An edge with a complex triangle on exactly one side (none: the hull's outside).
@@ -304,11 +307,11 @@ class ResidentTablesOn final : public ResidentTables {
     Buffer<uint8_t, System> in(sys, num_tri);
     thrust::for_each_n(sys.policy(), zero, num_tri, TriangleInComplex{t.tri_rank.data(), level, in.data()});
     // The pieces: the complex's triangles joined across the edges between two of them.
-    Buffer<uint32_t, System> piece(sys, num_tri);
-    thrust::sequence(sys.policy(), piece.data(), piece.data() + num_tri);
+    Buffer<uint32_t, System> parent(sys, num_tri), piece(sys, num_tri);
+    thrust::sequence(sys.policy(), parent.data(), parent.data() + num_tri);
     thrust::for_each_n(sys.policy(), zero, num_edges,
-                       JoinPiecesAcrossEdge{t.edge_triangles.data(), in.data(), piece.data()});
-    thrust::for_each_n(sys.policy(), zero, num_tri, LabelPiece{piece.data()});
+                       JoinPiecesAcrossEdge{t.edge_triangles.data(), in.data(), parent.data()});
+    thrust::for_each_n(sys.policy(), zero, num_tri, LabelPiece{parent.data(), piece.data()});
     Buffer<uint32_t, System> edges(sys, num_edges);
     const auto boundary = static_cast<size_t>(thrust::copy_if(sys.policy(), zero, zero + num_edges, edges.data(),
                                                               IsBoundaryEdge{t.edge_triangles.data(), in.data()}) -
