@@ -109,43 +109,44 @@ ClassificationSummary SummarizeClassification(const HostVector<uint32_t>& repres
   return summary;
 }
 
-ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const HostVector<uint32_t>& representative,
-                                              const HostVector<std::array<uint32_t, 3>>& mesh_triangles,
-                                              const Classification& classes) {
-  ClassificationSummary summary = CountAll(representative, classes);
-  const int64_t nt = static_cast<int64_t>(classes.triangles.size());
-  // The interior triangles' terms first, on every core (each reads three points at random: most of
-  // the pass's time), then added in order; the others' are 0 (written, since the packing reads
-  // every term, and first touched by the threads that fill them).
-  const std::unique_ptr<double[]> terms(new double[static_cast<size_t>(nt)]);
-#pragma omp parallel for schedule(static)
-  for (int64_t t = 0; t < nt; ++t) {
-    double term = 0.0;
-    if (classes.triangles[t] == SimplexClass::kInterior) {
-      const auto& tri = mesh_triangles[t];
-      term = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
-    }
-    terms[static_cast<size_t>(t)] = term;
-  }
-  summary.interior_area = InteriorArea(terms.get(), classes);
-  return summary;
-}
+namespace {
 
-double InteriorAreaOfFlagged(const HostVector<Point2>& p, const HostVector<std::array<uint32_t, 3>>& triangles,
-                             const std::vector<uint8_t>& in_complex) {
+// The interior triangles' terms first, on every core (each reads three points at random: most of
+// the pass's time), then added in order; the others' are 0 (written, since the packing reads every
+// term, and first touched by the threads that fill them).
+template <typename Interior>
+double InteriorAreaFromPoints(const HostVector<Point2>& p, const HostVector<std::array<uint32_t, 3>>& triangles,
+                              Interior interior) {
   const int64_t nt = static_cast<int64_t>(triangles.size());
   const std::unique_ptr<double[]> terms(new double[static_cast<size_t>(nt)]);
 #pragma omp parallel for schedule(static)
   for (int64_t t = 0; t < nt; ++t) {
     double term = 0.0;
-    if (in_complex[static_cast<size_t>(t)] != 0) {
+    if (interior(t)) {
       const auto& tri = triangles[t];
       term = 0.5 * Orient2dApprox(p[tri[0]], p[tri[1]], p[tri[2]]);
     }
     terms[static_cast<size_t>(t)] = term;
   }
+  return AddInteriorTermsInOrder(terms.get(), nt, interior);
+}
+
+}  // namespace
+
+ClassificationSummary SummarizeClassification(const HostVector<Point2>& p, const HostVector<uint32_t>& representative,
+                                              const HostVector<std::array<uint32_t, 3>>& mesh_triangles,
+                                              const Classification& classes) {
+  ClassificationSummary summary = CountAll(representative, classes);
+  const SimplexClass* cls = classes.triangles.data();
+  summary.interior_area =
+      InteriorAreaFromPoints(p, mesh_triangles, [cls](int64_t t) { return cls[t] == SimplexClass::kInterior; });
+  return summary;
+}
+
+double InteriorAreaOfFlagged(const HostVector<Point2>& p, const HostVector<std::array<uint32_t, 3>>& triangles,
+                             const std::vector<uint8_t>& in_complex) {
   const uint8_t* in = in_complex.data();
-  return AddInteriorTermsInOrder(terms.get(), nt, [in](int64_t t) { return in[t] != 0; });
+  return InteriorAreaFromPoints(p, triangles, [in](int64_t t) { return in[t] != 0; });
 }
 
 }  // namespace galpha

@@ -202,8 +202,8 @@ class NetworkClient:
         return_exceptions: bool = False,
     ) -> List[Any]:
         """Builds many point sets in one call (a GIS layer's features, a group-by's groups): the
-        server reads them from one stream and builds them one after the other, each cached under
-        its own handle as :meth:`build` would cache it. ``sets``: a mapping of name to points, or
+        server reads them from one stream and builds them in one job (small sets on its host's
+        cores at once, one a core), each cached under its own handle as :meth:`build` would cache it. ``sets``: a mapping of name to points, or
         a sequence of (name, points) pairs, each points argument as :meth:`build` takes it (the
         name labels the set, as :meth:`build`'s ``name``). ``crs`` applies to every set (by
         default each one's own, as :meth:`build`); geographic sets are each projected on their own.
