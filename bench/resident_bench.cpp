@@ -8,9 +8,8 @@
 // "keep_resident"; ClassifyAll at the middle level from each form; the regularized shape there
 // from each form (AssembleShape of the host family's complex, ResidentAlphaFamily::ShapeAt);
 // ToHostFamily (the download done later, when asked); bytes per input point that each form holds
-// (resident: where the tables live, and on the host), and each build's engine working-memory peak. Every answer of the resident
-// family at the middle level is checked against the host family's (the bench fails on a
-// difference).
+// (resident: where the tables live, and on the host), and each build's engine working-memory peak. Every answer of the
+// resident family at the middle level is checked against the host family's (the bench fails on a difference).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
