@@ -627,7 +627,7 @@ class NetworkFamilyBackend:
 
     def _classify_messages(self, request: pb.ClassifyRequest) -> List[bytes]:
         methods = [self._calls.classify] + self._calls.part_classify
-        if len(methods) == 1 or request.summary_only or request.part_count or request.part_index:
+        if len(methods) == 1 or request.summary_only:
             return self._stream(self._calls.classify, request)
         # The parts at once, a thread and a connection each (their waits release the GIL). The
         # first failure cancels the others; so does a server that answers every part whole.
