@@ -6,9 +6,10 @@
 // edges in filtration order, the elder of two components the one with the lowest vertex index),
 // H1 over the dual graph (triangles and the outer face, edges in reverse filtration order, the
 // elder the latest triangle in the filtration, the outer face before all). In both, the edges that
-// join two components are the minimum spanning forest of the processing order, which Borůvka's
-// rounds find in parallel (component_curve.cuh), and each forest edge kills the younger of the
-// two components' eldest members. Which those are is what Kruskal's order decides, and what
+// join two components are the minimum spanning forest of the processing order: the primal one
+// Borůvka's rounds find in parallel (component_curve.cuh), the dual one is its complement
+// (OutsideForest says why), and each forest edge kills the younger of the two components' eldest
+// members. Which those are is what Kruskal's order decides, and what
 // PairBySplicing computes without following it edge by edge (see there for why it is exact).
 //
 // Keys. The filtration orders edges by (birth rank, canonical position): one 64-bit key,
@@ -23,6 +24,7 @@
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
 #include <thrust/scatter.h>
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
@@ -525,12 +527,19 @@ void ElderRuleForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint3
 
 // ---- The pairs ---------------------------------------------------------------------------------
 
-/// Alexander duality, checked: an edge closes a loop in the primal (it is not in the primal
-/// forest) exactly when it joins two components of the complement (it is in the dual forest).
-struct ViolatesDuality {
-  const uint8_t* primal;
-  const uint8_t* dual;
-  GALPHA_HD bool operator()(uint32_t p) const { return primal[p] == dual[p]; }
+/// The dual forest is the primal forest's complement (tree-cotree duality). The mesh's edges form
+/// a connected plane graph (the triangulation of the visible distinct points; hidden points and
+/// duplicates are isolated nodes, in no edge), its faces the triangles and the outer face, and the
+/// weights are unique. An edge e outside the primal minimum spanning tree T is the heaviest edge of
+/// its fundamental cycle in T + e; the edges of a plane cycle are, in the dual, the edges of a cut,
+/// so e is the heaviest edge of a dual cut, and the maximum spanning tree of the dual (the minimum
+/// of the complemented weights: the dual forest) contains it (the cut property). So E \ T is in the
+/// dual tree, and both have E - V + 1 = F - 1 edges (Euler: V - E + F = 2, F = T + 1 faces): they
+/// are equal. The count is checked; the host's union-finds (core/family/persistence.cpp), which
+/// find both forests independently and check the duality edge by edge, are the tests' oracle.
+struct OutsideForest {
+  const uint8_t* forest;
+  GALPHA_HD uint8_t operator()(uint32_t p) const { return forest[p] == 0 ? 1 : 0; }
 };
 
 struct RecordVertexKiller {
@@ -633,7 +642,7 @@ uint32_t SortedPairs(System& sys, Buffer<PersistencePair, System>& candidates, u
 
 /// The diagram of core/family/persistence.hpp, pair for pair. `host_finish`: pair the forests'
 /// slow tails on the host (PairBySplicing); false runs every round on the system (tests).
-/// Throws EngineError kInternal if the family contradicts planar duality.
+/// Throws EngineError kInternal if the family's mesh is no connected plane triangulation.
 template <class System>
 void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_finish, StageTimer<System>& timer,
                                 PersistenceOut* out) {
@@ -681,23 +690,26 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
       sys.DownloadAsync({{out->pairs.data(), components.data(), num_components * sizeof(PersistencePair)}});
   timer.EndStage("persistence_h0");
   {
+    thrust::transform(policy, zero, zero + num_edges, dual_forest.data(), OutsideForest{primal_forest.data()});
+    const auto num_dual = static_cast<uint32_t>(
+        thrust::copy_if(policy, thrust::make_transform_iterator(zero, DualEdge{in.edge_tris, num_tri, key}),
+                        thrust::make_transform_iterator(zero + num_edges, DualEdge{in.edge_tris, num_tri, key}),
+                        graph.data(), InForest{dual_forest.data(), 0xFFFFFFFFu}) -
+        graph.data());
+    if (num_dual != num_tri) {
+      throw EngineError(EngineError::Kind::kInternal,
+                        "persistence: the mesh is no connected plane triangulation (" + std::to_string(num_edges) +
+                            " edges, " + std::to_string(num_edges - num_dual) + " in a spanning tree, " +
+                            std::to_string(num_tri) + " triangles)");
+    }
     Buffer<uint64_t, System> age(sys, size_t{num_tri} + 1);
     thrust::transform(policy, zero, zero + (num_tri + 1), age.data(),
                       DualNodeAge{in.tri_rank, triangle_position.data(), num_tri});
-    thrust::transform(policy, zero, zero + num_edges, graph.data(), DualEdge{in.edge_tris, num_tri, key});
-    // Cycles: the edges around each vertex (around a hull vertex through the outer face).
-    ElderRuleForest(sys, graph.data(), num_edges, num_tri + 1, EdgeCycles{nullptr, in.edges}, in.num_points, age.data(),
-                    0xFFFFFFFFu, host_finish, dual_forest.data(), dual_killed.data(), &out->report.forests[1]);
+    PairBySplicing(sys, graph.data(), num_dual, num_tri + 1, age.data(), 0xFFFFFFFFu, host_finish, dual_killed.data(),
+                   &out->report.forests[1]);
   }
   timer.EndStage("persistence_h1");
   graph.Reset();
-  const auto violations = static_cast<uint32_t>(
-      thrust::count_if(policy, zero, zero + num_edges, ViolatesDuality{primal_forest.data(), dual_forest.data()}));
-  if (violations != 0) {
-    throw EngineError(EngineError::Kind::kInternal,
-                      "persistence: " + std::to_string(violations) +
-                          " edges close a loop exactly when they do not join two components of the complement");
-  }
   Buffer<PersistencePair, System> holes(sys, 0);
   uint32_t num_holes = 0;
   {

@@ -19,8 +19,9 @@ struct ForestPairing {
 
 struct PersistenceReport {
   /// persistence_upload (CUDA, from a family in host memory), persistence_orders (canonical),
-  /// persistence_h0 and persistence_h1 (forest and elder rule), persistence_pairs (sorted on the
-  /// backend), persistence_download.
+  /// persistence_h0 (the primal forest and its elder rule), persistence_h1 (the dual forest, the
+  /// primal's complement, and its elder rule), persistence_pairs (sorted on the backend),
+  /// persistence_download.
   std::vector<StageTime> stage_times;
   /// The primal forest (H0) and the dual one (H1).
   ForestPairing forests[2];
