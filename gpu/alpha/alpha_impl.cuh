@@ -736,11 +736,13 @@ MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, con
 }
 
 /// Component and hole curves over all levels (Borůvka spanning forests, component_curve.cuh) and
-/// the area curve (area_curve.cuh).
+/// the area curve (area_curve.cuh). Given the canonical edge positions, the general forest is also
+/// the persistence diagram's primal forest, marked by position in `primal_forest_mark`.
 template <class System>
 ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                                         const Buffer<EdgeTris, System>& edge_tris, const SpectrumRanks<System>& ranks,
-                                        const IntervalRanks<System>& iv) {
+                                        const IntervalRanks<System>& iv, const uint32_t* edge_position = nullptr,
+                                        uint8_t* primal_forest_mark = nullptr) {
   const size_t levels = static_cast<size_t>(ranks.num_ranks) + 1;
   ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, levels),
                                  Buffer<uint32_t, System>(sys, levels),
@@ -753,9 +755,9 @@ ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
       sys,
       TopologyCurvesIn{mesh.n, mesh.num_vertices, mesh.num_tri, mesh.num_edges, ranks.num_ranks, mesh.edges,
                        edge_tris.data(), mesh.representative, ranks.tri_rank.data(), ranks.edge_rho_rank.data(),
-                       iv.edge_mu_low.data(), iv.edge_mu_high.data(), iv.vertex_tri_low.data()},
+                       iv.edge_mu_low.data(), iv.edge_mu_high.data(), iv.vertex_tri_low.data(), edge_position},
       TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
-                        counts.regularized_components.data(), counts.regularized_holes.data()});
+                        counts.regularized_components.data(), counts.regularized_holes.data(), primal_forest_mark});
   counts.area_scale =
       AreaCurve(sys, AreaCurveIn{mesh.points, mesh.tri, ranks.tri_rank.data(), mesh.n, mesh.num_tri, ranks.num_ranks},
                 counts.area_units.data());
@@ -885,24 +887,43 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   std::optional<PendingDownloadOf<System>> tables_download;
   if (resident == nullptr)
     tables_download.emplace(StartTablesDownload(sys, mesh, edge_tris, ranks, values, intervals, out));
+  // The persistence diagram reads the family's arrays where they lie, while the tables download.
+  // Its canonical orders come first: with them the curves' general forest is its primal forest.
+  const PersistenceIn persistence_in{mesh.n,
+                                     mesh.num_edges,
+                                     mesh.num_tri,
+                                     mesh.edges,
+                                     edge_tris.data(),
+                                     mesh.tri,
+                                     ranks.edge_rho_rank.data(),
+                                     intervals.edge_mu_low.data(),
+                                     ranks.tri_rank.data(),
+                                     mesh.representative,
+                                     mesh.hidden};
+  std::optional<CanonicalOrders<System>> orders;
+  Buffer<uint8_t, System> primal_forest(sys, persistence ? mesh.num_edges : 0);
+  if (persistence) {
+    orders.emplace(CanonicalOrdersOf(sys, persistence_in));
+    timer.EndStage("persistence_orders");
+  }
   // The curves before the master list: their forests' working space is the build's largest, and
   // the master list is not yet held beside it.
-  ComponentCounts<System> components = CountComponents(sys, mesh, edge_tris, ranks, intervals);
+  ComponentCounts<System> components =
+      CountComponents(sys, mesh, edge_tris, ranks, intervals, persistence ? orders->edge_position.data() : nullptr,
+                      persistence ? primal_forest.data() : nullptr);
   timer.EndStage("components");
   MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
   timer.EndStage("master_list");
   if (persistence) {
-    // While the tables download: the arrays it reads are the family's, where they lie.
     PersistenceOut diagram;
-    PersistenceDiagramOnSystem(sys,
-                               PersistenceIn{mesh.n, mesh.num_edges, mesh.num_tri, mesh.edges, edge_tris.data(),
-                                             mesh.tri, ranks.edge_rho_rank.data(), intervals.edge_mu_low.data(),
-                                             ranks.tri_rank.data(), mesh.representative, mesh.hidden},
-                               /*host_finish=*/true, timer, &diagram);
+    PersistenceDiagramOnSystem(sys, persistence_in, *orders, primal_forest.data(), /*host_finish=*/true, timer,
+                               &diagram);
     family->persistence.pairs = std::move(diagram.pairs);
     family->persistence.dimension_begin[1] = diagram.num_h0;
     family->persistence.dimension_begin[2] = family->persistence.pairs.size();
     family->has_persistence = true;
+    orders.reset();
+    primal_forest.Reset();
   }
   if (resident != nullptr) {
     KeepResidentTables(sys, mesh, t, edge_tris, ranks, values, intervals, master, components, &host_mesh, resident,

@@ -80,7 +80,8 @@ struct ForestOutputs {
   /// Forest edges counted at their rank (a weight's high word).
   uint32_t* merges_at_rank = nullptr;
   /// Forest edges marked with 1 at their index: (low word of the weight ^ mark_xor) - 1, for
-  /// weights that carry one (the persistence pairing's keys, persistence_pairs.cuh).
+  /// weights that carry one (the persistence pairing's keys, persistence_pairs.cuh). In a run of
+  /// several graphs, the first graph's edges only.
   uint8_t* forest_mark = nullptr;
   uint32_t mark_xor = 0;
   /// Whether edges of rank kNeverRank are graph edges (the curves leave them out).
@@ -126,8 +127,12 @@ struct HookAcrossEdge {
   }
   GALPHA_HD void Hook(uint32_t c, uint32_t other, unsigned long long weight) const {
     parent[c] = other;
-    if (out.merges_at_rank != nullptr) AtomicIncrement(&out.MergesOf(c)[static_cast<uint32_t>(weight >> 32)]);
-    if (out.forest_mark != nullptr) out.forest_mark[(static_cast<uint32_t>(weight) ^ out.mark_xor) - 1u] = 1;
+    const auto rank = static_cast<uint32_t>(weight >> 32);
+    // A kept kNeverRank edge (the persistence diagram's) joins at no level.
+    if (out.merges_at_rank != nullptr && rank != kNeverRank) AtomicIncrement(&out.MergesOf(c)[rank]);
+    if (out.forest_mark != nullptr && c < out.part_begin[0]) {
+      out.forest_mark[(static_cast<uint32_t>(weight) ^ out.mark_xor) - 1u] = 1;
+    }
   }
 };
 
@@ -293,16 +298,20 @@ void ForestOfGraphEdges(System& sys, WeightedEdge* active, uint32_t num_active, 
   }
 }
 
-/// The general graph: nodes are input indices, an edge appears at its birth.
+/// The general graph: nodes are input indices, an edge appears at its birth. Ties of rank are
+/// broken by edge id, or, given `edge_position`, by canonical position (the persistence diagram's
+/// filtration key, persistence_pairs.cuh: birth << 32 | (position + 1)).
 struct GeneralGraphEdge {
   const EdgeIdx* edges;
   const uint32_t* rho;
   const uint32_t* mu_low;
   uint32_t first_node = 0;  // where the graph's nodes start in a run of several graphs
+  const uint32_t* edge_position = nullptr;
   GALPHA_HD WeightedEdge operator()(uint32_t e) const {
     const uint32_t birth = EdgeBirthRank(rho[e], mu_low[e]);
+    const uint32_t tie = edge_position != nullptr ? edge_position[e] + 1u : e;
     return WeightedEdge{first_node + edges[e].v[0], first_node + edges[e].v[1],
-                        (static_cast<uint64_t>(birth) << 32) | e};
+                        (static_cast<uint64_t>(birth) << 32) | tie};
   }
 };
 
@@ -476,15 +485,16 @@ class ForestRun {
       : sys_(sys), num_edges_(num_edges), flags_(sys, size_t{num_edges} * num_graphs), cycle_max_(sys, max_cycles) {}
 
   /// Flags graph `index`'s candidate edges (the generator `graph` places its nodes; kNeverRank
-  /// edges are no graph edges: the curves count edges that appear).
+  /// edges are no graph edges unless `keep_never`: the curves count edges that appear).
   template <class Graph>
-  void Flag(uint32_t index, Graph graph, EdgeCycles cycles, uint32_t num_cycles) {
+  void Flag(uint32_t index, Graph graph, EdgeCycles cycles, uint32_t num_cycles, bool keep_never = false) {
     auto policy = sys_.policy();
     thrust::counting_iterator<uint32_t> zero(0);
     thrust::fill_n(policy, cycle_max_.data(), num_cycles, 0ull);
-    thrust::for_each_n(policy, zero, num_edges_, OfferWeightToCycles<Graph>{graph, cycles, cycle_max_.data(), false});
+    thrust::for_each_n(policy, zero, num_edges_,
+                       OfferWeightToCycles<Graph>{graph, cycles, cycle_max_.data(), keep_never});
     thrust::transform(policy, zero, zero + num_edges_, flags_.data() + size_t{index} * num_edges_,
-                      IsForestCandidate<Graph>{graph, cycles, cycle_max_.data(), false});
+                      IsForestCandidate<Graph>{graph, cycles, cycle_max_.data(), keep_never});
   }
 
   /// Packs the flagged edges of every graph (the same generators, in the same order) and runs the
@@ -553,6 +563,10 @@ struct TopologyCurvesIn {
   const uint32_t* edge_mu_low;
   const uint32_t* edge_mu_high;
   const uint32_t* vertex_tri_low;
+  /// Given, the general graph breaks ties by canonical position and keeps its kNeverRank edges:
+  /// its forest is then the persistence diagram's primal forest, marked in
+  /// TopologyCurvesOut::general_forest_mark.
+  const uint32_t* edge_position = nullptr;
 };
 
 /// The curves of one family over levels 0..num_ranks.
@@ -562,6 +576,9 @@ struct TopologyCurvesOut {
   uint32_t* holes;                   ///< b1 of the general complex
   uint32_t* regularized_components;  ///< b0 of the regularized complex (triangles joined at vertices)
   uint32_t* regularized_holes;       ///< b1 of the regularized complex
+  /// With TopologyCurvesIn::edge_position: the general forest's edges marked 1 by canonical
+  /// position (the others 0); one byte an edge.
+  uint8_t* general_forest_mark = nullptr;
 };
 
 /// The component and hole curves over levels 0..num_ranks: GENERAL components (every distinct
@@ -583,7 +600,8 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   if (num_nodes >= UINT32_MAX) {  // 4n at most, and the input has at most 2^30 points
     throw EngineError(EngineError::Kind::kInternal, "too many points and triangles for the component curves");
   }
-  const GeneralGraphEdge general{in.edges, in.edge_rho, in.edge_mu_low, 0};
+  const GeneralGraphEdge general{in.edges, in.edge_rho, in.edge_mu_low, 0, in.edge_position};
+  const bool primal_forest = in.edge_position != nullptr && out.general_forest_mark != nullptr;
   const RegularizedGraphEdge regularized{in.edges, in.edge_mu_low, in.num_points};
   const SolidGraphEdge solid{in.edge_tris, in.edge_mu_high, 2 * in.num_points};
   const EdgeCycles triangles{in.edge_tris, nullptr}, fans{nullptr, in.edges};
@@ -592,7 +610,8 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   uint32_t* solid_merges = out.solid_components;
   {
     ForestRun<System> run(sys, in.num_edges, in.num_tri > in.num_points ? in.num_tri : in.num_points, 3);
-    run.Flag(0, general, triangles, in.num_tri);
+    // The primal forest keeps the edges never born (they join last, and change no curve).
+    run.Flag(0, general, triangles, in.num_tri, /*keep_never=*/primal_forest);
     run.Flag(1, regularized, triangles, in.num_tri);
     run.Flag(2, solid, fans, in.num_points);
     for (uint32_t* merges : {general_merges, regularized_merges, solid_merges}) {
@@ -604,6 +623,10 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
     forest_out.part_begin[1] = 2 * in.num_points;
     forest_out.part_merges[0] = regularized_merges;
     forest_out.part_merges[1] = solid_merges;
+    if (primal_forest) {
+      thrust::fill_n(policy, out.general_forest_mark, in.num_edges, uint8_t{0});
+      forest_out.forest_mark = out.general_forest_mark;
+    }
     run.Run(static_cast<uint32_t>(num_nodes), forest_out, general, regularized, solid);
   }
   prefix(general_merges);

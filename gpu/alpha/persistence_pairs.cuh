@@ -169,6 +169,22 @@ void CanonicalTriangleOrder(System& sys, const PersistenceIn& in, Buffer<uint32_
   thrust::for_each_n(policy, zero, in.num_tri, InvertOrder{order->data(), position->data()});
 }
 
+/// A family's canonical orders: ids by position, and each id's position.
+template <class System>
+struct CanonicalOrders {
+  Buffer<uint32_t, System> edge_order, edge_position, triangle_order, triangle_position;
+};
+
+template <class System>
+CanonicalOrders<System> CanonicalOrdersOf(System& sys, const PersistenceIn& in) {
+  CanonicalOrders<System> orders{Buffer<uint32_t, System>(sys, in.num_edges),
+                                 Buffer<uint32_t, System>(sys, in.num_edges), Buffer<uint32_t, System>(sys, in.num_tri),
+                                 Buffer<uint32_t, System>(sys, in.num_tri)};
+  CanonicalEdgeOrder(sys, in, &orders.edge_order, &orders.edge_position);
+  CanonicalTriangleOrder(sys, in, &orders.triangle_order, &orders.triangle_position);
+  return orders;
+}
+
 // ---- The two graphs -------------------------------------------------------------------------------
 
 /// An edge's filtration key: birth << 32 | (canonical position + 1).
@@ -640,32 +656,46 @@ uint32_t SortedPairs(System& sys, Buffer<PersistencePair, System>& candidates, u
   return num_listed;
 }
 
-/// The diagram of core/family/persistence.hpp, pair for pair. `host_finish`: pair the forests'
-/// slow tails on the host (PairBySplicing); false runs every round on the system (tests).
-/// Throws EngineError kInternal if the family's mesh is no connected plane triangulation.
+/// The diagram of core/family/persistence.hpp, pair for pair, from the family's canonical
+/// `orders`. `primal_forest_found`: the primal forest's edges marked by canonical position where the
+/// build's component curves found them (TopologyCurvesOut::general_forest_mark: the same forest,
+/// their general graph then having these weights and edges), or null to find it here.
+/// `host_finish`: pair the forests' slow tails on the host (PairBySplicing); false runs every round
+/// on the system (tests). Throws EngineError kInternal if the family's mesh is no connected plane
+/// triangulation.
 template <class System>
-void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_finish, StageTimer<System>& timer,
+void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, const CanonicalOrders<System>& orders,
+                                const uint8_t* primal_forest_found, bool host_finish, StageTimer<System>& timer,
                                 PersistenceOut* out) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   const uint32_t num_edges = in.num_edges, num_tri = in.num_tri;
-  Buffer<uint32_t, System> edge_order(sys, num_edges), edge_position(sys, num_edges);
-  Buffer<uint32_t, System> triangle_order(sys, num_tri), triangle_position(sys, num_tri);
-  CanonicalEdgeOrder(sys, in, &edge_order, &edge_position);
-  CanonicalTriangleOrder(sys, in, &triangle_order, &triangle_position);
-  timer.EndStage("persistence_orders");
-  const EdgeFiltrationKey key{in.edge_rho_rank, in.edge_mu_low, edge_position.data()};
+  const uint32_t* edge_order = orders.edge_order.data();
+  const uint32_t* triangle_order = orders.triangle_order.data();
+  const EdgeFiltrationKey key{in.edge_rho_rank, in.edge_mu_low, orders.edge_position.data()};
 
   Buffer<WeightedEdge, System> graph(sys, num_edges);
-  Buffer<uint8_t, System> primal_forest(sys, num_edges), dual_forest(sys, num_edges);
+  Buffer<uint8_t, System> primal_forest(sys, primal_forest_found != nullptr ? 0 : num_edges),
+      dual_forest(sys, num_edges);
+  const uint8_t* primal_marks = primal_forest_found != nullptr ? primal_forest_found : primal_forest.data();
   Buffer<uint64_t, System> primal_killed(sys, num_edges), dual_killed(sys, num_edges);
   {
     Buffer<uint64_t, System> age(sys, in.num_points);
     thrust::transform(policy, zero, zero + in.num_points, age.data(), IdentityAge{});
-    thrust::transform(policy, zero, zero + num_edges, graph.data(), PrimalEdge{in.edges, key});
-    // Cycles: each triangle's edges.
-    ElderRuleForest(sys, graph.data(), num_edges, in.num_points, EdgeCycles{in.edge_tris, nullptr}, num_tri, age.data(),
-                    0u, host_finish, primal_forest.data(), primal_killed.data(), &out->report.forests[0]);
+    if (primal_forest_found != nullptr) {
+      const auto num_forest = static_cast<uint32_t>(
+          thrust::copy_if(policy, thrust::make_transform_iterator(zero, PrimalEdge{in.edges, key}),
+                          thrust::make_transform_iterator(zero + num_edges, PrimalEdge{in.edges, key}), graph.data(),
+                          InForest{primal_marks, 0u}) -
+          graph.data());
+      PairBySplicing(sys, graph.data(), num_forest, in.num_points, age.data(), 0u, host_finish, primal_killed.data(),
+                     &out->report.forests[0]);
+    } else {
+      thrust::transform(policy, zero, zero + num_edges, graph.data(), PrimalEdge{in.edges, key});
+      // Cycles: each triangle's edges.
+      ElderRuleForest(sys, graph.data(), num_edges, in.num_points, EdgeCycles{in.edge_tris, nullptr}, num_tri,
+                      age.data(), 0u, host_finish, primal_forest.data(), primal_killed.data(), &out->report.forests[0]);
+    }
   }
   // H0's pairs go to the host while the dual forest is computed. The host array has room for
   // every H1 pair too (at most one a dual forest edge: num_tri); it is not zeroed first
@@ -676,11 +706,11 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     Buffer<uint32_t, System> killer_position(sys, in.num_points);
     thrust::fill_n(policy, killer_position.data(), in.num_points, kNoPosition);
     thrust::for_each_n(policy, zero, num_edges,
-                       RecordVertexKiller{primal_forest.data(), primal_killed.data(), killer_position.data()});
+                       RecordVertexKiller{primal_marks, primal_killed.data(), killer_position.data()});
     Buffer<PersistencePair, System> candidates(sys, in.num_points);
     thrust::transform(policy, zero, zero + in.num_points, candidates.data(),
-                      ComponentPair{in.representative, in.hidden, killer_position.data(), edge_order.data(),
-                                    in.edge_rho_rank, in.edge_mu_low});
+                      ComponentPair{in.representative, in.hidden, killer_position.data(), edge_order, in.edge_rho_rank,
+                                    in.edge_mu_low});
     num_components = SortedPairs<System, uint32_t>(sys, candidates, in.num_points, DeathKey{}, &components);
   }
   out->pairs = HostVector<PersistencePair>(size_t{num_components} + num_tri);
@@ -690,7 +720,7 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
       sys.DownloadAsync({{out->pairs.data(), components.data(), num_components * sizeof(PersistencePair)}});
   timer.EndStage("persistence_h0");
   {
-    thrust::transform(policy, zero, zero + num_edges, dual_forest.data(), OutsideForest{primal_forest.data()});
+    thrust::transform(policy, zero, zero + num_edges, dual_forest.data(), OutsideForest{primal_marks});
     const auto num_dual = static_cast<uint32_t>(
         thrust::copy_if(policy, thrust::make_transform_iterator(zero, DualEdge{in.edge_tris, num_tri, key}),
                         thrust::make_transform_iterator(zero + num_edges, DualEdge{in.edge_tris, num_tri, key}),
@@ -704,7 +734,7 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
     }
     Buffer<uint64_t, System> age(sys, size_t{num_tri} + 1);
     thrust::transform(policy, zero, zero + (num_tri + 1), age.data(),
-                      DualNodeAge{in.tri_rank, triangle_position.data(), num_tri});
+                      DualNodeAge{in.tri_rank, orders.triangle_position.data(), num_tri});
     PairBySplicing(sys, graph.data(), num_dual, num_tri + 1, age.data(), 0xFFFFFFFFu, host_finish, dual_killed.data(),
                    &out->report.forests[1]);
   }
@@ -714,9 +744,9 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
   uint32_t num_holes = 0;
   {
     Buffer<PersistencePair, System> candidates(sys, num_edges);
-    thrust::transform(policy, zero, zero + num_edges, candidates.data(),
-                      HolePair{dual_forest.data(), dual_killed.data(), edge_order.data(), triangle_order.data(),
-                               in.edge_rho_rank, in.edge_mu_low});
+    thrust::transform(
+        policy, zero, zero + num_edges, candidates.data(),
+        HolePair{dual_forest.data(), dual_killed.data(), edge_order, triangle_order, in.edge_rho_rank, in.edge_mu_low});
     num_holes = SortedPairs<System, uint64_t>(sys, candidates, num_edges, BirthDeathKey{}, &holes);
   }
   if (num_holes > num_tri) throw EngineError(EngineError::Kind::kInternal, "persistence: more holes than triangles");
@@ -725,6 +755,15 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_
   components_download.Wait();
   out->pairs.resize(size_t{num_components} + num_holes);  // smaller: no copy, no fill
   timer.EndStage("persistence_download");
+}
+
+/// The diagram, its canonical orders and both forests computed here (stage "persistence_orders").
+template <class System>
+void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, bool host_finish, StageTimer<System>& timer,
+                                PersistenceOut* out) {
+  const CanonicalOrders<System> orders = CanonicalOrdersOf(sys, in);
+  timer.EndStage("persistence_orders");
+  PersistenceDiagramOnSystem(sys, in, orders, nullptr, host_finish, timer, out);
 }
 
 /// The diagram from a family's arrays in host memory (`host`): the CUDA system uploads them first

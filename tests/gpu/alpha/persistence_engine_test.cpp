@@ -118,6 +118,16 @@ TEST_P(PersistenceEngineTest, ComputedInTheBuild) {
     const absl::StatusOr<PersistenceDiagram> answered = PersistenceDiagramOf(*family);
     ASSERT_THAT(answered, IsOk());
     ExpectSame(*answered, *host);
+    // The curves' general forest doubles as the diagram's primal forest in such a build: its
+    // curves are the plain build's.
+    options.persistence = false;
+    absl::StatusOr<AlphaFamily> plain = BuildAlphaFamily(generator.generate(4000, 5), options);
+    ASSERT_THAT(plain, IsOk());
+    EXPECT_EQ(family->ranks().components, plain->ranks().components);
+    EXPECT_EQ(family->ranks().holes, plain->ranks().holes);
+    EXPECT_EQ(family->ranks().regularized_components, plain->ranks().regularized_components);
+    EXPECT_EQ(family->ranks().regularized_holes, plain->ranks().regularized_holes);
+    EXPECT_EQ(family->ranks().solid_components, plain->ranks().solid_components);
   }
   std::vector<Point2> points = gen::Uniform(3000, 4);
   std::vector<double> weights(points.size());
