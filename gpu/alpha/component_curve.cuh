@@ -409,8 +409,7 @@ struct CountRegularizedVertex {
 // A cycle counts only when all its edges are graph edges: an edge that is none (a loop, or a
 // kNeverRank edge the graph leaves out) offers the largest weight there is, so a cycle through it
 // drops nothing. A vertex on the hull has hull edges (mu-high kNeverRank) around it in the solid
-// graph, so its fan, which is no cycle there, drops nothing either; in the persistence diagram's
-// dual graph the hull edges join the outer face, and a hull vertex's fan is a cycle through it.
+// graph, so its fan, which is no cycle there, drops nothing either.
 
 /// The cycles an edge lies on: its triangles (`edge_tris`, for graphs over points) or the fans
 /// around its two ends (`edges`, for graphs over triangles); one of the two is null.
