@@ -23,6 +23,7 @@
 #include <thrust/count.h>
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
+#include <thrust/gather.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/scatter.h>
@@ -640,19 +641,34 @@ struct BirthDeathKey {
   }
 };
 
+/// The sort key of the candidate an index names.
+template <class KeyOf>
+struct KeyOfCandidate {
+  const PersistencePair* candidates;
+  KeyOf key_of;
+  GALPHA_HD auto operator()(uint32_t i) const { return key_of(candidates[i]); }
+};
+
 /// The listed pairs of `candidates` (made in the order of their last sort field: H0 by vertex,
 /// H1 by the creator's canonical position), stably sorted by `key`, into `*listed`; their number.
+/// The sort moves 4-byte indices beside the keys, not the 20-byte pairs, which are gathered once
+/// in the end (the same order: a stable sort of the same keys).
 template <class System, class Key, class KeyOf>
 uint32_t SortedPairs(System& sys, Buffer<PersistencePair, System>& candidates, uint32_t num_candidates, KeyOf key_of,
                      Buffer<PersistencePair, System>* listed) {
   auto policy = sys.policy();
-  *listed = Buffer<PersistencePair, System>(sys, num_candidates);
+  thrust::counting_iterator<uint32_t> zero(0);
+  Buffer<uint32_t, System> index(sys, num_candidates);
   const auto num_listed = static_cast<uint32_t>(
-      thrust::copy_if(policy, candidates.data(), candidates.data() + num_candidates, listed->data(), IsListed{}) -
-      listed->data());
-  Buffer<Key, System> keys(sys, num_listed);
-  thrust::transform(policy, listed->data(), listed->data() + num_listed, keys.data(), key_of);
-  thrust::stable_sort_by_key(policy, keys.data(), keys.data() + num_listed, listed->data());
+      thrust::copy_if(policy, zero, zero + num_candidates, candidates.data(), index.data(), IsListed{}) - index.data());
+  {
+    Buffer<Key, System> keys(sys, num_listed);
+    thrust::transform(policy, index.data(), index.data() + num_listed, keys.data(),
+                      KeyOfCandidate<KeyOf>{candidates.data(), key_of});
+    thrust::stable_sort_by_key(policy, keys.data(), keys.data() + num_listed, index.data());
+  }
+  *listed = Buffer<PersistencePair, System>(sys, num_listed);
+  thrust::gather(policy, index.data(), index.data() + num_listed, candidates.data(), listed->data());
   return num_listed;
 }
 
