@@ -551,15 +551,19 @@ absl::Status AlphaClient::ClassifyInParts(const v1::ClassifyRequest& request,
     std::unique_ptr<grpc::ClientReader<v1::ClassifyResponse>> reader = stub.Classify(&context, part_request);
     wire::SimplexChunkDecoder decoder;
     v1::ClassifyResponse message, decoded;
-    uint64_t chunks = 0;  // this part's, so far: chunk `chunks` of this part is the answer's part + parts * chunks
+    // This part's chunks so far. Its chunk k is the answer's chunk part + parts * k, unless the server
+    // (older than parts) answered part 0 whole; a decoding error names the part and k, right in both.
+    uint64_t chunks = 0;
     absl::Status failed;
     while (reader->Read(&message)) {
       read_bytes[part] += message.ByteSizeLong();
       if (!failed.ok()) continue;  // read on to the end after a failure
       try {
         if (message.has_encoded_chunk()) {
-          failed = decoder.Decode(message.encoded_chunk(), part + parts * chunks, decoded.mutable_chunk());
+          failed = decoder.Decode(message.encoded_chunk(), chunks, decoded.mutable_chunk());
           if (!failed.ok()) {
+            failed = absl::Status(failed.code(), absl::StrCat("part ", part, " of ", parts,
+                                                              " of the Classify answer, its ", failed.message()));
             context.TryCancel();
             continue;
           }
