@@ -519,27 +519,16 @@ struct InForest {
   }
 };
 
-/// The forest of a graph (edges one per family edge, clobbered), marked by canonical position,
-/// and its elder-rule kills.
+/// Marks by canonical position the minimum spanning forest of a graph whose edges are `graph` (one
+/// per family edge, weighted by their filtration keys; clobbered as working space).
 template <class System>
-void ElderRuleForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint32_t num_nodes, EdgeCycles cycles,
-                     uint32_t num_cycles, const uint64_t* node_age, uint32_t mark_xor, bool host_finish,
-                     uint8_t* forest_mark, uint64_t* killed_age, ForestPairing* report) {
-  auto policy = sys.policy();
-  thrust::fill_n(policy, forest_mark, num_edges, uint8_t{0});
-  Buffer<WeightedEdge, System> forest(sys, num_edges);
-  thrust::copy_n(policy, graph, num_edges, forest.data());
+void MarkSpanningForest(System& sys, WeightedEdge* graph, uint32_t num_edges, uint32_t num_nodes, EdgeCycles cycles,
+                        uint32_t num_cycles, uint8_t* forest_mark) {
+  thrust::fill_n(sys.policy(), forest_mark, num_edges, uint8_t{0});
   ForestOutputs out;
   out.forest_mark = forest_mark;
-  out.mark_xor = mark_xor;
   out.keep_never = true;
   SpanningForest(sys, graph, num_edges, num_nodes, cycles, num_cycles, out);
-  // The forest's edges, as the graph gave them (SpanningForest relabelled its copy).
-  const auto num_forest = static_cast<uint32_t>(
-      thrust::copy_if(policy, forest.data(), forest.data() + num_edges, graph, InForest{forest_mark, mark_xor}) -
-      graph);
-  forest.Reset();
-  PairBySplicing(sys, graph, num_forest, num_nodes, node_age, mark_xor, host_finish, killed_age, report);
 }
 
 // ---- The pairs ---------------------------------------------------------------------------------
@@ -698,20 +687,19 @@ void PersistenceDiagramOnSystem(System& sys, const PersistenceIn& in, const Cano
   {
     Buffer<uint64_t, System> age(sys, in.num_points);
     thrust::transform(policy, zero, zero + in.num_points, age.data(), IdentityAge{});
-    if (primal_forest_found != nullptr) {
-      const auto num_forest = static_cast<uint32_t>(
-          thrust::copy_if(policy, thrust::make_transform_iterator(zero, PrimalEdge{in.edges, key}),
-                          thrust::make_transform_iterator(zero + num_edges, PrimalEdge{in.edges, key}), graph.data(),
-                          InForest{primal_marks, 0u}) -
-          graph.data());
-      PairBySplicing(sys, graph.data(), num_forest, in.num_points, age.data(), 0u, host_finish, primal_killed.data(),
-                     &out->report.forests[0]);
-    } else {
+    if (primal_forest_found == nullptr) {
       thrust::transform(policy, zero, zero + num_edges, graph.data(), PrimalEdge{in.edges, key});
       // Cycles: each triangle's edges.
-      ElderRuleForest(sys, graph.data(), num_edges, in.num_points, EdgeCycles{in.edge_tris, nullptr}, num_tri,
-                      age.data(), 0u, host_finish, primal_forest.data(), primal_killed.data(), &out->report.forests[0]);
+      MarkSpanningForest(sys, graph.data(), num_edges, in.num_points, EdgeCycles{in.edge_tris, nullptr}, num_tri,
+                         primal_forest.data());
     }
+    const auto num_forest = static_cast<uint32_t>(
+        thrust::copy_if(policy, thrust::make_transform_iterator(zero, PrimalEdge{in.edges, key}),
+                        thrust::make_transform_iterator(zero + num_edges, PrimalEdge{in.edges, key}), graph.data(),
+                        InForest{primal_marks, 0u}) -
+        graph.data());
+    PairBySplicing(sys, graph.data(), num_forest, in.num_points, age.data(), 0u, host_finish, primal_killed.data(),
+                   &out->report.forests[0]);
   }
   // H0's pairs go to the host while the dual forest is computed. The host array has room for
   // every H1 pair too (at most one a dual forest edge: num_tri); it is not zeroed first
