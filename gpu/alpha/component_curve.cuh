@@ -79,11 +79,10 @@ struct OfferLightestEdge {
 struct ForestOutputs {
   /// Forest edges counted at their rank (a weight's high word).
   uint32_t* merges_at_rank = nullptr;
-  /// Forest edges marked with 1 at their index: (low word of the weight ^ mark_xor) - 1, for
+  /// Forest edges marked with 1 at their index: (low word of the weight) - 1, for
   /// weights that carry one (the persistence pairing's keys, persistence_pairs.cuh). In a run of
   /// several graphs, the first graph's edges only.
   uint8_t* forest_mark = nullptr;
-  uint32_t mark_xor = 0;
   /// Whether edges of rank kNeverRank are graph edges (the curves leave them out).
   bool keep_never = false;
   /// Several graphs in one run (disjoint node ranges, so that their rounds share launches and
@@ -131,7 +130,7 @@ struct HookAcrossEdge {
     // A kept kNeverRank edge (the persistence diagram's) joins at no level.
     if (out.merges_at_rank != nullptr && rank != kNeverRank) AtomicIncrement(&out.MergesOf(c)[rank]);
     if (out.forest_mark != nullptr && c < out.part_begin[0]) {
-      out.forest_mark[(static_cast<uint32_t>(weight) ^ out.mark_xor) - 1u] = 1;
+      out.forest_mark[static_cast<uint32_t>(weight) - 1u] = 1;
     }
   }
 };
