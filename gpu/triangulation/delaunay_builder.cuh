@@ -115,6 +115,7 @@ class DelaunayBuilder {
         nbr_(sys, capacity_),
         tri_vote_(sys, capacity_),
         edge_vote_(sys, capacity_),
+        edge_third_vote_(sys, 0),
         split_count_or_nb_(sys, capacity_),
         flip_vote_(sys, capacity_),
         partner_(sys, capacity_),
@@ -137,6 +138,7 @@ class DelaunayBuilder {
   void ReleaseWorkspace() {
     tri_vote_.Reset();
     edge_vote_.Reset();
+    edge_third_vote_.Reset();
     split_count_or_nb_.Reset();
     flip_vote_.Reset();
     partner_.Reset();
@@ -198,16 +200,22 @@ class DelaunayBuilder {
     for (;;) {
       ++rounds_;
       unsigned long long* edge_vote = second_winners ? edge_vote_.data() : nullptr;
+      // Votes by thirds (VoteForInsertion), unweighted only, from the round after one that saw a
+      // point on an edge's line: their slots are allocated then, so that input without such
+      // points (uniform) never holds them.
+      unsigned long long* edge_third_vote =
+          second_winners && edge_third_vote_.size() > 0 ? edge_third_vote_.data() : nullptr;
       const thrust::counting_iterator<int32_t> tfirst(0);
       thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       ResetVotes{tri_vote_.data(), edge_vote, second_count, saw_edge_point});
+                       ResetVotes{tri_vote_.data(), edge_vote, edge_third_vote, second_count, saw_edge_point});
       WithWeightedness([&](auto weighted) {
-        sys_.ForEachBelow(pending_count, VoteForInsertion<decltype(weighted)::value>{
-                                             mesh_, pending, location, tri_vote_.data(), edge_vote, saw_edge_point});
+        sys_.ForEachBelow(pending_count,
+                          VoteForInsertion<decltype(weighted)::value>{mesh_, pending, location, tri_vote_.data(),
+                                                                      edge_vote, saw_edge_point, edge_third_vote});
       });
       if (second_winners) {
         thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                         PickSecondWinners{tri_vote_.data(), edge_vote_.data(), second_count});
+                         PickSecondWinners{tri_vote_.data(), edge_vote_.data(), edge_third_vote, second_count});
       }
       // Inclusive, so that its last entry is the number of splits.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
@@ -232,6 +240,9 @@ class DelaunayBuilder {
       if (num_pending == 0) return;
       if (num_split == 0) throw EngineError(EngineError::Kind::kInternal, "insertion round elected no point");
       second_winners = saw_edge != 0;
+      if (second_winners && hidden_ == nullptr && edge_third_vote_.size() == 0) {
+        edge_third_vote_ = Buffer<unsigned long long, System>(sys_, capacity_);
+      }
       SplitElected(pending, inserted, num_split, /*num_listed=*/3, 0);
       if (num_second > 0) {
         // The second winners split the children that hold them; the number of those splits is
@@ -532,6 +543,9 @@ class DelaunayBuilder {
   // The votes of points on an edge's line (VoteForInsertion), then each triangle's second winner
   // (PickSecondWinners).
   Buffer<unsigned long long, System> edge_vote_;
+  // The votes by thirds of points on the second half of an edge's line (VoteForInsertion); empty
+  // until a round sees a point on an edge's line, and in weighted builds.
+  Buffer<unsigned long long, System> edge_third_vote_;
   // Split counts (inclusive scan) while splitting, the neighbour of each flip proposal while
   // flipping: never both at once, so one buffer serves both.
   Buffer<int32_t, System> split_count_or_nb_;

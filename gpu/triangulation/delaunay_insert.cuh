@@ -53,6 +53,16 @@ GALPHA_HD inline int ScoreExponent(double a, double b, double c, double d) {
 /// edge, and with one winner a round the two lines took turns there, so the second line fell
 /// behind by a factor that doubled every two rounds and its late points then took over fans of
 /// the first line's hundreds of points, one flip an iteration (bench/README.md, two_lines).
+///
+/// Points on an edge's line of a triangle that is not a sliver (that edge at least a quarter of
+/// its longest; `edge_third_vote` set) are voted by thirds instead: those on the edge's first half
+/// in `edge_vote`, nearest the point a third along it, those on its second half in
+/// `edge_third_vote`, nearest two thirds along. A triangle whose only points lie on its edge then
+/// inserts both, and the edge's points are split in three parts a round, not two: a line of
+/// points (parallel_lines, a grid's rows) takes log3 rounds instead of log2, and every round costs
+/// a relocation of all the points still pending. Slivers keep the one vote nearest the
+/// circumcentre: two crossing lines' long fans (a far point and the many close points of the other
+/// line) took more flip iterations by thirds, not fewer (measured: bench/README.md).
 template <bool kWeighted>
 struct VoteForInsertion {
   MeshView mesh;
@@ -62,6 +72,30 @@ struct VoteForInsertion {
   unsigned long long* edge_vote;  // per triangle: the votes of points on an edge's line; nullptr:
                                   // they vote in tri_vote (a round without second winners)
   uint32_t* saw_edge_point;       // set when a point on an edge's line voted
+  // Per triangle: the votes of points on the second half of an edge's line, by thirds; nullptr:
+  // no votes by thirds (weighted builds, and rounds before any point on an edge's line was seen).
+  unsigned long long* edge_third_vote;
+
+  /// The vote by thirds of point i, on the line of the edge from u to v (vectors relative to the
+  /// triangle's first vertex, scaled): its position along the edge picks the slot, its distance
+  /// from the third or the two thirds the key.
+  GALPHA_HD void VoteByThirds(uint32_t i, int32_t t, double ux, double uy, double vx, double vy, double px,
+                              double py) const {
+    const double ex = vx - ux, ey = vy - uy;
+    const double along = ((px - ux) * ex + (py - uy) * ey) / (ex * ex + ey * ey);
+    const bool second_half = along >= 0.5;
+    const double off = along - (second_half ? 2.0 / 3.0 : 1.0 / 3.0);
+    const float score = static_cast<float>(off * off);
+    const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
+    cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(second_half ? edge_third_vote[t]
+                                                                                     : edge_vote[t]);
+    slot.fetch_min(key);
+  }
+
+  GALPHA_HD void MarkEdgePointSeen() const {
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device> seen(*saw_edge_point);
+    if (seen.load(cuda::memory_order_relaxed) == 0) seen.store(1u, cuda::memory_order_relaxed);
+  }
 
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t t = location[i];
@@ -114,8 +148,27 @@ struct VoteForInsertion {
       const double px = ldexp(p.x - a.x, -e), py = ldexp(p.y - a.y, -e);
       const double d = bx * cy - by * cx;
       const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-      on_edge_line =
-          bx * py - by * px == 0.0 || cx * py - cy * px == 0.0 || (cx - bx) * (py - by) - (cy - by) * (px - bx) == 0.0;
+      const bool on_ab = bx * py - by * px == 0.0, on_ac = cx * py - cy * px == 0.0;
+      const bool on_bc = (cx - bx) * (py - by) - (cy - by) * (px - bx) == 0.0;
+      on_edge_line = on_ab || on_ac || on_bc;
+      if constexpr (!kWeighted) {
+        if (on_edge_line && edge_third_vote != nullptr) {
+          const double bc2 = (cx - bx) * (cx - bx) + (cy - by) * (cy - by);
+          const double longest2 = fmax(fmax(b2, c2), bc2);
+          const double edge2 = on_ab ? b2 : (on_ac ? c2 : bc2);
+          if (16.0 * edge2 >= longest2) {
+            MarkEdgePointSeen();
+            if (on_ab) {
+              VoteByThirds(i, t, 0.0, 0.0, bx, by, px, py);
+            } else if (on_ac) {
+              VoteByThirds(i, t, 0.0, 0.0, cx, cy, px, py);
+            } else {
+              VoteByThirds(i, t, bx, by, cx, cy, px, py);
+            }
+            return;
+          }
+        }
+      }
       if (d != 0.0) {
         // Weighted, the same height of p's lift over the triangle's lifted plane, with lifts less
         // their weight relative to a's: the deepest point wins, and a heavy point, which hides the
@@ -149,26 +202,25 @@ struct VoteForInsertion {
       }
     }
     const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
-    if (on_edge_line) {
-      cuda::atomic_ref<uint32_t, cuda::thread_scope_device> seen(*saw_edge_point);
-      if (seen.load(cuda::memory_order_relaxed) == 0) seen.store(1u, cuda::memory_order_relaxed);
-    }
+    if (on_edge_line) MarkEdgePointSeen();
     cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(
         on_edge_line && edge_vote != nullptr ? edge_vote[t] : tri_vote[t]);
     slot.fetch_min(key);
   }
 };
 
-/// Clears a round's votes (`edge_vote` too unless it is nullptr) and, in thread 0, its counts of
-/// second winners and of points on an edge's line: one launch for what were three.
+/// Clears a round's votes (`edge_vote` and `edge_third_vote` too unless nullptr) and, in thread 0,
+/// its counts of second winners and of points on an edge's line: one launch for what were three.
 struct ResetVotes {
   unsigned long long* tri_vote;
   unsigned long long* edge_vote;
+  unsigned long long* edge_third_vote;
   uint32_t* second_count;
   uint32_t* saw_edge_point;
   GALPHA_HD void operator()(int32_t t) const {
     tri_vote[t] = kNoVote;
     if (edge_vote != nullptr) edge_vote[t] = kNoVote;
+    if (edge_third_vote != nullptr) edge_third_vote[t] = kNoVote;
     if (t == 0) {
       *second_count = 0;
       *saw_edge_point = 0;
@@ -178,13 +230,26 @@ struct ResetVotes {
 
 /// Per triangle: the better of its two classes' votes becomes the round's winner (`tri_vote`),
 /// the other class's best, where both voted, its second winner (`edge_vote`, else kNoVote),
-/// counted into `*num_second`.
+/// counted into `*num_second`. With votes by thirds (`edge_third_vote` set), a triangle with
+/// points inside takes the better of its two edge votes as its edge class's; one without takes
+/// its first-half edge vote as the inside class's and its second-half one as the edge class's, so
+/// that an edge's points alone still give two winners.
 struct PickSecondWinners {
   unsigned long long* tri_vote;
   unsigned long long* edge_vote;
+  const unsigned long long* edge_third_vote;
   uint32_t* num_second;
   GALPHA_HD void operator()(int32_t t) const {
-    const unsigned long long inside = tri_vote[t], on_edge = edge_vote[t];
+    unsigned long long inside = tri_vote[t], on_edge = edge_vote[t];
+    if (edge_third_vote != nullptr) {
+      const unsigned long long second_half = edge_third_vote[t];
+      if (inside == kNoVote) {
+        inside = on_edge != kNoVote ? on_edge : second_half;
+        on_edge = on_edge != kNoVote ? second_half : kNoVote;
+      } else {
+        on_edge = on_edge < second_half ? on_edge : second_half;
+      }
+    }
     tri_vote[t] = inside < on_edge ? inside : on_edge;
     const bool both = inside != kNoVote && on_edge != kNoVote;
     edge_vote[t] = both ? (inside < on_edge ? on_edge : inside) : kNoVote;
