@@ -14,6 +14,7 @@
 
 #include <thrust/copy.h>
 #include <thrust/count.h>
+#include <thrust/extrema.h>
 #include <thrust/fill.h>
 #include <thrust/find.h>
 #include <thrust/for_each.h>
@@ -357,11 +358,40 @@ struct IsHeavyVertex {
   GALPHA_HD bool operator()(int32_t v) const { return weight[v] > threshold; }
 };
 
+/// Orders vertex ids by their points in (x, y) order.
+struct VertexLexLess {
+  const Point2* pts;
+  GALPHA_HD bool operator()(int32_t a, int32_t b) const { return LexLess(pts[a], pts[b]); }
+};
+
+/// Orders vertex ids by their points in (y, x) order.
+struct VertexLexLessYX {
+  const Point2* pts;
+  GALPHA_HD bool operator()(int32_t a, int32_t b) const {
+    return pts[a].y < pts[b].y || (pts[a].y == pts[b].y && pts[a].x < pts[b].x);
+  }
+};
+
+/// Whether a vertex is one of the four extremes InsertRemainingVertices inserts first.
+struct IsExtremeVertex {
+  int32_t v[4];
+  GALPHA_HD bool operator()(int32_t x) const { return x == v[0] || x == v[1] || x == v[2] || x == v[3]; }
+};
+
 /// The most heavy vertices inserted before the others (InsertRemainingVertices): the others then
 /// walk from the first triangle through a mesh of at most this many vertices.
 constexpr uint32_t kMaxHeavyFirst = 1024;
 
 /// Inserts every vertex but the first triangle's into the builder's mesh, in rounds.
+///
+/// Unweighted, the first and last vertices in (x, y) and in (y, x) order, hull vertices all, are
+/// inserted first (a few rounds of one to four points). Why: a hull vertex inserted late takes
+/// over the fan its predecessor built, one flip an iteration; the ends of collinear runs (the ends
+/// of two crossing lines, whose longer line's far points all fan from the shorter line's end) are
+/// such vertices. Counted on the CPU backend at 1M: parallel_lines 212 -> 145 one-block flip
+/// iterations, two_lines 451 -> 402, grid 73 -> 60, uniform 76 -> 68 (ulp_lattice 66 -> 75,
+/// circle 280 -> 288); on an H200 the insertion of two_lines, parallel_lines and grid took 1.0 to
+/// 1.3 ms less (bench/README.md, twentieth session).
 ///
 /// Weighted, a few heavy vertices (IsHeavyVertex, at most kMaxHeavyFirst) are inserted first: the
 /// points their disks hide are then hidden on relocation, instead of being inserted before them
@@ -379,24 +409,32 @@ void InsertRemainingVertices(System& sys, DelaunayBuilder<System>* builder, Firs
   thrust::copy_if(pol, vfirst, vfirst + m, pending.begin(), NotInitialVertex{first.a, first.b, first.c});
   thrust::fill(pol, location.begin(), location.end(), 0);
   thrust::fill(pol, inserted.begin(), inserted.end(), uint8_t{0});
-  uint32_t num_heavy = 0;
+  // The vertices inserted first (heavy ones, or the extremes), moved to the front of `pending`.
+  uint32_t num_first = 0;
+  const Point2* pts = vertex_points.data();
   if (weights.weighted()) {
-    const Point2* pts = vertex_points.data();
     const BoundingBox box =
         thrust::transform_reduce(pol, pts, pts + m, PointToBox(), PointToBox()(sys.Read(pts)), MergeBoxes());
     const double spacing_sq = (box.max_x - box.min_x) * (box.max_y - box.min_y) / m;
     const double mean = thrust::reduce(pol, weights.weight.data(), weights.weight.data() + m, 0.0) / m;
     const auto heavy = IsHeavyVertex{weights.weight.data(), mean + 16.0 * spacing_sq};
-    num_heavy = static_cast<uint32_t>(thrust::count_if(pol, pending.begin(), pending.end(), heavy));
-    if (num_heavy > kMaxHeavyFirst) {
-      num_heavy = 0;
-    } else if (num_heavy > 0) {
+    num_first = static_cast<uint32_t>(thrust::count_if(pol, pending.begin(), pending.end(), heavy));
+    if (num_first > kMaxHeavyFirst) {
+      num_first = 0;
+    } else if (num_first > 0) {
       thrust::stable_partition(pol, pending.begin(), pending.end(), heavy);
-      builder->InsertAll(pending.data(), location.data(), inserted.data(), num_heavy);
     }
+  } else {
+    const IsExtremeVertex extreme{{*thrust::min_element(pol, vfirst, vfirst + m, VertexLexLess{pts}),
+                                   *thrust::max_element(pol, vfirst, vfirst + m, VertexLexLess{pts}),
+                                   *thrust::min_element(pol, vfirst, vfirst + m, VertexLexLessYX{pts}),
+                                   *thrust::max_element(pol, vfirst, vfirst + m, VertexLexLessYX{pts})}};
+    num_first = static_cast<uint32_t>(thrust::count_if(pol, pending.begin(), pending.end(), extreme));
+    if (num_first > 0) thrust::stable_partition(pol, pending.begin(), pending.end(), extreme);
   }
-  builder->InsertAll(pending.data() + num_heavy, location.data() + num_heavy, inserted.data() + num_heavy,
-                     num_pending - num_heavy);
+  if (num_first > 0) builder->InsertAll(pending.data(), location.data(), inserted.data(), num_first);
+  builder->InsertAll(pending.data() + num_first, location.data() + num_first, inserted.data() + num_first,
+                     num_pending - num_first);
 }
 
 /// The Delaunay mesh of the distinct points (Hilbert order): the first triangle, then every other
