@@ -390,8 +390,8 @@ constexpr uint32_t kMaxHeavyFirst = 1024;
 /// of two crossing lines, whose longer line's far points all fan from the shorter line's end) are
 /// such vertices. Counted on the CPU backend at 1M: parallel_lines 212 -> 145 one-block flip
 /// iterations, two_lines 451 -> 402, grid 73 -> 60, uniform 76 -> 68 (ulp_lattice 66 -> 75,
-/// circle 280 -> 288); on an H200 the insertion of two_lines, parallel_lines and grid took 1.0 to
-/// 1.3 ms less (bench/README.md, twentieth session).
+/// circle 280 -> 288); on an H200 the insertion of two_lines, parallel_lines and grid took 0.7 to
+/// 1.7 ms less (bench/README.md, twentieth session).
 ///
 /// Weighted, a few heavy vertices (IsHeavyVertex, at most kMaxHeavyFirst) are inserted first: the
 /// points their disks hide are then hidden on relocation, instead of being inserted before them
@@ -425,10 +425,10 @@ void InsertRemainingVertices(System& sys, DelaunayBuilder<System>* builder, Firs
       thrust::stable_partition(pol, pending.begin(), pending.end(), heavy);
     }
   } else {
-    const IsExtremeVertex extreme{{*thrust::min_element(pol, vfirst, vfirst + m, VertexLexLess{pts}),
-                                   *thrust::max_element(pol, vfirst, vfirst + m, VertexLexLess{pts}),
-                                   *thrust::min_element(pol, vfirst, vfirst + m, VertexLexLessYX{pts}),
-                                   *thrust::max_element(pol, vfirst, vfirst + m, VertexLexLessYX{pts})}};
+    // One pass (and one wait) per order: its first and last vertex.
+    const auto xy = thrust::minmax_element(pol, vfirst, vfirst + m, VertexLexLess{pts});
+    const auto yx = thrust::minmax_element(pol, vfirst, vfirst + m, VertexLexLessYX{pts});
+    const IsExtremeVertex extreme{{*xy.first, *xy.second, *yx.first, *yx.second}};
     num_first = static_cast<uint32_t>(thrust::count_if(pol, pending.begin(), pending.end(), extreme));
     if (num_first > 0) thrust::stable_partition(pol, pending.begin(), pending.end(), extreme);
   }

@@ -76,13 +76,10 @@ struct VoteForInsertion {
   // no votes by thirds (weighted builds, and rounds before any point on an edge's line was seen).
   unsigned long long* edge_third_vote;
 
-  /// The vote by thirds of point i, on the line of the edge from u to v (vectors relative to the
-  /// triangle's first vertex, scaled): its position along the edge picks the slot, its distance
-  /// from the third or the two thirds the key.
-  GALPHA_HD void VoteByThirds(uint32_t i, int32_t t, double ux, double uy, double vx, double vy, double px,
-                              double py) const {
-    const double ex = vx - ux, ey = vy - uy;
-    const double along = ((px - ux) * ex + (py - uy) * ey) / (ex * ex + ey * ey);
+  /// The vote by thirds of point i, at `along` (its position along the edge's line, 0 and 1 at
+  /// the edge's ends): the half it lies in picks the slot, its distance from the third or the two
+  /// thirds the key.
+  GALPHA_HD void VoteByThirds(uint32_t i, int32_t t, double along) const {
     const bool second_half = along >= 0.5;
     const double off = along - (second_half ? 2.0 / 3.0 : 1.0 / 3.0);
     const float score = static_cast<float>(off * off);
@@ -153,18 +150,14 @@ struct VoteForInsertion {
       on_edge_line = on_ab || on_ac || on_bc;
       if constexpr (!kWeighted) {
         if (on_edge_line && edge_third_vote != nullptr) {
-          const double bc2 = (cx - bx) * (cx - bx) + (cy - by) * (cy - by);
-          const double longest2 = fmax(fmax(b2, c2), bc2);
-          const double edge2 = on_ab ? b2 : (on_ac ? c2 : bc2);
+          // The edge from u to u + (ex, ey) whose line holds p (relative to a, scaled).
+          const double ux = on_ab || on_ac ? 0.0 : bx, uy = on_ab || on_ac ? 0.0 : by;
+          const double ex = (on_ab ? bx : cx) - ux, ey = (on_ab ? by : cy) - uy;
+          const double edge2 = ex * ex + ey * ey;
+          const double longest2 = fmax(fmax(b2, c2), (cx - bx) * (cx - bx) + (cy - by) * (cy - by));
           if (16.0 * edge2 >= longest2) {
             MarkEdgePointSeen();
-            if (on_ab) {
-              VoteByThirds(i, t, 0.0, 0.0, bx, by, px, py);
-            } else if (on_ac) {
-              VoteByThirds(i, t, 0.0, 0.0, cx, cy, px, py);
-            } else {
-              VoteByThirds(i, t, bx, by, cx, cy, px, py);
-            }
+            VoteByThirds(i, t, ((px - ux) * ex + (py - uy) * ey) / edge2);
             return;
           }
         }
