@@ -4,7 +4,7 @@
 // perturbed by single ulps); here the entries of such a run are first grouped into classes of
 // congruent simplices (equal values, proved by RadiusCongruent: a lattice's long runs are mostly
 // copies of a few cells), every class gets a key certified within 2^-150 from its first member,
-// the classes are radix-sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
+// the classes are sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
 // and only adjacent classes the keys cannot separate are compared exactly: O(n) comparisons, all
 // in parallel, on the backend's cores. Each class's other members then follow its first one.
 //
@@ -23,8 +23,10 @@
 //    and the equal pairs marked as one value.
 //  - A cluster with a pair out of order ("bad": distinct values closer than the keys' error, as a
 //    lattice nudged by single ulps has, 2^-146 to 2^-224 apart, among thousands of exact ties) is
-//    sorted again on the system by rounds of exact three-way partitions (SortBadClusters); its
-//    boundaries are certified, so it may be reordered freely. A cluster where some bounded
+//    sorted again on the system (SortBadClusters): one thread's stable insertion sort with exact
+//    signs for a cluster of up to kMaxThreadCluster entries, rounds of exact three-way partitions
+//    for a larger one. Its boundaries are certified, so it may be reordered freely; both ways give
+//    the order by (exact value, key order). A cluster where some bounded
 //    comparison is undecided, or that needs more than kMaxPartitionRounds rounds, keeps its first
 //    order and its links, and becomes a run of its own for the exact repair of short runs (a
 //    thread's insertion sort for up to kMaxDeviceRun entries, the host's beyond).
@@ -76,16 +78,21 @@ struct RefinedEntry {
   RefinedRadiusSq key;
 };
 
-/// Word `w` of entry perm[k]'s sort words (one pass of the least-significant-word-first sort).
-/// Computed again each pass rather than kept: four words of every entry would be the stage's
-/// largest buffer (a lattice nudged by ulps peaked 19 B/pt higher with them, on the H100).
-struct SortWordOf {
+/// Strict order of refined entries a and b by their sort words (RefinedSortWords), computed in
+/// the comparison rather than kept (four words of every entry would be the stage's largest
+/// buffer on a run of many classes).
+struct RefinedEntryLess {
   const RefinedEntry* entries;
-  const uint32_t* perm;
-  int w;
-  GALPHA_HD uint64_t operator()(uint32_t k) const {
-    const RefinedEntry& entry = entries[perm[k]];
-    return RefinedSortWordsOf(entry.run, entry.id, entry.key).word[w];
+  GALPHA_HD bool operator()(uint32_t a, uint32_t b) const {
+    const RefinedEntry& ea = entries[a];
+    const RefinedEntry& eb = entries[b];
+    if (ea.run != eb.run) return ea.run < eb.run;  // the high half of word 0
+    const RefinedSortWords wa = RefinedSortWordsOf(ea.run, ea.id, ea.key);
+    const RefinedSortWords wb = RefinedSortWordsOf(eb.run, eb.id, eb.key);
+    for (int w = 0; w < 4; ++w) {
+      if (wa.word[w] != wb.word[w]) return wa.word[w] < wb.word[w];
+    }
+    return false;
   }
 };
 
@@ -180,18 +187,22 @@ struct JudgeRefinedPair {
 };
 
 /// The grouping key of long-run entry k (spectrum position positions[k]): its run and the hash of
-/// its congruence form, so that sorting by it puts each run's congruent simplices together.
+/// its congruence form, so that sorting by it puts each run's congruent simplices together. 32
+/// bits, the mixed hash's high half: the sort is half the radix passes of a 64-bit key (a lattice
+/// nudged by single ulps groups 4.6M entries at 1M), and a collision only splits a class (the
+/// classes of one key are told apart by the exact congruence test, StartsCongruenceGroup).
 struct CongruenceGroupKey {
   SimplexPoints simplex;
   const uint32_t* positions;
   const uint32_t* run_of;
   const uint32_t* ids;
-  GALPHA_HD uint64_t operator()(uint32_t k) const {
+  GALPHA_HD uint32_t operator()(uint32_t k) const {
     const uint32_t i = positions[k];
     Point2 p[3];
     double w[3];
     const int n = simplex(ids[i], p, w);
-    return (SimplexCongruenceHash(p, simplex.Weights(w), n) ^ run_of[i]) * 0x9e3779b97f4a7c15ULL;
+    return static_cast<uint32_t>(
+        ((SimplexCongruenceHash(p, simplex.Weights(w), n) ^ run_of[i]) * 0x9e3779b97f4a7c15ULL) >> 32);
   }
 };
 
@@ -200,7 +211,7 @@ struct CongruenceGroupKey {
 /// congruence test does not confirm (a hash collision: the group is only smaller).
 struct StartsCongruenceGroup {
   SimplexPoints simplex;
-  const uint64_t* key;
+  const uint32_t* key;
   const uint32_t* member;
   const uint32_t* positions;
   const uint32_t* run_of;
@@ -406,6 +417,68 @@ struct ScatterSortedCluster {
   }
 };
 
+/// Bad clusters of at most this many entries are sorted by one thread each (SortSmallBadCluster)
+/// instead of by partition rounds: a lattice nudged by single ulps at 1M has 19 bad clusters of
+/// at most 10 entries, and each round is about ten launches and two waits (five rounds, 1.1 ms on
+/// the H200), where one thread sorts such a cluster in a few dozen comparisons.
+constexpr uint32_t kMaxThreadCluster = 32;
+
+/// 1 where a cluster starts among the sorted entries (a separated pair, or the first entry).
+struct StartsCluster {
+  const uint8_t* verdict;
+  GALPHA_HD bool operator()(uint32_t k) const { return verdict[k] == kPairSeparated; }
+};
+
+/// Sorts bad cluster c, when it has at most kMaxThreadCluster entries, by a stable insertion sort
+/// with exact signs (ExactClusterEntrySign), so that equal values keep their key order as the
+/// partition rounds keep it: both give the one order by (exact value, key order). Then writes
+/// where each sorted entry comes from (`source`, for a gather) and the verdicts after the first
+/// (kPairLess where a value starts, kPairEqual inside one; the first stays kPairSeparated). A
+/// cluster with an undecided sign keeps its order and verdicts, and so stays bad. Either way it
+/// leaves `cluster_bad` (the rounds skip it; the caller marks bad clusters again from the
+/// verdicts).
+struct SortSmallBadCluster {
+  SimplexPoints simplex;
+  const RefinedEntry* entries;
+  const uint32_t* cluster_begin;  // num_clusters + 1 sorted positions
+  uint8_t* cluster_bad;
+  uint8_t* cluster_undecided;
+  uint32_t* source;  // per sorted position: the position whose entry goes there
+  uint8_t* verdict;
+  uint32_t* comparisons;  // one counter
+  GALPHA_HD void operator()(uint32_t c) const {
+    const uint32_t begin = cluster_begin[c], size = cluster_begin[c + 1] - begin;
+    if (!cluster_bad[c] || size > kMaxThreadCluster) return;
+    cluster_bad[c] = 0;
+    uint8_t order[kMaxThreadCluster];
+    for (uint32_t i = 0; i < size; ++i) order[i] = static_cast<uint8_t>(i);
+    for (uint32_t i = 1; i < size; ++i) {
+      const uint8_t x = order[i];
+      uint32_t j = i;
+      while (j > 0) {
+        const int sign = ExactClusterEntrySign(simplex, entries[begin + x], entries[begin + order[j - 1]], c,
+                                               cluster_undecided, comparisons);
+        if (cluster_undecided[c]) return;
+        if (sign >= 0) break;
+        order[j] = order[j - 1];
+        --j;
+      }
+      order[j] = x;
+    }
+    uint32_t equal_to_previous = 0;  // bit i: sorted entry i equals entry i - 1
+    for (uint32_t i = 1; i < size; ++i) {
+      const int sign = ExactClusterEntrySign(simplex, entries[begin + order[i - 1]], entries[begin + order[i]], c,
+                                             cluster_undecided, comparisons);
+      if (cluster_undecided[c]) return;
+      if (sign == 0) equal_to_previous |= 1u << i;
+    }
+    for (uint32_t i = 0; i < size; ++i) {
+      source[begin + i] = begin + order[i];
+      if (i > 0) verdict[begin + i] = (equal_to_previous >> i) & 1u ? kPairEqual : kPairLess;
+    }
+  }
+};
+
 /// Rounds of partitions before a bad cluster is given up to the host: each round at least halves
 /// the number of distinct values in a segment it splits evenly, and settles the pivot's value.
 constexpr int kMaxPartitionRounds = 64;
@@ -447,50 +520,69 @@ struct ApplyRefinedVerdicts {
   }
 };
 
-/// Sorts refined entries by their sort words (RefinedSortWords): least significant word first, each
-/// pass a stable radix sort of one 64-bit word carrying a permutation, then one gather. A word
-/// that is the same in every entry (one run at one exponent: a lattice's long run) orders nothing,
-/// and its sort is skipped: a stable sort by a constant key leaves the permutation as it is.
+/// Sorts refined entries by their sort words (RefinedSortWords) with one comparison sort of a
+/// permutation, then one gather. The words are a strict total order (the simplex id is the last
+/// one, and a run holds each simplex once), so every sort gives this one order, on both
+/// backends. The entries are congruence classes, few even on hard input (at 1M: 13K on a lattice
+/// nudged by ulps, 38K on a circle): four radix passes of 64-bit words, each with a check for a
+/// constant word, were about 120 launches and four waits for that (0.7-0.9 ms on the H200).
 template <class System>
 void SortRefinedEntries(System& sys, Buffer<RefinedEntry, System>* entries, uint32_t num_refined) {
   auto policy = sys.policy();
-  thrust::counting_iterator<uint32_t> zero(0);
   Buffer<uint32_t, System> perm(sys, num_refined);
   thrust::sequence(policy, perm.data(), perm.data() + num_refined);
-  Buffer<uint64_t, System> word(sys, num_refined);
-  for (int w = 3; w >= 0; --w) {
-    thrust::transform(policy, zero, zero + num_refined, word.data(), SortWordOf{entries->data(), perm.data(), w});
-    const auto extremes = thrust::minmax_element(policy, word.data(), word.data() + num_refined);
-    if (sys.Read(extremes.first) == sys.Read(extremes.second)) continue;
-    thrust::stable_sort_by_key(policy, word.data(), word.data() + num_refined, perm.data());
-  }
-  word.Reset();
+  thrust::sort(policy, perm.data(), perm.data() + num_refined, RefinedEntryLess{entries->data()});
   Buffer<RefinedEntry, System> sorted(sys, num_refined);
   thrust::gather(policy, perm.data(), perm.data() + num_refined, entries->data(), sorted.data());
   *entries = std::move(sorted);
 }
 
-/// Sorts the entries of bad clusters exactly by rounds of three-way partitions (see above) and sets
-/// their verdicts, clearing `cluster_bad` for the clusters that come out in exact order.
+/// Sorts the bad clusters of at most kMaxThreadCluster entries, one thread each
+/// (SortSmallBadCluster), and moves their entries into the sorted order. `cluster_bad` is cleared
+/// for every cluster it took, sorted or left undecided.
 template <class System>
-void SortBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
-                     uint32_t num_clusters, uint32_t num_refined, Buffer<uint8_t, System>* verdict,
-                     Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
+void SortSmallBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, uint32_t num_clusters,
+                          uint32_t num_refined, Buffer<uint8_t, System>* verdict, Buffer<uint8_t, System>* cluster_bad,
+                          Buffer<uint8_t, System>* cluster_undecided, ComparisonCounts* counts) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
-  if (thrust::count(policy, cluster_bad->data(), cluster_bad->data() + num_clusters, uint8_t{1}) == 0) return;
+  Buffer<uint32_t, System> cluster_begin(sys, num_clusters + 1);
+  thrust::copy_if(policy, zero, zero + num_refined, cluster_begin.data(), StartsCluster{verdict->data()});
+  thrust::fill_n(policy, cluster_begin.data() + num_clusters, 1, num_refined);
+  Buffer<uint32_t, System> source(sys, num_refined);
+  thrust::sequence(policy, source.data(), source.data() + num_refined);
+  Buffer<uint32_t, System> comparisons(sys, 1);
+  thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});
+  thrust::for_each_n(
+      policy, zero, num_clusters,
+      SortSmallBadCluster{simplex, entries, cluster_begin.data(), cluster_bad->data(), cluster_undecided->data(),
+                          source.data(), verdict->data(), comparisons.data()});
+  Buffer<RefinedEntry, System> moved(sys, num_refined);
+  thrust::gather(policy, source.data(), source.data() + num_refined, entries, moved.data());
+  thrust::copy_n(policy, moved.data(), num_refined, entries);
+  counts->bounded_exact += sys.Read(comparisons.data());
+}
+
+/// Sorts the entries of the bad clusters still marked in `cluster_bad` exactly by rounds of
+/// three-way partitions (see above) and sets their verdicts.
+template <class System>
+void PartitionBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
+                          uint32_t num_refined, Buffer<uint8_t, System>* verdict,
+                          const Buffer<uint8_t, System>& cluster_bad, Buffer<uint8_t, System>* cluster_undecided,
+                          ComparisonCounts* counts) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
   Buffer<uint32_t, System> bad_k(sys, num_refined);
   const auto num_slots = static_cast<uint32_t>(
-      thrust::copy_if(policy, zero, zero + num_refined, bad_k.data(), InBadCluster{cluster_of, cluster_bad->data()}) -
+      thrust::copy_if(policy, zero, zero + num_refined, bad_k.data(), InBadCluster{cluster_of, cluster_bad.data()}) -
       bad_k.data());
+  if (num_slots == 0) return;
   Buffer<uint32_t, System> item(sys, num_slots);
   thrust::copy_n(policy, bad_k.data(), num_slots, item.data());
   Buffer<uint32_t, System> segment(sys, num_slots);
   thrust::gather(policy, bad_k.data(), bad_k.data() + num_slots, cluster_of, segment.data());
   Buffer<uint8_t, System> settled(sys, num_slots);
   thrust::fill_n(policy, settled.data(), num_slots, uint8_t{0});
-  Buffer<uint8_t, System> cluster_undecided(sys, num_clusters);
-  thrust::fill_n(policy, cluster_undecided.data(), num_clusters, uint8_t{0});
   Buffer<uint32_t, System> comparisons(sys, 1);
   Buffer<uint32_t, System> segment_begin(sys, num_slots), segment_end(sys, num_slots);
   Buffer<uint64_t, System> word(sys, num_slots);
@@ -504,7 +596,7 @@ void SortBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* en
     thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});  // one round's count fits 32 bits
     thrust::transform(policy, zero, zero + num_slots, word.data(),
                       PartitionWord{simplex, entries, cluster_of, item.data(), segment.data(), segment_begin.data(),
-                                    segment_end.data(), settled.data(), cluster_undecided.data(), comparisons.data()});
+                                    segment_end.data(), settled.data(), cluster_undecided->data(), comparisons.data()});
     thrust::stable_sort_by_key(policy, word.data(), word.data() + num_slots, item.data());
     const auto starts = thrust::make_transform_iterator(zero, NewSegmentStart{word.data()});
     thrust::inclusive_scan(policy, starts, starts + num_slots, segment.data());
@@ -517,13 +609,30 @@ void SortBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* en
   segment_end.Reset();
   if (!all_settled) {
     thrust::for_each_n(policy, zero, num_slots,
-                       GiveUpUnsettled{cluster_of, item.data(), settled.data(), cluster_undecided.data()});
+                       GiveUpUnsettled{cluster_of, item.data(), settled.data(), cluster_undecided->data()});
   }
   Buffer<RefinedEntry, System> by_slot(sys, num_slots);
   thrust::gather(policy, item.data(), item.data() + num_slots, entries, by_slot.data());
   thrust::for_each_n(policy, zero, num_slots,
                      ScatterSortedCluster{by_slot.data(), bad_k.data(), cluster_of, segment.data(),
-                                          cluster_undecided.data(), entries, verdict->data()});
+                                          cluster_undecided->data(), entries, verdict->data()});
+}
+
+/// Sorts the entries of bad clusters exactly (small ones one thread each, the others by partition
+/// rounds) and sets their verdicts; `cluster_bad` then marks the clusters left undecided.
+template <class System>
+void SortBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
+                     uint32_t num_clusters, uint32_t num_refined, Buffer<uint8_t, System>* verdict,
+                     Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  if (thrust::count(policy, cluster_bad->data(), cluster_bad->data() + num_clusters, uint8_t{1}) == 0) return;
+  Buffer<uint8_t, System> cluster_undecided(sys, num_clusters);
+  thrust::fill_n(policy, cluster_undecided.data(), num_clusters, uint8_t{0});
+  SortSmallBadClusters(sys, simplex, entries, num_clusters, num_refined, verdict, cluster_bad, &cluster_undecided,
+                       counts);
+  PartitionBadClusters(sys, simplex, entries, cluster_of, num_refined, verdict, *cluster_bad, &cluster_undecided,
+                       counts);
   thrust::fill_n(policy, cluster_bad->data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict->data(), cluster_of, cluster_bad->data()});
 }
@@ -569,7 +678,7 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   thrust::sequence(policy, member.data(), member.data() + num_refined);
   Buffer<uint32_t, System> group_of(sys, num_refined);  // 1-based, by grouping position
   {
-    Buffer<uint64_t, System> group_key(sys, num_refined);
+    Buffer<uint32_t, System> group_key(sys, num_refined);
     thrust::transform(policy, zero, zero + num_refined, group_key.data(),
                       CongruenceGroupKey{simplex, positions.data(), run_of.data(), ids});
     thrust::stable_sort_by_key(policy, group_key.data(), group_key.data() + num_refined, member.data());

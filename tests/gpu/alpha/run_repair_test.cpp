@@ -13,51 +13,15 @@
 #include <random>
 #include <vector>
 
-#include "core/exact/radius_rational.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
+#include "tests/gpu/alpha/simplex_pool.hpp"
 
 namespace galpha::detail {
 namespace {
 
-// A pool of simplices over one point array, in SimplexPoints' layout (triangles, then edges).
-struct SimplexPool {
-  std::vector<Point2> points;
-  std::vector<TriIdx> tris;
-  std::vector<EdgeIdx> edges;
-  SimplexPoints view() const {
-    return SimplexPoints{points.data(), tris.data(), edges.data(), static_cast<uint32_t>(tris.size())};
-  }
-  uint32_t size() const { return static_cast<uint32_t>(tris.size() + edges.size()); }
-};
-
-// Every triangle and edge among `count` random points, which `point` draws.
-template <class Draw>
-SimplexPool PoolOf(int count, Draw point) {
-  SimplexPool pool;
-  for (int i = 0; i < count; ++i) pool.points.push_back(point());
-  const auto n = static_cast<uint32_t>(count);
-  for (uint32_t a = 0; a < n; ++a) {
-    for (uint32_t b = a + 1; b < n; ++b) {
-      pool.edges.push_back({{a, b}});
-      for (uint32_t c = b + 1; c < n; ++c) {
-        const Point2& pa = pool.points[a];
-        const Point2& pb = pool.points[b];
-        const Point2& pc = pool.points[c];
-        // Collinear triples have no finite radius; the spectrum never holds them.
-        if ((pb.x - pa.x) * (pc.y - pa.y) != (pb.y - pa.y) * (pc.x - pa.x)) pool.tris.push_back({{a, b, c}});
-      }
-    }
-  }
-  return pool;
-}
-
-int Compare(const SimplexPool& pool, uint32_t a, uint32_t b) {
-  Point2 pa[3], pb[3];
-  const SimplexPoints simplex = pool.view();
-  const int na = simplex(a, pa);
-  const int nb = simplex(b, pb);
-  return CompareRadiusSqRational(pa, na, pb, nb);
-}
+using testing_pool::Compare;
+using testing_pool::PoolOf;
+using testing_pool::SimplexPool;
 
 struct Outcome {
   int runs = 0;
@@ -68,12 +32,10 @@ struct Outcome {
 
 // Repairs `trials` runs of 2..16 entries drawn from the pool, each run made of simplices whose
 // values are close (the pool sorted by exact value, a window of it: shuffled in odd trials, in
-// exact order in even ones, with its equal values in the sort's arbitrary order), and checks each
+// exact order in even ones, with its equal values in id order), and checks each
 // against GMP.
 Outcome RepairRandomRuns(const SimplexPool& pool, int trials, uint64_t seed) {
-  std::vector<uint32_t> by_value(pool.size());
-  for (uint32_t i = 0; i < pool.size(); ++i) by_value[i] = i;
-  std::sort(by_value.begin(), by_value.end(), [&](uint32_t a, uint32_t b) { return Compare(pool, a, b) < 0; });
+  const std::vector<uint32_t> by_value = testing_pool::ByExactValue(pool);
   std::mt19937_64 rng(seed);
   Outcome outcome;
   for (int t = 0; t < trials; ++t) {
