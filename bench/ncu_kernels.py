@@ -8,8 +8,21 @@ Usage (on the GPU machine, after `tar -xJf .carry-pack/carry.tar.xz`):
 Prints the TOP (default 25) kernels by total time: launches, total ms, share of all kernels.
 """
 import csv
+import re
 import sys
 from collections import defaultdict
+
+
+def short_name(name: str) -> str:
+    """The kernel's own name and the galpha functors in its template arguments, which a Thrust
+    kernel's name (transform_kernel<policy, tuple<counting_iterator<...>>, ...>) buries; a
+    kernel without one (CUB's sorts and scans) keeps the start of its full name."""
+    kernel = name.split("<", 1)[0].removeprefix("void ")
+    functors = []
+    for found in re.findall(r"galpha::(?:detail::)?[A-Za-z_][A-Za-z0-9_]*", name):
+        if found not in functors:
+            functors.append(found)
+    return f"{kernel} [{', '.join(functors)}]" if functors else name.removeprefix("void ")[:140]
 
 
 def main() -> int:
@@ -33,7 +46,7 @@ def main() -> int:
     everything = sum(total_ns.values())
     print(f"all kernels: {everything / 1e6:.2f} ms in {sum(launches.values())} launches")
     for name, ns in sorted(total_ns.items(), key=lambda kv: -kv[1])[:top]:
-        print(f"{ns / 1e6:9.2f} ms {100 * ns / everything:5.1f}% {launches[name]:6d}x  {name[:160]}")
+        print(f"{ns / 1e6:9.2f} ms {100 * ns / everything:5.1f}% {launches[name]:6d}x  {short_name(name)}")
     return 0
 
 

@@ -1,6 +1,5 @@
-// Sort words for refined keys (radius_refined.hpp): the spectrum's long runs of near ties are
-// sorted by comparing these words, four integers an entry, instead of by exact comparisons of the
-// keys.
+// Radix-sortable words for refined keys (radius_refined.hpp): the spectrum's long runs of near ties
+// are sorted by these words, 64 bits at a time, instead of by exact comparisons of the keys.
 //
 // Why the order they give is good enough (gpu/alpha/spectrum_refine.cuh relies on it): the words
 // order entries by run, then by T, a truncation of the key's value to 160 fractional bits of its
@@ -24,7 +23,7 @@
 namespace galpha {
 
 /// A spectrum entry (run, simplex id, refined key) as four 64-bit words whose lexicographic order is its sort order, so
-/// that a sort compares integers (a merge sort comparing keys exactly took most of this stage):
+/// that radix sorts order the entries (a merge sort comparing keys exactly took most of this stage):
 ///  word 0: the run (high half), then the key's exponent E, biased (low half);
 ///  words 1, 2 and the high half of word 3: the fraction of the key's mantissa m, m = 1.f with
 ///    f to 160 bits, E and m renormalized so that m is in [1, 2);

@@ -4,7 +4,7 @@
 // perturbed by single ulps); here the entries of such a run are first grouped into classes of
 // congruent simplices (equal values, proved by RadiusCongruent: a lattice's long runs are mostly
 // copies of a few cells), every class gets a key certified within 2^-150 from its first member,
-// the classes are sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
+// the classes are radix-sorted by (run, key truncated to 160 bits, id) (refined_sort_words.hpp),
 // and only adjacent classes the keys cannot separate are compared exactly: O(n) comparisons, all
 // in parallel, on the backend's cores. Each class's other members then follow its first one.
 //
@@ -23,9 +23,9 @@
 //    and the equal pairs marked as one value.
 //  - A cluster with a pair out of order ("bad": distinct values closer than the keys' error, as a
 //    lattice nudged by single ulps has, 2^-146 to 2^-224 apart, among thousands of exact ties) is
-//    sorted again on the system (SortBadClusters): one thread's stable insertion sort with exact
-//    signs for a cluster of up to kMaxThreadCluster entries, rounds of exact three-way partitions
-//    for a larger one. Its boundaries are certified, so it may be reordered freely; both ways give
+//    sorted again on the system (SortBadClusters): by all its pairs' exact signs at once for a
+//    cluster of up to kMaxPairwiseCluster entries, by rounds of exact three-way partitions for a
+//    larger one. Its boundaries are certified, so it may be reordered freely; both ways give
 //    the order by (exact value, key order). A cluster where some bounded
 //    comparison is undecided, or that needs more than kMaxPartitionRounds rounds, keeps its first
 //    order and its links, and becomes a run of its own for the exact repair of short runs (a
@@ -78,21 +78,43 @@ struct RefinedEntry {
   RefinedRadiusSq key;
 };
 
-/// Strict order of refined entries a and b by their sort words (RefinedSortWords), computed in
-/// the comparison rather than kept (four words of every entry would be the stage's largest
-/// buffer on a run of many classes).
-struct RefinedEntryLess {
+/// Word `w` of entry perm[k]'s sort words (one pass of the least-significant-word-first sort).
+/// Computed again each pass rather than kept: four words of every entry would be the stage's
+/// largest buffer (a lattice nudged by ulps peaked 19 B/pt higher with them, on the H100).
+struct SortWordOf {
   const RefinedEntry* entries;
-  GALPHA_HD bool operator()(uint32_t a, uint32_t b) const {
-    const RefinedEntry& ea = entries[a];
-    const RefinedEntry& eb = entries[b];
-    if (ea.run != eb.run) return ea.run < eb.run;  // the high half of word 0
-    const RefinedSortWords wa = RefinedSortWordsOf(ea.run, ea.id, ea.key);
-    const RefinedSortWords wb = RefinedSortWordsOf(eb.run, eb.id, eb.key);
+  const uint32_t* perm;
+  int w;
+  GALPHA_HD uint64_t operator()(uint32_t k) const {
+    const RefinedEntry& entry = entries[perm[k]];
+    return RefinedSortWordsOf(entry.run, entry.id, entry.key).word[w];
+  }
+};
+
+/// The smallest and largest value of each sort word over a set of entries.
+struct SortWordRange {
+  uint64_t low[4];
+  uint64_t high[4];
+};
+
+struct SortWordRangeOf {
+  const RefinedEntry* entries;
+  GALPHA_HD SortWordRange operator()(uint32_t k) const {
+    const RefinedSortWords words = RefinedSortWordsOf(entries[k].run, entries[k].id, entries[k].key);
+    SortWordRange range;
+    for (int w = 0; w < 4; ++w) range.low[w] = range.high[w] = words.word[w];
+    return range;
+  }
+};
+
+struct MergeSortWordRanges {
+  GALPHA_HD SortWordRange operator()(const SortWordRange& a, const SortWordRange& b) const {
+    SortWordRange range;
     for (int w = 0; w < 4; ++w) {
-      if (wa.word[w] != wb.word[w]) return wa.word[w] < wb.word[w];
+      range.low[w] = a.low[w] < b.low[w] ? a.low[w] : b.low[w];
+      range.high[w] = a.high[w] > b.high[w] ? a.high[w] : b.high[w];
     }
-    return false;
+    return range;
   }
 };
 
@@ -123,6 +145,16 @@ struct CutLinksOfOneDouble {
   GALPHA_HD void operator()(uint32_t i) const {
     const uint32_t r = run_of[i] - 1;
     if (one_double[r] && i != run_begin[r]) link[i - 1] = 0;
+  }
+};
+
+/// Adds a settled run of one double's comparisons (one per entry after its first) to the count.
+struct CountSettledComparisons {
+  const uint32_t* run_begin;
+  const uint8_t* settled;
+  unsigned long long* exact_count;
+  GALPHA_HD void operator()(uint32_t r) const {
+    if (settled[r]) AtomicAdd(exact_count, run_begin[r + 1] - run_begin[r] - 1);
   }
 };
 
@@ -160,9 +192,8 @@ struct JudgeRefinedPair {
   const RefinedEntry* entries;
   const uint8_t* run_unrefinable;
   uint8_t* verdict;
-  uint32_t* comparisons;  // per entry: bounded exact comparisons done (0 or 1)
+  unsigned long long* exact_count;  // bounded exact comparisons
   GALPHA_HD void operator()(uint32_t k) const {
-    comparisons[k] = 0;
     if (k == 0 || entries[k - 1].run != entries[k].run || run_unrefinable[entries[k].run]) {
       verdict[k] = kPairSeparated;
       return;
@@ -180,7 +211,7 @@ struct JudgeRefinedPair {
       verdict[k] = kPairEqual;
       return;
     }
-    comparisons[k] = 1;
+    AtomicAdd(exact_count, 1);
     const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
     verdict[k] = order == Order::kLess ? kPairLess : order == Order::kEqual ? kPairEqual : kPairBad;
   }
@@ -227,10 +258,14 @@ struct StartsCongruenceGroup {
   }
 };
 
-/// 1 at a grouping position where a new group starts (group_of: 1-based inclusive scan).
-struct StartsGroupOf {
+/// Writes the grouping position where each group starts (group_of: 1-based inclusive scan). A
+/// scatter rather than a compaction, whose count the host would wait for.
+struct MarkGroupFirst {
   const uint32_t* group_of;
-  GALPHA_HD bool operator()(uint32_t s) const { return s == 0 || group_of[s] != group_of[s - 1]; }
+  uint32_t* group_first;
+  GALPHA_HD void operator()(uint32_t s) const {
+    if (s == 0 || group_of[s] != group_of[s - 1]) group_first[group_of[s] - 1] = s;
+  }
 };
 
 /// The spectrum position of group g's first member (its representative, whose key the group
@@ -305,14 +340,15 @@ struct ClusterStartAsU32 {
 /// are separated, else a congruence proof or the bounded exact comparison (counted). Where that is
 /// undecided the cluster is marked (it goes to the host in its first order) and 0 is answered.
 GALPHA_HD inline int ExactClusterEntrySign(const SimplexPoints& simplex, const RefinedEntry& a, const RefinedEntry& b,
-                                           uint32_t cluster, uint8_t* cluster_undecided, uint32_t* comparisons) {
+                                           uint32_t cluster, uint8_t* cluster_undecided,
+                                           unsigned long long* exact_count) {
   if (RefinedKeysSeparated(a.key, b.key)) return -1;
   if (RefinedKeysSeparated(b.key, a.key)) return 1;
   Point2 pa[3], pb[3];
   double wa[3], wb[3];
   const int na = simplex(a.id, pa, wa), nb = simplex(b.id, pb, wb);
   if (SimplexRadiusCongruent(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb)) return 0;
-  AtomicIncrement(comparisons);
+  AtomicAdd(exact_count, 1);
   const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
   if (order != Order::kUndecided) return SignOf(order);
   cluster_undecided[cluster] = 1;  // concurrent writes only ever write 1
@@ -349,7 +385,7 @@ struct PartitionWord {
   const uint32_t* segment_end;  // exclusive
   const uint8_t* settled;
   uint8_t* cluster_undecided;
-  uint32_t* comparisons;  // one counter
+  unsigned long long* exact_count;
   GALPHA_HD uint64_t operator()(uint32_t j) const {
     const uint64_t high = uint64_t{segment[j]} << 2;
     if (settled[j]) return high | 1;
@@ -357,7 +393,7 @@ struct PartitionWord {
     if (pivot_slot == j) return high | 1;
     const uint32_t k = item[j];
     const int sign = ExactClusterEntrySign(simplex, entries[k], entries[item[pivot_slot]], cluster_of[k] - 1,
-                                           cluster_undecided, comparisons);
+                                           cluster_undecided, exact_count);
     return high | static_cast<uint64_t>(sign + 1);
   }
 };
@@ -417,65 +453,88 @@ struct ScatterSortedCluster {
   }
 };
 
-/// Bad clusters of at most this many entries are sorted by one thread each (SortSmallBadCluster)
-/// instead of by partition rounds: a lattice nudged by single ulps at 1M has 19 bad clusters of
-/// at most 10 entries, and each round is about ten launches and two waits (five rounds, 1.1 ms on
-/// the H200), where one thread sorts such a cluster in a few dozen comparisons.
-constexpr uint32_t kMaxThreadCluster = 32;
+/// Bad clusters of at most this many entries are sorted by comparing all their pairs at once
+/// (SignOfClusterPair, PlaceByRank) instead of by partition rounds: a lattice nudged by single ulps
+/// at 1M has 19 bad clusters of at most 10 entries, and each round is about ten launches and two
+/// waits (five rounds, 1.1 ms on the H200). One thread's insertion sort of such a cluster (tried)
+/// waited 1.7 ms on its chain of exact comparisons; all pairs side by side wait for one.
+constexpr uint32_t kMaxPairwiseCluster = 32;
 
-/// 1 where a cluster starts among the sorted entries (a separated pair, or the first entry).
-struct StartsCluster {
+/// Writes where each cluster begins: at a separated pair (or the first entry). A scatter rather
+/// than a compaction, whose count the host would wait for.
+struct MarkClusterBegin {
   const uint8_t* verdict;
-  GALPHA_HD bool operator()(uint32_t k) const { return verdict[k] == kPairSeparated; }
+  const uint32_t* cluster_of;  // 1-based
+  uint32_t* cluster_begin;
+  GALPHA_HD void operator()(uint32_t k) const {
+    if (verdict[k] == kPairSeparated) cluster_begin[cluster_of[k] - 1] = k;
+  }
 };
 
-/// Sorts bad cluster c, when it has at most kMaxThreadCluster entries, by a stable insertion sort
-/// with exact signs (ExactClusterEntrySign), so that equal values keep their key order as the
-/// partition rounds keep it: both give the one order by (exact value, key order). Then writes
-/// where each sorted entry comes from (`source`, for a gather) and the verdicts after the first
-/// (kPairLess where a value starts, kPairEqual inside one; the first stays kPairSeparated). A
-/// cluster with an undecided sign keeps its order and verdicts, and so stays bad. Either way it
-/// leaves `cluster_bad` (the rounds skip it; the caller marks bad clusters again from the
-/// verdicts).
-struct SortSmallBadCluster {
+/// 1 for a bad cluster of at most kMaxPairwiseCluster entries.
+struct IsSmallBadCluster {
+  const uint8_t* cluster_bad;
+  const uint32_t* cluster_begin;  // num_clusters + 1
+  GALPHA_HD bool operator()(uint32_t c) const {
+    return cluster_bad[c] != 0 && cluster_begin[c + 1] - cluster_begin[c] <= kMaxPairwiseCluster;
+  }
+};
+
+/// Sign of value(i) - value(j) for entries i < j of small bad cluster small[t / 1024] (i and j
+/// from t's low bits), into sign[t]. An undecided pair marks its cluster (ExactClusterEntrySign).
+struct SignOfClusterPair {
   SimplexPoints simplex;
   const RefinedEntry* entries;
-  const uint32_t* cluster_begin;  // num_clusters + 1 sorted positions
-  uint8_t* cluster_bad;
+  const uint32_t* small;  // cluster indices
+  const uint32_t* cluster_begin;
   uint8_t* cluster_undecided;
+  int8_t* sign;  // kMaxPairwiseCluster^2 per small cluster; only i < j written
+  unsigned long long* exact_count;
+  GALPHA_HD void operator()(uint32_t t) const {
+    constexpr uint32_t kSide = kMaxPairwiseCluster;
+    const uint32_t c = small[t / (kSide * kSide)];
+    const uint32_t i = (t / kSide) % kSide, j = t % kSide;
+    const uint32_t begin = cluster_begin[c], size = cluster_begin[c + 1] - begin;
+    if (i >= j || j >= size) return;
+    sign[t] = static_cast<int8_t>(
+        ExactClusterEntrySign(simplex, entries[begin + i], entries[begin + j], c, cluster_undecided, exact_count));
+  }
+};
+
+/// Places entry i of small bad cluster small[t / 32] at its rank: the entries below it, and the
+/// equal ones before it (so equal values keep their key order, as the partition rounds keep it:
+/// both give the one order by (exact value, key order)). Writes where the entry comes from
+/// (`source`, for a gather) and its verdict: kPairLess where a value starts, kPairEqual inside
+/// one; the cluster's first position keeps kPairSeparated. A cluster with an undecided pair keeps
+/// its order and verdicts, and so stays bad. Either way it leaves `cluster_bad` (the rounds skip
+/// it; the caller marks bad clusters again from the verdicts).
+struct PlaceByRank {
+  const uint32_t* small;
+  const uint32_t* cluster_begin;
+  const uint8_t* cluster_undecided;
+  const int8_t* sign;
+  uint8_t* cluster_bad;
   uint32_t* source;  // per sorted position: the position whose entry goes there
   uint8_t* verdict;
-  uint32_t* comparisons;  // one counter
-  GALPHA_HD void operator()(uint32_t c) const {
+  GALPHA_HD void operator()(uint32_t t) const {
+    constexpr uint32_t kSide = kMaxPairwiseCluster;
+    const uint32_t slot = t / kSide, i = t % kSide;
+    const uint32_t c = small[slot];
     const uint32_t begin = cluster_begin[c], size = cluster_begin[c + 1] - begin;
-    if (!cluster_bad[c] || size > kMaxThreadCluster) return;
-    cluster_bad[c] = 0;
-    uint8_t order[kMaxThreadCluster];
-    for (uint32_t i = 0; i < size; ++i) order[i] = static_cast<uint8_t>(i);
-    for (uint32_t i = 1; i < size; ++i) {
-      const uint8_t x = order[i];
-      uint32_t j = i;
-      while (j > 0) {
-        const int sign = ExactClusterEntrySign(simplex, entries[begin + x], entries[begin + order[j - 1]], c,
-                                               cluster_undecided, comparisons);
-        if (cluster_undecided[c]) return;
-        if (sign >= 0) break;
-        order[j] = order[j - 1];
-        --j;
-      }
-      order[j] = x;
+    if (i == 0) cluster_bad[c] = 0;
+    if (i >= size || cluster_undecided[c]) return;
+    const int8_t* pairs = sign + size_t{slot} * kSide * kSide;
+    uint32_t rank = 0;
+    bool equal_before = false;
+    for (uint32_t j = 0; j < size; ++j) {
+      if (j == i) continue;
+      // Sign of value(j) - value(i), from the pair's one comparison.
+      const int s = j < i ? pairs[j * kSide + i] : -pairs[i * kSide + j];
+      if (s < 0 || (s == 0 && j < i)) ++rank;
+      if (s == 0 && j < i) equal_before = true;
     }
-    uint32_t equal_to_previous = 0;  // bit i: sorted entry i equals entry i - 1
-    for (uint32_t i = 1; i < size; ++i) {
-      const int sign = ExactClusterEntrySign(simplex, entries[begin + order[i - 1]], entries[begin + order[i]], c,
-                                             cluster_undecided, comparisons);
-      if (cluster_undecided[c]) return;
-      if (sign == 0) equal_to_previous |= 1u << i;
-    }
-    for (uint32_t i = 0; i < size; ++i) {
-      source[begin + i] = begin + order[i];
-      if (i > 0) verdict[begin + i] = (equal_to_previous >> i) & 1u ? kPairEqual : kPairLess;
-    }
+    source[begin + rank] = begin + i;
+    if (rank > 0) verdict[begin + rank] = equal_before ? kPairEqual : kPairLess;
   }
 };
 
@@ -520,47 +579,72 @@ struct ApplyRefinedVerdicts {
   }
 };
 
-/// Sorts refined entries by their sort words (RefinedSortWords) with one comparison sort of a
-/// permutation, then one gather. The words are a strict total order (the simplex id is the last
-/// one, and a run holds each simplex once), so every sort gives this one order, on both
-/// backends. The entries are congruence classes, few even on hard input (at 1M: 13K on a lattice
-/// nudged by ulps, 38K on a circle): four radix passes of 64-bit words, each with a check for a
-/// constant word, were about 120 launches and four waits for that (0.7-0.9 ms on the H200).
+/// Sorts refined entries by their sort words (RefinedSortWords): least significant word first, each
+/// pass a stable radix sort of one 64-bit word carrying a permutation, then one gather. A word
+/// that is the same in every entry (one run at one exponent: a lattice's long run) orders nothing,
+/// and its sort is skipped: a stable sort by a constant key leaves the permutation as it is. The
+/// constant words are found by one reduction before the passes (one wait instead of four: the
+/// passes are short and the stage is mostly launches and waits).
 template <class System>
 void SortRefinedEntries(System& sys, Buffer<RefinedEntry, System>* entries, uint32_t num_refined) {
   auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
   Buffer<uint32_t, System> perm(sys, num_refined);
   thrust::sequence(policy, perm.data(), perm.data() + num_refined);
-  thrust::sort(policy, perm.data(), perm.data() + num_refined, RefinedEntryLess{entries->data()});
+  SortWordRange empty;
+  for (int w = 0; w < 4; ++w) {
+    empty.low[w] = ~uint64_t{0};
+    empty.high[w] = 0;
+  }
+  const SortWordRange range = thrust::transform_reduce(policy, zero, zero + num_refined,
+                                                       SortWordRangeOf{entries->data()}, empty, MergeSortWordRanges{});
+  Buffer<uint64_t, System> word(sys, num_refined);
+  for (int w = 3; w >= 0; --w) {
+    if (range.low[w] == range.high[w]) continue;
+    thrust::transform(policy, zero, zero + num_refined, word.data(), SortWordOf{entries->data(), perm.data(), w});
+    thrust::stable_sort_by_key(policy, word.data(), word.data() + num_refined, perm.data());
+  }
+  word.Reset();
   Buffer<RefinedEntry, System> sorted(sys, num_refined);
   thrust::gather(policy, perm.data(), perm.data() + num_refined, entries->data(), sorted.data());
   *entries = std::move(sorted);
 }
 
-/// Sorts the bad clusters of at most kMaxThreadCluster entries, one thread each
-/// (SortSmallBadCluster), and moves their entries into the sorted order. `cluster_bad` is cleared
-/// for every cluster it took, sorted or left undecided.
+/// Sorts the bad clusters of at most kMaxPairwiseCluster entries by all their pairs' exact signs
+/// (SignOfClusterPair, PlaceByRank) and moves their entries into the sorted order. `cluster_bad`
+/// is cleared for every cluster it took, sorted or left undecided.
 template <class System>
-void SortSmallBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, uint32_t num_clusters,
-                          uint32_t num_refined, Buffer<uint8_t, System>* verdict, Buffer<uint8_t, System>* cluster_bad,
-                          Buffer<uint8_t, System>* cluster_undecided, ComparisonCounts* counts) {
+void SortSmallBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
+                          uint32_t num_clusters, uint32_t num_refined, Buffer<uint8_t, System>* verdict,
+                          Buffer<uint8_t, System>* cluster_bad, Buffer<uint8_t, System>* cluster_undecided,
+                          unsigned long long* exact_count) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   Buffer<uint32_t, System> cluster_begin(sys, num_clusters + 1);
-  thrust::copy_if(policy, zero, zero + num_refined, cluster_begin.data(), StartsCluster{verdict->data()});
+  thrust::for_each_n(policy, zero, num_refined, MarkClusterBegin{verdict->data(), cluster_of, cluster_begin.data()});
   thrust::fill_n(policy, cluster_begin.data() + num_clusters, 1, num_refined);
+  Buffer<uint32_t, System> small(sys, num_clusters);
+  const auto num_small =
+      static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_clusters, small.data(),
+                                            IsSmallBadCluster{cluster_bad->data(), cluster_begin.data()}) -
+                            small.data());
+  if (num_small == 0) return;
+  constexpr uint32_t kSide = kMaxPairwiseCluster;
+  if (uint64_t{num_small} * kSide * kSide > 0xFFFFFFFFull) {
+    throw EngineError(EngineError::Kind::kInternal, "too many small bad clusters for one launch of pair signs");
+  }
+  Buffer<int8_t, System> sign(sys, size_t{num_small} * kSide * kSide);
+  thrust::for_each_n(policy, zero, num_small * kSide * kSide,
+                     SignOfClusterPair{simplex, entries, small.data(), cluster_begin.data(), cluster_undecided->data(),
+                                       sign.data(), exact_count});
   Buffer<uint32_t, System> source(sys, num_refined);
   thrust::sequence(policy, source.data(), source.data() + num_refined);
-  Buffer<uint32_t, System> comparisons(sys, 1);
-  thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});
-  thrust::for_each_n(
-      policy, zero, num_clusters,
-      SortSmallBadCluster{simplex, entries, cluster_begin.data(), cluster_bad->data(), cluster_undecided->data(),
-                          source.data(), verdict->data(), comparisons.data()});
+  thrust::for_each_n(policy, zero, num_small * kSide,
+                     PlaceByRank{small.data(), cluster_begin.data(), cluster_undecided->data(), sign.data(),
+                                 cluster_bad->data(), source.data(), verdict->data()});
   Buffer<RefinedEntry, System> moved(sys, num_refined);
   thrust::gather(policy, source.data(), source.data() + num_refined, entries, moved.data());
   thrust::copy_n(policy, moved.data(), num_refined, entries);
-  counts->bounded_exact += sys.Read(comparisons.data());
 }
 
 /// Sorts the entries of the bad clusters still marked in `cluster_bad` exactly by rounds of
@@ -569,7 +653,7 @@ template <class System>
 void PartitionBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
                           uint32_t num_refined, Buffer<uint8_t, System>* verdict,
                           const Buffer<uint8_t, System>& cluster_bad, Buffer<uint8_t, System>* cluster_undecided,
-                          ComparisonCounts* counts) {
+                          unsigned long long* exact_count) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   Buffer<uint32_t, System> bad_k(sys, num_refined);
@@ -583,7 +667,6 @@ void PartitionBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntr
   thrust::gather(policy, bad_k.data(), bad_k.data() + num_slots, cluster_of, segment.data());
   Buffer<uint8_t, System> settled(sys, num_slots);
   thrust::fill_n(policy, settled.data(), num_slots, uint8_t{0});
-  Buffer<uint32_t, System> comparisons(sys, 1);
   Buffer<uint32_t, System> segment_begin(sys, num_slots), segment_end(sys, num_slots);
   Buffer<uint64_t, System> word(sys, num_slots);
   bool all_settled = false;
@@ -593,16 +676,14 @@ void PartitionBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntr
     const auto ends = thrust::make_transform_iterator(zero, SegmentEndCandidate{segment.data(), num_slots});
     thrust::inclusive_scan(policy, thrust::make_reverse_iterator(ends + num_slots), thrust::make_reverse_iterator(ends),
                            thrust::make_reverse_iterator(segment_end.data() + num_slots), thrust::minimum<uint32_t>());
-    thrust::fill_n(policy, comparisons.data(), 1, uint32_t{0});  // one round's count fits 32 bits
     thrust::transform(policy, zero, zero + num_slots, word.data(),
                       PartitionWord{simplex, entries, cluster_of, item.data(), segment.data(), segment_begin.data(),
-                                    segment_end.data(), settled.data(), cluster_undecided->data(), comparisons.data()});
+                                    segment_end.data(), settled.data(), cluster_undecided->data(), exact_count});
     thrust::stable_sort_by_key(policy, word.data(), word.data() + num_slots, item.data());
     const auto starts = thrust::make_transform_iterator(zero, NewSegmentStart{word.data()});
     thrust::inclusive_scan(policy, starts, starts + num_slots, segment.data());
     thrust::transform(policy, word.data(), word.data() + num_slots, settled.data(), SettledOfWord{});
     all_settled = thrust::count(policy, settled.data(), settled.data() + num_slots, uint8_t{0}) == 0;
-    counts->bounded_exact += sys.Read(comparisons.data());
   }
   word.Reset();
   segment_begin.Reset();
@@ -618,21 +699,21 @@ void PartitionBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntr
                                           cluster_undecided->data(), entries, verdict->data()});
 }
 
-/// Sorts the entries of bad clusters exactly (small ones one thread each, the others by partition
+/// Sorts the entries of bad clusters exactly (small ones by all their pairs, the others by partition
 /// rounds) and sets their verdicts; `cluster_bad` then marks the clusters left undecided.
 template <class System>
 void SortBadClusters(System& sys, const SimplexPoints& simplex, RefinedEntry* entries, const uint32_t* cluster_of,
                      uint32_t num_clusters, uint32_t num_refined, Buffer<uint8_t, System>* verdict,
-                     Buffer<uint8_t, System>* cluster_bad, ComparisonCounts* counts) {
+                     Buffer<uint8_t, System>* cluster_bad, unsigned long long* exact_count) {
   auto policy = sys.policy();
   thrust::counting_iterator<uint32_t> zero(0);
   if (thrust::count(policy, cluster_bad->data(), cluster_bad->data() + num_clusters, uint8_t{1}) == 0) return;
   Buffer<uint8_t, System> cluster_undecided(sys, num_clusters);
   thrust::fill_n(policy, cluster_undecided.data(), num_clusters, uint8_t{0});
-  SortSmallBadClusters(sys, simplex, entries, num_clusters, num_refined, verdict, cluster_bad, &cluster_undecided,
-                       counts);
+  SortSmallBadClusters(sys, simplex, entries, cluster_of, num_clusters, num_refined, verdict, cluster_bad,
+                       &cluster_undecided, exact_count);
   PartitionBadClusters(sys, simplex, entries, cluster_of, num_refined, verdict, *cluster_bad, &cluster_undecided,
-                       counts);
+                       exact_count);
   thrust::fill_n(policy, cluster_bad->data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_refined, MarkBadCluster{verdict->data(), cluster_of, cluster_bad->data()});
 }
@@ -652,6 +733,9 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   Buffer<uint8_t, System> one_double(sys, num_runs);
   thrust::transform(policy, zero, zero + num_runs, one_double.data(), IsLongRun{run_begin});
   if (thrust::count(policy, one_double.data(), one_double.data() + num_runs, uint8_t{1}) == 0) return 0;
+  // The stage's exact comparisons are counted on the system and read once, when it ends.
+  Buffer<unsigned long long, System> exact_count(sys, 1);
+  thrust::fill_n(policy, exact_count.data(), 1, 0ull);
   Buffer<uint32_t, System> run_of(sys, num_entries);
   const auto starts = thrust::make_transform_iterator(zero, RunStartAsU32{link});
   thrust::inclusive_scan(policy, starts, starts + num_entries, run_of.data());
@@ -659,9 +743,7 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
                      CheckRunOfOneDouble{simplex, ids, run_of.data(), run_begin, one_double.data()});
   thrust::for_each_n(policy, zero, num_entries,
                      SettleRunOfOneDouble{run_of.data(), run_begin, one_double.data(), new_value});
-  counts->bounded_exact +=
-      thrust::transform_reduce(policy, zero, zero + num_runs, SettledComparisons{run_begin, one_double.data()},
-                               uint64_t{0}, thrust::plus<uint64_t>());
+  thrust::for_each_n(policy, zero, num_runs, CountSettledComparisons{run_begin, one_double.data(), exact_count.data()});
   Buffer<uint32_t, System> positions(sys, num_entries);
   const auto num_refined =
       static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_entries, positions.data(),
@@ -669,10 +751,13 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
                             positions.data());
   thrust::for_each_n(policy, zero, num_entries, CutLinksOfOneDouble{run_of.data(), run_begin, one_double.data(), link});
   one_double.Reset();
-  if (num_refined == 0) return 1;  // links may have been cut: the caller lists the runs again
+  if (num_refined == 0) {
+    counts->bounded_exact += sys.Read(exact_count.data());
+    return 1;  // links may have been cut: the caller lists the runs again
+  }
 
   // Congruent entries of a run are equal, and a lattice's long runs are mostly such copies (a
-  // lattice nudged by single ulps at 1M: 4.6M entries in 106K classes). Each class is keyed,
+  // lattice nudged by single ulps at 1M: 4.6M entries in 13K classes). Each class is keyed,
   // sorted and judged once, by its first member, and its other members follow that one.
   Buffer<uint32_t, System> member(sys, num_refined);  // grouping position -> entry
   thrust::sequence(policy, member.data(), member.data() + num_refined);
@@ -692,7 +777,7 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   }
   const uint32_t num_groups = sys.Read(group_of.data() + (num_refined - 1));
   Buffer<uint32_t, System> group_first(sys, num_groups + 1);  // grouping position of each first member
-  thrust::copy_if(policy, zero, zero + num_refined, group_first.data(), StartsGroupOf{group_of.data()});
+  thrust::for_each_n(policy, zero, num_refined, MarkGroupFirst{group_of.data(), group_first.data()});
   thrust::fill_n(policy, group_first.data() + num_groups, 1, num_refined);
   group_of.Reset();
   Buffer<uint32_t, System> member_id(sys, num_refined);
@@ -713,13 +798,9 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   SortRefinedEntries(sys, &entries, num_groups);
 
   Buffer<uint8_t, System> verdict(sys, num_groups);
-  {
-    Buffer<uint32_t, System> comparisons(sys, num_groups);
-    thrust::for_each_n(
-        policy, zero, num_groups,
-        JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(), comparisons.data()});
-    counts->bounded_exact += thrust::reduce(policy, comparisons.data(), comparisons.data() + num_groups, uint64_t{0});
-  }
+  thrust::for_each_n(
+      policy, zero, num_groups,
+      JudgeRefinedPair{simplex, entries.data(), run_unrefinable.data(), verdict.data(), exact_count.data()});
 
   Buffer<uint32_t, System> cluster_of(sys, num_groups);
   const auto cluster_starts = thrust::make_transform_iterator(zero, ClusterStartAsU32{verdict.data()});
@@ -730,7 +811,7 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
   thrust::fill_n(policy, cluster_bad.data(), num_clusters, uint8_t{0});
   thrust::for_each_n(policy, zero, num_groups, MarkBadCluster{verdict.data(), cluster_of.data(), cluster_bad.data()});
   SortBadClusters(sys, simplex, entries.data(), cluster_of.data(), num_clusters, num_groups, &verdict, &cluster_bad,
-                  counts);
+                  exact_count.data());
 
   // The groups, in their exact order, over the runs' positions.
   Buffer<uint32_t, System> expanded_start(sys, num_groups);
@@ -751,6 +832,7 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
       policy, zero, num_refined,
       ApplyRefinedVerdicts{positions.data(), expanded_run.data(), run_unrefinable.data(), expanded_verdict.data(),
                            expanded_cluster.data(), cluster_bad.data(), link, new_value});
+  counts->bounded_exact += sys.Read(exact_count.data());
   return num_refined;
 }
 

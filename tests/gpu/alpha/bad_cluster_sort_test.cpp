@@ -1,8 +1,8 @@
 // The exact sort of the refined spectrum's bad clusters (SortBadClusters in
 // gpu/alpha/spectrum_refine.cuh), run on the OpenMP backend as the CPU engine runs it, against GMP
 // rationals. A bad cluster is a range of entries whose refined keys cannot order them; clusters
-// of up to kMaxThreadCluster entries are sorted by one thread each, larger ones by rounds of
-// three-way partitions. Both must give the order by (exact value, input order), mark each value's
+// of up to kMaxPairwiseCluster entries are sorted by all their pairs' exact signs at once, larger
+// ones by rounds of three-way partitions. Both must give the order by (exact value, input order), mark each value's
 // first entry kPairLess and the others kPairEqual, and leave the cluster's first verdict (a
 // certified boundary) alone. The entries are windows of an ulp-perturbed lattice's simplices
 // (near ties 2^-146 to 2^-224 apart and exact ties that are not congruent), shuffled.
@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "core/exact/simplex_radius.hpp"
-#include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/spectrum_refine.cuh"
 #include "gpu/system/engine_system.cuh"
 #include "tests/gpu/alpha/simplex_pool.hpp"
@@ -81,9 +80,10 @@ uint64_t SortAndCheck(const SimplexPool& pool, const std::vector<uint32_t>& size
   sys.FromHost(verdict.data(), host_verdict.data(), num_refined);
   const std::vector<uint8_t> all_bad(num_clusters, 1);
   sys.FromHost(cluster_bad.data(), all_bad.data(), num_clusters);
-  ComparisonCounts counts;
+  Buffer<unsigned long long, CpuSystem> exact_count(sys, 1);
+  *exact_count.data() = 0;
   SortBadClusters(sys, simplex, entries.data(), cluster_of.data(), num_clusters, num_refined, &verdict, &cluster_bad,
-                  &counts);
+                  exact_count.data());
 
   const std::vector<RefinedEntry> sorted = entries.ToHostVector(num_refined);
   const std::vector<uint8_t> verdicts = verdict.ToHostVector(num_refined);
@@ -110,18 +110,18 @@ uint64_t SortAndCheck(const SimplexPool& pool, const std::vector<uint32_t>& size
       }
     }
   }
-  return counts.bounded_exact;
+  return *exact_count.data();
 }
 
-TEST(BadClusterSortTest, ClustersOneThreadSorts) {
+TEST(BadClusterSortTest, ClustersSortedByTheirPairs) {
   const SimplexPool pool = UlpLatticePool(41);
-  const uint64_t bounded = SortAndCheck(pool, {2, 3, 7, 16, 31, kMaxThreadCluster, 5, 12}, 42);
+  const uint64_t bounded = SortAndCheck(pool, {2, 3, 7, 16, 31, kMaxPairwiseCluster, 5, 12}, 42);
   EXPECT_GT(bounded, 0u) << "the windows hold pairs the keys cannot order";
 }
 
 TEST(BadClusterSortTest, ClustersSortedByPartitionRounds) {
   const SimplexPool pool = UlpLatticePool(51);
-  const uint64_t bounded = SortAndCheck(pool, {kMaxThreadCluster + 1, 60, 150, 300}, 52);
+  const uint64_t bounded = SortAndCheck(pool, {kMaxPairwiseCluster + 1, 60, 150, 300}, 52);
   EXPECT_GT(bounded, 0u);
 }
 
@@ -129,7 +129,7 @@ TEST(BadClusterSortTest, BothKindsInOneCall) {
   const SimplexPool pool = UlpLatticePool(61);
   for (uint64_t seed = 0; seed < 20; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
-    SortAndCheck(pool, {4, 90, kMaxThreadCluster, 2, kMaxThreadCluster + 1, 20, 200}, 100 + seed);
+    SortAndCheck(pool, {4, 90, kMaxPairwiseCluster, 2, kMaxPairwiseCluster + 1, 20, 200}, 100 + seed);
     if (HasFailure()) return;
   }
 }
