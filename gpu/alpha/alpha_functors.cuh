@@ -596,6 +596,40 @@ struct EntryOfRankedKey {
   GALPHA_HD uint64_t operator()(uint64_t key) const { return key & ((uint64_t{1} << kMasterEntryBits) - 1); }
 };
 
+/// The number of master-list entries of an item (its end points with a real rank); 0 past the
+/// last item, so that an exclusive scan over num_items + 1 values ends with the total.
+struct MasterEntriesOfItem {
+  MasterEndpoints endpoints;
+  uint32_t num_items;
+  GALPHA_HD uint32_t operator()(uint32_t item) const {
+    if (item >= num_items) return 0;
+    uint32_t count = 0;
+    auto visit = [&count](uint32_t, uint64_t) { ++count; };
+    endpoints.Visit(item, visit);
+    return count;
+  }
+};
+
+/// Writes an item's (rank, entry) keys (RankedMasterKey's layout) from its offset: no atomics,
+/// so no contention where millions of entries share a few ranks.
+struct WriteRankedMasterKeys {
+  MasterEndpoints endpoints;
+  const uint32_t* offset;
+  uint64_t* keys;
+  GALPHA_HD void operator()(uint32_t item) const {
+    uint32_t at = offset[item];
+    auto visit = [this, &at](uint32_t rank, uint64_t packed) {
+      keys[at++] = (uint64_t{rank} << kMasterEntryBits) | packed;
+    };
+    endpoints.Visit(item, visit);
+  }
+};
+
+/// The smallest (rank, entry) key of rank r: where r's segment begins among sorted keys.
+struct FirstRankedMasterKey {
+  GALPHA_HD uint64_t operator()(uint32_t r) const { return uint64_t{r} << kMasterEntryBits; }
+};
+
 /// Largest rank segment sorted by one thread; longer ones (exact ties: a grid's congruent
 /// triangles) are sorted by a Thrust call each.
 constexpr uint32_t kMaxThreadSegment = 64;
