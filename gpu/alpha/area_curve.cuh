@@ -25,6 +25,7 @@
 #include "core/exact/expansion.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
+#include "gpu/system/atomic_increment.cuh"
 #include "gpu/triangulation/point_order.cuh"
 
 namespace galpha::detail {
@@ -36,14 +37,6 @@ constexpr int kAreaFractionBits = 57;
 /// of the coordinates is at most this times |bx*cy| + |by*cx| (the predicates' filter, which we
 /// enlarge the same way: by a relative 2^-20).
 constexpr double kTwiceAreaErrBound = (3.0 + 16.0 * exact::kEpsilon) * exact::kEpsilon * (1.0 + 0x1p-20);
-
-GALPHA_HD inline void AtomicAddU64(unsigned long long* p, unsigned long long v) {
-#if defined(__CUDA_ARCH__)
-  atomicAdd(p, v);
-#else
-  __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
-#endif
-}
 
 /// One triangle's twice-area in units and its error bound in units.
 struct TriangleAreaUnits {

@@ -154,7 +154,7 @@ struct CountSettledComparisons {
   const uint8_t* settled;
   unsigned long long* exact_count;
   GALPHA_HD void operator()(uint32_t r) const {
-    if (settled[r]) AtomicAdd(exact_count, run_begin[r + 1] - run_begin[r] - 1);
+    if (settled[r]) AtomicAddU64(exact_count, run_begin[r + 1] - run_begin[r] - 1);
   }
 };
 
@@ -211,7 +211,7 @@ struct JudgeRefinedPair {
       verdict[k] = kPairEqual;
       return;
     }
-    AtomicAdd(exact_count, 1);
+    AtomicAddU64(exact_count, 1);
     const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
     verdict[k] = order == Order::kLess ? kPairLess : order == Order::kEqual ? kPairEqual : kPairBad;
   }
@@ -348,7 +348,7 @@ GALPHA_HD inline int ExactClusterEntrySign(const SimplexPoints& simplex, const R
   double wa[3], wb[3];
   const int na = simplex(a.id, pa, wa), nb = simplex(b.id, pb, wb);
   if (SimplexRadiusCongruent(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb)) return 0;
-  AtomicAdd(exact_count, 1);
+  AtomicAddU64(exact_count, 1);
   const Order order = CompareSimplexRadiusSqBounded(pa, simplex.Weights(wa), na, pb, simplex.Weights(wb), nb);
   if (order != Order::kUndecided) return SignOf(order);
   cluster_undecided[cluster] = 1;  // concurrent writes only ever write 1

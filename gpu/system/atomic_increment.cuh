@@ -28,9 +28,9 @@ GALPHA_HD inline uint32_t AtomicIncrement(uint32_t* p) {
 #endif
 }
 
-/// *p += v, atomically: a 64-bit counter (the refine stage's exact comparisons, read once when the
-/// stage ends instead of reduced and read after each of its passes).
-GALPHA_HD inline void AtomicAdd(unsigned long long* p, unsigned long long v) {
+/// *p += v, atomically, on a 64-bit counter (the area curve's units, the refine stage's count of
+/// exact comparisons).
+GALPHA_HD inline void AtomicAddU64(unsigned long long* p, unsigned long long v) {
 #if defined(__CUDA_ARCH__)
   atomicAdd(p, v);
 #else

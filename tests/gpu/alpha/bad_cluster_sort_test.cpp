@@ -22,20 +22,8 @@ namespace galpha::detail {
 namespace {
 
 using testing_pool::Compare;
-using testing_pool::PoolOf;
 using testing_pool::SimplexPool;
-
-SimplexPool UlpLatticePool(uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_int_distribution<int> step(0, 5);
-  std::uniform_int_distribution<int> ulps(-2, 2);
-  auto nudge = [&](double v) {
-    const int n = ulps(rng);
-    for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? 1e300 : -1e300);
-    return v;
-  };
-  return PoolOf(14, [&] { return Point2{nudge(1000.0 + 0.125 * step(rng)), nudge(2000.0 + 0.125 * step(rng))}; });
-}
+using testing_pool::UlpLatticePool;
 
 // Sorts clusters of the given sizes, each a shuffled window of the pool's exact order, as one call,
 // and checks every cluster. Returns the bounded exact comparisons made.

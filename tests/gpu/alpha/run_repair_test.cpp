@@ -118,17 +118,7 @@ TEST(RunRepairTest, PointsOnACircle) {
 }
 
 TEST(RunRepairTest, UlpPerturbedLattice) {
-  std::mt19937_64 rng(31);
-  std::uniform_int_distribution<int> step(0, 5);
-  std::uniform_int_distribution<int> ulps(-2, 2);
-  auto nudge = [&](double v) {
-    const int n = ulps(rng);
-    for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? 1e300 : -1e300);
-    return v;
-  };
-  const SimplexPool pool = PoolOf(14, [&] {
-    return Point2{nudge(1000.0 + 0.125 * step(rng)), nudge(2000.0 + 0.125 * step(rng))};
-  });
+  const SimplexPool pool = testing_pool::UlpLatticePool(31);
   const Outcome outcome = RepairRandomRuns(pool, 3000, 32);
   EXPECT_GT(outcome.runs, 2500);
   EXPECT_GT(outcome.in_order, 1200);

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <random>
 #include <vector>
 
 #include "core/base/point.hpp"
@@ -42,6 +45,20 @@ SimplexPool PoolOf(int count, Draw point) {
     }
   }
   return pool;
+}
+
+// A pool over 14 points of a lattice with step 1/8, each coordinate nudged by up to two ulps: near
+// ties 2^-146 to 2^-224 apart and exact ties that are not congruent.
+inline SimplexPool UlpLatticePool(uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> step(0, 5);
+  std::uniform_int_distribution<int> ulps(-2, 2);
+  auto nudge = [&](double v) {
+    const int n = ulps(rng);
+    for (int i = 0; i < std::abs(n); ++i) v = std::nextafter(v, n > 0 ? 1e300 : -1e300);
+    return v;
+  };
+  return PoolOf(14, [&] { return Point2{nudge(1000.0 + 0.125 * step(rng)), nudge(2000.0 + 0.125 * step(rng))}; });
 }
 
 // Sign of rho^2(a) - rho^2(b), by GMP rationals.
