@@ -52,7 +52,7 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
       front->encoded.wait(lock, [&] { return front->ready; });
     }
     if (!front->status.ok()) {
-      status_ = front->status;
+      status_ = UnsharedCopy(front->status);
       ahead_.clear();  // their tasks finish on their own
       return false;
     }
@@ -99,6 +99,15 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
         Finish(*pending, OutOfMemory(index), nullptr);  // never queued: Next must not wait for it
       }
     }
+  }
+
+  // A copy of a pool task's status that shares nothing with it. absl::Status copies share one
+  // counted message, and the task's copy may be released last on the pool's thread; the count's
+  // atomics live in Debian's uninstrumented libabsl_status, so ThreadSanitizer cannot see that
+  // release order and reported the message's delete as racing with this thread's reads (a CI run
+  // on 2026-11-28, in encoded_answer_test). The code and the message are what the answer needs.
+  static absl::Status UnsharedCopy(const absl::Status& status) {
+    return absl::Status(status.code(), status.message());
   }
 
   static absl::Status OutOfMemory(uint64_t index) {
