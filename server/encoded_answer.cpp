@@ -106,9 +106,7 @@ class EncodedClassifySource final : public ChunkSource<v1::ClassifyResponse> {
   // atomics live in Debian's uninstrumented libabsl_status, so ThreadSanitizer cannot see that
   // release order and reported the message's delete as racing with this thread's reads (a CI run
   // on 2026-11-28, in encoded_answer_test). The code and the message are what the answer needs.
-  static absl::Status UnsharedCopy(const absl::Status& status) {
-    return absl::Status(status.code(), status.message());
-  }
+  static absl::Status UnsharedCopy(const absl::Status& status) { return absl::Status(status.code(), status.message()); }
 
   static absl::Status OutOfMemory(uint64_t index) {
     return absl::ResourceExhaustedError(
