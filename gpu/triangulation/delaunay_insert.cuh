@@ -11,6 +11,7 @@
 #include <cuda/atomic>
 
 #include "core/base/hd.hpp"
+#include "gpu/system/atomic_increment.cuh"
 #include "gpu/triangulation/mesh.cuh"
 
 namespace galpha::detail {
@@ -75,6 +76,37 @@ struct VoteForInsertion {
   // Per triangle: the votes of points on the second half of an edge's line, by thirds; nullptr:
   // no votes by thirds (weighted builds, and rounds before any point on an edge's line was seen).
   unsigned long long* edge_third_vote;
+  // Points outside the hull vote twice, for the two supports of their sector (SupportSlope):
+  // in tri_vote toward the hull edge's first end, in edge_vote toward its second. Needs edge_vote.
+  bool sector_pairs;
+
+  /// Hull vertex of the infinite triangle across `t`'s edge opposite its vertex at `k` other than
+  /// `shared` (the next vertex along the hull past `shared`).
+  GALPHA_HD int32_t NextHullVertex(int32_t t, int k, int32_t shared) const {
+    const Tri y = mesh.tri[mesh.nbr[t].n[k]];
+    for (int j = 0; j < 3; ++j) {
+      if (y.v[j] != mesh.inf && y.v[j] != shared) return y.v[j];
+    }
+    return shared;
+  }
+
+  /// The slope of a sector's support direction away from its hull edge's normal, toward one end:
+  /// tan(turn / 6), approximated by tan(turn / 2) / 3, where `turn` is the hull's turning angle
+  /// at that end between the edges `in` and `out` (scaled vectors). On a circle's arcs, whose
+  /// neighbours were split alike, the turn is about twice an arc's half angle, and the two supports
+  /// are then the arc's points a third and two thirds along it: the arc is split in three parts a
+  /// round. Any slope keeps the choice a support point of the sector's points, a vertex of their
+  /// hull with the edge's ends (what the farthest point is too), so that points beyond a blob's
+  /// hull edge still elect hull vertices. Capped at 1 (45 degrees), which is also the slope where the
+  /// turn is a half turn or undefined.
+  GALPHA_HD static double SupportSlope(double in_x, double in_y, double out_x, double out_y) {
+    const double cross = fabs(in_x * out_y - in_y * out_x);
+    const double dot = in_x * out_x + in_y * out_y;
+    const double denominator = sqrt((in_x * in_x + in_y * in_y) * (out_x * out_x + out_y * out_y)) + dot;
+    if (!(denominator > 0.0)) return 1.0;
+    const double slope = cross / denominator / 3.0;
+    return slope < 1.0 ? slope : 1.0;
+  }
 
   /// The vote by thirds of point i, at `along` (its position along the edge's line, 0 and 1 at
   /// the edge's ends): the half it lies in picks the slot, its distance from the third or the two
@@ -113,6 +145,25 @@ struct VoteForInsertion {
       const double wx = ldexp(w.x - u.x, -e), wy = ldexp(w.y - u.y, -e);
       const double px = ldexp(p.x - u.x, -e), py = ldexp(p.y - u.y, -e);
       const double outside = wx * py - wy * px;
+      if (outside > 0.0 && sector_pairs) {
+        // The sector's two supports (SupportSlope): toward u, the direction of largest outside -
+        // s_u * along; toward w, outside + s_w * along (along: the position along the edge).
+        const int32_t u_prev = NextHullVertex(t, Prev(inf_pos), x.v[Next(inf_pos)]);
+        const int32_t w_next = NextHullVertex(t, Next(inf_pos), x.v[Prev(inf_pos)]);
+        const Point2 before = mesh.pts[u_prev], after = mesh.pts[w_next];
+        const double bx = ldexp(before.x - u.x, -e), by = ldexp(before.y - u.y, -e);
+        const double ax = ldexp(after.x - w.x, -e), ay = ldexp(after.y - w.y, -e);
+        const double slope_u = SupportSlope(-bx, -by, wx, wy);
+        const double slope_w = SupportSlope(wx, wy, ax, ay);
+        const double along = wx * px + wy * py;
+        const float toward_u = -static_cast<float>(outside - slope_u * along);
+        const float toward_w = -static_cast<float>(outside + slope_w * along);
+        cuda::atomic_ref<unsigned long long, cuda::thread_scope_device>(tri_vote[t])
+            .fetch_min((static_cast<unsigned long long>(OrderedFloatKey(toward_u)) << 32) | i);
+        cuda::atomic_ref<unsigned long long, cuda::thread_scope_device>(edge_vote[t])
+            .fetch_min((static_cast<unsigned long long>(OrderedFloatKey(toward_w)) << 32) | i);
+        return;
+      }
       if (outside > 0.0) {
         score = -static_cast<float>(outside);
       } else if constexpr (!kWeighted) {
@@ -244,7 +295,8 @@ struct PickSecondWinners {
       }
     }
     tri_vote[t] = inside < on_edge ? inside : on_edge;
-    const bool both = inside != kNoVote && on_edge != kNoVote;
+    // A sector's two supports (VoteForInsertion::sector_pairs) may be one point.
+    const bool both = inside != kNoVote && on_edge != kNoVote && (inside & 0xffffffffull) != (on_edge & 0xffffffffull);
     edge_vote[t] = both ? (inside < on_edge ? on_edge : inside) : kNoVote;
     if (both) {
       cuda::atomic_ref<uint32_t, cuda::thread_scope_device> count(*num_second);
@@ -305,6 +357,7 @@ struct SplitTriangles {
   const int32_t* pending;
   uint8_t* inserted;  // per uninserted point
   int32_t num_tri;
+  uint32_t* sector_splits;  // the build's count of split infinite triangles (points added to the hull)
 
   GALPHA_HD void operator()(int32_t t) const {
     const unsigned long long vote = tri_vote[t];
@@ -313,6 +366,7 @@ struct SplitTriangles {
     inserted[winner] = 1;
     const int32_t w = pending[winner];
     const Tri x = mesh.tri[t];
+    if (x.v[0] == mesh.inf || x.v[1] == mesh.inf || x.v[2] == mesh.inf) AtomicIncrement(sector_splits);
     const TriNbr nx = mesh.nbr[t];
     int32_t child[3];
     for (int k = 0; k < 3; ++k) child[k] = ChildSlot(t, k, split_count[t], num_tri);
