@@ -707,10 +707,14 @@ void SortMasterSegments(System& sys, const MasterEndpoints& endpoints, uint32_t 
   }
 }
 
-/// On the device, with at least this many simplices a rank on average (a lattice nudged by ulps at
-/// 1M: 475; uniform points: 1.5), the master list is built by one sort of (rank, entry) keys
-/// (BuildSortedMasterList) instead of per-rank counters and cursors.
-constexpr uint32_t kMinItemsPerRankToSortMaster = 16;
+/// On the device, with at least this many simplices a rank on average, the master list is built by
+/// one sort of (rank, entry) keys (BuildSortedMasterList) instead of per-rank counters and cursors.
+/// Measured at 1M on an H200 (bench/README.md, twenty-second session): two crossing lines (3
+/// simplices a rank) took 1.0 ms sorted against 2.0-2.5 with the counters, centimetre LiDAR (4.8)
+/// 1.1-1.4 against 2.1-2.2, a lattice nudged by ulps (475: sorted at either threshold) 1.1; uniform points (1.5)
+/// took 1.2-1.3 ms either way, and keep the counters, which need 36 B a point less at the engine's
+/// peak.
+constexpr uint32_t kMinItemsPerRankToSortMaster = 2;
 
 /// The master list in CSR form by one sort: every item writes its (rank, entry) keys at its own
 /// offset, the keys are sorted, each rank's segment begins at the lower bound of its first key,
