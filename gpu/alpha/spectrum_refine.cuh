@@ -38,7 +38,6 @@
 
 #include <thrust/copy.h>
 #include <thrust/count.h>
-#include <thrust/extrema.h>
 #include <thrust/fill.h>
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
@@ -46,7 +45,6 @@
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/reverse_iterator.h>
 #include <thrust/iterator/transform_iterator.h>
-#include <thrust/reduce.h>
 #include <thrust/scan.h>
 #include <thrust/sequence.h>
 #include <thrust/sort.h>
@@ -150,11 +148,11 @@ struct CutLinksOfOneDouble {
 
 /// Adds a settled run of one double's comparisons (one per entry after its first) to the count.
 struct CountSettledComparisons {
-  const uint32_t* run_begin;
-  const uint8_t* settled;
+  SettledComparisons comparisons;
   unsigned long long* exact_count;
   GALPHA_HD void operator()(uint32_t r) const {
-    if (settled[r]) AtomicAddU64(exact_count, run_begin[r + 1] - run_begin[r] - 1);
+    const uint64_t proved = comparisons(r);
+    if (proved > 0) AtomicAddU64(exact_count, proved);
   }
 };
 
@@ -743,7 +741,8 @@ uint32_t RefineLongRuns(System& sys, const SimplexPoints& simplex, uint8_t* link
                      CheckRunOfOneDouble{simplex, ids, run_of.data(), run_begin, one_double.data()});
   thrust::for_each_n(policy, zero, num_entries,
                      SettleRunOfOneDouble{run_of.data(), run_begin, one_double.data(), new_value});
-  thrust::for_each_n(policy, zero, num_runs, CountSettledComparisons{run_begin, one_double.data(), exact_count.data()});
+  thrust::for_each_n(policy, zero, num_runs,
+                     CountSettledComparisons{SettledComparisons{run_begin, one_double.data()}, exact_count.data()});
   Buffer<uint32_t, System> positions(sys, num_entries);
   const auto num_refined =
       static_cast<uint32_t>(thrust::copy_if(policy, zero, zero + num_entries, positions.data(),
