@@ -80,13 +80,8 @@ struct MarkRedundantVertices {
     }
     // Hull edge u -> w; w's other hull edge lies in the infinite triangle across (w, inf).
     const int32_t u = x.v[Next(inf_pos)], w = x.v[Prev(inf_pos)];
-    const Tri y = mesh.tri[mesh.nbr[t].n[Next(inf_pos)]];
-    int32_t other = -1;
-    for (int k = 0; k < 3; ++k) {
-      if (y.v[k] != mesh.inf) continue;
-      other = y.v[Next(k)] == w ? y.v[Prev(k)] : y.v[Next(k)];
-    }
-    if (other < 0 || other == u) return;
+    const int32_t other = mesh.NextHullVertex(t, Next(inf_pos), w);
+    if (other == w || other == u) return;
     const Point2* pts = mesh.pts;
     if (Orient2dSign(pts[u], pts[w], pts[other]) == 0 && mesh.OnOpenSegment(u, other, w) &&
         CollinearPowerSign(pts[u], mesh.weight[u], pts[other], mesh.weight[other], pts[w], mesh.weight[w]) < 0) {

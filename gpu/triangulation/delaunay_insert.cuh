@@ -80,24 +80,14 @@ struct VoteForInsertion {
   // in tri_vote toward the hull edge's first end, in edge_vote toward its second. Needs edge_vote.
   bool sector_pairs;
 
-  /// Hull vertex of the infinite triangle across `t`'s edge opposite its vertex at `k` other than
-  /// `shared` (the next vertex along the hull past `shared`).
-  GALPHA_HD int32_t NextHullVertex(int32_t t, int k, int32_t shared) const {
-    const Tri y = mesh.tri[mesh.nbr[t].n[k]];
-    for (int j = 0; j < 3; ++j) {
-      if (y.v[j] != mesh.inf && y.v[j] != shared) return y.v[j];
-    }
-    return shared;
-  }
-
   /// The slope of a sector's support direction away from its hull edge's normal, toward one end:
   /// tan(turn / 6), approximated by tan(turn / 2) / 3, where `turn` is the hull's turning angle
   /// at that end between the edges `in` and `out` (scaled vectors). On a circle's arcs, whose
   /// neighbours were split alike, the turn is about twice an arc's half angle, and the two supports
   /// are then the arc's points a third and two thirds along it: the arc is split in three parts a
   /// round. Any slope keeps the choice a support point of the sector's points, a vertex of their
-  /// hull with the edge's ends (what the farthest point is too), so that points beyond a blob's
-  /// hull edge still elect hull vertices. Capped at 1 (45 degrees), which is also the slope where the
+  /// convex hull (as the farthest point is), so that points beyond a blob's hull edge still elect
+  /// points of its outline. Capped at 1 (45 degrees), which is also the slope where the
   /// turn is a half turn or undefined.
   GALPHA_HD static double SupportSlope(double in_x, double in_y, double out_x, double out_y) {
     const double cross = fabs(in_x * out_y - in_y * out_x);
@@ -148,8 +138,8 @@ struct VoteForInsertion {
       if (outside > 0.0 && sector_pairs) {
         // The sector's two supports (SupportSlope): toward u, the direction of largest outside -
         // s_u * along; toward w, outside + s_w * along (along: the position along the edge).
-        const int32_t u_prev = NextHullVertex(t, Prev(inf_pos), x.v[Next(inf_pos)]);
-        const int32_t w_next = NextHullVertex(t, Next(inf_pos), x.v[Prev(inf_pos)]);
+        const int32_t u_prev = mesh.NextHullVertex(t, Prev(inf_pos), x.v[Next(inf_pos)]);
+        const int32_t w_next = mesh.NextHullVertex(t, Next(inf_pos), x.v[Prev(inf_pos)]);
         const Point2 before = mesh.pts[u_prev], after = mesh.pts[w_next];
         const double bx = ldexp(before.x - u.x, -e), by = ldexp(before.y - u.y, -e);
         const double ax = ldexp(after.x - w.x, -e), ay = ldexp(after.y - w.y, -e);
@@ -366,7 +356,7 @@ struct SplitTriangles {
     inserted[winner] = 1;
     const int32_t w = pending[winner];
     const Tri x = mesh.tri[t];
-    if (x.v[0] == mesh.inf || x.v[1] == mesh.inf || x.v[2] == mesh.inf) AtomicIncrement(sector_splits);
+    if (mesh.IsInfinite(t)) AtomicIncrement(sector_splits);
     const TriNbr nx = mesh.nbr[t];
     int32_t child[3];
     for (int k = 0; k < 3; ++k) child[k] = ChildSlot(t, k, split_count[t], num_tri);

@@ -78,6 +78,17 @@ struct MeshView {
     return x.v[0] == inf || x.v[1] == inf || x.v[2] == inf;
   }
 
+  /// For an infinite triangle t and its hull vertex `shared` opposite its position k: the next hull
+  /// vertex past `shared`, the finite vertex other than `shared` of the infinite triangle across
+  /// that edge (from `shared` to the vertex at infinity); `shared` itself if there is none.
+  GALPHA_HD int32_t NextHullVertex(int32_t t, int k, int32_t shared) const {
+    const Tri& y = tri[nbr[t].n[k]];
+    for (int j = 0; j < 3; ++j) {
+      if (y.v[j] != inf && y.v[j] != shared) return y.v[j];
+    }
+    return shared;
+  }
+
   /// Exact, never-zero orientation of three finite vertices.
   GALPHA_HD int Orient(int32_t a, int32_t b, int32_t c) const {
     return Orient2dSoS(pts[a], sos_rank[a], pts[b], sos_rank[b], pts[c], sos_rank[c]);
