@@ -19,26 +19,23 @@ namespace galpha::detail {
 constexpr uint32_t kNoFlipVote = ~0u;
 constexpr int32_t kNoPartner = -1;
 
-/// The two triangles of a flip before it happens: t = (r, p, q) with the flipped edge p-q opposite
-/// position k, and nb = (s, q, p) with s at position j. After it: t = (r, p, s), nb = (s, q, r).
-/// Edges (r,p) and (s,q) stay in their slots; edge (p,s) moves from nb to t and (q,r) from t to nb.
-struct FlipPlan {
-  int32_t t, nb;
-  int k, j;
-};
-
-/// Writes the flipped pair; outside neighbours are the old ones (the caller re-links).
-GALPHA_HD inline void WriteFlip(const MeshView& mesh, const FlipPlan& f) {
-  const Tri x = mesh.tri[f.t], y = mesh.tri[f.nb];
-  const TriNbr nx = mesh.nbr[f.t], ny = mesh.nbr[f.nb];
-  const int32_t r = x.v[f.k], p = x.v[Next(f.k)];
-  const int32_t s = y.v[f.j], q = y.v[Next(f.j)];
-  const int32_t across_rp = nx.n[Prev(f.k)], across_qr = nx.n[Next(f.k)];
-  const int32_t across_ps = ny.n[Next(f.j)], across_sq = ny.n[Prev(f.j)];
-  mesh.tri[f.t] = Tri{{r, p, s}};
-  mesh.nbr[f.t] = TriNbr{{across_ps, f.nb, across_rp}};
-  mesh.tri[f.nb] = Tri{{s, q, r}};
-  mesh.nbr[f.nb] = TriNbr{{across_qr, f.t, across_sq}};
+/// Flips the edge of triangle t opposite position k, shared with triangle nb. Before: t = (r, p, q)
+/// with the edge p-q opposite k, and nb = (s, q, p) with s at position j. After: t = (r, p, s), nb =
+/// (s, q, r). Edges (r,p) and (s,q) stay in their slots; edge (p,s) moves from nb to t and (q,r) from
+/// t to nb. Outside neighbours are the old ones (the caller re-links). Both triangles are loaded
+/// together, before j is looked for (one memory latency, not two).
+GALPHA_HD inline void WriteFlip(const MeshView& mesh, int32_t t, int k, int32_t nb) {
+  const Tri x = mesh.tri[t], y = mesh.tri[nb];
+  const TriNbr nx = mesh.nbr[t], ny = mesh.nbr[nb];
+  const int j = ApexPos(y, x.v[Prev(k)], x.v[Next(k)]);
+  const int32_t r = x.v[k], p = x.v[Next(k)];
+  const int32_t s = y.v[j], q = y.v[Next(j)];
+  const int32_t across_rp = nx.n[Prev(k)], across_qr = nx.n[Next(k)];
+  const int32_t across_ps = ny.n[Next(j)], across_sq = ny.n[Prev(j)];
+  mesh.tri[t] = Tri{{r, p, s}};
+  mesh.nbr[t] = TriNbr{{across_ps, nb, across_rp}};
+  mesh.tri[nb] = Tri{{s, q, r}};
+  mesh.nbr[nb] = TriNbr{{across_qr, t, across_sq}};
 }
 
 /// Edge masks of active triangles: which positions may have stopped being locally Delaunay. After a
@@ -62,18 +59,13 @@ struct ProposeFlips {
 
   GALPHA_HD void operator()(uint32_t i) const {
     const int32_t t = active[i];
-    proposal_edge[i] = -1;
-    const uint8_t mask = active_mask[i];
-    for (int k = 0; k < 3; ++k) {
-      if (((mask >> k) & 1u) && mesh.template ShouldFlip<kWeighted>(t, k, hull_may_change)) {
-        const int32_t nb = mesh.nbr[t].n[k];
-        proposal_edge[i] = static_cast<int8_t>(k);
-        proposal_nb[i] = nb;
-        cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[t]).fetch_min(static_cast<uint32_t>(t));
-        cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[nb]).fetch_min(static_cast<uint32_t>(t));
-        return;
-      }
-    }
+    int32_t nb = -1;
+    const int k = mesh.template FirstEdgeToFlip<kWeighted>(t, active_mask[i], hull_may_change, &nb);
+    proposal_edge[i] = static_cast<int8_t>(k);
+    if (k < 0) return;
+    proposal_nb[i] = nb;
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[t]).fetch_min(static_cast<uint32_t>(t));
+    cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(flip_vote[nb]).fetch_min(static_cast<uint32_t>(t));
   }
 };
 
@@ -87,13 +79,11 @@ struct ExecuteFlips {
   int32_t* partner;
 
   GALPHA_HD void operator()(uint32_t i) const {
-    if (proposal_edge[i] < 0) return;
+    const int k = proposal_edge[i];
+    if (k < 0) return;
     const int32_t t = active[i], nb = proposal_nb[i];
     if (flip_vote[t] != static_cast<uint32_t>(t) || flip_vote[nb] != static_cast<uint32_t>(t)) return;
-    const int k = proposal_edge[i];
-    const Tri x = mesh.tri[t];
-    const int j = mesh.EdgePos(nb, x.v[Prev(k)], x.v[Next(k)]);
-    WriteFlip(mesh, FlipPlan{t, nb, k, j});
+    WriteFlip(mesh, t, k, nb);
     partner[t] = nb;
     partner[nb] = t;
     proposal_edge[i] = 3;
@@ -102,6 +92,12 @@ struct ExecuteFlips {
 
 /// After ExecuteFlips: points each flipped triangle's outside edges at their current owners, and
 /// untouched neighbours of a moved edge back at the flipped triangle. One writer per slot.
+///
+/// Everything a flip's four re-links read is loaded first, side by side: the pass reads the
+/// vertices of triangles (which it never writes), partners (never written), and the neighbours of
+/// the flipped pair (written only by the pair's own thread, in slots it has read by then; an
+/// outside triangle's neighbours, which it also writes, belong to triangles that did not flip and
+/// are read by no thread). Re-linked one after the other, the four were a chain of dependent loads.
 struct LinkFlips {
   MeshView mesh;
   const int32_t* active;
@@ -109,24 +105,33 @@ struct LinkFlips {
   const int32_t* proposal_nb;
   const int32_t* partner;
 
-  GALPHA_HD void Relink(int32_t y, int pos, bool moved) const {
-    const int32_t x = mesh.nbr[y].n[pos];
-    const int32_t a = mesh.tri[y].v[Next(pos)], b = mesh.tri[y].v[Prev(pos)];
-    const int32_t px = partner[x];
+  /// Slot `pos` of flipped triangle y (vertices `yv`), whose old neighbour there was x (vertices
+  /// `xv`, flip partner `px`); `moved`: the edge came from y's partner.
+  GALPHA_HD void Relink(int32_t y, const Tri& yv, int pos, int32_t x, const Tri& xv, int32_t px, bool moved) const {
+    const int32_t a = yv.v[Next(pos)], b = yv.v[Prev(pos)];
     if (px != kNoPartner) {
-      mesh.nbr[y].n[pos] = mesh.EdgePos(x, b, a) >= 0 ? x : px;
+      mesh.nbr[y].n[pos] = EdgePosIn(xv, b, a) >= 0 ? x : px;
     } else if (moved) {
-      mesh.nbr[x].n[mesh.EdgePos(x, b, a)] = y;
+      mesh.nbr[x].n[EdgePosIn(xv, b, a)] = y;
     }
   }
 
   GALPHA_HD void operator()(uint32_t i) const {
     if (proposal_edge[i] != 3) return;
     const int32_t t = active[i], nb = proposal_nb[i];
-    Relink(t, 0, true);
-    Relink(t, 2, false);
-    Relink(nb, 0, true);
-    Relink(nb, 2, false);
+    const Tri tv = mesh.tri[t], nbv = mesh.tri[nb];
+    const TriNbr tn = mesh.nbr[t], nbn = mesh.nbr[nb];
+    const int32_t x[4] = {tn.n[0], tn.n[2], nbn.n[0], nbn.n[2]};
+    Tri xv[4];
+    int32_t px[4];
+    for (int e = 0; e < 4; ++e) {
+      xv[e] = mesh.tri[x[e]];
+      px[e] = partner[x[e]];
+    }
+    Relink(t, tv, 0, x[0], xv[0], px[0], true);
+    Relink(t, tv, 2, x[1], xv[1], px[1], false);
+    Relink(nb, nbv, 0, x[2], xv[2], px[2], true);
+    Relink(nb, nbv, 2, x[3], xv[3], px[3], false);
   }
 };
 
@@ -158,45 +163,59 @@ struct CollectNextActive {
     return cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(stamp[t]).exchange(now) != now;
   }
 
-  GALPHA_HD void operator()(uint32_t i) const {
-    candidates[2 * i] = -1;
-    candidates[2 * i + 1] = -1;
-    if (proposal_edge[i] < 0) return;
+  /// Clears entry i's votes and partners and calls keep(slot, triangle, edge mask) for each of its
+  /// (up to two) triangles to check next, slot 0 for the proposer and 1 for its partner.
+  template <class Keep>
+  GALPHA_HD void ForEachNext(uint32_t i, Keep&& keep) const {
+    const int edge = proposal_edge[i];
+    if (edge < 0) return;
     const uint32_t now = *generation;
     const int32_t t = active[i], nb = proposal_nb[i];
     flip_vote[t] = kNoFlipVote;
     flip_vote[nb] = kNoFlipVote;
-    const bool flipped = proposal_edge[i] == 3;
+    const bool flipped = edge == 3;
     if (Claim(t, now)) {
-      candidates[2 * i] = t;
       // A losing proposer may also have been flipped as another flip's neighbour, and only one
       // of its two claims lands: check every edge so that neither reason is lost.
-      candidate_mask[2 * i] = flipped ? kCheckFlipOuterEdges : kCheckAllEdges;
+      keep(0, t, flipped ? kCheckFlipOuterEdges : kCheckAllEdges);
     }
     if (flipped) {
       partner[t] = kNoPartner;
       partner[nb] = kNoPartner;
-      if (Claim(nb, now)) {
-        candidates[2 * i + 1] = nb;
-        candidate_mask[2 * i + 1] = kCheckFlipOuterEdges;
-      }
+      if (Claim(nb, now)) keep(1, nb, kCheckFlipOuterEdges);
     }
+  }
+
+  /// The grid's pass: entry i's triangles go to candidates[2i] and [2i+1] (-1 when unused), which
+  /// AppendIf then compacts.
+  GALPHA_HD void operator()(uint32_t i) const {
+    candidates[2 * i] = -1;
+    candidates[2 * i + 1] = -1;
+    ForEachNext(i, [&](int slot, int32_t t, uint8_t mask) {
+      candidates[2 * i + slot] = t;
+      candidate_mask[2 * i + slot] = mask;
+    });
   }
 };
 
 /// The flip iterations of a short active list, in one block: the same steps as a grid iteration
-/// (StartFlipIteration, ProposeFlips, ExecuteFlips, LinkFlips, CollectNextActive, then the append
-/// of the next list), with a barrier between steps instead of one launch each. The result of an
+/// (StartFlipIteration, ProposeFlips, ExecuteFlips, LinkFlips, CollectNextActive and the append of
+/// the next list), with a barrier between steps instead of one launch each. The result of an
 /// iteration does not depend on the order in which its items run, so it is the grid's, bit for
 /// bit. Why: on collinear input a new point takes over the fan of a neighbour one flip per
 /// iteration (two_lines at 1M: ~3,700 iterations, most of them with 2 to 7 active triangles; its
 /// insertion took 122 ms on an H100, ~30 us an iteration of five launches), while an iteration in
 /// one block costs a few memory latencies.
 ///
+/// The lists alternate between `active` and `candidates` (with their masks): CollectNextActive
+/// appends the next list straight into the other array, where the grid's pass writes two slots an
+/// entry and compacts them after; the next iteration's start is made by the step that ends the
+/// previous one. Five barriers an iteration instead of seven, and one pass fewer.
+///
 /// Runs while the list is nonempty and at most `max_count` long (it returns at once when it starts
-/// longer: the grid's launches take over, and take it back when it is short again). The count in
-/// `*count` is the current list's on return; `scratch_count` holds the next list's count while an
-/// iteration builds it. `*iterations_run` counts its iterations over the whole build: past
+/// longer: the grid's launches take over, and take it back when it is short again). The list is in
+/// `active` and its count in `*count` on return; `scratch_count` holds the next list's count while
+/// an iteration builds it. `*iterations_run` counts its iterations over the whole build: past
 /// `max_iterations` it runs no more, so that a flip loop that did not end would go on in the grid's
 /// launches, where the host's replay limit reports it (without the budget, each of those launches
 /// could run a loop of its own).
@@ -211,7 +230,7 @@ struct FlipTailInOneBlock {
   int32_t* partner;
   uint32_t* stamp;
   uint32_t* generation;
-  int32_t* candidates;  // two per active entry
+  int32_t* candidates;  // at least 2 * max_count entries: the alternate list
   uint8_t* candidate_mask;
   uint32_t* count;
   uint32_t* scratch_count;
@@ -221,39 +240,59 @@ struct FlipTailInOneBlock {
   bool hull_may_change;
 
   GALPHA_HD void operator()(const BlockLanes& lanes) const {
+    int32_t* list[2] = {active, candidates};
+    uint8_t* list_mask[2] = {active_mask, candidate_mask};
+    int now = 0;  // which array holds the current list
+    bool started = false;
     for (;;) {
       // The same for every lane: written (by lane 0) before the last barrier, and not again
       // before the next one.
       const uint32_t n = *count;
-      if (n == 0 || n > max_count || *iterations_run >= max_iterations) return;
-      if (lanes.id == 0) StartFlipIteration{scratch_count, generation}(0);
-      lanes.Sync();
-      const ProposeFlips<kWeighted> propose{mesh,        active,    active_mask,    proposal_edge,
+      if (n == 0 || n > max_count || *iterations_run >= max_iterations) {
+        // Leave the list where the grid's launches read it.
+        if (now == 1) {
+          for (uint32_t i = lanes.id; i < n; i += lanes.count) {
+            active[i] = candidates[i];
+            active_mask[i] = candidate_mask[i];
+          }
+        }
+        return;
+      }
+      if (!started) {
+        if (lanes.id == 0) StartFlipIteration{scratch_count, generation}(0);
+        lanes.Sync();
+        started = true;
+      }
+      int32_t* const current = list[now];
+      int32_t* const next = list[1 - now];
+      uint8_t* const next_mask = list_mask[1 - now];
+      const ProposeFlips<kWeighted> propose{mesh,        current,   list_mask[now], proposal_edge,
                                             proposal_nb, flip_vote, hull_may_change};
       for (uint32_t i = lanes.id; i < n; i += lanes.count) propose(i);
       lanes.Sync();
-      const ExecuteFlips execute{mesh, active, proposal_edge, proposal_nb, flip_vote, partner};
+      const ExecuteFlips execute{mesh, current, proposal_edge, proposal_nb, flip_vote, partner};
       for (uint32_t i = lanes.id; i < n; i += lanes.count) execute(i);
       lanes.Sync();
-      const LinkFlips link{mesh, active, proposal_edge, proposal_nb, partner};
+      const LinkFlips link{mesh, current, proposal_edge, proposal_nb, partner};
       for (uint32_t i = lanes.id; i < n; i += lanes.count) link(i);
       lanes.Sync();
-      const CollectNextActive collect{active, proposal_edge, proposal_nb, flip_vote,     partner,
-                                      stamp,  generation,    candidates,  candidate_mask};
-      for (uint32_t i = lanes.id; i < n; i += lanes.count) collect(i);
-      lanes.Sync();
-      for (uint32_t i = lanes.id; i < 2 * n; i += lanes.count) {
-        if (candidates[i] < 0) continue;
-        const uint32_t slot = AtomicIncrement(scratch_count);
-        active[slot] = candidates[i];
-        active_mask[slot] = candidate_mask[i];
+      const CollectNextActive collect{current, proposal_edge, proposal_nb, flip_vote, partner,
+                                      stamp,   generation,    nullptr,     nullptr};
+      for (uint32_t i = lanes.id; i < n; i += lanes.count) {
+        collect.ForEachNext(i, [&](int, int32_t t, uint8_t mask) {
+          const uint32_t slot = AtomicIncrement(scratch_count);
+          next[slot] = t;
+          next_mask[slot] = mask;
+        });
       }
       lanes.Sync();
       if (lanes.id == 0) {
         *count = *scratch_count;
         *iterations_run += 1;
+        StartFlipIteration{scratch_count, generation}(0);  // the next iteration's
       }
       lanes.Sync();
+      now = 1 - now;
     }
   }
 };
@@ -347,10 +386,8 @@ struct RepairFlatChainsSerially {
   int32_t* touched;  // the two triangles of every repair flip, for the Lawson pass after
 
   GALPHA_HD void SerialFlip(int32_t t, int k) const {
-    const Tri x = mesh.tri[t];
     const int32_t nb = mesh.nbr[t].n[k];
-    const int j = mesh.EdgePos(nb, x.v[Prev(k)], x.v[Next(k)]);
-    WriteFlip(mesh, FlipPlan{t, nb, k, j});
+    WriteFlip(mesh, t, k, nb);
     // The two moved edges: re-point their outside neighbours.
     for (int32_t y : {t, nb}) {
       const int32_t o = mesh.nbr[y].n[0];

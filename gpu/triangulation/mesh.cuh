@@ -41,6 +41,21 @@ struct TriNbr {
 GALPHA_HD inline int Next(int k) { return k == 2 ? 0 : k + 1; }
 GALPHA_HD inline int Prev(int k) { return k == 0 ? 2 : k - 1; }
 
+/// Position in triangle x of the edge running from a to b (the edge opposite that position), or -1.
+GALPHA_HD inline int EdgePosIn(const Tri& x, int32_t a, int32_t b) {
+  for (int k = 0; k < 3; ++k) {
+    if (x.v[Next(k)] == a && x.v[Prev(k)] == b) return k;
+  }
+  return -1;
+}
+
+/// Position in triangle y of its vertex other than a and b, two of its vertices (in a valid mesh, the
+/// apex across y's edge a-b; never out of range, where EdgePosIn's -1 would be).
+GALPHA_HD inline int ApexPos(const Tri& y, int32_t a, int32_t b) {
+  if (y.v[0] != a && y.v[0] != b) return 0;
+  return y.v[1] != a && y.v[1] != b ? 1 : 2;
+}
+
 /// Mutable view of the mesh; copied by value into functors.
 ///
 /// Weighted (a regular triangulation: `weight` set): the in-circle test becomes the power test
@@ -129,8 +144,13 @@ struct MeshView {
   /// open segment (HullEdgeConflict). Weighted: the power test's (s's lift below the plane).
   template <bool kWeighted = false>
   GALPHA_HD bool InConflict(int32_t t, int32_t s) const {
+    return InConflictWith<kWeighted>(tri[t], s);
+  }
+
+  /// InConflict for a triangle already loaded (its vertices `x`).
+  template <bool kWeighted = false>
+  GALPHA_HD bool InConflictWith(const Tri& x, int32_t s) const {
     if (s == inf) return false;
-    const Tri& x = tri[t];
     for (int k = 0; k < 3; ++k) {
       if (x.v[k] == inf) return HullEdgeConflict<kWeighted>(x.v[Next(k)], x.v[Prev(k)], s);
     }
@@ -178,13 +198,7 @@ struct MeshView {
   }
 
   /// Position in triangle t of the edge running from a to b (the edge opposite that position), or -1.
-  GALPHA_HD int EdgePos(int32_t t, int32_t a, int32_t b) const {
-    const Tri& x = tri[t];
-    for (int k = 0; k < 3; ++k) {
-      if (x.v[Next(k)] == a && x.v[Prev(k)] == b) return k;
-    }
-    return -1;
-  }
+  GALPHA_HD int EdgePos(int32_t t, int32_t a, int32_t b) const { return EdgePosIn(tri[t], a, b); }
 
   /// Visibility walk from triangle t to a triangle containing vertex p: a finite triangle with p
   /// inside (SoS orientation: never on an edge), or an infinite triangle whose hull edge p sees.
@@ -230,24 +244,45 @@ struct MeshView {
     return -1;
   }
 
-  /// Whether the edge of t opposite position k must be flipped to restore the (SoS) Delaunay
-  /// property. While the hull is still being built (`hull_may_change`): an edge between two infinite
-  /// triangles flips when its finite vertex is not convex, and a hull edge flips when the finite
-  /// triangle on it is flat with its apex on the edge (the apex joins the hull). Otherwise hull edges
-  /// never flip.
+  /// The first edge of triangle t, among the positions `mask` names, that must be flipped to
+  /// restore the (SoS) Delaunay property, or -1; `*across` is then the triangle across it. While the
+  /// hull is still being built (`hull_may_change`): an edge between two infinite triangles flips
+  /// when its finite vertex is not convex, and a hull edge flips when the finite triangle on it is
+  /// flat with its apex on the edge (the apex joins the hull). Otherwise hull edges never flip.
+  ///
+  /// t and the triangles across its masked edges are loaded before the first predicate: the flip
+  /// loop's short tail waits on memory latency, and checked one edge after the other (a load of t's
+  /// neighbour, then of its apex), the three edges of a triangle made three chains of dependent loads.
   template <bool kWeighted = false>
-  GALPHA_HD bool ShouldFlip(int32_t t, int k, bool hull_may_change) const {
-    const Tri& x = tri[t];
+  GALPHA_HD int FirstEdgeToFlip(int32_t t, uint8_t mask, bool hull_may_change, int32_t* across) const {
+    const Tri x = tri[t];
+    const TriNbr n = nbr[t];
+    Tri y[3]{};
+    for (int k = 0; k < 3; ++k) {
+      if ((mask >> k) & 1u) y[k] = tri[n.n[k]];
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (!((mask >> k) & 1u)) continue;
+      const int32_t s = y[k].v[ApexPos(y[k], x.v[Next(k)], x.v[Prev(k)])];
+      if (EdgeMustFlip<kWeighted>(x, k, s, hull_may_change)) {
+        *across = n.n[k];
+        return k;
+      }
+    }
+    return -1;
+  }
+
+  /// Whether the edge of triangle x opposite position k, whose other triangle has apex s, must be
+  /// flipped (FirstEdgeToFlip).
+  template <bool kWeighted = false>
+  GALPHA_HD bool EdgeMustFlip(const Tri& x, int k, int32_t s, bool hull_may_change) const {
     const int32_t r = x.v[k], p = x.v[Next(k)], q = x.v[Prev(k)];
-    const int32_t nb = nbr[t].n[k];
-    const int j = EdgePos(nb, q, p);
-    const int32_t s = tri[nb].v[j];
     if (r == inf || s == inf) {
       if (!hull_may_change || (r == inf && s == inf)) return false;
       return r == inf ? HullEdgeConflict<kWeighted>(p, q, s) : HullEdgeConflict<kWeighted>(q, p, r);
     }
     if ((p == inf || q == inf) && !hull_may_change) return false;
-    if (!InConflict<kWeighted>(t, s)) return false;
+    if (!InConflictWith<kWeighted>(x, s)) return false;
     if constexpr (kWeighted) {
       // A regular triangulation may meet a non-regular edge whose quadrilateral is not convex: it
       // cannot flip (the flip would fold the mesh); its reflex vertex is hidden (BlockedVertex).
