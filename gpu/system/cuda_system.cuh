@@ -8,7 +8,6 @@
 
 #include <cstdint>
 #include <future>
-#include <memory>
 #include <mutex>
 #include <string>
 #include <utility>
@@ -23,6 +22,7 @@
 #include "gpu/system/block_lanes.hpp"
 #include "gpu/system/engine_system.cuh"
 #include "gpu/system/host_copy.hpp"
+#include "gpu/system/loop_condition.hpp"
 #include "gpu/system/pinned_staging.cuh"
 
 namespace galpha::detail {
@@ -108,6 +108,13 @@ __global__ void __launch_bounds__(kOneBlockLanes) OneBlockKernel(F f) {
   f(BlockLanes{threadIdx.x, blockDim.x});
 }
 
+/// ReplayWhile's last kernel in each run of its body: sets whether the loop runs the body again.
+/// (A template, so that every translation unit that includes this header may define it.)
+template <class Condition>
+__global__ void SetLoopConditionKernel(cudaGraphConditionalHandle handle, Condition condition) {
+  cudaGraphSetConditional(handle, condition() ? 1u : 0u);
+}
+
 /// AppendIf's kernel.
 template <class InIt, class FlagIt, class Keep, class OutIt>
 __global__ void AppendIfKernel(const uint32_t* count, uint32_t per_item, InIt in, FlagIt flags, Keep keep, OutIt out,
@@ -191,23 +198,6 @@ class CudaSystem {
     CheckCuda(cudaGetLastError(), "kernel launch");
     CheckCuda(cudaStreamSynchronize(stream_), "cudaStreamSynchronize");
   }
-
-  /// A count on its way to the host (ReadCountLater), redeemed by CountOf.
-  struct CountTicket {
-    int word;
-  };
-  /// Starts copying `*device`, as it is once the work queued so far is done, without waiting:
-  /// the host goes on queueing work and asks for the value a step later. At most
-  /// PinnedCounters::kWords tickets may be outstanding.
-  CountTicket ReadCountLater(const uint32_t* device) {
-    CheckCuda(cudaGetLastError(), "kernel launch");
-    if (!counters_) counters_ = std::make_unique<PinnedCounters>();
-    const int word = next_counter_word_;
-    next_counter_word_ = (next_counter_word_ + 1) % PinnedCounters::kWords;
-    counters_->StartRead(word, device, stream_);
-    return {word};
-  }
-  uint32_t CountOf(CountTicket ticket) { return counters_->Finish(ticket.word); }
 
   /// Keeps, in place and in order, the first `n` items of `data` whose flag satisfies `keep`;
   /// their number goes to `*count` in device memory (no host sync).
@@ -298,6 +288,52 @@ class CudaSystem {
     CheckCuda(cudaGraphLaunch(recording.exec_, stream_), "cudaGraphLaunch");
   }
 
+  /// Records `body` (stream work of kernels only: no waits, allocations or CUB calls) the first
+  /// time as the body of a graph's while loop, then launches the graph: the body runs at least
+  /// once, and again while `condition` says so after a run, on the device, without the host (the
+  /// host's wait for a count after each replay, and the replays queued while it waited, cost the
+  /// flip loop tens of microseconds an insertion round).
+  template <class Body>
+  void ReplayWhile(Recording& recording, const WhileCountNonzero& condition, Body&& body) {
+    if (recording.exec_ == nullptr) {
+      cudaGraph_t graph = nullptr;
+      CheckCuda(cudaGraphCreate(&graph, 0), "cudaGraphCreate");
+      try {
+        cudaGraphConditionalHandle handle{};
+        CheckCuda(cudaGraphConditionalHandleCreate(&handle, graph, 1, cudaGraphCondAssignDefault),
+                  "cudaGraphConditionalHandleCreate");
+        cudaGraphNodeParams params{};
+        params.type = cudaGraphNodeTypeConditional;
+        params.conditional.handle = handle;
+        params.conditional.type = cudaGraphCondTypeWhile;
+        params.conditional.size = 1;
+        cudaGraphNode_t loop = nullptr;
+        CheckCuda(cudaGraphAddNode(&loop, graph, nullptr, nullptr, 0, &params), "cudaGraphAddNode (while)");
+        cudaGraph_t loop_body = params.conditional.phGraph_out[0];
+        CheckCuda(
+            cudaStreamBeginCaptureToGraph(stream_, loop_body, nullptr, nullptr, 0, cudaStreamCaptureModeThreadLocal),
+            "cudaStreamBeginCaptureToGraph");
+        try {
+          body();
+          SetLoopConditionKernel<<<1, 1, 0, stream_>>>(handle, condition);
+          CheckCuda(cudaGetLastError(), "kernel launch");
+        } catch (...) {
+          cudaStreamEndCapture(stream_, &loop_body);
+          cudaGetLastError();
+          throw;
+        }
+        CheckCuda(cudaStreamEndCapture(stream_, &loop_body), "cudaStreamEndCapture");
+        CheckCuda(cudaGraphInstantiate(&recording.exec_, graph, 0), "cudaGraphInstantiate");
+      } catch (...) {
+        cudaGraphDestroy(graph);
+        throw;
+      }
+      cudaGraphDestroy(graph);
+      recording.stream_ = stream_;
+    }
+    CheckCuda(cudaGraphLaunch(recording.exec_, stream_), "cudaGraphLaunch");
+  }
+
   /// Stage marks are events on the stream: a stage's time is the stream's, with no host sync at
   /// stage ends (StageTimer reads them all once, at the end of the build).
   using StageMark = cudaEvent_t;
@@ -335,8 +371,6 @@ class CudaSystem {
   cudaStream_t copy_stream_ = nullptr;  // DownloadAsync's, made on first use
   MemoryLedger ledger_;                 // declared before temp_, which points at it
   StreamOrderedAllocator temp_;
-  std::unique_ptr<PinnedCounters> counters_;  // ReadCountLater's, leased on first use
-  int next_counter_word_ = 0;
   // ForEachBelow's fixed grid: enough blocks to fill every multiprocessor, striding over the rest.
   static constexpr unsigned kBlockThreads = 256;
   static constexpr unsigned kBlocksPerSm = 8;

@@ -22,6 +22,7 @@
 #include "gpu/system/backend.hpp"
 #include "gpu/system/block_lanes.hpp"
 #include "gpu/system/host_copy.hpp"
+#include "gpu/system/loop_condition.hpp"
 
 namespace galpha::detail {
 
@@ -135,13 +136,6 @@ class CpuSystem {
   /// Waits for queued work; the CPU backend runs synchronously.
   void Synchronize() {}
 
-  /// The CUDA system's count read a step late; here the value is there at once.
-  struct CountTicket {
-    uint32_t value;
-  };
-  CountTicket ReadCountLater(const uint32_t* system) { return {*system}; }
-  uint32_t CountOf(CountTicket ticket) { return ticket.value; }
-
   /// Keeps, in place and in order, the first `n` items of `data` whose flag satisfies `keep`;
   /// their number goes to `*count`.
   template <class DataIt, class FlagIt, class Keep>
@@ -177,6 +171,13 @@ class CpuSystem {
   template <class Body>
   void Replay(Recording&, Body&& body) {
     body();
+  }
+  /// Runs `body` while `condition` says so after each run (the CUDA system's loop on the device).
+  template <class Body>
+  void ReplayWhile(Recording&, const WhileCountNonzero& condition, Body&& body) {
+    do {
+      body();
+    } while (condition());
   }
 
   using StageMark = std::chrono::steady_clock::time_point;

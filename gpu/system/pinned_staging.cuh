@@ -40,28 +40,4 @@ class PinnedStaging {
   Slots* slots_;
 };
 
-/// A few pinned words and their events, leased from a process-wide pool for one build: counts the
-/// build reads from the device a step late (CudaSystem::ReadCountLater), so that the host queues
-/// the next step's work instead of waiting for the stream to drain. Pinned, because a copy to
-/// pageable memory makes the host wait for the stream.
-class PinnedCounters {
- public:
-  static constexpr int kWords = 4;
-
-  PinnedCounters();
-  ~PinnedCounters();
-  PinnedCounters(const PinnedCounters&) = delete;
-  PinnedCounters& operator=(const PinnedCounters&) = delete;
-
-  /// Queues the copy of `*device` into word `i` on `stream`, after the work queued so far.
-  void StartRead(int i, const uint32_t* device, cudaStream_t stream);
-  /// Waits for word `i`'s last copy and returns the word.
-  uint32_t Finish(int i);
-
-  struct Block;
-
- private:
-  Block* block_;
-};
-
 }  // namespace galpha::detail

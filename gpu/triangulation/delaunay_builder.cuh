@@ -119,7 +119,7 @@ class DelaunayBuilder {
         active_mask_(sys, capacity_),
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
-        flags_(sys, 3),
+        flags_(sys, 4),
         counts_(sys, kNumCounts) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c, sos_rank, weight};
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
@@ -225,11 +225,12 @@ class DelaunayBuilder {
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
                                        HasWinner(), thrust::plus<int32_t>());
       // The round's one wait: splits, second splits, pending points, and whether a relocation
-      // walk failed.
+      // walk failed or the last round's flip loop reached its cap.
       int32_t num_split = 0;
       uint32_t num_second = 0;
       int32_t walk_failed = 0;
       int32_t second_left_parent = 0;
+      int32_t flips_capped = 0;
       uint32_t saw_edge = 0;
       uint32_t sector_splits = 0;
       sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
@@ -238,7 +239,9 @@ class DelaunayBuilder {
                      {&saw_edge, saw_edge_point, sizeof(uint32_t)},
                      {&num_pending, pending_count, sizeof(uint32_t)},
                      {&walk_failed, flags_.data(), sizeof(int32_t)},
-                     {&second_left_parent, flags_.data() + 2, sizeof(int32_t)}});
+                     {&second_left_parent, flags_.data() + 2, sizeof(int32_t)},
+                     {&flips_capped, flags_.data() + kFlipLoopCapped, sizeof(int32_t)}});
+      if (flips_capped != 0) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
       if (second_left_parent != 0) {
         throw EngineError(EngineError::Kind::kInternal, "a second winner of an insertion round left its triangle");
       }
@@ -519,27 +522,25 @@ class DelaunayBuilder {
 
   /// Parallel Lawson flips from the `count` triangles in active_ until no edge needs a flip.
   ///
-  /// Two iterations (their counts alternate between two words) are recorded once and replayed:
-  /// the loop's hundreds of small kernels would otherwise be bound by the host's cost of
-  /// launching them. The host stays one replay ahead: it learns a replay's starting count while
-  /// the next one runs, and stops after a replay that started with none.
+  /// Two iterations (their counts alternate between two words) are recorded once as the body of a
+  /// loop that the device repeats while the list is not empty (System::ReplayWhile): the loop's
+  /// hundreds of small kernels would otherwise be bound by the host's cost of launching them, and
+  /// by its waits for the count. A loop that reaches kMaxFlipRuns raises a flag: the insertion
+  /// round's wait reads it; here it is read at once for the other callers (hull repair, weighted
+  /// removal), which are rare.
   void RestoreDelaunay(uint32_t count, bool hull_may_change) {
     if (count == 0) return;
     uint32_t* even = counts_.data() + kEvenIterationCount;
     uint32_t* odd = counts_.data() + kOddIterationCount;
     thrust::fill(sys_.policy(), even, even + 1, count);
     typename System::Recording& recording = hull_may_change ? insertion_flips_ : repair_flips_;
-    typename System::CountTicket started_with{};
-    for (int replay = 0;; ++replay) {
-      if (replay > (1 << 19)) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
-      sys_.Replay(recording, [&] {
-        FlipIteration(even, odd, hull_may_change);
-        FlipIteration(odd, even, hull_may_change);
-      });
-      const typename System::CountTicket next = sys_.ReadCountLater(even);
-      const uint32_t started = replay == 0 ? count : sys_.CountOf(started_with);
-      if (started == 0) return;
-      started_with = next;
+    const WhileCountNonzero more{even, counts_.data() + kFlipRuns, kMaxFlipRuns, flags_.data() + kFlipLoopCapped};
+    sys_.ReplayWhile(recording, more, [&] {
+      FlipIteration(even, odd, hull_may_change);
+      FlipIteration(odd, even, hull_may_change);
+    });
+    if (!hull_may_change && sys_.Read(flags_.data() + kFlipLoopCapped) != 0) {
+      throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
     }
   }
 
@@ -568,8 +569,13 @@ class DelaunayBuilder {
   Buffer<uint8_t, System> active_mask_;
   Buffer<uint8_t, System> candidate_mask_;
   Buffer<int8_t, System> proposal_edge_;
-  // [0] walk or repair failed, [1] serial repair flips, [2] a second winner left its triangle
+  // [0] walk or repair failed, [1] serial repair flips, [2] a second winner left its triangle,
+  // [kFlipLoopCapped] a flip loop reached kMaxFlipRuns
   Buffer<int32_t, System> flags_;
+  static constexpr int kFlipLoopCapped = 3;
+  // Runs of RestoreDelaunay's loop body (two flip iterations each) before it gives up: far more
+  // than any input measured needs (at 1M, a few a round: the one-block tail does most iterations).
+  static constexpr uint32_t kMaxFlipRuns = 1u << 19;
   // Counts kept in system memory between the host's waits, and the flip stamps' generation.
   static constexpr int kPendingCount = 0;
   static constexpr int kEvenIterationCount = 1;
@@ -581,13 +587,14 @@ class DelaunayBuilder {
   static constexpr int kSawEdgePoint = 7;
   static constexpr int kRedundantCount = 8;
   static constexpr int kSectorSplits = 9;
-  static constexpr int kNumCounts = 10;
+  static constexpr int kFlipRuns = 10;  // WhileCountNonzero's runs of the loop under way
+  static constexpr int kNumCounts = 11;
   // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): one item a
   // lane of its 1,024, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;
   // The one-block iterations of a whole build: far more than any measured (two_lines at 1M: about
   // 3,700 flip iterations in all), and few enough (seconds, at a few us each) that a loop that did
-  // not end soon reaches the grid's launches and the host's replay limit.
+  // not end soon reaches the grid's launches and the flip loop's cap (kMaxFlipRuns).
   static constexpr uint32_t kFlipTailMaxIterations = 1u << 20;
   Buffer<uint32_t, System> counts_;
   MeshView mesh_{};

@@ -217,8 +217,8 @@ struct CollectNextActive {
 /// `active` and its count in `*count` on return; `scratch_count` holds the next list's count while
 /// an iteration builds it. `*iterations_run` counts its iterations over the whole build: past
 /// `max_iterations` it runs no more, so that a flip loop that did not end would go on in the grid's
-/// launches, where the host's replay limit reports it (without the budget, each of those launches
-/// could run a loop of its own).
+/// launches, where the loop's cap reports it (DelaunayBuilder::RestoreDelaunay; without the budget,
+/// each of those launches could run a loop of its own).
 template <bool kWeighted>
 struct FlipTailInOneBlock {
   MeshView mesh;
