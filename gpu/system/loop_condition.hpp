@@ -1,4 +1,4 @@
-// The condition of a loop that runs on the device without the host (ReplayWhileNonzero), shared by
+// The condition of a loop that runs on the device without the host (System::ReplayWhile), shared by
 // both systems so that they stop at the same run.
 #pragma once
 

@@ -46,7 +46,7 @@ constexpr uint8_t kCheckFlipOuterEdges = 0b101;
 constexpr uint8_t kCheckAllEdges = 0b111;
 
 /// Each active triangle proposes its first edge that must flip and votes on both triangles
-/// (kWeighted: by the regular triangulation's predicates, MeshView::ShouldFlip).
+/// (kWeighted: by the regular triangulation's predicates, MeshView::FirstEdgeToFlip).
 template <bool kWeighted>
 struct ProposeFlips {
   MeshView mesh;
