@@ -669,21 +669,26 @@ void TopologyCurves(System& sys, const TopologyCurvesIn& in, const TopologyCurve
   Buffer<uint32_t, System> births(sys, levels), edge_births(sys, levels), regularized_edge_births(sys, levels),
       regularized_vertices(sys, levels);
   {
+    uint32_t* const totals[4] = {births.data(), edge_births.data(), regularized_edge_births.data(),
+                                 regularized_vertices.data()};
+    // With one replica a level (many levels: uniform input), the totals are the counters: no
+    // replicated array to fill and sum.
     const uint32_t replicas = CounterReplicas(levels);
     const size_t replicated = size_t{replicas} * levels;
-    Buffer<uint32_t, System> counters(sys, 4 * replicated);
-    thrust::fill_n(policy, counters.data(), 4 * replicated, 0u);
+    Buffer<uint32_t, System> counters(sys, replicas > 1 ? 4 * replicated : 0);
     const auto replicas_of = [&](int k) {
-      return ReplicatedCounts{counters.data() + k * replicated, static_cast<uint32_t>(levels), replicas};
+      return replicas > 1 ? ReplicatedCounts{counters.data() + k * replicated, static_cast<uint32_t>(levels), replicas}
+                          : ReplicatedCounts{totals[k], static_cast<uint32_t>(levels), 1};
     };
+    for (int k = 0; k < 4; ++k) thrust::fill_n(policy, replicas_of(k).counts, replicated, 0u);
     thrust::for_each_n(policy, zero, in.num_tri, CountTriangleBirth{in.tri_rank, replicas_of(0)});
     thrust::for_each_n(policy, zero, in.num_edges,
                        CountEdgeBirths{in.edge_rho, in.edge_mu_low, replicas_of(1), replicas_of(2)});
     thrust::for_each_n(policy, zero, in.num_points,
                        CountRegularizedVertex{in.representative, in.vertex_tri_low, replicas_of(3)});
-    uint32_t* const totals[4] = {births.data(), edge_births.data(), regularized_edge_births.data(),
-                                 regularized_vertices.data()};
-    for (int k = 0; k < 4; ++k) thrust::for_each_n(policy, zero, levels, SumReplicas{replicas_of(k), totals[k]});
+    if (replicas > 1) {
+      for (int k = 0; k < 4; ++k) thrust::for_each_n(policy, zero, levels, SumReplicas{replicas_of(k), totals[k]});
+    }
   }
   prefix(births.data());
   prefix(edge_births.data());
