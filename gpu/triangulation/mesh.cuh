@@ -139,15 +139,10 @@ struct MeshView {
     return (LexLess(a, m) && LexLess(m, b)) || (LexLess(b, m) && LexLess(m, a));
   }
 
-  /// Whether vertex s lies inside the (symbolically perturbed) circumcircle of triangle t. For an
-  /// infinite triangle the "circle" is the half-plane beyond its hull edge, closed on the edge's
-  /// open segment (HullEdgeConflict). Weighted: the power test's (s's lift below the plane).
-  template <bool kWeighted = false>
-  GALPHA_HD bool InConflict(int32_t t, int32_t s) const {
-    return InConflictWith<kWeighted>(tri[t], s);
-  }
-
-  /// InConflict for a triangle already loaded (its vertices `x`).
+  /// Whether vertex s lies inside the (symbolically perturbed) circumcircle of the triangle with
+  /// vertices `x`. For an infinite triangle the "circle" is the half-plane beyond its hull edge,
+  /// closed on the edge's open segment (HullEdgeConflict). Weighted: the power test's (s's lift
+  /// below the plane).
   template <bool kWeighted = false>
   GALPHA_HD bool InConflictWith(const Tri& x, int32_t s) const {
     if (s == inf) return false;
@@ -189,9 +184,9 @@ struct MeshView {
     const Tri& x = tri[t];
     const int32_t r = x.v[k], p = x.v[Next(k)], q = x.v[Prev(k)];
     if (r == inf || p == inf || q == inf) return -1;
-    const int32_t nb = nbr[t].n[k];
-    const int32_t s = tri[nb].v[EdgePos(nb, q, p)];
-    if (s == inf || !InConflict<true>(t, s)) return -1;
+    const Tri& y = tri[nbr[t].n[k]];
+    const int32_t s = y.v[ApexPos(y, p, q)];
+    if (s == inf || !InConflictWith<true>(x, s)) return -1;
     if (Orient(r, p, s) < 0) return p;
     if (Orient(s, q, r) < 0) return q;
     return -1;
@@ -206,9 +201,20 @@ struct MeshView {
   /// weighted mesh between rounds may hold non-regular edges that could not flip, where that
   /// argument does not hold: returns -1 if it exceeds `max_steps` (never measured), which the
   /// caller reports as an internal error.
+  ///
+  /// A step loads its triangle's neighbours with its vertices (one dependent load a step instead of
+  /// two: the walks wait on memory), and does not test the edge it entered by: p was strictly
+  /// beyond that edge as seen from the triangle it left, and the SoS orientation is antisymmetric,
+  /// so p is strictly inside it as seen from this one. Two crossing lines of points walk 4.3 steps
+  /// a point and a round, on collinear (degenerate) edges a fifth of the time, against uniform
+  /// input's 2.5: the test saved is one of three on most of their steps.
   GALPHA_HD int32_t Locate(int32_t t, int32_t p, uint32_t max_steps) const {
+    // The edge the walk came in by, as its two vertices (-1: none, or the walk is in an infinite
+    // triangle, whose tests below do not use it).
+    int32_t entry_a = -1, entry_b = -1;
     for (uint32_t step = 0; step < max_steps; ++step) {
       const Tri x = tri[t];
+      const TriNbr n = nbr[t];
       int inf_pos = -1;
       for (int k = 0; k < 3; ++k) {
         if (x.v[k] == inf) inf_pos = k;
@@ -218,28 +224,36 @@ struct MeshView {
         // center->w counter-clockwise to ray center->u.
         const int32_t u = x.v[Next(inf_pos)], w = x.v[Prev(inf_pos)];
         if (CenterOrient(w, p) < 0) {
-          t = nbr[t].n[Next(inf_pos)];  // across the edge (w, inf): the sector clockwise of w
+          t = n.n[Next(inf_pos)];  // across the edge (w, inf): the sector clockwise of w
+          entry_a = -1;
         } else if (CenterOrient(u, p) > 0) {
-          t = nbr[t].n[Prev(inf_pos)];  // across the edge (inf, u): the sector beyond u
+          t = n.n[Prev(inf_pos)];  // across the edge (inf, u): the sector beyond u
+          entry_a = -1;
         } else if (Orient(u, w, p) > 0) {
           return t;
         } else {
-          t = nbr[t].n[inf_pos];
+          t = n.n[inf_pos];  // inside the hull, beyond its edge u->w (Orient(u, w, p) < 0)
+          entry_a = u;
+          entry_b = w;
         }
         continue;
       }
+      // The position opposite the entry edge, whose edge is not tested (-1: test all three).
+      const int skip = entry_a < 0 ? -1 : ApexPos(x, entry_a, entry_b);
       // Start at a rotating edge so that walks through long chains spread over the three choices.
       const int first = static_cast<int>((static_cast<uint32_t>(p) + step) % 3u);
       int exit_edge = -1;
       for (int i = 0; i < 3; ++i) {
         const int k = (first + i) % 3;
-        if (Orient(x.v[Next(k)], x.v[Prev(k)], p) < 0) {
+        if (k != skip && Orient(x.v[Next(k)], x.v[Prev(k)], p) < 0) {
           exit_edge = k;
           break;
         }
       }
       if (exit_edge < 0) return t;
-      t = nbr[t].n[exit_edge];
+      entry_a = x.v[Next(exit_edge)];
+      entry_b = x.v[Prev(exit_edge)];
+      t = n.n[exit_edge];
     }
     return -1;
   }
