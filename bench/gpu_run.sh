@@ -28,6 +28,9 @@
 #           input in GALPHA_KERNEL_DISTS (default uniform): where a slow input's stages go
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
 #           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
+#   warm_up the server's first two 1M-point builds (alphactl over loopback) in three fresh
+#           processes with --warm_up=false and three with --warm_up=true: each build's engine time
+#           (galpha_build_seconds_sum) and the warm-up's (galpha_warm_up_seconds)
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
 # short summary goes to standard output.
 set -uo pipefail
@@ -192,6 +195,37 @@ for phase in "${phases[@]}"; do
       # shellcheck disable=SC2086
       run_step service 420 .carry/bin/service_bench ${GALPHA_SERVICE_BENCH_ARGS:---backend=cuda --points=1000000 --clients=1,2,4,8 --repeat=3}
       sed -n '/^service_bench:/,$p' "$out/service.log"
+      ;;
+    warm_up)
+      [ -x .carry/bin/galpha_server ] || { echo "no galpha_server in .carry (bench/gpu_bundle.sh service)"; status=1; continue; }
+      # Two sets of 1M uniform points in the data files' format (uint64 N, then N x, y doubles).
+      python3 -c "
+import random, struct
+for name, seed in (('$out/warm_a.bin', 1), ('$out/warm_b.bin', 2)):
+    r = random.Random(seed)
+    with open(name, 'wb') as f:
+        f.write(struct.pack('<Q', 1000000))
+        f.write(struct.pack('<2000000d', *[r.random() for _ in range(2000000)]))"
+      port=50061
+      for run in 1 2 3; do
+        for warm in false true; do
+          port=$((port + 2))
+          .carry/bin/galpha_server --backend=cuda --listen=127.0.0.1:$port --metrics_listen=127.0.0.1:$((port + 1)) \
+            --warm_up=$warm > "$out/warm_up_server.log" 2>&1 &
+          server=$!
+          for _ in $(seq 1 300); do grep -q listening "$out/warm_up_server.log" && break; sleep 0.1; done
+          for set in a b; do
+            .carry/bin/alphactl --server 127.0.0.1:$port summary "$out/warm_$set.bin" --rank 1 > /dev/null 2>> "$out/warm_up.log"
+            echo "warm_up=$warm run=$run after build $set: $(python3 -c "
+import urllib.request
+page = urllib.request.urlopen('http://127.0.0.1:$((port + 1))/metrics').read().decode()
+print(' '.join(l for l in page.splitlines() if l.startswith(('galpha_build_seconds_sum', 'galpha_warm_up_seconds'))))")" |
+              tee -a "$out/warm_up.log"
+          done
+          kill $server; wait $server 2> /dev/null
+        done
+      done
+      rm -f "$out/warm_a.bin" "$out/warm_b.bin" "$out/warm_up_server.log"
       ;;
     bench)
       [ -x .carry/bin/delaunay_bench ] || { echo "no delaunay_bench in .carry"; status=1; continue; }

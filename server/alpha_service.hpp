@@ -89,6 +89,12 @@ class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {
   size_t in_flight_bytes() const { return in_flight_.held(); }
   size_t in_flight_bytes_of(const std::string& tenant) const { return in_flight_.held_by(tenant); }
 
+  /// Builds the warm-up lattice (server/warm_up.hpp), unweighted and weighted, on a build slot as
+  /// a caller's build runs (the same backend, stream and family form; nothing is cached), and
+  /// returns the seconds both took. The server calls it before it listens (ServerOptions::warm_up).
+  /// The engine's error if a build fails.
+  absl::StatusOr<double> WarmUp();
+
   /// Refuses new builds (UNAVAILABLE); queued builds that have not started fail UNAVAILABLE,
   /// running ones finish. Queries go on until the server shuts down.
   void StartDraining();

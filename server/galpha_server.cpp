@@ -46,6 +46,17 @@ absl::StatusOr<std::unique_ptr<GalphaServer>> GalphaServer::Start(const ServerOp
   server->service_ = *std::move(service);
   auto credentials = Credentials(options);
   if (!credentials.ok()) return credentials.status();
+  // After the cheap checks (a bad TLS file fails at once), before listening: the first caller finds
+  // the kernels loaded.
+  if (options.warm_up) {
+    absl::StatusOr<double> seconds = server->service_->WarmUp();
+    if (!seconds.ok()) {
+      return absl::Status(seconds.status().code(), absl::StrCat("the warm-up build failed (--warm_up=false skips it): ",
+                                                                seconds.status().message()));
+    }
+    server->warm_up_seconds_ = *seconds;
+    server->metrics_->SetWarmUpSeconds(*seconds);
+  }
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

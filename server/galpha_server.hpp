@@ -40,6 +40,10 @@ struct ServerOptions {
   std::chrono::milliseconds drain_notice{5000};
   /// How long a drain then waits for running calls before cancelling them.
   std::chrono::milliseconds drain_grace{25000};  // the flag's default (main.cpp)
+  /// Before listening, build the warm-up lattice once, unweighted and weighted
+  /// (AlphaService::WarmUp), so that the first caller's build does not pay the process's one-time
+  /// costs; a failure stops the start.
+  bool warm_up = true;
   ServiceOptions service;
 };
 
@@ -52,6 +56,8 @@ class GalphaServer {
   ~GalphaServer();
 
   int port() const { return port_; }
+  /// Seconds the warm-up builds took (ServerOptions::warm_up); 0 without them.
+  double warm_up_seconds() const { return warm_up_seconds_; }
   int metrics_port() const { return metrics_port_; }
   AlphaService& service() { return *service_; }
   ServerMetrics& metrics() { return *metrics_; }
@@ -75,6 +81,7 @@ class GalphaServer {
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   int metrics_port_ = 0;
+  double warm_up_seconds_ = 0;
   std::mutex mutex_;
   std::condition_variable stopped_changed_;
   std::condition_variable notice_over_;

@@ -61,6 +61,10 @@ ABSL_FLAG(std::string, tls_key, "", "PEM private key");
 ABSL_FLAG(std::string, token_file, "", "file of 'TOKEN TENANT' lines; when set, every call needs a bearer token");
 ABSL_FLAG(int, drain_notice_ms, 5000, "on SIGTERM: NOT_SERVING this long before refusing calls");
 ABSL_FLAG(int, drain_grace_ms, 25000, "then: how long running calls may finish before they are cancelled");
+ABSL_FLAG(bool, warm_up, true,
+          "before listening, build a 16K-point lattice nudged by ulps, unweighted and weighted, so that the first "
+          "caller does not pay the process's one-time costs (loading the GPU kernels, their first launches); its "
+          "time is galpha_warm_up_seconds");
 ABSL_FLAG(std::string, health_check, "",
           "instead of serving: ask the server at this address (plaintext) whether the API is SERVING; "
           "exit 0 if so, 1 otherwise (the container image's HEALTHCHECK)");
@@ -102,6 +106,7 @@ int main(int argc, char** argv) {
   options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_message_bytes);
   options.drain_notice = std::chrono::milliseconds(absl::GetFlag(FLAGS_drain_notice_ms));
   options.drain_grace = std::chrono::milliseconds(absl::GetFlag(FLAGS_drain_grace_ms));
+  options.warm_up = absl::GetFlag(FLAGS_warm_up);
   const std::string backend = absl::GetFlag(FLAGS_backend);
   if (backend == "auto") {
     options.service.backend = galpha::Backend::kAuto;
@@ -157,6 +162,7 @@ int main(int argc, char** argv) {
               options.tls_cert_file.empty() ? "plaintext" : "TLS",
               options.service.tokens.enabled() ? "bearer tokens required" : "no authentication");
   if (s.metrics_port() != 0) std::printf("galpha_server: metrics on port %d\n", s.metrics_port());
+  if (options.warm_up) std::printf("galpha_server: warm-up builds took %.1f ms\n", 1e3 * s.warm_up_seconds());
   std::fflush(stdout);
 
   int signal_number = 0;

@@ -98,6 +98,10 @@ struct ServerMetrics::Families {
                     .Name("galpha_backend_info")
                     .Help("1 for the backend this server runs")
                     .Register(r)),
+        warm_up(prometheus::BuildGauge()
+                    .Name("galpha_warm_up_seconds")
+                    .Help("Seconds the warm-up builds took before the server listened (--warm_up); 0 without them")
+                    .Register(r)),
         filter(comparisons.Add({{"path", "filter"}})),
         device_exact(comparisons.Add({{"path", "device_exact"}})),
         cpu_fallback(comparisons.Add({{"path", "cpu_fallback"}})),
@@ -113,7 +117,8 @@ struct ServerMetrics::Families {
         in_flight(builds_in_flight.Add({})),
         queued(queue_length.Add({})),
         admitted(admitted_bytes.Add({})),
-        device(device_memory.Add({})) {
+        device(device_memory.Add({})),
+        warm_up_seconds(warm_up.Add({})) {
     // Every reason from the start, at 0: an alert on a rate sees the series before its first refusal.
     for (const BuildRefusal reason : kAllBuildRefusals) rejected.Add({{"reason", std::string(RefusalLabel(reason))}});
   }
@@ -137,6 +142,7 @@ struct ServerMetrics::Families {
   prometheus::Family<prometheus::Gauge>& admitted_bytes;
   prometheus::Family<prometheus::Gauge>& device_memory;
   prometheus::Family<prometheus::Gauge>& backend;
+  prometheus::Family<prometheus::Gauge>& warm_up;
   prometheus::Counter& filter;
   prometheus::Counter& device_exact;
   prometheus::Counter& cpu_fallback;
@@ -154,6 +160,7 @@ struct ServerMetrics::Families {
   prometheus::Gauge& queued;
   prometheus::Gauge& admitted;
   prometheus::Gauge& device;
+  prometheus::Gauge& warm_up_seconds;
 };
 
 ServerMetrics::ServerMetrics()
@@ -194,6 +201,8 @@ void ServerMetrics::RecordRejectedBuild(std::string_view reason) {
 }
 
 void ServerMetrics::SetDeviceMemoryInUse(double bytes) { families_->device.Set(bytes); }
+
+void ServerMetrics::SetWarmUpSeconds(double seconds) { families_->warm_up_seconds.Set(seconds); }
 
 void ServerMetrics::SetBackend(const std::string& backend) { families_->backend.Add({{"backend", backend}}).Set(1); }
 

@@ -32,6 +32,8 @@ class ServerMetrics final : public CacheObserver, public SchedulerObserver {
   void RecordRpc(std::string_view method, std::string_view code, double seconds);
   /// Device memory in use (total - free) on the GPU, sampled by the server.
   void SetDeviceMemoryInUse(double bytes);
+  /// How long the warm-up builds took before the server listened (AlphaService::WarmUp).
+  void SetWarmUpSeconds(double seconds);
   /// 1 for the backend this server runs ("cuda" or "cpu").
   void SetBackend(const std::string& backend);
   /// A Build refused or ended by a limit; `reason` is a RefusalLabel (build_refusal.hpp).

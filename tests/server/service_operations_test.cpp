@@ -223,6 +223,28 @@ TEST(ServiceTest, MetricsAreScrapedOverHttp) {
   EXPECT_TRUE(testing::WaitFor([&] { return testing::ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 5.0));
   EXPECT_EQ(MetricValue(page, "galpha_build_queue_length"), 0.0);
   EXPECT_EQ(MetricValue(page, "galpha_backend_info{backend=\"" + testing::TestBackend() + "\"}"), 1.0);
+  EXPECT_EQ(MetricValue(page, "galpha_warm_up_seconds"), 0.0);  // TestServerOptions: no warm-up
+}
+
+TEST(ServiceTest, WarmUpBuildsRunBeforeTheServerListens) {
+  ServerOptions options = TestServerOptions();
+  options.warm_up = true;
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  EXPECT_GT(server->warm_up_seconds(), 0.0);
+  const std::string page = testing::HttpGet(server->metrics_port(), "/metrics");
+  using testing::MetricValue;
+  EXPECT_NEAR(MetricValue(page, "galpha_warm_up_seconds"), server->warm_up_seconds(), 1e-6 * server->warm_up_seconds())
+      << page;
+  // Not a caller's build: nothing cached, no build counted.
+  EXPECT_EQ(MetricValue(page, "galpha_cache_entries{tier=\"resident\"}"), 0.0);
+  EXPECT_EQ(MetricValue(page, "galpha_build_seconds_count"), 0.0);
+  // Its slot is handed back just after the warm-up's result is: the gauge settles to 0 right after.
+  EXPECT_TRUE(testing::WaitFor([&] { return testing::ScrapeMetric(*server, "galpha_builds_in_flight") == 0.0; }, 5.0));
+  auto client = ClientOf(*server);
+  auto built = client->Build(gen::Uniform(2000, 43));
+  ASSERT_THAT(built, IsOk());
+  EXPECT_FALSE(built->cached);
 }
 
 TEST(ServiceTest, HealthReflectionAndDrain) {

@@ -31,6 +31,9 @@ ServerOptions TestServerOptions() {
   options.drain_notice = std::chrono::milliseconds(0);
   options.drain_grace = std::chrono::milliseconds(5000);
   options.service.backend = TestBackend() == "cuda" ? Backend::kCuda : Backend::kCpu;
+  // Most tests start servers by the dozen: without the warm-up builds (a test of its own turns
+  // them on).
+  options.warm_up = false;
   // GALPHA_SERVICE_DEVICE_CACHE_BYTES: on CUDA, every test's families resident on the GPU (a GPU
   // run sets it for a second pass of the suite; bench/gpu_run.sh service).
   if (const char* bytes = std::getenv("GALPHA_SERVICE_DEVICE_CACHE_BYTES"); bytes != nullptr) {

@@ -1,0 +1,27 @@
+// The point set a server builds before it listens (AlphaService::WarmUp), so that its first caller
+// does not pay the process's one-time costs of the engine: on a GPU, loading the kernels (CUDA loads
+// each on its first launch), the first launch of the exact comparisons' kernels (their deep stacks
+// grow the device's local-memory reservation, measured at about 9 ms: bench/README.md), and the
+// stream-ordered pool's first mappings.
+#pragma once
+
+#include <vector>
+
+#include "core/base/point.hpp"
+
+namespace galpha::server {
+
+/// Points and their weights (squared radii), one per point.
+struct WarmUpInput {
+  std::vector<Point2> points;
+  std::vector<double> weights;
+};
+
+/// A `side` x `side` lattice of spacing 1 whose coordinates are nudged by 0 to 3 ulps in a fixed
+/// pattern: its co-circular quadruples, broken by ulps, reach the exact radius comparisons and the
+/// degenerate predicates as well as the common path. Weighted, one point in 16 has weight 3 (it
+/// hides its four nearest neighbours), the others 0, so that a weighted build also removes hidden
+/// points.
+WarmUpInput WarmUpLattice(int side);
+
+}  // namespace galpha::server
