@@ -234,7 +234,7 @@ absl::StatusOr<std::unique_ptr<AlphaService>> AlphaService::Create(const Service
 }
 
 absl::StatusOr<double> AlphaService::WarmUp() {
-  // 16K points, unweighted and weighted: 120-160 ms on an H200, most of it the one-time costs it
+  // 16K points, unweighted and weighted: 120-170 ms on an H200, most of it the one-time costs it
   // is there to pay (they do not grow with the size), 170-230 ms on two cores (bench/README.md).
   constexpr int kWarmUpSide = 128;
   // Shared with the job, which may still be returning on its worker thread when this returns.

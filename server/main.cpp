@@ -62,7 +62,8 @@ ABSL_FLAG(std::string, token_file, "", "file of 'TOKEN TENANT' lines; when set, 
 ABSL_FLAG(int, drain_notice_ms, 5000, "on SIGTERM: NOT_SERVING this long before refusing calls");
 ABSL_FLAG(int, drain_grace_ms, 25000, "then: how long running calls may finish before they are cancelled");
 ABSL_FLAG(bool, warm_up, true,
-          "before listening, build a 16K-point lattice nudged by ulps, unweighted and weighted, so that the first "
+          "before listening, build a 16K-point lattice (half of it nudged by ulps), unweighted and weighted, so that "
+          "the first "
           "caller does not pay the process's one-time costs (loading the GPU kernels, their first launches); its "
           "time is galpha_warm_up_seconds");
 ABSL_FLAG(std::string, health_check, "",

@@ -17,11 +17,11 @@ struct WarmUpInput {
   std::vector<double> weights;
 };
 
-/// A `side` x `side` lattice of spacing 1 whose coordinates are nudged by 0 to 3 ulps in a fixed
-/// pattern: its co-circular quadruples, broken by ulps, reach the exact radius comparisons and the
-/// degenerate predicates as well as the common path. Weighted, one point in 16 has weight 3 (it
-/// hides its four nearest neighbours), the others 0, so that a weighted build also removes hidden
-/// points.
+/// A `side` x `side` lattice of spacing 1 whose first `side` / 2 rows have their coordinates nudged
+/// by 0 to 3 ulps in a fixed pattern: there its co-circular quadruples, broken by ulps, reach the
+/// exact radius comparisons of near ties, and in the exact rows those of exact ties, besides the
+/// degenerate predicates and the common path. Weighted, one point in 16 has weight 3 (it hides its
+/// nearest neighbours), the others 0, so that a weighted build also removes hidden points.
 WarmUpInput WarmUpLattice(int side);
 
 }  // namespace galpha::server
