@@ -29,8 +29,9 @@
 #   service service_test with the CUDA backend, then service_bench (the gRPC service on loopback:
 #           transport cost, Classify rate, concurrent builds, query latency; CGAL in the same run)
 #   warm_up the server's first two 1M-point builds (alphactl over loopback) in three fresh
-#           processes with --warm_up=false and three with --warm_up=true: each build's engine time
-#           (galpha_build_seconds_sum) and the warm-up's (galpha_warm_up_seconds)
+#           processes with --warm_up=false and three with --warm_up=true: the running sum of the
+#           builds' engine times after each (galpha_build_seconds_sum; the second build's is the
+#           difference) and the warm-up's time (galpha_warm_up_seconds)
 # Full logs go to $OUT (or /tmp/galpha-gpu), 8 files at most so that all of them come back; a
 # short summary goes to standard output.
 set -uo pipefail
@@ -198,34 +199,46 @@ for phase in "${phases[@]}"; do
       ;;
     warm_up)
       [ -x .carry/bin/galpha_server ] || { echo "no galpha_server in .carry (bench/gpu_bundle.sh service)"; status=1; continue; }
-      # Two sets of 1M uniform points in the data files' format (uint64 N, then N x, y doubles).
-      python3 -c "
-import random, struct
-for name, seed in (('$out/warm_a.bin', 1), ('$out/warm_b.bin', 2)):
+      # Two sets of 1M uniform points in the data files' format (uint64 N, then N x, y doubles),
+      # outside $out (only logs come back), removed however the phase ends.
+      work=$(mktemp -d)
+      trap 'kill "${server:-}" 2> /dev/null; rm -rf "$work"' EXIT
+      python3 - "$work" <<'PY'
+import random, struct, sys
+for name, seed in (("a", 1), ("b", 2)):
     r = random.Random(seed)
-    with open(name, 'wb') as f:
-        f.write(struct.pack('<Q', 1000000))
-        f.write(struct.pack('<2000000d', *[r.random() for _ in range(2000000)]))"
-      port=50061
+    with open(f"{sys.argv[1]}/{name}.bin", "wb") as f:
+        f.write(struct.pack("<Q", 1000000))
+        f.write(struct.pack("<2000000d", *[r.random() for _ in range(2000000)]))
+PY
       for run in 1 2 3; do
         for warm in false true; do
-          port=$((port + 2))
-          .carry/bin/galpha_server --backend=cuda --listen=127.0.0.1:$port --metrics_listen=127.0.0.1:$((port + 1)) \
-            --warm_up=$warm > "$out/warm_up_server.log" 2>&1 &
+          .carry/bin/galpha_server --backend=cuda --listen=127.0.0.1:0 --metrics_listen=127.0.0.1:0 \
+            --warm_up=$warm --drain_notice_ms=0 > "$work/server.log" 2>&1 &
           server=$!
-          for _ in $(seq 1 300); do grep -q listening "$out/warm_up_server.log" && break; sleep 0.1; done
+          for _ in $(seq 1 300); do grep -q "metrics on port" "$work/server.log" && break; sleep 0.1; done
+          port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$work/server.log")
+          metrics=$(sed -n 's/.*metrics on port \([0-9]*\).*/\1/p' "$work/server.log")
+          if [ -z "$port" ] || [ -z "$metrics" ]; then
+            echo "warm_up=$warm run=$run: the server did not start" | tee -a "$out/warm_up.log"
+            cat "$work/server.log" >> "$out/warm_up.log"; status=1; kill $server; continue
+          fi
           for set in a b; do
-            .carry/bin/alphactl --server 127.0.0.1:$port summary "$out/warm_$set.bin" --rank 1 > /dev/null 2>> "$out/warm_up.log"
-            echo "warm_up=$warm run=$run after build $set: $(python3 -c "
-import urllib.request
-page = urllib.request.urlopen('http://127.0.0.1:$((port + 1))/metrics').read().decode()
-print(' '.join(l for l in page.splitlines() if l.startswith(('galpha_build_seconds_sum', 'galpha_warm_up_seconds'))))")" |
-              tee -a "$out/warm_up.log"
+            if ! timeout 120 .carry/bin/alphactl --server 127.0.0.1:$port summary "$work/$set.bin" --rank 1 \
+              > /dev/null 2>> "$out/warm_up.log"; then
+              echo "warm_up=$warm run=$run: build $set failed" | tee -a "$out/warm_up.log"; status=1
+            fi
+            echo "warm_up=$warm run=$run after build $set: $(python3 - "$metrics" <<'PY'
+import sys, urllib.request
+page = urllib.request.urlopen(f"http://127.0.0.1:{sys.argv[1]}/metrics", timeout=10).read().decode()
+print(" ".join(l for l in page.splitlines() if l.startswith(("galpha_build_seconds_sum", "galpha_warm_up_seconds"))))
+PY
+)" | tee -a "$out/warm_up.log"
           done
           kill $server; wait $server 2> /dev/null
         done
       done
-      rm -f "$out/warm_a.bin" "$out/warm_b.bin" "$out/warm_up_server.log"
+      rm -rf "$work"; trap - EXIT
       ;;
     bench)
       [ -x .carry/bin/delaunay_bench ] || { echo "no delaunay_bench in .carry"; status=1; continue; }

@@ -83,7 +83,13 @@ absl::StatusOr<std::unique_ptr<GalphaServer>> GalphaServer::Start(const ServerOp
 }
 
 GalphaServer::~GalphaServer() {
-  Drain();
+  if (server_ != nullptr) {
+    Drain();
+  } else if (service_ != nullptr) {
+    // A start that failed before listening (bad TLS files, a failed warm-up, a port that cannot be
+    // bound): nothing to drain but the build workers.
+    service_->StartDraining();
+  }
   if (sampler_.joinable()) sampler_.join();
 }
 

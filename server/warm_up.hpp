@@ -2,7 +2,7 @@
 // does not pay the process's one-time costs of the engine: on a GPU, loading the kernels (CUDA loads
 // each on its first launch), the first launch of the exact comparisons' kernels (their deep stacks
 // grow the device's local-memory reservation, measured at about 9 ms: bench/README.md), and the
-// stream-ordered pool's first mappings.
+// stream-ordered pool's first mappings (until the server's idle release gives them back).
 #pragma once
 
 #include <vector>

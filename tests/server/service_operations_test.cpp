@@ -1,5 +1,6 @@
 // The real server as operators see it: eviction under a small cache budget, the metrics page over
 // HTTP, health, reflection and the drain.
+#include <gmock/gmock.h>
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 
@@ -23,6 +24,7 @@ namespace v1 = galpha::v1;
 using galpha::testing::IsOk;
 using galpha::testing::StatusIs;
 using testing::ClientOf;
+using ::testing::HasSubstr;
 using ::testing::Not;
 using testing::ScrapeMetric;
 using testing::StartServer;
@@ -226,7 +228,7 @@ TEST(ServiceTest, MetricsAreScrapedOverHttp) {
   EXPECT_EQ(MetricValue(page, "galpha_warm_up_seconds"), 0.0);  // TestServerOptions: no warm-up
 }
 
-TEST(ServiceTest, WarmUpBuildsRunBeforeTheServerListens) {
+TEST(ServiceTest, WarmUpRunsAtStartAndIsNotACallersBuild) {
   ServerOptions options = TestServerOptions();
   options.warm_up = true;
   auto server = StartServer(options);
@@ -245,6 +247,26 @@ TEST(ServiceTest, WarmUpBuildsRunBeforeTheServerListens) {
   auto built = client->Build(gen::Uniform(2000, 43));
   ASSERT_THAT(built, IsOk());
   EXPECT_FALSE(built->cached);
+}
+
+TEST(ServiceTest, AFailedWarmUpStopsTheStartWithItsReason) {
+  ServerOptions options = TestServerOptions();
+  options.warm_up = true;
+  options.service.build_memory_bytes = 1 << 20;  // below the warm-up lattice's 13 MB
+  auto server = GalphaServer::Start(options);
+  ASSERT_FALSE(server.ok());
+  EXPECT_EQ(server.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_THAT(server.status().message(), HasSubstr("the warm-up build failed (--warm_up=false skips it)"));
+  EXPECT_THAT(server.status().message(), HasSubstr("--build_memory_bytes"));
+}
+
+TEST(ServiceTest, UnreadableTlsFilesStopTheStartWithTheirName) {
+  ServerOptions options = TestServerOptions();
+  options.tls_cert_file = "/nonexistent/galpha-cert.pem";
+  options.tls_key_file = "/nonexistent/galpha-key.pem";
+  auto server = GalphaServer::Start(options);
+  ASSERT_FALSE(server.ok());
+  EXPECT_THAT(server.status().message(), HasSubstr("galpha-cert.pem"));
 }
 
 TEST(ServiceTest, HealthReflectionAndDrain) {
