@@ -242,7 +242,7 @@ absl::StatusOr<double> AlphaService::WarmUp() {
   auto finished = std::make_shared<std::promise<absl::Status>>();
   std::future<absl::Status> done = finished->get_future();
   const size_t points = input->points.size();
-  const size_t need = points * (kBuildBytesPerPoint + sizeof(Point2)) + points * kBuildBytesPerWeight;
+  const size_t need = UploadedBuildBytes(points, input->weights.size());  // the weighted build's
   const bool resident = resident_families_ && cache_->FitsDeviceTier(points);
   const Backend backend = backend_;
   const auto start = std::chrono::steady_clock::now();

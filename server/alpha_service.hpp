@@ -5,10 +5,12 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
 
+#include "core/base/point.hpp"
 #include "galpha/v1/alpha_shapes.grpc.pb.h"
 #include "gpu/system/device_streams.hpp"
 #include "gpu/triangulation/delaunay.hpp"
@@ -30,6 +32,12 @@ namespace galpha::server {
 /// points) and 584 B/pt of host memory on the CPU backend. Admission charges this plus the point
 /// itself (16 bytes): 656 B/pt.
 inline constexpr size_t kBuildBytesPerPoint = 640;
+
+/// What admission charges a build of `points` uploaded points with `weights` weights (0 or one a
+/// point): the estimate above plus the points themselves, and kBuildBytesPerWeight a weight.
+inline size_t UploadedBuildBytes(size_t points, size_t weights) {
+  return points * (kBuildBytesPerPoint + sizeof(Point2)) + weights * kBuildBytesPerWeight;
+}
 
 struct ServiceOptions {
   /// kAuto: the GPU when this build and machine have one, else the CPU.

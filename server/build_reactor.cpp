@@ -64,8 +64,7 @@ void BuildReactor::EndOfStream() {
   // A compact entry of these points: they are here, so they are built as uploaded (the cache then
   // drops the entry: a promotion); the frame it kept stays attached, as on a resident hit.
   if (found.compact != nullptr && build_->frame == nullptr) build_->frame = found.compact->frame();
-  const size_t need =
-      build_->points.size() * (kBuildBytesPerPoint + sizeof(Point2)) + build_->weights.size() * kBuildBytesPerWeight;
+  const size_t need = UploadedBuildBytes(build_->points.size(), build_->weights.size());
   absl::Status submitted = service_->scheduler_->Submit(
       tenant_, need, [this](const BuildSlot& slot, bool draining) { Run(slot, draining); });
   if (!submitted.ok()) Respond(submitted);
