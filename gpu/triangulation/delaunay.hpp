@@ -91,4 +91,32 @@ absl::StatusOr<Triangulation> Triangulate(absl::Span<const Point2> points, const
 absl::StatusOr<Triangulation> TriangulateWeighted(absl::Span<const Point2> points, absl::Span<const double> weights,
                                                   const TriangulateOptions& options = {});
 
+/// The most sets one TriangulateSets call takes (its Hilbert keys keep a set's id above 42 bits).
+inline constexpr uint32_t kMaxTriangulatedSets = 1u << 22;
+
+/// Many point sets triangulated together (TriangulateSets).
+struct TriangulatedSets {
+  /// One triangulation a set, in the sets' order, each equal to Triangulate's of the set alone on
+  /// the same backend (its indices are the set's own, from 0); their stage times are empty and their
+  /// peak memory 0: the build's are below.
+  std::vector<Triangulation> sets;
+  Backend backend = Backend::kCpu;
+  std::vector<StageTime> stage_times;
+  size_t peak_memory_bytes = 0;
+  /// Sets built alone after the packed build, with their own launches (a mesh with a flat
+  /// triangle after insertion; none measured).
+  uint32_t built_alone = 0;
+};
+
+/// Triangulates many point sets in one build: set s is points[set_begin[s], set_begin[s + 1]), with
+/// set_begin running from 0 to points.size() (set_begin.size() - 1 sets, empty ones allowed). The
+/// sets are packed into one mesh's arrays and built by the same launches (not one build a set):
+/// thousands of small sets take about what one build of all their points takes.
+///
+/// Errors: Triangulate's, naming the set and its index for a NaN or infinite coordinate, and
+/// InvalidArgument for offsets that do not run from 0 to points.size() without decreasing, or more
+/// than kMaxTriangulatedSets sets.
+absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
+                                                 const TriangulateOptions& options = {});
+
 }  // namespace galpha

@@ -27,6 +27,19 @@ struct DelaunayOutput {
   size_t peak_memory_bytes = 0;
 };
 
+/// What a packed build of many sets hands back (delaunay_batch.cuh), named by indices of the whole
+/// input: a one-set build's output for all the sets with a mesh together (each set's triangles,
+/// neighbours and edges in the order of a build of that set alone, interleaved with the other
+/// sets'; representatives for every input index), and the chains of the sets on one line.
+struct DelaunaySetsOutput {
+  DelaunayOutput meshes;
+  /// The chains of the sets on one line, set after set, each in a one-set build's order.
+  std::vector<std::array<uint32_t, 2>> chain_edges;
+  /// Per set: 1 where its mesh held a flat triangle; its part of `meshes` is then not its
+  /// triangulation, and the caller builds it alone.
+  std::vector<uint8_t> build_alone;
+};
+
 /// Runs the triangulation on the OpenMP backend. `points` holds `n` finite points; `weights`, when
 /// not null, `n` weights (a regular triangulation). Throws EngineError (or a Thrust/std exception)
 /// on failure.
@@ -35,5 +48,13 @@ void TriangulateOnCpu(const Point2* points, const double* weights, uint32_t n, D
 /// Runs the triangulation on the CUDA backend on `stream` (a cudaStream_t, or nullptr for a stream
 /// of the engine's own). Only defined in CUDA builds.
 void TriangulateOnCuda(const Point2* points, const double* weights, uint32_t n, void* stream, DelaunayOutput* out);
+
+/// Runs the packed build of `num_sets` sets of the `n` points (set s: [set_begin[s],
+/// set_begin[s + 1]); n > 0) on the OpenMP backend, or on the CUDA backend on `stream` (only
+/// defined in CUDA builds). Unweighted.
+void TriangulateSetsOnCpu(const Point2* points, const uint32_t* set_begin, uint32_t num_sets, uint32_t n,
+                          DelaunaySetsOutput* out);
+void TriangulateSetsOnCuda(const Point2* points, const uint32_t* set_begin, uint32_t num_sets, uint32_t n, void* stream,
+                           DelaunaySetsOutput* out);
 
 }  // namespace galpha::detail

@@ -90,6 +90,51 @@ struct MarkRedundantVertices {
   }
 };
 
+/// A packed build's sets as the builder sees them (delaunay_batch.cuh): many meshes, one a set, in
+/// one mesh's arrays. Empty (num_sets 0) for a build of one set.
+struct MeshSets {
+  const uint32_t* vertex_set = nullptr;  // per vertex
+  const int32_t* set_center = nullptr;   // per set, the vertices of its first triangle (MeshView)
+  uint32_t num_sets = 0;                 // sets numbered below it (vertex_set's values)
+};
+
+/// The first four triangles of a set's mesh, in slots 4j to 4j + 3 for the j-th set with a mesh
+/// (`mesh_set[j]`): its first triangle (a, b, c) and the three infinite ones, as
+/// DelaunayBuilder::Start lays out a build's.
+struct StartSetMesh {
+  MeshView mesh;
+  const uint32_t* mesh_set;
+  GALPHA_HD void operator()(uint32_t j) const {
+    const int32_t* center = mesh.set_center + 3 * static_cast<size_t>(mesh_set[j]);
+    const int32_t a = center[0], b = center[1], c = center[2], inf = mesh.inf;
+    const Tri init[4] = {{{a, b, c}}, {{b, a, inf}}, {{c, b, inf}}, {{a, c, inf}}};
+    const int32_t base = 4 * static_cast<int32_t>(j);
+    for (int t = 0; t < 4; ++t) {
+      TriNbr links{};
+      for (int k = 0; k < 3; ++k) {
+        const int32_t p = init[t].v[Next(k)], q = init[t].v[Prev(k)];
+        for (int u = 0; u < 4; ++u) {
+          for (int i = 0; i < 3; ++i) {
+            if (u != t && init[u].v[Next(i)] == q && init[u].v[Prev(i)] == p) links.n[k] = base + u;
+          }
+        }
+      }
+      mesh.tri[base + t] = init[t];
+      mesh.nbr[base + t] = links;
+    }
+  }
+};
+
+/// Marks the sets that hold a flat finite triangle (a packed build leaves them to builds of their
+/// own: the hull repair's choice between parallel and serial rounds is global).
+struct MarkSetOfFlatTriangle {
+  MeshView mesh;
+  uint8_t* set_has_flat;
+  GALPHA_HD void operator()(int32_t t) const {
+    if (IsFlatTriangle(mesh, t)) set_has_flat[mesh.vertex_set[mesh.tri[t].v[0]]] = 1;
+  }
+};
+
 /// The working state of one triangulation and the steps that change it.
 ///
 /// Weighted (`weight` set), it builds the regular triangulation of the points it is given, with
@@ -97,11 +142,17 @@ struct MarkRedundantVertices {
 /// turns out hidden only after it was inserted is found by MarkRedundant and removed in place by
 /// RemoveMarked (regular_removal.cuh), or, on the hull, by the caller building again without it
 /// (delaunay_impl.cuh).
+///
+/// Packed (`sets` not empty): the disjoint meshes of many sets, each started from its own first
+/// triangle (StartSets), whose insertion rounds are each the rounds its set would have alone
+/// (SetRoundState): every set's triangles then take the slots, in the same order, that they take in
+/// a build of that set alone, and its output is that build's (delaunay_batch.cuh).
 template <class System>
 class DelaunayBuilder {
  public:
   DelaunayBuilder(System& sys, const Point2* vertex_points, const uint32_t* sos, const uint32_t* sos_rank,
-                  const double* weight, uint8_t* hidden, uint32_t m, int32_t a, int32_t b, int32_t c)
+                  const double* weight, uint8_t* hidden, uint32_t m, int32_t a, int32_t b, int32_t c,
+                  MeshSets sets = {})
       : sys_(sys),
         hidden_(hidden),
         m_(m),
@@ -120,8 +171,17 @@ class DelaunayBuilder {
         candidate_mask_(sys, 2 * capacity_),
         proposal_edge_(sys, capacity_),
         flags_(sys, 4),
-        counts_(sys, kNumCounts) {
+        counts_(sys, kNumCounts),
+        num_sets_(sets.num_sets),
+        set_flags_(sys, num_sets_),
+        set_counts_(sys, 4 * static_cast<size_t>(num_sets_)) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c, sos_rank, weight};
+    mesh_.vertex_set = sets.vertex_set;
+    mesh_.set_center = sets.set_center;
+    if (num_sets_ > 0) {
+      thrust::fill(sys_.policy(), set_flags_.begin(), set_flags_.end(), uint8_t{0});
+      thrust::fill(sys_.policy(), set_counts_.begin(), set_counts_.end(), 0u);
+    }
     thrust::fill(sys_.policy(), flip_vote_.begin(), flip_vote_.end(), kNoFlipVote);
     thrust::fill(sys_.policy(), partner_.begin(), partner_.end(), kNoPartner);
     thrust::fill(sys_.policy(), stamp_.begin(), stamp_.end(), 0u);
@@ -168,6 +228,21 @@ class DelaunayBuilder {
     num_tri_ = 4;
   }
 
+  /// Packed: starts each of `num_meshes` sets from its first triangle (MeshSets::set_center of
+  /// `mesh_set[j]`) as Start does, in slots 4j to 4j + 3.
+  void StartSets(const uint32_t* mesh_set, uint32_t num_meshes) {
+    thrust::for_each(sys_.policy(), thrust::counting_iterator<uint32_t>(0),
+                     thrust::counting_iterator<uint32_t>(num_meshes), StartSetMesh{mesh_, mesh_set});
+    num_tri_ = 4 * static_cast<int32_t>(num_meshes);
+  }
+
+  /// Packed: marks in `set_has_flat` (per set, cleared by the caller) the sets whose mesh holds a
+  /// flat finite triangle, in place of RepairHull.
+  void MarkSetsWithFlatTriangles(uint8_t* set_has_flat) {
+    const thrust::counting_iterator<int32_t> tfirst(0);
+    thrust::for_each(sys_.policy(), tfirst, tfirst + num_tri_, MarkSetOfFlatTriangle{mesh_, set_has_flat});
+  }
+
   /// Inserts every pending vertex in rounds; `location` starts at a triangle of the mesh.
   ///
   /// Each round waits for the device once, for the number of points elected (the mesh's size on
@@ -201,6 +276,14 @@ class DelaunayBuilder {
     bool sector_pairs = false;
     uint32_t sector_splits_before = 0;
     uint32_t last_splits = 0;
+    // Packed, each set decides these for its own rounds (DecideSetRounds); the host's then say
+    // whether any set's round has them.
+    const SetRoundState sets = set_rounds();
+    uint32_t* sets_with_second_winners = counts_.data() + kSetsWithSecondWinners;
+    if (num_sets_ > 0) {
+      thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(num_sets_),
+                       StartSetRounds{sets});
+    }
     for (;;) {
       ++rounds_;
       unsigned long long* edge_vote = second_winners ? edge_vote_.data() : nullptr;
@@ -215,7 +298,7 @@ class DelaunayBuilder {
       WithWeightedness([&](auto weighted) {
         sys_.ForEachBelow(pending_count, VoteForInsertion<decltype(weighted)::value>{
                                              mesh_, pending, location, tri_vote_.data(), edge_vote, saw_edge_point,
-                                             edge_third_vote, sector_pairs});
+                                             edge_third_vote, sector_pairs, mesh_.vertex_set, sets});
       });
       if (second_winners) {
         thrust::for_each(pol, tfirst, tfirst + num_tri_,
@@ -224,6 +307,11 @@ class DelaunayBuilder {
       // Inclusive, so that its last entry is the number of splits.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
                                        HasWinner(), thrust::plus<int32_t>());
+      if (num_sets_ > 0) {
+        thrust::fill(pol, sets_with_second_winners, sets_with_second_winners + 1, 0u);
+        thrust::for_each(pol, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(num_sets_),
+                         DecideSetRounds{sets, hidden_ != nullptr, sets_with_second_winners});
+      }
       // The round's one wait: splits, second splits, pending points, and whether a relocation
       // walk failed or the last round's flip loop reached its cap.
       int32_t num_split = 0;
@@ -233,14 +321,17 @@ class DelaunayBuilder {
       int32_t flips_capped = 0;
       uint32_t saw_edge = 0;
       uint32_t sector_splits = 0;
-      sys_.Download({{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
-                     {&sector_splits, counts_.data() + kSectorSplits, sizeof(uint32_t)},
-                     {&num_second, second_count, sizeof(uint32_t)},
-                     {&saw_edge, saw_edge_point, sizeof(uint32_t)},
-                     {&num_pending, pending_count, sizeof(uint32_t)},
-                     {&walk_failed, flags_.data(), sizeof(int32_t)},
-                     {&second_left_parent, flags_.data() + 2, sizeof(int32_t)},
-                     {&flips_capped, flags_.data() + kFlipLoopCapped, sizeof(int32_t)}});
+      uint32_t num_sets_with_second = 0;
+      std::vector<HostCopy> round_counts{{&num_split, split_count_or_nb_.data() + num_tri_ - 1, sizeof(int32_t)},
+                                         {&sector_splits, counts_.data() + kSectorSplits, sizeof(uint32_t)},
+                                         {&num_second, second_count, sizeof(uint32_t)},
+                                         {&saw_edge, saw_edge_point, sizeof(uint32_t)},
+                                         {&num_pending, pending_count, sizeof(uint32_t)},
+                                         {&walk_failed, flags_.data(), sizeof(int32_t)},
+                                         {&second_left_parent, flags_.data() + 2, sizeof(int32_t)},
+                                         {&flips_capped, flags_.data() + kFlipLoopCapped, sizeof(int32_t)}};
+      if (num_sets_ > 0) round_counts.push_back({&num_sets_with_second, sets_with_second_winners, sizeof(uint32_t)});
+      sys_.Download(round_counts);
       if (flips_capped != 0) throw EngineError(EngineError::Kind::kInternal, "flipping did not terminate");
       if (second_left_parent != 0) {
         throw EngineError(EngineError::Kind::kInternal, "a second winner of an insertion round left its triangle");
@@ -253,7 +344,7 @@ class DelaunayBuilder {
       sector_splits_before = sector_splits;
       sector_pairs = hidden_ == nullptr && 4 * uint64_t{last_sector_splits} >= last_splits && last_splits > 0;
       last_splits = static_cast<uint32_t>(num_split) + num_second;
-      second_winners = saw_edge != 0 || sector_pairs;
+      second_winners = num_sets_ > 0 ? num_sets_with_second > 0 : saw_edge != 0 || sector_pairs;
       if (second_winners && hidden_ == nullptr && edge_third_vote_.size() == 0) {
         edge_third_vote_ = Buffer<unsigned long long, System>(sys_, capacity_);
       }
@@ -452,7 +543,7 @@ class DelaunayBuilder {
     const thrust::counting_iterator<int32_t> tfirst(0);
     thrust::for_each(pol, tfirst, tfirst + num_tri_,
                      SplitTriangles{mesh_, tri_vote_.data(), split_count_or_nb_.data(), pending, inserted, num_tri_,
-                                    counts_.data() + kSectorSplits});
+                                    counts_.data() + kSectorSplits, set_rounds()});
     thrust::for_each(pol, tfirst, tfirst + num_tri_,
                      LinkSplitChildren{mesh_, tri_vote_.data(), split_count_or_nb_.data(), num_tri_});
     thrust::for_each(pol, tfirst, tfirst + num_tri_,
@@ -471,6 +562,14 @@ class DelaunayBuilder {
     } else {
       f(std::false_type{});
     }
+  }
+
+  /// Packed: each set's round state (empty pointers for a build of one set).
+  SetRoundState set_rounds() {
+    if (num_sets_ == 0) return {};
+    uint32_t* counts = set_counts_.data();
+    return SetRoundState{set_flags_.data(), counts, counts + num_sets_, counts + 2 * size_t{num_sets_},
+                         counts + 3 * size_t{num_sets_}};
   }
 
   int32_t* candidates() {
@@ -588,7 +687,8 @@ class DelaunayBuilder {
   static constexpr int kRedundantCount = 8;
   static constexpr int kSectorSplits = 9;
   static constexpr int kFlipRuns = 10;  // WhileCountNonzero's runs of the loop under way
-  static constexpr int kNumCounts = 11;
+  static constexpr int kSetsWithSecondWinners = 11;
+  static constexpr int kNumCounts = 12;
   // Lists of at most this many triangles are flipped in one block (FlipTailInOneBlock): one item a
   // lane of its 1,024, where a grid iteration's launches cost more than the block's passes.
   static constexpr uint32_t kFlipTailMaxCount = 1024;
@@ -597,6 +697,11 @@ class DelaunayBuilder {
   // not end soon reaches the grid's launches and the flip loop's cap (kMaxFlipRuns).
   static constexpr uint32_t kFlipTailMaxIterations = 1u << 20;
   Buffer<uint32_t, System> counts_;
+  // Packed: the sets' round state (SetRoundState): flags, then saw_edge, splits, sector splits and
+  // voted.
+  uint32_t num_sets_;
+  Buffer<uint8_t, System> set_flags_;
+  Buffer<uint32_t, System> set_counts_;
   MeshView mesh_{};
   int32_t num_tri_ = 0;
   int rounds_ = 0;

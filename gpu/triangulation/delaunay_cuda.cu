@@ -3,6 +3,7 @@
 
 #include "gpu/system/cuda_system.cuh"
 #include "gpu/triangulation/delaunay_backend.hpp"
+#include "gpu/triangulation/delaunay_batch.cuh"
 #include "gpu/triangulation/delaunay_impl.cuh"
 
 namespace galpha::detail {
@@ -16,6 +17,18 @@ void TriangulateOnCuda(const Point2* points, const double* weights, uint32_t n, 
   OwnedStream owned;
   CudaSystem system(owned.get());
   RunTriangulation(system, points, weights, n, out);
+}
+
+void TriangulateSetsOnCuda(const Point2* points, const uint32_t* set_begin, uint32_t num_sets, uint32_t n, void* stream,
+                           DelaunaySetsOutput* out) {
+  if (stream != nullptr) {
+    CudaSystem system(static_cast<cudaStream_t>(stream));
+    RunSetsTriangulation(system, points, set_begin, num_sets, n, out);
+    return;
+  }
+  OwnedStream owned;
+  CudaSystem system(owned.get());
+  RunSetsTriangulation(system, points, set_begin, num_sets, n, out);
 }
 
 }  // namespace galpha::detail

@@ -148,10 +148,12 @@ Buffer<Point2, System> UploadPoints(System& sys, const Point2* host_points, uint
 /// Exact duplicates: sort by (point, index); each run's head is the first occurrence. Writes every
 /// input index's representative into `result`. Weighted (`weights` set: per input index), sorted by
 /// (point, weight descending, index): a run is one point with one weight, and a run lighter than
-/// another at its position is hidden (result->hidden) and is no vertex.
+/// another at its position is hidden (result->hidden) and is no vertex. Packed (`input_set` set:
+/// the set of each input index; unweighted only), sorted by (set, point, index): duplicates are
+/// duplicates within a set, and the distinct points come grouped by set.
 template <class System>
 DistinctPoints<System> FindDistinctPoints(System& sys, const Buffer<Point2, System>& input, const double* weights,
-                                          SystemTriangulation<System>* result) {
+                                          SystemTriangulation<System>* result, const uint32_t* input_set = nullptr) {
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
   const uint32_t n = static_cast<uint32_t>(input.size());
@@ -173,12 +175,16 @@ DistinctPoints<System> FindDistinctPoints(System& sys, const Buffer<Point2, Syst
         thrust::transform(pol, first, first + n, keys.begin(), CoordinateKey{input.data(), sorted.data(), axis});
         thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
       }
+      if (input_set != nullptr) {
+        thrust::transform(pol, first, first + n, keys.begin(), InputSetKey{input_set, sorted.data()});
+        thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
+      }
     }
     if (weights != nullptr) {
       thrust::transform(pol, first, first + n, head.begin(),
                         WeightedRunHeadPosition{input.data(), weights, sorted.data()});
     } else {
-      thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data()});
+      thrust::transform(pol, first, first + n, head.begin(), RunHeadPosition{input.data(), sorted.data(), input_set});
     }
     thrust::inclusive_scan(pol, head.begin(), head.end(), head.begin(), thrust::maximum<uint32_t>());
     thrust::for_each(pol, first, first + n,
@@ -264,6 +270,14 @@ void WriteWeightedCollinearChain(System& sys, const Buffer<Point2, System>& inpu
   if (!edges.empty()) sys.FromHost(result->edges.data(), edges.data(), edges.size());
 }
 
+/// A packed build's input (delaunay_batch.cuh): the set of every input index, and every set's
+/// bounding box and power of two, as a build of the set alone computes them.
+struct InputSets {
+  const uint32_t* input_set;
+  const BoundingBox* set_box;
+  const int* set_scale_exponent;
+};
+
 /// Hilbert order of the distinct points: neighbours in the order are neighbours in the plane.
 /// Returns the points in that order, scaled by an exact power of two (ExactScaleExponent), as the
 /// mesh's vertices; `unique` is put in the same order. The output keeps the input's coordinates.
@@ -271,9 +285,14 @@ void WriteWeightedCollinearChain(System& sys, const Buffer<Point2, System>& inpu
 /// Weighted (`weights` per input index), also fills `vertex_weights`: the weights, scaled by the
 /// square of the points' power of two, and the ranks in decreasing (x, y) order (`unique` arrives
 /// in (x, y) order).
+///
+/// Packed (`sets` set; unweighted), the points are ordered by set, then along the curve over their
+/// set's box, each scaled by its set's power of two: within a set, the order and the coordinates of
+/// a build of that set alone.
 template <class System>
 Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, const double* weights,
-                                    DistinctPoints<System>* distinct, VertexWeights<System>* vertex_weights) {
+                                    DistinctPoints<System>* distinct, VertexWeights<System>* vertex_weights,
+                                    const InputSets* sets = nullptr) {
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
   const uint32_t m = distinct->m;
@@ -284,19 +303,28 @@ Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, 
     thrust::for_each(pol, first, first + m, WriteLexicographicPosition{unique.data(), lexicographic_position.data()});
   }
   {
-    const BoundingBox box = thrust::transform_reduce(pol, input.begin(), input.end(), PointToBox(),
-                                                     PointToBox()(sys.Read(input.data())), MergeBoxes());
-    int scale_exponent = ExactScaleExponent(box, [&] {
-      return thrust::transform_reduce(pol, input.begin(), input.end(), SmallestNonzeroMagnitude(),
-                                      static_cast<double>(INFINITY), Minimum());
-    });
+    BoundingBox box{};
+    int scale_exponent = 0;
+    if (sets == nullptr) {
+      box = thrust::transform_reduce(pol, input.begin(), input.end(), PointToBox(),
+                                     PointToBox()(sys.Read(input.data())), MergeBoxes());
+      scale_exponent = ExactScaleExponent(box, [&] {
+        return thrust::transform_reduce(pol, input.begin(), input.end(), SmallestNonzeroMagnitude(),
+                                        static_cast<double>(INFINITY), Minimum());
+      });
+    }
     if (weights != nullptr) {
       scale_exponent = WeightedScaleExponent(
           scale_exponent, thrust::transform_reduce(pol, weights, weights + input.size(), SmallestNonzeroWeight(),
                                                    static_cast<double>(INFINITY), Minimum()));
     }
     Buffer<uint64_t, System> keys(sys, m);
-    thrust::transform(pol, first, first + m, keys.begin(), HilbertKey{input.data(), unique.data(), box});
+    if (sets == nullptr) {
+      thrust::transform(pol, first, first + m, keys.begin(), HilbertKey{input.data(), unique.data(), box});
+    } else {
+      thrust::transform(pol, first, first + m, keys.begin(),
+                        SetHilbertKey{input.data(), unique.data(), sets->input_set, sets->set_box});
+    }
     // Stable (ties keep the (x, y) order of `unique`), so that both backends number the same way.
     thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
     // Points that share a cell of the curve are ordered by a curve over their run's own box.
@@ -314,8 +342,14 @@ Buffer<Point2, System> HilbertOrder(System& sys, Buffer<Point2, System>& input, 
                         RunHilbertKey{input.data(), unique.data(), run_number.data(), run_box.data()});
       thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), unique.begin());
     }
-    thrust::for_each(pol, first, first + m,
-                     GatherVertex{input.data(), unique.data(), vertex_points.data(), scale_exponent});
+    if (sets == nullptr) {
+      thrust::for_each(pol, first, first + m,
+                       GatherVertex{input.data(), unique.data(), vertex_points.data(), scale_exponent});
+    } else {
+      thrust::for_each(pol, first, first + m,
+                       GatherSetVertex{input.data(), unique.data(), sets->input_set, sets->set_scale_exponent,
+                                       vertex_points.data()});
+    }
     if (weights != nullptr) {
       vertex_weights->weight = Buffer<double, System>(sys, m);
       vertex_weights->sos_rank = Buffer<uint32_t, System>(sys, m);

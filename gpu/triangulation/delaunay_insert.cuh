@@ -18,6 +18,35 @@ namespace galpha::detail {
 
 constexpr unsigned long long kNoVote = ~0ull;
 
+/// Sets a flag word to 1, read first so that the many threads that raise one flag write it once.
+GALPHA_HD inline void RaiseFlag(uint32_t* flag) {
+  cuda::atomic_ref<uint32_t, cuda::thread_scope_device> word(*flag);
+  if (word.load(cuda::memory_order_relaxed) == 0) word.store(1u, cuda::memory_order_relaxed);
+}
+
+/// A packed build's per-set round state (delaunay_batch.cuh): what a build of one set decides on
+/// the host between rounds (DelaunayBuilder::InsertAll), decided for every set on the device
+/// (DecideSetRounds), so that each set's rounds are the ones it would have alone.
+struct SetRoundState {
+  // Per set: kSetSecondWinners, kSetSectorPairs and kSetThirds, for the round under way.
+  uint8_t* flags = nullptr;
+  // Per set: points on an edge's line voted this round; splits and splits of infinite triangles
+  // (points added to the hull) of the previous round.
+  uint32_t* saw_edge = nullptr;
+  uint32_t* splits = nullptr;
+  uint32_t* sector_splits = nullptr;
+  // Per set: a point of the set voted this round (one build's rounds end where none is left, and
+  // it then decides nothing more).
+  uint32_t* voted = nullptr;
+};
+// The round picks second winners (one build's `second_winners`).
+constexpr uint8_t kSetSecondWinners = 1;
+// Points outside the hull vote for their sector's two supports (one build's `sector_pairs`).
+constexpr uint8_t kSetSectorPairs = 2;
+// Votes by thirds are on: set from the first round after one that picked second winners, and kept
+// (one build allocates their buffer then, and keeps it).
+constexpr uint8_t kSetThirds = 4;
+
 /// Where the three children of a split triangle live: child 2 reuses the parent's slot, children
 /// 0 and 1 take two fresh slots after the current triangles. `split_count` is the inclusive scan of
 /// HasWinner, so a split parent is the (split_count - 1)-th split of the round.
@@ -79,6 +108,12 @@ struct VoteForInsertion {
   // Points outside the hull vote twice, for the two supports of their sector (SupportSlope):
   // in tri_vote toward the hull edge's first end, in edge_vote toward its second. Needs edge_vote.
   bool sector_pairs;
+  // A packed build: the set of each vertex, and each set's round state, whose flags replace
+  // `sector_pairs` and the null `edge_vote` and `edge_third_vote` of a set's rounds without them
+  // (those pointers are then set when any set's round has them), and whose `saw_edge` replaces
+  // `saw_edge_point`. nullptr: one set.
+  const uint32_t* vertex_set = nullptr;
+  SetRoundState sets{};
 
   /// The slope of a sector's support direction away from its hull edge's normal, toward one end:
   /// tan(turn / 6), approximated by tan(turn / 2) / 3, where `turn` is the hull's turning angle
@@ -101,7 +136,8 @@ struct VoteForInsertion {
   /// The vote by thirds of point i, at `along` (its position along the edge's line, 0 and 1 at
   /// the edge's ends): the half it lies in picks the slot, its distance from the third or the two
   /// thirds the key.
-  GALPHA_HD void VoteByThirds(uint32_t i, int32_t t, double along) const {
+  GALPHA_HD static void VoteByThirds(uint32_t i, int32_t t, double along, unsigned long long* edge_vote,
+                                     unsigned long long* edge_third_vote) {
     const bool second_half = along >= 0.5;
     const double off = along - (second_half ? 2.0 / 3.0 : 1.0 / 3.0);
     const float score = static_cast<float>(off * off);
@@ -111,12 +147,21 @@ struct VoteForInsertion {
     slot.fetch_min(key);
   }
 
-  GALPHA_HD void MarkEdgePointSeen() const {
-    cuda::atomic_ref<uint32_t, cuda::thread_scope_device> seen(*saw_edge_point);
-    if (seen.load(cuda::memory_order_relaxed) == 0) seen.store(1u, cuda::memory_order_relaxed);
-  }
-
   GALPHA_HD void operator()(uint32_t i) const {
+    // This point's round: the build's, or in a packed build its set's.
+    unsigned long long* edge_vote = this->edge_vote;
+    unsigned long long* edge_third_vote = this->edge_third_vote;
+    uint32_t* saw_edge_point = this->saw_edge_point;
+    bool sector_pairs = this->sector_pairs;
+    if (vertex_set != nullptr) {
+      const uint32_t set = vertex_set[pending[i]];
+      const uint8_t flags = sets.flags[set];
+      if ((flags & kSetSecondWinners) == 0) edge_vote = nullptr;
+      if ((flags & kSetSecondWinners) == 0 || (flags & kSetThirds) == 0) edge_third_vote = nullptr;
+      sector_pairs = (flags & kSetSectorPairs) != 0;
+      saw_edge_point = sets.saw_edge + set;
+      RaiseFlag(sets.voted + set);
+    }
     const int32_t t = location[i];
     const Point2 p = mesh.pts[pending[i]];
     const Tri x = mesh.tri[t];
@@ -197,8 +242,8 @@ struct VoteForInsertion {
           const double edge2 = ex * ex + ey * ey;
           const double longest2 = fmax(fmax(b2, c2), (cx - bx) * (cx - bx) + (cy - by) * (cy - by));
           if (16.0 * edge2 >= longest2) {
-            MarkEdgePointSeen();
-            VoteByThirds(i, t, ((px - ux) * ex + (py - uy) * ey) / edge2);
+            RaiseFlag(saw_edge_point);
+            VoteByThirds(i, t, ((px - ux) * ex + (py - uy) * ey) / edge2, edge_vote, edge_third_vote);
             return;
           }
         }
@@ -236,7 +281,7 @@ struct VoteForInsertion {
       }
     }
     const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
-    if (on_edge_line) MarkEdgePointSeen();
+    if (on_edge_line) RaiseFlag(saw_edge_point);
     cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(
         on_edge_line && edge_vote != nullptr ? edge_vote[t] : tri_vote[t]);
     slot.fetch_min(key);
@@ -332,6 +377,50 @@ struct PlaceSecondWinners {
   }
 };
 
+/// A packed build, after a round's votes: every set decides its next round as DelaunayBuilder::
+/// InsertAll decides a build's (second winners where the round saw a point on an edge's line or
+/// the next has sector pairs; sector pairs after a round where at least a quarter of the splits
+/// were on the hull; votes by thirds from the first round with second winners on, unweighted),
+/// from its own counts, which it then clears; the sets whose next round has second winners are
+/// counted into `*with_second_winners`.
+struct DecideSetRounds {
+  SetRoundState sets;
+  bool weighted;
+  uint32_t* with_second_winners;
+  GALPHA_HD void operator()(uint32_t set) const {
+    if (sets.voted[set] == 0) return;  // the set's rounds are over: it decides nothing
+    sets.voted[set] = 0;
+    const uint32_t last_splits = sets.splits[set];
+    const bool sector_pairs =
+        !weighted && last_splits > 0 && 4 * static_cast<uint64_t>(sets.sector_splits[set]) >= last_splits;
+    const bool second_winners = sets.saw_edge[set] != 0 || sector_pairs;
+    uint8_t flags = sets.flags[set] & kSetThirds;
+    if (sector_pairs) flags |= kSetSectorPairs;
+    if (second_winners) {
+      flags |= kSetSecondWinners;
+      if (!weighted) flags |= kSetThirds;
+      AtomicIncrement(with_second_winners);
+    }
+    sets.flags[set] = flags;
+    sets.saw_edge[set] = 0;
+    sets.splits[set] = 0;
+    sets.sector_splits[set] = 0;
+  }
+};
+
+/// A packed build, before its first round of insertions: every set starts as a build starts
+/// InsertAll (second winners on, sector pairs off, no splits counted), its votes by thirds kept.
+struct StartSetRounds {
+  SetRoundState sets;
+  GALPHA_HD void operator()(uint32_t set) const {
+    sets.flags[set] = static_cast<uint8_t>((sets.flags[set] & kSetThirds) | kSetSecondWinners);
+    sets.voted[set] = 0;
+    sets.saw_edge[set] = 0;
+    sets.splits[set] = 0;
+    sets.sector_splits[set] = 0;
+  }
+};
+
 /// 1 where a triangle won a point this round.
 struct HasWinner {
   GALPHA_HD int32_t operator()(unsigned long long vote) const { return vote != kNoVote ? 1 : 0; }
@@ -348,6 +437,7 @@ struct SplitTriangles {
   uint8_t* inserted;  // per uninserted point
   int32_t num_tri;
   uint32_t* sector_splits;  // the build's count of split infinite triangles (points added to the hull)
+  SetRoundState sets{};     // a packed build: the splits are also counted per set (mesh.vertex_set)
 
   GALPHA_HD void operator()(int32_t t) const {
     const unsigned long long vote = tri_vote[t];
@@ -356,7 +446,13 @@ struct SplitTriangles {
     inserted[winner] = 1;
     const int32_t w = pending[winner];
     const Tri x = mesh.tri[t];
-    if (mesh.IsInfinite(t)) AtomicIncrement(sector_splits);
+    const bool infinite = mesh.IsInfinite(t);
+    if (infinite) AtomicIncrement(sector_splits);
+    if (mesh.vertex_set != nullptr) {
+      const uint32_t set = mesh.vertex_set[w];
+      AtomicIncrement(sets.splits + set);
+      if (infinite) AtomicIncrement(sets.sector_splits + set);
+    }
     const TriNbr nx = mesh.nbr[t];
     int32_t child[3];
     for (int k = 0; k < 3; ++k) child[k] = ChildSlot(t, k, split_count[t], num_tri);

@@ -8,4 +8,8 @@ void TriangulateOnCuda(const Point2*, const double*, uint32_t, void*, DelaunayOu
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 
+void TriangulateSetsOnCuda(const Point2*, const uint32_t*, uint32_t, uint32_t, void*, DelaunaySetsOutput*) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
 }  // namespace galpha::detail

@@ -78,13 +78,25 @@ struct MeshView {
   // Weight of each vertex, scaled with `pts` (by the square of their power of two); nullptr:
   // unweighted, a Delaunay triangulation.
   const double* weight;
+  // A packed build of many point sets (delaunay_batch.cuh), one mesh each in the same arrays: the
+  // set of each vertex, and the vertices of each set's first triangle (three a set), whose centre
+  // replaces center_a, b and c. nullptr: one set.
+  const uint32_t* vertex_set = nullptr;
+  const int32_t* set_center = nullptr;
 
   /// Sign of orient(center, w, p): orient is affine in its first point, so it is the first
   /// nonzero of the exact signs with a, b, c in its place (never zero: a, b, c are not collinear).
   GALPHA_HD int CenterOrient(int32_t w, int32_t p) const {
-    int s = Orient2dSign(pts[center_a], pts[w], pts[p]);
-    if (s == 0) s = Orient2dSign(pts[center_b], pts[w], pts[p]);
-    if (s == 0) s = Orient2dSign(pts[center_c], pts[w], pts[p]);
+    int32_t a = center_a, b = center_b, c = center_c;
+    if (set_center != nullptr) {
+      const int32_t* center = set_center + 3 * static_cast<size_t>(vertex_set[p]);
+      a = center[0];
+      b = center[1];
+      c = center[2];
+    }
+    int s = Orient2dSign(pts[a], pts[w], pts[p]);
+    if (s == 0) s = Orient2dSign(pts[b], pts[w], pts[p]);
+    if (s == 0) s = Orient2dSign(pts[c], pts[w], pts[p]);
     return s;
   }
 

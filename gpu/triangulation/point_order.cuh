@@ -35,13 +35,23 @@ struct CoordinateKey {
 };
 
 /// Position of the head of the run of equal points that sorted position k belongs to (0 when k is
-/// not a head, for a max-scan).
+/// not a head, for a max-scan). Packed (`input_set` set: many point sets, sorted by set first), a
+/// run is one point of one set.
 struct RunHeadPosition {
   const Point2* pts;
   const uint32_t* sorted;
+  const uint32_t* input_set = nullptr;
   GALPHA_HD uint32_t operator()(uint32_t k) const {
-    return (k == 0 || !(pts[sorted[k]] == pts[sorted[k - 1]])) ? k : 0u;
+    if (k == 0 || !(pts[sorted[k]] == pts[sorted[k - 1]])) return k;
+    return input_set != nullptr && input_set[sorted[k]] != input_set[sorted[k - 1]] ? k : 0u;
   }
+};
+
+/// The set of the input point a permutation entry names, as a sort key (packed builds).
+struct InputSetKey {
+  const uint32_t* input_set;
+  const uint32_t* order;
+  GALPHA_HD uint64_t operator()(uint32_t k) const { return input_set[order[k]]; }
 };
 
 /// representative[input index] = input index of the run's head.
@@ -149,6 +159,20 @@ struct HilbertKey {
   }
 };
 
+/// A packed build's Hilbert key: the point's set in the bits above the curve's 42 (so that the
+/// sets stay apart, in order), and its key on the curve over its set's box below.
+struct SetHilbertKey {
+  static constexpr int kSetShift = 2 * HilbertKey::kHilbertOrder;
+  const Point2* pts;
+  const uint32_t* input_index;
+  const uint32_t* input_set;
+  const BoundingBox* set_box;
+  GALPHA_HD uint64_t operator()(uint32_t i) const {
+    const uint32_t set = input_set[input_index[i]];
+    return (static_cast<uint64_t>(set) << kSetShift) | HilbertKey{pts, input_index, set_box[set]}(i);
+  }
+};
+
 /// 1 where sorted position k starts a run of equal Hilbert keys (points in one cell of the curve).
 struct StartsKeyRun {
   const uint64_t* keys;
@@ -222,6 +246,21 @@ struct GatherVertex {
   GALPHA_HD void operator()(uint32_t v) const {
     const Point2 p = input_points[input_index[v]];
     vertex_points[v] = Point2{ldexp(p.x, scale_exponent), ldexp(p.y, scale_exponent)};
+  }
+};
+
+/// GatherVertex for a packed build: each point scaled by its set's power of two.
+struct GatherSetVertex {
+  const Point2* input_points;
+  const uint32_t* input_index;
+  const uint32_t* input_set;
+  const int* set_scale_exponent;
+  Point2* vertex_points;
+  GALPHA_HD void operator()(uint32_t v) const {
+    const uint32_t i = input_index[v];
+    const Point2 p = input_points[i];
+    const int e = set_scale_exponent[input_set[i]];
+    vertex_points[v] = Point2{ldexp(p.x, e), ldexp(p.y, e)};
   }
 };
 
