@@ -10,6 +10,13 @@
 // many_hidden, ...), the regular triangulation: galpha::TriangulateWeighted against CGAL's
 // Regular_triangulation_2, with the hidden points counted.
 //
+// With --sets=SETSxPOINTS (e.g. 10000x1000), the packed build of many sets instead (issue 20):
+// for each distribution, SETS sets of POINTS points (generated with seeds seed, seed + 1, ...) in
+// one TriangulateSets call, against one Triangulate of SETS * POINTS points of the distribution
+// (the issue's reference: a batch should take under 10x that), Triangulate called once a set and
+// CGAL a set (both timed over the first 200 sets and scaled to SETS). The sampled sets' packed
+// triangulations must equal their own builds, triangle for triangle, or the run fails.
+//
 // With --data and no --dists/--sizes, only the files run. Times are the best of --repeat runs;
 // point generation and conversion are not timed.
 #include <CGAL/Delaunay_triangulation_2.h>
@@ -27,6 +34,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "bench/bench_options.hpp"
 #include "core/io/point_io.hpp"
@@ -66,7 +74,8 @@ struct BenchResult {
 
 constexpr char kUsage[] =
     "usage: delaunay_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...]\n"
-    "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]... [--weights=KIND]\n";
+    "                      [--dists=NAME,NAME,...] [--seed=N] [--data FILE.bin]... [--weights=KIND]\n"
+    "                      [--sets=SETSxPOINTS]\n";
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -135,6 +144,102 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
   return result;
 }
 
+std::string StageSummary(const std::vector<StageTime>& stages);
+
+/// Takes --sets=SETSxPOINTS out of argv (the rest into *rest); 0 sets without it.
+absl::Status TakeSetsOption(int argc, char** argv, size_t* sets, size_t* points, std::vector<char*>* rest) {
+  *sets = 0;
+  rest->push_back(argv[0]);
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--sets=", 0) != 0) {
+      rest->push_back(argv[i]);
+      continue;
+    }
+    const std::string value = arg.substr(7);
+    const size_t x = value.find('x');
+    if (x == std::string::npos || !absl::SimpleAtoi(value.substr(0, x), sets) ||
+        !absl::SimpleAtoi(value.substr(x + 1), points) || *sets == 0 || *points == 0) {
+      return absl::InvalidArgumentError(absl::StrCat("--sets: '", value, "' is not SETSxPOINTS (e.g. 10000x1000)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+/// --sets: one distribution's packed build against its references (see the file comment). Returns
+/// false on an engine error or a sampled set unlike its own build.
+bool RunPackedSets(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options) {
+  constexpr size_t kSampledSets = 200;
+  const gen::NamedGenerator* generator = gen::FindDistribution(name);
+  std::vector<Point2> points;
+  std::vector<uint32_t> set_begin{0};
+  for (size_t s = 0; s < num_sets; ++s) {
+    const std::vector<Point2> set = generator->generate(points_per_set, options.seed + s);
+    points.insert(points.end(), set.begin(), set.end());
+    set_begin.push_back(static_cast<uint32_t>(points.size()));
+  }
+  TriangulateOptions triangulate_options;
+  triangulate_options.backend = options.backend;
+  double packed_ms = std::numeric_limits<double>::infinity(), whole_ms = packed_ms;
+  absl::StatusOr<TriangulatedSets> packed = absl::UnknownError("not run");
+  for (int r = 0; r < options.repeat; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+    packed = TriangulateSets(points, set_begin, triangulate_options);
+    if (!packed.ok()) break;
+    packed_ms = std::min(packed_ms, MillisecondsSince(start));
+  }
+  if (!packed.ok()) {
+    std::printf("| %s | %zux%zu | error: %s | | | | | | | |\n", name.c_str(), num_sets, points_per_set,
+                packed.status().ToString().c_str());
+    return false;
+  }
+  {
+    const std::vector<Point2> whole = generator->generate(num_sets * points_per_set, options.seed);
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      if (!Triangulate(whole, triangulate_options).ok()) return false;
+      whole_ms = std::min(whole_ms, MillisecondsSince(start));
+    }
+  }
+  // The sampled sets one call each, and by CGAL; their packed triangulations checked against their own.
+  const size_t sampled = std::min(num_sets, kSampledSets);
+  bool equal = true;
+  double alone_ms = 0, cgal_ms = 0;
+  for (size_t s = 0; s < sampled; ++s) {
+    const absl::Span<const Point2> set(points.data() + set_begin[s], set_begin[s + 1] - set_begin[s]);
+    double best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      absl::StatusOr<Triangulation> alone = Triangulate(set, triangulate_options);
+      best = std::min(best, MillisecondsSince(start));
+      if (!alone.ok()) return false;
+      equal &= alone->triangles == packed->sets[s].triangles && alone->edges == packed->sets[s].edges;
+    }
+    alone_ms += best;
+    std::vector<Kernel::Point_2> cgal_points;
+    for (const Point2& p : set) cgal_points.emplace_back(p.x, p.y);
+    best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      const CgalDelaunay dt(cgal_points.begin(), cgal_points.end());
+      best = std::min(best, MillisecondsSince(start));
+    }
+    cgal_ms += best;
+  }
+  const double scale = static_cast<double>(num_sets) / static_cast<double>(sampled);
+  alone_ms *= scale;
+  cgal_ms *= scale;
+  std::printf(
+      "| %s | %zux%zu | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.1f | %.1f | %s |\n", name.c_str(), num_sets,
+      points_per_set, BackendName(packed->backend), packed_ms, whole_ms, packed_ms / whole_ms, alone_ms,
+      alone_ms / packed_ms, cgal_ms, cgal_ms / packed_ms,
+      equal ? (packed->built_alone == 0 ? "yes" : absl::StrCat("yes (", packed->built_alone, " built alone)").c_str())
+            : "NO: MISMATCH");
+  std::printf("|  | stages (ms) | %s |||||||||\n", StageSummary(packed->stage_times).c_str());
+  std::fflush(stdout);
+  return equal;
+}
+
 std::string StageSummary(const std::vector<StageTime>& stages) {
   std::string out;
   for (const StageTime& stage : stages) {
@@ -190,6 +295,15 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n%s", std::string(taken.message()).c_str(), kUsage);
     return 2;
   }
+  size_t num_sets = 0, points_per_set = 0;
+  std::vector<char*> rest;
+  if (const absl::Status taken =
+          TakeSetsOption(static_cast<int>(args.size()), args.data(), &num_sets, &points_per_set, &rest);
+      !taken.ok()) {
+    std::fprintf(stderr, "%s\n%s", std::string(taken.message()).c_str(), kUsage);
+    return 2;
+  }
+  args = std::move(rest);
   const absl::StatusOr<BenchOptions> options = ParseBenchArgs(static_cast<int>(args.size()), args.data(), nullptr);
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
@@ -200,6 +314,19 @@ int Main(int argc, char** argv) {
               std::thread::hardware_concurrency(),
               weight_kind.empty() ? "" : absl::StrCat("; weights ", weight_kind, " (regular triangulations)").c_str());
 
+  if (num_sets > 0) {
+    std::printf(
+        "| distribution | sets x points | backend | packed ms (TriangulateSets) | one set of all the points ms | "
+        "packed / all in one | one call a set ms (200 sampled, scaled) | calls a set / packed | CGAL a set ms "
+        "(same sample) | CGAL / packed | sampled sets equal their own builds |\n"
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    bool all_equal = true;
+    for (const std::string& name : options->distributions) {
+      std::fprintf(stderr, "running %s, %zu sets of %zu points\n", name.c_str(), num_sets, points_per_set);
+      all_equal &= RunPackedSets(name, num_sets, points_per_set, *options);
+    }
+    return all_equal ? 0 : 1;
+  }
   PrintHeader();
   std::vector<BenchResult> results;
   bool failed = false;
