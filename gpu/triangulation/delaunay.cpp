@@ -70,46 +70,46 @@ absl::Status ValidateSetOffsets(absl::Span<const uint32_t> set_begin, size_t n) 
   return absl::OkStatus();
 }
 
-/// Splits the packed build's output (indices of the whole input) into one triangulation a set
-/// (indices of the set), keeping each set's order.
-void SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin, detail::DelaunaySetsOutput& raw,
-                std::vector<Triangulation>* sets) {
+/// Splits the packed build's output (indices of the whole input, each set's triangles one run) into
+/// one triangulation a set (indices of the set), keeping each set's order.
+void SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
+                const detail::DelaunaySetsOutput& raw, std::vector<Triangulation>* sets) {
   const size_t num_sets = set_begin.size() - 1;
-  std::vector<uint32_t> set_of(points.size());
+  const detail::DelaunayOutput& all = raw.meshes;
+  const size_t num_tri = all.triangles.size();
   for (size_t s = 0; s < num_sets; ++s) {
     Triangulation& t = (*sets)[s];
     const uint32_t begin = set_begin[s], end = set_begin[s + 1];
-    std::fill(set_of.begin() + begin, set_of.begin() + end, static_cast<uint32_t>(s));
     t.points.assign(points.begin() + begin, points.begin() + end);
     t.representative.resize(end - begin);
     for (uint32_t i = begin; i < end; ++i) {
-      t.representative[i - begin] = raw.meshes.representative[i] - begin;
-      if (raw.meshes.representative[i] == i) ++t.num_unique;
+      t.representative[i - begin] = all.representative[i] - begin;
+      if (all.representative[i] == i) ++t.num_unique;
+    }
+    if (num_tri == 0) continue;
+    const uint32_t tri_begin = raw.set_triangle_begin[s], tri_end = raw.set_triangle_begin[s + 1];
+    const size_t edge_begin = tri_begin < num_tri ? all.tri_edge_begin[tri_begin] : all.edges.size();
+    const size_t edge_end = tri_end < num_tri ? all.tri_edge_begin[tri_end] : all.edges.size();
+    t.triangles.resize(tri_end - tri_begin);
+    t.neighbors.resize(tri_end - tri_begin);
+    t.tri_edge_begin.resize(tri_end - tri_begin);
+    for (uint32_t g = tri_begin; g < tri_end; ++g) {
+      const std::array<uint32_t, 3>& x = all.triangles[g];
+      t.triangles[g - tri_begin] = {x[0] - begin, x[1] - begin, x[2] - begin};
+      std::array<int32_t, 3> n = all.neighbors[g];
+      for (int32_t& k : n) k = k < 0 ? Triangulation::kNoNeighbor : k - static_cast<int32_t>(tri_begin);
+      t.neighbors[g - tri_begin] = n;
+      t.tri_edge_begin[g - tri_begin] = static_cast<uint32_t>(all.tri_edge_begin[g] - edge_begin);
+    }
+    t.edges.resize(edge_end - edge_begin);
+    for (size_t e = edge_begin; e < edge_end; ++e) {
+      t.edges[e - edge_begin] = {all.edges[e][0] - begin, all.edges[e][1] - begin};
     }
   }
-  const std::vector<std::array<uint32_t, 3>>& tri = raw.meshes.triangles;
-  std::vector<int32_t> local_id(tri.size());
-  for (size_t g = 0; g < tri.size(); ++g) {
-    Triangulation& t = (*sets)[set_of[tri[g][0]]];
-    const uint32_t begin = set_begin[set_of[tri[g][0]]];
-    local_id[g] = static_cast<int32_t>(t.triangles.size());
-    t.triangles.push_back({tri[g][0] - begin, tri[g][1] - begin, tri[g][2] - begin});
-  }
-  const std::vector<std::array<uint32_t, 2>>& edges = raw.meshes.edges;
-  for (size_t g = 0; g < tri.size(); ++g) {
-    Triangulation& t = (*sets)[set_of[tri[g][0]]];
-    const uint32_t begin = set_begin[set_of[tri[g][0]]];
-    std::array<int32_t, 3> nbr = raw.meshes.neighbors[g];
-    for (int32_t& n : nbr) n = n < 0 ? Triangulation::kNoNeighbor : local_id[n];
-    t.neighbors.push_back(nbr);
-    t.tri_edge_begin.push_back(static_cast<uint32_t>(t.edges.size()));
-    const size_t edge_end = g + 1 < tri.size() ? raw.meshes.tri_edge_begin[g + 1] : edges.size();
-    for (size_t e = raw.meshes.tri_edge_begin[g]; e < edge_end; ++e) {
-      t.edges.push_back({edges[e][0] - begin, edges[e][1] - begin});
-    }
-  }
+  // The chains of the sets on one line, set after set.
+  size_t s = 0;
   for (const std::array<uint32_t, 2>& e : raw.chain_edges) {
-    const uint32_t s = set_of[e[0]];
+    while (e[0] >= set_begin[s + 1]) ++s;
     (*sets)[s].edges.push_back({e[0] - set_begin[s], e[1] - set_begin[s]});
   }
 }

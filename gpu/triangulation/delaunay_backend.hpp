@@ -28,11 +28,15 @@ struct DelaunayOutput {
 };
 
 /// What a packed build of many sets hands back (delaunay_batch.cuh), named by indices of the whole
-/// input: a one-set build's output for all the sets with a mesh together (each set's triangles,
-/// neighbours and edges in the order of a build of that set alone, interleaved with the other
-/// sets'; representatives for every input index), and the chains of the sets on one line.
+/// input: a one-set build's output for all the sets with a mesh together (each set's triangles one
+/// run, set after set, in the order of a build of that set alone, neighbours by position in the
+/// whole list, edges laid out from the triangles; representatives for every input index), and the
+/// chains of the sets on one line.
 struct DelaunaySetsOutput {
   DelaunayOutput meshes;
+  /// Where each set's run of triangles starts in `meshes.triangles` (num_sets + 1 entries; empty
+  /// when no set has a mesh).
+  std::vector<uint32_t> set_triangle_begin;
   /// The chains of the sets on one line, set after set, each in a one-set build's order.
   std::vector<std::array<uint32_t, 2>> chain_edges;
   /// Per set: 1 where its mesh held a flat triangle; its part of `meshes` is then not its

@@ -29,6 +29,8 @@
 #include <thrust/iterator/transform_iterator.h>
 #include <thrust/partition.h>
 #include <thrust/reduce.h>
+#include <thrust/sequence.h>
+#include <thrust/sort.h>
 #include <thrust/transform.h>
 #include <cuda/atomic>
 
@@ -186,6 +188,68 @@ struct IsSetExtremeVertex {
     return v == e.v[0] || v == e.v[1] || v == e.v[2] || v == e.v[3];
   }
 };
+
+/// The set of an output triangle (of its first vertex, an input index).
+struct TriangleSet {
+  const uint32_t* input_set;
+  const Tri* tri;
+  GALPHA_HD uint64_t operator()(uint32_t t) const { return input_set[tri[t].v[0]]; }
+};
+
+/// new_position[order[k]] = k.
+struct WriteNewPosition {
+  const uint32_t* order;
+  int32_t* new_position;
+  GALPHA_HD void operator()(uint32_t k) const { new_position[order[k]] = static_cast<int32_t>(k); }
+};
+
+/// Output triangle k of the grouped order: the old triangle order[k], its neighbours renamed.
+struct GatherGroupedTriangle {
+  const uint32_t* order;
+  const Tri* tri;
+  const TriNbr* nbr;
+  const int32_t* new_position;
+  Tri* grouped_tri;
+  TriNbr* grouped_nbr;
+  GALPHA_HD void operator()(uint32_t k) const {
+    const uint32_t old = order[k];
+    grouped_tri[k] = tri[old];
+    TriNbr n = nbr[old];
+    for (int j = 0; j < 3; ++j) n.n[j] = n.n[j] < 0 ? n.n[j] : new_position[n.n[j]];
+    grouped_nbr[k] = n;
+  }
+};
+
+/// Puts the output's triangles (finite, by input index, slot order) in order of their set, each
+/// set's in its slot order (a stable sort), with their neighbours renamed: a set's triangles are
+/// then one run, in the order of its build alone, and the edges written from them (OutputEdges)
+/// too. The runs' starts (num_sets + 1) go to `set_triangle_begin` on the host.
+template <class System>
+void GroupTrianglesBySet(System& sys, const uint32_t* input_set, uint32_t num_sets, SystemTriangulation<System>* result,
+                         std::vector<uint32_t>* set_triangle_begin) {
+  auto pol = sys.policy();
+  const thrust::counting_iterator<uint32_t> first(0);
+  const auto num_tri = static_cast<uint32_t>(result->tri.size());
+  Buffer<uint32_t, System> order(sys, num_tri);
+  {
+    Buffer<uint64_t, System> keys(sys, num_tri);
+    thrust::transform(pol, first, first + num_tri, keys.begin(), TriangleSet{input_set, result->tri.data()});
+    thrust::sequence(pol, order.begin(), order.end());
+    thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), order.begin());
+    Buffer<uint32_t, System> begin(sys, size_t{num_sets} + 1);
+    thrust::lower_bound(pol, keys.begin(), keys.end(), first, first + num_sets + 1, begin.begin());
+    *set_triangle_begin = begin.ToHostVector(size_t{num_sets} + 1);
+  }
+  Buffer<int32_t, System> new_position(sys, num_tri);
+  thrust::for_each(pol, first, first + num_tri, WriteNewPosition{order.data(), new_position.data()});
+  Buffer<Tri, System> tri(sys, num_tri);
+  Buffer<TriNbr, System> nbr(sys, num_tri);
+  thrust::for_each(pol, first, first + num_tri,
+                   GatherGroupedTriangle{order.data(), result->tri.data(), result->nbr.data(), new_position.data(),
+                                         tri.data(), nbr.data()});
+  result->tri = std::move(tri);
+  result->nbr = std::move(nbr);
+}
 
 /// Triangulates the `num_sets` sets of `n` host points (set s: points [set_begin[s],
 /// set_begin[s + 1])) in one build on `sys` and downloads the result into `out`.
@@ -347,6 +411,7 @@ void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t
     builder.reset();
     vertex_points.Reset();
     distinct.unique.Reset();
+    GroupTrianglesBySet(sys, input_set.data(), num_sets, &result, &out->set_triangle_begin);
     if (result.tri.size() > 0) OutputEdges(sys, &result);
     timer.EndStage("output");
   }
