@@ -20,6 +20,8 @@ const char kUsage[] =
     "commands:\n"
     "  triangulate FILE              the Delaunay triangulation's counts and stage times, one JSON line\n"
     "                              (with --weights, the regular triangulation and its hidden points)\n"
+    "  triangulate FILE --group-by COLUMN\n"
+    "                              each group's counts from one build of all the groups (unweighted)\n"
     "  spectrum FILE               the spectrum: one alpha_sq per line, ascending (shortest round-trip decimals)\n"
     "  classify FILE THRESHOLD [--mode general|regularized] [--vertex-rule report|cgal]\n"
     "           [--answer-encoding raw|delta|zstd]\n"

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <exception>
 #include <iterator>
+#include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -313,6 +315,18 @@ int PrintBenchTable(const std::string& file, size_t input_points, uint64_t disti
   }
   std::fputs(table.c_str(), stdout);
   return kExitOk;
+}
+
+std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> GroupsOf(
+    const std::vector<std::optional<std::string>>& values) {
+  std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> groups;
+  std::map<std::optional<std::string>, size_t> position;
+  for (uint32_t i = 0; i < values.size(); ++i) {
+    auto [it, added] = position.emplace(values[i], groups.size());
+    if (added) groups.emplace_back(values[i], std::vector<uint32_t>());
+    groups[it->second].second.push_back(i);
+  }
+  return groups;
 }
 
 }  // namespace galpha::alphactl

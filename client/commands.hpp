@@ -174,6 +174,11 @@ int PrintBenchTable(const std::string& file, size_t input_points, uint64_t disti
 absl::Status CheckThresholdRank(int64_t rank, int64_t k);
 absl::Status CheckMasterListRank(int64_t rank, int64_t k);
 
+/// The points of each group (--group-by: a point's value of the column, or none), by input
+/// index, in the order the groups first appear.
+std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> GroupsOf(
+    const std::vector<std::optional<std::string>>& values);
+
 /// shape --group-by COLUMN: one regularized shape per group of FILE's points (their values of a
 /// GeoJSON property or a GDAL layer's field), each built on its own (with --server: all in one
 /// BuildBatch call), in the order the groups first appear: a GeoJSON FeatureCollection (one MultiPolygon feature per

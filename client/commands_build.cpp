@@ -2,11 +2,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "client/commands.hpp"
@@ -17,8 +19,96 @@
 
 namespace galpha::alphactl {
 
+namespace {
+
+// Milliseconds to the microsecond: a clock's noise needs no more digits.
+double Milliseconds(double seconds) { return std::round(seconds * 1e6) / 1e3; }
+
+/// The hull edges of a triangulation: edges with one triangle, or every edge of a chain.
+size_t HullEdges(const Triangulation& t) {
+  if (t.triangles.empty()) return t.edges.size();
+  size_t hull_edges = 0;
+  for (const auto& n : t.neighbors) {
+    for (int32_t x : n) hull_edges += x == Triangulation::kNoNeighbor ? 1 : 0;
+  }
+  return hull_edges;
+}
+
+/// The stage times as a JSON object, and their sum into *total (seconds).
+nlohmann::ordered_json StageJson(const std::vector<StageTime>& stage_times, double* total) {
+  nlohmann::ordered_json stages = nlohmann::ordered_json::object();
+  for (const auto& s : stage_times) {
+    stages[s.stage] = Milliseconds(s.seconds);
+    *total += s.seconds;
+  }
+  return stages;
+}
+
+/// triangulate --group-by: every group's triangulation from one packed build (TriangulateSets),
+/// one JSON line with each group's counts and the build's times.
+int RunGroupedTriangulate(const CommonArgs& common, const TriangulateOptions& options) {
+  if (common.input.weights != InputOptions::Weights::kNone) {
+    return UsageError(absl::InvalidArgumentError(
+        "--group-by triangulates unweighted groups: triangulate a weighted set without --group-by"));
+  }
+  absl::StatusOr<GeoreferencedPoints> read;
+  try {
+    read = ReadInputPointsAndCrs(common.file, common.input);
+  } catch (const std::exception& e) {
+    read = absl::DataLossError(absl::StrCat("points file '", common.file, "' cannot be read: ", e.what()));
+  }
+  if (!read.ok()) return Failure(read.status());
+  const auto groups = GroupsOf(read->groups);
+  std::vector<Point2> points;
+  points.reserve(read->points.size());
+  std::vector<uint32_t> set_begin{0};
+  for (const auto& [group, indices] : groups) {
+    for (const uint32_t i : indices) points.push_back(read->points[i]);
+    set_begin.push_back(static_cast<uint32_t>(points.size()));
+  }
+  auto sets = TriangulateSets(points, set_begin, options);
+  if (!sets.ok()) {
+    // The engine names a set by its index: name its group instead.
+    const std::string message(sets.status().message());
+    size_t set = 0;
+    if (message.rfind("set ", 0) == 0 && absl::SimpleAtoi(message.substr(4, message.find(':') - 4), &set) &&
+        set < groups.size()) {
+      const std::string name =
+          groups[set].first ? absl::StrCat("group '", *groups[set].first, "'") : "the group without a value";
+      return Failure(absl::Status(sets.status().code(), absl::StrCat(name, message.substr(message.find(':')))));
+    }
+    return Failure(sets.status());
+  }
+  nlohmann::ordered_json per_group = nlohmann::ordered_json::array();
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const Triangulation& t = sets->sets[g];
+    per_group.push_back(
+        {{"group", groups[g].first ? nlohmann::ordered_json(*groups[g].first) : nlohmann::ordered_json()},
+         {"points", t.points.size()},
+         {"distinct_points", t.num_unique},
+         {"duplicates", t.points.size() - t.num_unique},
+         {"triangles", t.triangles.size()},
+         {"edges", t.edges.size()},
+         {"hull_edges", HullEdges(t)}});
+  }
+  double total = 0.0;
+  nlohmann::ordered_json stages = StageJson(sets->stage_times, &total);
+  const nlohmann::ordered_json json = {{"file", common.file},
+                                       {"points", points.size()},
+                                       {"groups", std::move(per_group)},
+                                       {"backend", BackendName(sets->backend)},
+                                       {"built_alone", sets->built_alone},
+                                       {"peak_memory_bytes", sets->peak_memory_bytes},
+                                       {"total_ms", Milliseconds(total)},
+                                       {"stage_ms", std::move(stages)}};
+  std::fputs(JsonLine(json).c_str(), stdout);
+  return kExitOk;
+}
+
+}  // namespace
+
 int RunTriangulate(Args args) {
-  auto common = ParseCommon("triangulate", args, {});
+  auto common = ParseCommon("triangulate", args, {"group-by"});
   if (!common.ok()) return UsageError(common.status());
   if (!common->server.empty()) {
     return UsageError(absl::InvalidArgumentError(
@@ -26,6 +116,11 @@ int RunTriangulate(Args args) {
   }
   TriangulateOptions options;
   options.backend = common->backend;
+  if (const std::string* column = common->line.Find("group-by")) {
+    if (column->empty()) return UsageError(absl::InvalidArgumentError("--group-by needs a column's name"));
+    common->input.group_by = *column;
+    return RunGroupedTriangulate(*common, options);
+  }
 
   const bool weighted = common->input.weights != InputOptions::Weights::kNone;
   absl::StatusOr<GeoreferencedPoints> read;
@@ -39,19 +134,8 @@ int RunTriangulate(Args args) {
   auto tri = weighted ? TriangulateWeighted(*points, read->weights, options) : Triangulate(*points, options);
   if (!tri.ok()) return Failure(tri.status());
 
-  size_t hull_edges = 0;
-  for (const auto& n : tri->neighbors) {
-    for (int32_t x : n) hull_edges += x == Triangulation::kNoNeighbor ? 1 : 0;
-  }
-  if (tri->triangles.empty()) hull_edges = tri->edges.size();
-  // Milliseconds to the microsecond: a clock's noise needs no more digits.
-  auto ms = [](double seconds) { return std::round(seconds * 1e6) / 1e3; };
   double total = 0.0;
-  nlohmann::ordered_json stages = nlohmann::ordered_json::object();
-  for (const auto& s : tri->stage_times) {
-    stages[s.stage] = ms(s.seconds);
-    total += s.seconds;
-  }
+  nlohmann::ordered_json stages = StageJson(tri->stage_times, &total);
   const nlohmann::ordered_json json = {
       {"file", common->file},
       {"points", points->size()},
@@ -60,10 +144,10 @@ int RunTriangulate(Args args) {
       {"hidden_points", weighted ? nlohmann::ordered_json(tri->hidden.size()) : nlohmann::ordered_json(nullptr)},
       {"triangles", tri->triangles.size()},
       {"edges", tri->edges.size()},
-      {"hull_edges", hull_edges},
+      {"hull_edges", HullEdges(*tri)},
       {"backend", BackendName(tri->backend)},
       {"peak_memory_bytes", tri->peak_memory_bytes},
-      {"total_ms", ms(total)},
+      {"total_ms", Milliseconds(total)},
       {"stage_ms", std::move(stages)}};
   std::fputs(JsonLine(json).c_str(), stdout);
   return kExitOk;

@@ -3,7 +3,6 @@
 // CRS), built and shaped on its own, here or, with --server, by the server from one BuildBatch
 // call.
 #include <cstdio>
-#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -18,23 +17,6 @@
 #include "core/io/json_text.hpp"
 
 namespace galpha::alphactl {
-
-namespace {
-
-/// The points of each group, by input index, in the order the groups first appear.
-std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> GroupsOf(
-    const std::vector<std::optional<std::string>>& values) {
-  std::vector<std::pair<std::optional<std::string>, std::vector<uint32_t>>> groups;
-  std::map<std::optional<std::string>, size_t> position;
-  for (uint32_t i = 0; i < values.size(); ++i) {
-    auto [it, added] = position.emplace(values[i], groups.size());
-    if (added) groups.emplace_back(values[i], std::vector<uint32_t>());
-    groups[it->second].second.push_back(i);
-  }
-  return groups;
-}
-
-}  // namespace
 
 int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, const std::string& format,
                     double min_hole_area) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <exception>
 #include <new>
 #include <utility>
@@ -77,7 +78,10 @@ void SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_
   const size_t num_sets = set_begin.size() - 1;
   const detail::DelaunayOutput& all = raw.meshes;
   const size_t num_tri = all.triangles.size();
-  for (size_t s = 0; s < num_sets; ++s) {
+  // The sets are independent: one a thread, the host's cores sharing them out in small chunks.
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int64_t set = 0; set < static_cast<int64_t>(num_sets); ++set) {
+    const auto s = static_cast<size_t>(set);
     Triangulation& t = (*sets)[s];
     const uint32_t begin = set_begin[s], end = set_begin[s + 1];
     t.points.assign(points.begin() + begin, points.begin() + end);
@@ -86,7 +90,7 @@ void SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_
       t.representative[i - begin] = all.representative[i] - begin;
       if (all.representative[i] == i) ++t.num_unique;
     }
-    if (num_tri == 0) continue;
+    if (num_tri == 0) continue;  // no set has a mesh
     const uint32_t tri_begin = raw.set_triangle_begin[s], tri_end = raw.set_triangle_begin[s + 1];
     const size_t edge_begin = tri_begin < num_tri ? all.tri_edge_begin[tri_begin] : all.edges.size();
     const size_t edge_end = tri_end < num_tri ? all.tri_edge_begin[tri_end] : all.edges.size();

@@ -707,6 +707,62 @@ TEST(AlphactlTest, GroupByGivesEachGroupsOwnShape) {
   std::filesystem::remove(file);
 }
 
+// triangulate --group-by: one packed build of all groups, each group's counts those of the
+// group's points triangulated as a file of their own (the oracle), in the order the groups first
+// appear; a group on one line has its chain's edges and no triangles.
+TEST(AlphactlTest, TriangulateGroupByCountsEachGroupAsAlone) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::map<std::string, std::string> alone_csv;
+  std::string features;
+  auto add = [&](const std::string& group, double x, double y) {
+    alone_csv[group] += Printed(x) + "," + Printed(y) + "\n";
+    const std::string properties = group.empty() ? R"({"other":1})" : R"({"kind":")" + group + R"("})";
+    features += (features.empty() ? "" : ",") + std::string(R"({"type":"Feature","properties":)") + properties +
+                R"(,"geometry":{"type":"Point","coordinates":[)" + Printed(x) + "," + Printed(y) + "]}}";
+  };
+  for (int i = 0; i < 300; ++i) {
+    add(i % 3 == 0   ? "field"
+        : i % 3 == 1 ? ""
+                     : "grid",
+        i % 3 == 2 ? (i / 3) % 10 : unit(random), i % 3 == 2 ? (i / 30) : unit(random));
+  }
+  for (int i = 0; i < 7; ++i) add("fence", i * 0.5, 1.0);  // all on one line
+  add("field", 0.5, 0.5);                                  // twice: a duplicate in its group
+  add("field", 0.5, 0.5);
+  const std::string file =
+      WriteFile("alphactl_tri_groups.geojson", R"({"type":"FeatureCollection","features":[)" + features + "]}");
+  const nlohmann::json grouped =
+      nlohmann::json::parse(Succeeds("triangulate", file, "--backend=cpu --crs none --group-by kind"));
+  ASSERT_EQ(grouped["groups"].size(), 4u);
+  EXPECT_EQ(grouped["points"], 309);
+  EXPECT_EQ(grouped["built_alone"], 0);
+  EXPECT_EQ(grouped["backend"], "cpu");
+  const std::vector<std::string> order = {"field", "", "grid", "fence"};
+  for (size_t g = 0; g < order.size(); ++g) {
+    SCOPED_TRACE(order[g]);
+    const nlohmann::json& group = grouped["groups"][g];
+    if (order[g].empty()) {
+      EXPECT_TRUE(group["group"].is_null());
+    } else {
+      EXPECT_EQ(group["group"], order[g]);
+    }
+    const std::string alone = WriteFile("alphactl_tri_group_alone.csv", alone_csv[order[g]]);
+    const nlohmann::json expected = nlohmann::json::parse(Succeeds("triangulate", alone, "--backend=cpu"));
+    for (const char* key : {"points", "distinct_points", "duplicates", "triangles", "edges", "hull_edges"}) {
+      EXPECT_EQ(group[key], expected[key]) << key;
+    }
+    std::filesystem::remove(alone);
+  }
+  EXPECT_EQ(grouped["groups"][3]["triangles"], 0);
+  EXPECT_EQ(grouped["groups"][3]["edges"], 6);
+  ExpectError(Alphactl("triangulate " + Quote(file) + " --group-by kind --weights radius --crs none"), 2,
+              "--group-by triangulates unweighted groups");
+  ExpectError(Alphactl("triangulate " + Quote(file) + " --group-by nope --crs none"), 1,
+              "no feature has a property 'nope'");
+  std::filesystem::remove(file);
+}
+
 TEST(AlphactlTest, ShapesInEveryFormat) {
   const std::string& square = SquareCsv();
   // WKT is the simplest type that holds the shape: one polygon is a POLYGON, in either mode;
