@@ -26,7 +26,7 @@ rm -rf .carry && mkdir -p .carry/bin .carry/lib
 bins=()
 # By name, wherever the build tree puts them (it mirrors the source folders).
 case "$set_name" in
-  engine) names="predicates_test predicates_device_test power_test delaunay_test delaunay_cgal_test regular_test regular_cgal_test triangulation_checks_test
+  engine) names="predicates_test predicates_device_test power_test delaunay_test delaunay_cgal_test regular_test regular_cgal_test triangulation_checks_test triangulate_sets_test
                  radius_test weighted_radius_test alpha_family_cgal_test weighted_family_cgal_test alpha_family_test
                  alpha_bruteforce_test alpha_backend_identity_test
                  persistence_gudhi_test persistence_engine_test resident_family_test shape_test delaunay_bench alpha_bench
