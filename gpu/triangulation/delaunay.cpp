@@ -72,61 +72,90 @@ absl::Status ValidateSetOffsets(absl::Span<const uint32_t> set_begin, size_t n) 
 }
 
 /// Splits the packed build's output (indices of the whole input, each set's triangles one run) into
-/// one triangulation a set (indices of the set), keeping each set's order.
-void SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
+/// one triangulation a set (indices of the set), keeping each set's order. False when the host's
+/// memory ran out (caught in the parallel loop, whose exceptions would otherwise terminate).
+bool SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
                 const detail::DelaunaySetsOutput& raw, std::vector<Triangulation>* sets) {
   const size_t num_sets = set_begin.size() - 1;
   const detail::DelaunayOutput& all = raw.meshes;
   const size_t num_tri = all.triangles.size();
+  int out_of_memory = 0;
   // The sets are independent: one a thread, the host's cores sharing them out in small chunks.
 #pragma omp parallel for schedule(dynamic, 16)
   for (int64_t set = 0; set < static_cast<int64_t>(num_sets); ++set) {
     const auto s = static_cast<size_t>(set);
     Triangulation& t = (*sets)[s];
     const uint32_t begin = set_begin[s], end = set_begin[s + 1];
-    t.points.assign(points.begin() + begin, points.begin() + end);
-    t.representative.resize(end - begin);
-    for (uint32_t i = begin; i < end; ++i) {
-      t.representative[i - begin] = all.representative[i] - begin;
-      if (all.representative[i] == i) ++t.num_unique;
-    }
-    if (num_tri == 0) continue;  // no set has a mesh
-    const uint32_t tri_begin = raw.set_triangle_begin[s], tri_end = raw.set_triangle_begin[s + 1];
-    const size_t edge_begin = tri_begin < num_tri ? all.tri_edge_begin[tri_begin] : all.edges.size();
-    const size_t edge_end = tri_end < num_tri ? all.tri_edge_begin[tri_end] : all.edges.size();
-    t.triangles.resize(tri_end - tri_begin);
-    t.neighbors.resize(tri_end - tri_begin);
-    t.tri_edge_begin.resize(tri_end - tri_begin);
-    for (uint32_t g = tri_begin; g < tri_end; ++g) {
-      const std::array<uint32_t, 3>& x = all.triangles[g];
-      t.triangles[g - tri_begin] = {x[0] - begin, x[1] - begin, x[2] - begin};
-      std::array<int32_t, 3> n = all.neighbors[g];
-      for (int32_t& k : n) k = k < 0 ? Triangulation::kNoNeighbor : k - static_cast<int32_t>(tri_begin);
-      t.neighbors[g - tri_begin] = n;
-      t.tri_edge_begin[g - tri_begin] = static_cast<uint32_t>(all.tri_edge_begin[g] - edge_begin);
-    }
-    t.edges.resize(edge_end - edge_begin);
-    for (size_t e = edge_begin; e < edge_end; ++e) {
-      t.edges[e - edge_begin] = {all.edges[e][0] - begin, all.edges[e][1] - begin};
+    try {
+      t.points.assign(points.begin() + begin, points.begin() + end);
+      t.representative.resize(end - begin);
+      for (uint32_t i = begin; i < end; ++i) {
+        t.representative[i - begin] = all.representative[i] - begin;
+        if (all.representative[i] == i) ++t.num_unique;
+      }
+      if (num_tri == 0) continue;  // no set has a mesh
+      const uint32_t tri_begin = raw.set_triangle_begin[s], tri_end = raw.set_triangle_begin[s + 1];
+      const size_t edge_begin = tri_begin < num_tri ? all.tri_edge_begin[tri_begin] : all.edges.size();
+      const size_t edge_end = tri_end < num_tri ? all.tri_edge_begin[tri_end] : all.edges.size();
+      t.triangles.resize(tri_end - tri_begin);
+      t.neighbors.resize(tri_end - tri_begin);
+      t.tri_edge_begin.resize(tri_end - tri_begin);
+      for (uint32_t g = tri_begin; g < tri_end; ++g) {
+        const std::array<uint32_t, 3>& x = all.triangles[g];
+        t.triangles[g - tri_begin] = {x[0] - begin, x[1] - begin, x[2] - begin};
+        std::array<int32_t, 3> n = all.neighbors[g];
+        for (int32_t& k : n) k = k < 0 ? Triangulation::kNoNeighbor : k - static_cast<int32_t>(tri_begin);
+        t.neighbors[g - tri_begin] = n;
+        t.tri_edge_begin[g - tri_begin] = static_cast<uint32_t>(all.tri_edge_begin[g] - edge_begin);
+      }
+      t.edges.resize(edge_end - edge_begin);
+      for (size_t e = edge_begin; e < edge_end; ++e) {
+        t.edges[e - edge_begin] = {all.edges[e][0] - begin, all.edges[e][1] - begin};
+      }
+    } catch (const std::bad_alloc&) {
+#pragma omp atomic write
+      out_of_memory = 1;
     }
   }
+  if (out_of_memory != 0) return false;
   // The chains of the sets on one line, set after set.
-  size_t s = 0;
-  for (const std::array<uint32_t, 2>& e : raw.chain_edges) {
-    while (e[0] >= set_begin[s + 1]) ++s;
-    (*sets)[s].edges.push_back({e[0] - set_begin[s], e[1] - set_begin[s]});
+  try {
+    size_t s = 0;
+    for (const std::array<uint32_t, 2>& e : raw.chain_edges) {
+      while (e[0] >= set_begin[s + 1]) ++s;
+      (*sets)[s].edges.push_back({e[0] - set_begin[s], e[1] - set_begin[s]});
+    }
+  } catch (const std::bad_alloc&) {
+    return false;
   }
+  return true;
 }
 
 }  // namespace
 
 absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
                                                  const TriangulateOptions& options) {
+  // The packed build numbers all the points together: its limit is one build's.
+  if (points.size() > kMaxPoints) {
+    return absl::ResourceExhaustedError(absl::StrCat("too many points: ", points.size(),
+                                                     " in all the sets exceeds the limit of ", kMaxPoints,
+                                                     " of one build (32-bit triangle indices)"));
+  }
   GALPHA_RETURN_IF_ERROR(ValidateSetOffsets(set_begin, points.size()));
   const size_t num_sets = set_begin.size() - 1;
-  for (size_t s = 0; s < num_sets; ++s) {
-    const absl::Status valid = ValidatePoints(points.subspan(set_begin[s], set_begin[s + 1] - set_begin[s]));
-    if (!valid.ok()) return absl::Status(valid.code(), absl::StrCat("set ", s, ": ", valid.message()));
+  {
+    // Each set is validated as Triangulate validates it (its own input domain), the sets shared
+    // out over the host's cores (ValidatePoints' own parallel pass then runs on one thread), and
+    // the first set in order that fails names the error.
+    std::vector<absl::Status> valid(num_sets);
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int64_t set = 0; set < static_cast<int64_t>(num_sets); ++set) {
+      const auto s = static_cast<size_t>(set);
+      valid[s] = ValidatePoints(points.subspan(set_begin[s], set_begin[s + 1] - set_begin[s]));
+    }
+    for (size_t s = 0; s < num_sets; ++s) {
+      if (!valid[s].ok()) return absl::Status(valid[s].code(), absl::StrCat("set ", s, ": ", valid[s].message()));
+    }
   }
   GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
   TriangulatedSets result;
@@ -144,7 +173,10 @@ absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points
       detail::TriangulateSetsOnCpu(points.data(), set_begin.data(), static_cast<uint32_t>(num_sets), n, &raw);
     }
   }));
-  SplitBySet(points, set_begin, raw, &result.sets);
+  if (!SplitBySet(points, set_begin, raw, &result.sets)) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("out of host memory splitting the triangulations of ", num_sets, " sets of ", n, " points"));
+  }
   result.stage_times = std::move(raw.meshes.stage_times);
   result.peak_memory_bytes = raw.meshes.peak_memory_bytes;
   TriangulateOptions alone = options;

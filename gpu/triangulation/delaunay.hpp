@@ -113,9 +113,10 @@ struct TriangulatedSets {
 /// sets are packed into one mesh's arrays and built by the same launches (not one build a set):
 /// thousands of small sets take about what one build of all their points takes.
 ///
-/// Errors: Triangulate's, naming the set and its index for a NaN or infinite coordinate, and
-/// InvalidArgument for offsets that do not run from 0 to points.size() without decreasing, or more
-/// than kMaxTriangulatedSets sets.
+/// Errors: Triangulate's for each set, its message prefixed by the set ("set 2: point 2 is not
+/// finite..."; the point's index is the set's own); ResourceExhausted for more than 2^30 points in
+/// all (one build's limit); InvalidArgument for offsets that do not run from 0 to points.size()
+/// without decreasing, or more than kMaxTriangulatedSets sets.
 absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
                                                  const TriangulateOptions& options = {});
 

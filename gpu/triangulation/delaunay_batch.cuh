@@ -6,7 +6,9 @@
 // same order, the same neighbours and edges): the sets are sorted apart at every step (by set, then
 // as one set is), so every set's vertex ids, pending points and triangle slots keep the relative
 // order they have alone; the mesh's kernels only follow a triangle's own links, which never leave
-// its set, and decide ties by those orders (votes by smallest index, flips by smallest triangle);
+// its set, and decide ties by those orders (votes by smallest index, flips by smallest triangle; a
+// relocation walk's first edge depends on the point's id, which changes its path but not the one
+// triangle it ends in);
 // what a build decides for all its points between rounds, each set decides for itself
 // (SetRoundState, DecideSetRounds); each set starts from its own first triangle, and its walks
 // outside the hull turn around that triangle's centre (MeshView::set_center). Two global choices

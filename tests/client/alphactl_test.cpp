@@ -760,6 +760,15 @@ TEST(AlphactlTest, TriangulateGroupByCountsEachGroupAsAlone) {
               "--group-by triangulates unweighted groups");
   ExpectError(Alphactl("triangulate " + Quote(file) + " --group-by nope --crs none"), 1,
               "no feature has a property 'nope'");
+  // A group outside the input domain is named by its value (the point's index is the group's own).
+  const std::string huge = WriteFile(
+      "alphactl_tri_groups_huge.geojson",
+      R"({"type":"FeatureCollection","features":[)"
+      R"({"type":"Feature","properties":{"kind":"a"},"geometry":{"type":"Point","coordinates":[0,0]}},)"
+      R"({"type":"Feature","properties":{"kind":"b"},"geometry":{"type":"Point","coordinates":[1e200,0]}}]})");
+  ExpectError(Alphactl("triangulate " + Quote(huge) + " --group-by kind --crs none"), 1,
+              "group 'b': point 0 (1e+200, 0) has a coordinate of magnitude 2^500");
+  std::filesystem::remove(huge);
   std::filesystem::remove(file);
 }
 

@@ -96,6 +96,30 @@ TEST_P(TriangulateSetsTest, DegenerateSetsEqualTheirSetAlone) {
   ExpectEqualToEachAlone(sets);
 }
 
+TEST_P(TriangulateSetsTest, SetsWithoutAMeshEqualTheirSetAlone) {
+  // No set has a mesh (every one on a line, or of at most two distinct points): the packed build
+  // writes chains only.
+  SetsToPack sets;
+  std::vector<Point2> vertical, repeated_pair;
+  for (int i = 0; i < 30; ++i) vertical.push_back({-2.0, 0.125 * (i % 17) + i});
+  for (int i = 0; i < 9; ++i) repeated_pair.push_back(i % 2 == 0 ? Point2{1.0, 1.0} : Point2{3.0, -5.0});
+  sets.Add("vertical line", vertical);
+  sets.Add("empty", {});
+  sets.Add("two points, repeated", repeated_pair);
+  sets.Add("one point", {Point2{0.5, 0.5}});
+  ExpectEqualToEachAlone(sets);
+}
+
+TEST_P(TriangulateSetsTest, SetsOfThreePointsEqualTheirSetAlone) {
+  // Every set is its first triangle: nothing is left to insert in any set.
+  SetsToPack sets;
+  for (int s = 0; s < 50; ++s) {
+    const double d = 1.0 + s;
+    sets.Add("triangle " + std::to_string(s), {Point2{0.0, 0.0}, Point2{d, s % 2 == 0 ? 0.0 : 1.0}, Point2{0.0, d}});
+  }
+  ExpectEqualToEachAlone(sets);
+}
+
 TEST_P(TriangulateSetsTest, SetsOfVeryDifferentMagnitudesEachScaleAsAlone) {
   // Each set's power of two (the floating filters' scaling) is its own: a set of tiny coordinates
   // beside one offset by 1e15 and one of ordinary ones.
@@ -152,8 +176,11 @@ TEST_P(TriangulateSetsTest, BadOffsetsAndPointsAreRefusedByName) {
   const absl::Status nan = TriangulateSets(with_nan, std::vector<uint32_t>{0, 3, 5, 10}, Options()).status();
   EXPECT_EQ(nan.code(), absl::StatusCode::kInvalidArgument);
   // The set, then ValidatePoints' message for the set's own index of the point (7 - 5 = 2).
-  EXPECT_EQ(std::string(nan.message()).rfind("set 2: ", 0), 0u) << nan.message();
-  EXPECT_NE(std::string(nan.message()).find('2', 7), std::string::npos) << nan.message();
+  EXPECT_EQ(std::string(nan.message()).rfind("set 2: point 2 is not finite", 0), 0u) << nan.message();
+  // More sets than the Hilbert keys can keep apart (all of them empty).
+  const std::vector<uint32_t> too_many(size_t{kMaxTriangulatedSets} + 2, 0);
+  EXPECT_THAT(TriangulateSets({}, too_many, Options()).status(),
+              StatusIs(absl::StatusCode::kInvalidArgument, "4194305 sets: at most 4194304 in one call"));
 }
 
 GALPHA_INSTANTIATE_BACKEND_TEST_SUITE(TriangulateSetsTest);
