@@ -417,21 +417,10 @@ void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t
     if (result.tri.size() > 0) OutputEdges(sys, &result);
     timer.EndStage("output");
   }
-  DelaunayOutput& meshes = out->meshes;
-  meshes.num_unique = result.num_unique;
-  meshes.triangles.resize(result.tri.size());
-  meshes.neighbors.resize(result.nbr.size());
-  meshes.tri_edge_begin.resize(result.edge_begin.size());
-  meshes.edges.resize(result.edges.size());
-  meshes.representative.resize(n);
-  sys.Download({{meshes.triangles.data(), result.tri.data(), result.tri.size() * sizeof(Tri)},
-                {meshes.neighbors.data(), result.nbr.data(), result.nbr.size() * sizeof(TriNbr)},
-                {meshes.tri_edge_begin.data(), result.edge_begin.data(), result.edge_begin.size() * sizeof(uint32_t)},
-                {meshes.edges.data(), result.edges.data(), result.edges.size() * sizeof(EdgePair)},
-                {meshes.representative.data(), result.representative.data(), size_t{n} * sizeof(uint32_t)}});
+  DownloadTriangulation(sys, result, n, &out->meshes);
   timer.EndStage("download");
   timer.Finish();
-  meshes.peak_memory_bytes = sys.peak_bytes();
+  out->meshes.peak_memory_bytes = sys.peak_bytes();
 }
 
 }  // namespace galpha::detail

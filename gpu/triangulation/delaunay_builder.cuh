@@ -98,35 +98,39 @@ struct MeshSets {
   uint32_t num_sets = 0;                 // sets numbered below it (vertex_set's values)
 };
 
-/// The first four triangles of a set's mesh, in slots 4j to 4j + 3 for the j-th set with a mesh
-/// (`mesh_set[j]`): its first triangle (a, b, c) and the three infinite ones, as
-/// DelaunayBuilder::Start lays out a build's.
+/// A mesh's first four triangles, in slots base to base + 3 of `tri` and `nbr`: the first triangle
+/// (a, b, c), counter-clockwise, and the three infinite triangles on its edges, linked.
+GALPHA_HD inline void WriteFirstTriangles(int32_t a, int32_t b, int32_t c, int32_t inf, int32_t base, Tri* tri,
+                                          TriNbr* nbr) {
+  const Tri init[4] = {{{a, b, c}}, {{b, a, inf}}, {{c, b, inf}}, {{a, c, inf}}};
+  for (int t = 0; t < 4; ++t) {
+    TriNbr links{};
+    for (int k = 0; k < 3; ++k) {
+      const int32_t p = init[t].v[Next(k)], q = init[t].v[Prev(k)];
+      for (int u = 0; u < 4; ++u) {
+        for (int i = 0; i < 3; ++i) {
+          if (u != t && init[u].v[Next(i)] == q && init[u].v[Prev(i)] == p) links.n[k] = base + u;
+        }
+      }
+    }
+    tri[base + t] = init[t];
+    nbr[base + t] = links;
+  }
+}
+
+/// The first four triangles of a set's mesh (WriteFirstTriangles), in slots 4j to 4j + 3 for the
+/// j-th set with a mesh (`mesh_set[j]`), from its first triangle (MeshView::set_center).
 struct StartSetMesh {
   MeshView mesh;
   const uint32_t* mesh_set;
   GALPHA_HD void operator()(uint32_t j) const {
     const int32_t* center = mesh.set_center + 3 * static_cast<size_t>(mesh_set[j]);
-    const int32_t a = center[0], b = center[1], c = center[2], inf = mesh.inf;
-    const Tri init[4] = {{{a, b, c}}, {{b, a, inf}}, {{c, b, inf}}, {{a, c, inf}}};
-    const int32_t base = 4 * static_cast<int32_t>(j);
-    for (int t = 0; t < 4; ++t) {
-      TriNbr links{};
-      for (int k = 0; k < 3; ++k) {
-        const int32_t p = init[t].v[Next(k)], q = init[t].v[Prev(k)];
-        for (int u = 0; u < 4; ++u) {
-          for (int i = 0; i < 3; ++i) {
-            if (u != t && init[u].v[Next(i)] == q && init[u].v[Prev(i)] == p) links.n[k] = base + u;
-          }
-        }
-      }
-      mesh.tri[base + t] = init[t];
-      mesh.nbr[base + t] = links;
-    }
+    WriteFirstTriangles(center[0], center[1], center[2], mesh.inf, 4 * static_cast<int32_t>(j), mesh.tri, mesh.nbr);
   }
 };
 
 /// Marks the sets that hold a flat finite triangle (a packed build leaves them to builds of their
-/// own: the hull repair's choice between parallel and serial rounds is global).
+/// own: the hull repair chooses parallel or serial rounds, and the device or the host, globally).
 struct MarkSetOfFlatTriangle {
   MeshView mesh;
   uint8_t* set_has_flat;
@@ -210,19 +214,9 @@ class DelaunayBuilder {
 
   /// Starts from the triangle (a, b, c), counter-clockwise, and its three infinite neighbours.
   void Start(int32_t a, int32_t b, int32_t c) {
-    const int32_t inf = mesh_.inf;
-    const Tri init[4] = {{{a, b, c}}, {{b, a, inf}}, {{c, b, inf}}, {{a, c, inf}}};
+    Tri init[4];
     TriNbr links[4];
-    for (int t = 0; t < 4; ++t) {
-      for (int k = 0; k < 3; ++k) {
-        const int32_t p = init[t].v[Next(k)], q = init[t].v[Prev(k)];
-        for (int u = 0; u < 4; ++u) {
-          for (int j = 0; j < 3; ++j) {
-            if (u != t && init[u].v[Next(j)] == q && init[u].v[Prev(j)] == p) links[t].n[k] = u;
-          }
-        }
-      }
-    }
+    WriteFirstTriangles(a, b, c, mesh_.inf, 0, init, links);
     sys_.FromHost(tri_.data(), init, 4);
     sys_.FromHost(nbr_.data(), links, 4);
     num_tri_ = 4;

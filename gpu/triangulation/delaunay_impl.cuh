@@ -644,12 +644,10 @@ SystemTriangulation<System> TriangulateOnSystem(System& sys, const Point2* host_
   return result;
 }
 
-/// Runs the whole triangulation of `n` host points on `sys` and downloads it into `out`.
+/// The triangulation of `n` input points into `out`'s host vectors: its distinct count, triangles,
+/// neighbours, edges and every input index's representative (not the hidden points).
 template <class System>
-void RunTriangulation(System& sys, const Point2* host_points, const double* host_weights, uint32_t n,
-                      DelaunayOutput* out) {
-  StageTimer<System> timer(sys, &out->stage_times);
-  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, host_weights, n, /*keep_points=*/false, timer);
+void DownloadTriangulation(System& sys, const SystemTriangulation<System>& t, uint32_t n, DelaunayOutput* out) {
   out->num_unique = t.num_unique;
   out->triangles.resize(t.tri.size());
   out->neighbors.resize(t.nbr.size());
@@ -661,6 +659,15 @@ void RunTriangulation(System& sys, const Point2* host_points, const double* host
                 {out->tri_edge_begin.data(), t.edge_begin.data(), t.edge_begin.size() * sizeof(uint32_t)},
                 {out->edges.data(), t.edges.data(), t.edges.size() * sizeof(EdgePair)},
                 {out->representative.data(), t.representative.data(), size_t{n} * sizeof(uint32_t)}});
+}
+
+/// Runs the whole triangulation of `n` host points on `sys` and downloads it into `out`.
+template <class System>
+void RunTriangulation(System& sys, const Point2* host_points, const double* host_weights, uint32_t n,
+                      DelaunayOutput* out) {
+  StageTimer<System> timer(sys, &out->stage_times);
+  SystemTriangulation<System> t = TriangulateOnSystem(sys, host_points, host_weights, n, /*keep_points=*/false, timer);
+  DownloadTriangulation(sys, t, n, out);
   if (host_weights != nullptr) {
     const std::vector<uint8_t> hidden = t.hidden.ToHostVector(n);
     for (uint32_t i = 0; i < n; ++i) {
