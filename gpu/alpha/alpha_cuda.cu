@@ -19,14 +19,7 @@ void BuildFamilyOnCuda(const Point2* points, const double* weights, uint32_t n, 
     out->resident = std::move(resident);
     return;
   }
-  if (stream != nullptr) {
-    CudaSystem system(static_cast<cudaStream_t>(stream));
-    RunFamilyBuild(system, points, weights, n, hooks, out);
-    return;
-  }
-  OwnedStream owned;
-  CudaSystem system(owned.get());
-  RunFamilyBuild(system, points, weights, n, hooks, out);
+  RunOnCudaStream(stream, [&](CudaSystem& system) { RunFamilyBuild(system, points, weights, n, hooks, out); });
 }
 
 }  // namespace galpha::detail

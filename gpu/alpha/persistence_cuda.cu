@@ -8,14 +8,9 @@
 namespace galpha::detail {
 
 void PersistenceOnCuda(const PersistenceIn& host, bool host_finish, void* stream, PersistenceOut* out) {
-  if (stream != nullptr) {
-    CudaSystem system(static_cast<cudaStream_t>(stream));
+  RunOnCudaStream(stream, [&](CudaSystem& system) {
     PersistenceDiagramUploading(system, host, /*upload_tables=*/true, host_finish, out);
-    return;
-  }
-  OwnedStream owned;
-  CudaSystem system(owned.get());
-  PersistenceDiagramUploading(system, host, /*upload_tables=*/true, host_finish, out);
+  });
 }
 
 void PersistenceOnCudaWithTables(const PersistenceIn& in, bool host_finish, void* stream, PersistenceOut* out) {

@@ -390,4 +390,18 @@ class OwnedStream {
   cudaStream_t stream_ = nullptr;
 };
 
+/// Calls run(system) with a CudaSystem on `stream` (a cudaStream_t), or on a stream of its own
+/// when `stream` is null: how every CUDA entry point of the engine starts.
+template <class F>
+void RunOnCudaStream(void* stream, F&& run) {
+  if (stream != nullptr) {
+    CudaSystem system(static_cast<cudaStream_t>(stream));
+    run(system);
+    return;
+  }
+  OwnedStream owned;
+  CudaSystem system(owned.get());  // destroyed before its stream
+  run(system);
+}
+
 }  // namespace galpha::detail

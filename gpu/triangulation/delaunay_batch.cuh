@@ -58,13 +58,6 @@ struct MarkSetOffLine {
   }
 };
 
-/// The set of an input index, of a distinct point (sorted position) or of a vertex.
-struct SetOfIndex {
-  const uint32_t* input_set;
-  const uint32_t* input_index;
-  GALPHA_HD uint32_t operator()(uint32_t k) const { return input_set[input_index[k]]; }
-};
-
 /// Sorted position k of a set on one line starts an edge of its chain (WriteCollinearChain's).
 struct StartsChainEdge {
   const uint32_t* unique_set;
@@ -195,7 +188,7 @@ struct IsSetExtremeVertex {
 struct TriangleSet {
   const uint32_t* input_set;
   const Tri* tri;
-  GALPHA_HD uint64_t operator()(uint32_t t) const { return input_set[tri[t].v[0]]; }
+  GALPHA_HD uint32_t operator()(uint32_t t) const { return input_set[tri[t].v[0]]; }
 };
 
 /// new_position[order[k]] = k.
@@ -234,7 +227,7 @@ void GroupTrianglesBySet(System& sys, const uint32_t* input_set, uint32_t num_se
   const auto num_tri = static_cast<uint32_t>(result->tri.size());
   Buffer<uint32_t, System> order(sys, num_tri);
   {
-    Buffer<uint64_t, System> keys(sys, num_tri);
+    Buffer<uint32_t, System> keys(sys, num_tri);
     thrust::transform(pol, first, first + num_tri, keys.begin(), TriangleSet{input_set, result->tri.data()});
     thrust::sequence(pol, order.begin(), order.end());
     thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), order.begin());

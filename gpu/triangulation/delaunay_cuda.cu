@@ -9,26 +9,13 @@
 namespace galpha::detail {
 
 void TriangulateOnCuda(const Point2* points, const double* weights, uint32_t n, void* stream, DelaunayOutput* out) {
-  if (stream != nullptr) {
-    CudaSystem system(static_cast<cudaStream_t>(stream));
-    RunTriangulation(system, points, weights, n, out);
-    return;
-  }
-  OwnedStream owned;
-  CudaSystem system(owned.get());
-  RunTriangulation(system, points, weights, n, out);
+  RunOnCudaStream(stream, [&](CudaSystem& system) { RunTriangulation(system, points, weights, n, out); });
 }
 
 void TriangulateSetsOnCuda(const Point2* points, const uint32_t* set_begin, uint32_t num_sets, uint32_t n, void* stream,
                            DelaunaySetsOutput* out) {
-  if (stream != nullptr) {
-    CudaSystem system(static_cast<cudaStream_t>(stream));
-    RunSetsTriangulation(system, points, set_begin, num_sets, n, out);
-    return;
-  }
-  OwnedStream owned;
-  CudaSystem system(owned.get());
-  RunSetsTriangulation(system, points, set_begin, num_sets, n, out);
+  RunOnCudaStream(stream,
+                  [&](CudaSystem& system) { RunSetsTriangulation(system, points, set_begin, num_sets, n, out); });
 }
 
 }  // namespace galpha::detail

@@ -176,8 +176,10 @@ DistinctPoints<System> FindDistinctPoints(System& sys, const Buffer<Point2, Syst
         thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
       }
       if (input_set != nullptr) {
-        thrust::transform(pol, first, first + n, keys.begin(), InputSetKey{input_set, sorted.data()});
-        thrust::stable_sort_by_key(pol, keys.begin(), keys.end(), sorted.begin());
+        // 32-bit keys: half the radix passes of the coordinates' 64.
+        Buffer<uint32_t, System> set_keys(sys, n);
+        thrust::transform(pol, first, first + n, set_keys.begin(), SetOfIndex{input_set, sorted.data()});
+        thrust::stable_sort_by_key(pol, set_keys.begin(), set_keys.end(), sorted.begin());
       }
     }
     if (weights != nullptr) {

@@ -47,11 +47,12 @@ struct RunHeadPosition {
   }
 };
 
-/// The set of the input point a permutation entry names, as a sort key (packed builds).
-struct InputSetKey {
+/// A packed build's set of the input index at position k of a permutation (or of a list of input
+/// indices: distinct points, vertices).
+struct SetOfIndex {
   const uint32_t* input_set;
-  const uint32_t* order;
-  GALPHA_HD uint64_t operator()(uint32_t k) const { return input_set[order[k]]; }
+  const uint32_t* input_index;
+  GALPHA_HD uint32_t operator()(uint32_t k) const { return input_set[input_index[k]]; }
 };
 
 /// representative[input index] = input index of the run's head.
