@@ -424,11 +424,14 @@ struct ToU32 {
   GALPHA_HD uint32_t operator()(uint8_t v) const { return v; }
 };
 
-/// Scatters each sorted entry's rank to its simplex and records one simplex per rank.
+/// Scatters each sorted entry's rank to its simplex and records the smallest simplex id of every
+/// rank (`spectrum_simplex` filled with ~0u first). The smallest, not the first in the exact order:
+/// the order of exactly tied entries depends on the path that repaired their run, and a packed
+/// build of many sets (several sets' entries in one run) must name the simplex its set's build
+/// alone names.
 struct ScatterRanks {
   const uint32_t* ids;
   const uint32_t* rank;  // inclusive scan of new_value: 1..K
-  const uint8_t* new_value;
   uint32_t num_tri;
   uint32_t* tri_rank;
   uint32_t* edge_rho_rank;
@@ -440,7 +443,7 @@ struct ScatterRanks {
     } else {
       edge_rho_rank[id - num_tri] = rank[i];
     }
-    if (new_value[i]) spectrum_simplex[rank[i] - 1] = id;
+    AtomicMinU32WarpCombined(&spectrum_simplex[rank[i] - 1], id);
   }
 };
 

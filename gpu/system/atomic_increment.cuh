@@ -1,4 +1,5 @@
-// A counter increment shared by the triangulation's and the alpha pipeline's functors.
+// Atomic updates shared by the triangulation's and the alpha pipeline's functors: a counter
+// increment, a 64-bit add and a minimum.
 #pragma once
 
 #include <cstdint>
@@ -35,6 +36,24 @@ GALPHA_HD inline void AtomicAddU64(unsigned long long* p, unsigned long long v) 
   atomicAdd(p, v);
 #else
   __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
+/// *p = min(*p, v), atomically, for words that many threads update at once. On the device the
+/// threads of a warp that update the same word take their minimum first (one atomic per distinct
+/// word and warp; alpha_functors.cuh's AtomicMinU32 is the plain one): a grid's exactly tied radii
+/// give millions of entries one rank, and each offers its simplex as the rank's (ScatterRanks).
+GALPHA_HD inline void AtomicMinU32WarpCombined(uint32_t* p, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  const unsigned active = __activemask();
+  const unsigned peers = __match_any_sync(active, reinterpret_cast<unsigned long long>(p));
+  unsigned lane;
+  asm("mov.u32 %0, %%laneid;" : "=r"(lane));
+  const unsigned smallest = __reduce_min_sync(peers, v);
+  if (static_cast<int>(lane) == __ffs(peers) - 1) atomicMin(p, smallest);
+#else
+  uint32_t old = __atomic_load_n(p, __ATOMIC_RELAXED);
+  while (v < old && !__atomic_compare_exchange_n(p, &old, v, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {}
 #endif
 }
 
