@@ -7,7 +7,7 @@
 //
 //   alpha_bench [--backend=auto|cpu|cuda] [--repeat=3] [--sizes=100000,1000000]
 //               [--dists=NAME,...(default: every generator)] [--seed=1] [--cgal-max=1000000]
-//               [--data FILE.bin]... [--weights=KIND]
+//               [--data FILE.bin]... [--weights=KIND] [--sets=SETSxPOINTS]
 //
 // With --weights (a kind of tests/support/weight_generators.hpp: uniform, signed, one_huge, ...),
 // every input gets those weights and both sides build the weighted family: galpha's
@@ -15,6 +15,13 @@
 // constructions). The same inputs are also built unweighted by galpha, and the hardness table
 // prints the weighted pipeline over the unweighted one. CGAL's spectrum keeps only the values > 0:
 // the spectrum check compares galpha's positive values with it.
+//
+// With --sets=SETSxPOINTS (e.g. 10000x1000), the families of many sets in one packed build instead
+// (issue 20): for each distribution, SETS sets of POINTS points (seeds seed, seed + 1, ...) in one
+// BuildAlphaFamilies call, against one BuildAlphaFamily of SETS * POINTS points of the distribution
+// (the issue's reference: at most 10x its time), one BuildAlphaFamily call a set and CGAL's
+// Alpha_shape_2 a set (both timed over the first 200 sets and scaled to SETS). The sampled sets'
+// packed families are checked against their own builds (every rank table).
 //
 // Memory: the peak resident set of the process during the call minus the resident set before it
 // (Linux: VmHWM reset through /proc/self/clear_refs), so it counts everything the call allocates on
@@ -70,7 +77,8 @@ using CgalWeightedAlphaShape = CGAL::Alpha_shape_2<CGAL::Regular_triangulation_2
 
 constexpr char kUsage[] =
     "usage: alpha_bench [--backend=auto|cpu|cuda] [--repeat=N] [--sizes=N,N,...] [--dists=NAME,...]\n"
-    "                   [--seed=N] [--cgal-max=N] [--data FILE.bin]... [--weights=KIND]\n";
+    "                   [--seed=N] [--cgal-max=N] [--data FILE.bin]... [--weights=KIND]\n"
+    "                   [--sets=SETSxPOINTS]\n";
 
 double MillisecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -338,6 +346,98 @@ void PrintHardness(const std::vector<BenchResult>& results) {
   }
 }
 
+template <class V>
+bool SameVector(const V& a, const V& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin());
+}
+
+/// Whether two families of one set have the same rank tables (the packed build's check; the full
+/// field-by-field check is packed_families_test's).
+bool SameRankTables(const AlphaFamily& a, const AlphaFamily& b) {
+  const AlphaRanks& x = a.ranks();
+  const AlphaRanks& y = b.ranks();
+  bool same = SameVector(x.spectrum, y.spectrum) && SameVector(x.spectrum_simplex, y.spectrum_simplex) &&
+              SameVector(x.tri_rank, y.tri_rank) && SameVector(x.edge_rho_rank, y.edge_rho_rank) &&
+              SameVector(x.edge_mu_low, y.edge_mu_low) && SameVector(x.edge_mu_high, y.edge_mu_high) &&
+              SameVector(x.vertex_mu_low, y.vertex_mu_low) && SameVector(x.vertex_tri_low, y.vertex_tri_low) &&
+              SameVector(x.master_begin, y.master_begin) && SameVector(x.components, y.components) &&
+              SameVector(x.holes, y.holes) && SameVector(x.area_units, y.area_units);
+  for (size_t i = 0; same && i < x.master.size(); ++i) same = x.master[i].packed() == y.master[i].packed();
+  return same && x.master.size() == y.master.size();
+}
+
+/// --sets: one distribution's packed families against their references (see the file comment).
+/// Returns false on an engine error or a sampled set unlike its own build.
+bool RunPackedFamilies(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options) {
+  constexpr size_t kSampledSets = 200;
+  const gen::NamedGenerator* generator = gen::FindDistribution(name);
+  std::vector<Point2> points;
+  std::vector<uint32_t> set_begin;
+  GenerateBenchSets(*generator, num_sets, points_per_set, options.seed, &points, &set_begin);
+  BuildOptions build_options;
+  build_options.backend = options.backend;
+  double packed_ms = std::numeric_limits<double>::infinity(), whole_ms = packed_ms;
+  absl::StatusOr<AlphaFamilies> packed = absl::UnknownError("not run");
+  for (int r = 0; r < options.repeat; ++r) {
+    packed = absl::UnknownError("not run");  // the last run's families are freed outside the timing
+    const auto start = std::chrono::steady_clock::now();
+    packed = BuildAlphaFamilies(points, set_begin, build_options);
+    if (!packed.ok()) break;
+    packed_ms = std::min(packed_ms, MillisecondsSince(start));
+  }
+  if (!packed.ok()) {
+    std::printf("| %s | %zux%zu | error: %s | | | | | | | |\n", name.c_str(), num_sets, points_per_set,
+                packed.status().ToString().c_str());
+    return false;
+  }
+  {
+    const std::vector<Point2> whole = generator->generate(num_sets * points_per_set, options.seed);
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      if (!BuildAlphaFamily(whole, build_options).ok()) return false;
+      whole_ms = std::min(whole_ms, MillisecondsSince(start));
+    }
+  }
+  const size_t sampled = std::min(num_sets, kSampledSets);
+  bool equal = true;
+  double alone_ms = 0, cgal_ms = 0;
+  for (size_t s = 0; s < sampled; ++s) {
+    const absl::Span<const Point2> set(points.data() + set_begin[s], set_begin[s + 1] - set_begin[s]);
+    double best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      absl::StatusOr<AlphaFamily> alone = BuildAlphaFamily(set, build_options);
+      best = std::min(best, MillisecondsSince(start));
+      if (!alone.ok()) return false;
+      equal &= SameRankTables(packed->families[s], *alone);
+    }
+    alone_ms += best;
+    std::vector<Kernel::Point_2> cgal_points;
+    for (const Point2& p : set) cgal_points.emplace_back(p.x, p.y);
+    const auto start = std::chrono::steady_clock::now();
+    const CgalAlphaShape shape(cgal_points.begin(), cgal_points.end(), Kernel::FT(0), CgalAlphaShape::GENERAL);
+    cgal_ms += MillisecondsSince(start);
+  }
+  const double scale = static_cast<double>(num_sets) / static_cast<double>(sampled);
+  alone_ms *= scale;
+  cgal_ms *= scale;
+  std::printf(
+      "| %s | %zux%zu | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.1f | %.1f | %s |\n", name.c_str(), num_sets,
+      points_per_set, packed->report.backend.c_str(), packed_ms, whole_ms, packed_ms / whole_ms, alone_ms,
+      alone_ms / packed_ms, cgal_ms, cgal_ms / packed_ms,
+      equal ? (packed->built_alone == 0 ? "yes" : absl::StrCat("yes (", packed->built_alone, " built alone)").c_str())
+            : "NO: MISMATCH");
+  std::string stages;
+  for (const StageTime& stage : packed->report.stage_times) {
+    char ms[64];
+    std::snprintf(ms, sizeof ms, "%s%s %.2f", stages.empty() ? "" : ", ", stage.stage.c_str(), stage.seconds * 1e3);
+    stages += ms;
+  }
+  std::printf("|  | stages (ms) | %s |||||||||\n", stages.c_str());
+  std::fflush(stdout);
+  return equal;
+}
+
 int Main(int argc, char** argv) {
   // --weights is this benchmark's own; the shared parser gets the rest.
   std::string weight_kind;
@@ -346,6 +446,18 @@ int Main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n%s", std::string(taken.message()).c_str(), kUsage);
     return 2;
   }
+  size_t num_sets = 0, points_per_set = 0;
+  std::vector<char*> rest;
+  if (const absl::Status taken =
+          TakeSetsOption(static_cast<int>(args.size()), args.data(), &num_sets, &points_per_set, &rest);
+      !taken.ok() || (num_sets > 0 && !weight_kind.empty())) {
+    std::fprintf(
+        stderr, "%s\n%s",
+        taken.ok() ? "--sets builds unweighted families: drop --weights" : std::string(taken.message()).c_str(),
+        kUsage);
+    return 2;
+  }
+  args = std::move(rest);
   const absl::StatusOr<BenchOptions> options = ParseBenchArgs(static_cast<int>(args.size()), args.data(), "--cgal-max");
   if (!options.ok()) {
     std::fprintf(stderr, "%s\n%s", std::string(options.status().message()).c_str(), kUsage);
@@ -355,6 +467,19 @@ int Main(int argc, char** argv) {
               BackendName(options->backend), CudaBackendAvailable() ? "available" : "unavailable", options->repeat,
               std::thread::hardware_concurrency(),
               weight_kind.empty() ? "" : absl::StrCat("; weights ", weight_kind, " (weighted families)").c_str());
+  if (num_sets > 0) {
+    std::printf(
+        "| distribution | sets x points | backend | packed ms (BuildAlphaFamilies) | one family of all the points "
+        "ms | packed / all in one | one call a set ms (200 sampled, scaled) | calls a set / packed | CGAL a set ms "
+        "(same sample) | CGAL / packed | sampled sets equal their own builds |\n"
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|\n");
+    bool all_equal = true;
+    for (const std::string& name : options->distributions) {
+      std::fprintf(stderr, "running %s, %zu sets of %zu points\n", name.c_str(), num_sets, points_per_set);
+      all_equal &= RunPackedFamilies(name, num_sets, points_per_set, *options);
+    }
+    return all_equal ? 0 : 1;
+  }
   PrintHeader();
   std::vector<BenchResult> results;
   bool failed = false;

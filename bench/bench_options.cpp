@@ -101,4 +101,34 @@ absl::Status TakeWeightsOption(int argc, char** argv, std::string* kind, std::ve
   return absl::OkStatus();
 }
 
+absl::Status TakeSetsOption(int argc, char** argv, size_t* sets, size_t* points, std::vector<char*>* rest) {
+  *sets = 0;
+  for (int i = 0; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.rfind("--sets=", 0) != 0) {
+      rest->push_back(argv[i]);
+      continue;
+    }
+    const std::string value = arg.substr(7);
+    const size_t x = value.find('x');
+    if (x == std::string::npos || !absl::SimpleAtoi(value.substr(0, x), sets) ||
+        !absl::SimpleAtoi(value.substr(x + 1), points) || *sets == 0 || *points == 0) {
+      return absl::InvalidArgumentError(absl::StrCat("--sets: '", value, "' is not SETSxPOINTS (e.g. 10000x1000)"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+void GenerateBenchSets(const gen::NamedGenerator& generator, size_t num_sets, size_t points_per_set, uint64_t seed,
+                       std::vector<Point2>* points, std::vector<uint32_t>* set_begin) {
+  points->clear();
+  points->reserve(num_sets * points_per_set);
+  set_begin->assign(1, 0);
+  for (size_t s = 0; s < num_sets; ++s) {
+    const std::vector<Point2> set = generator.generate(points_per_set, seed + s);
+    points->insert(points->end(), set.begin(), set.end());
+    set_begin->push_back(static_cast<uint32_t>(points->size()));
+  }
+}
+
 }  // namespace galpha

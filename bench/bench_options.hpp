@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "core/base/point.hpp"
 #include "gpu/triangulation/delaunay.hpp"
+#include "tests/support/point_generators.hpp"
 
 namespace galpha {
 
@@ -36,6 +37,16 @@ absl::StatusOr<BenchOptions> ParseBenchArgs(int argc, char** argv, const char* c
 /// benchmarks that build weighted inputs: the kind ("" without the flag) into *kind, every other
 /// argument into *rest (ParseBenchArgs parses them). InvalidArgument for an unknown kind.
 absl::Status TakeWeightsOption(int argc, char** argv, std::string* kind, std::vector<char*>* rest);
+
+/// Takes --sets=SETSxPOINTS (the benchmarks of many sets in one build, issue 20) out of argv: the
+/// counts into *sets and *points (0 sets without the flag), every other argument into *rest.
+/// InvalidArgument for a value that is not two positive counts.
+absl::Status TakeSetsOption(int argc, char** argv, size_t* sets, size_t* points, std::vector<char*>* rest);
+
+/// `num_sets` sets of `points_per_set` points of `generator`, set s generated with seed + s, one
+/// after the other in *points, with their offsets (num_sets + 1) in *set_begin.
+void GenerateBenchSets(const gen::NamedGenerator& generator, size_t num_sets, size_t points_per_set, uint64_t seed,
+                       std::vector<Point2>* points, std::vector<uint32_t>* set_begin);
 
 /// Calls `run` with every input the options name: each distribution at each size (generated with
 /// the seed), then each data file (named by its file name). An error reading a file stops there.

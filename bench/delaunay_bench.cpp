@@ -146,38 +146,14 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
 
 std::string StageSummary(const std::vector<StageTime>& stages);
 
-/// Takes --sets=SETSxPOINTS out of argv (the rest into *rest); 0 sets without it.
-absl::Status TakeSetsOption(int argc, char** argv, size_t* sets, size_t* points, std::vector<char*>* rest) {
-  *sets = 0;
-  rest->push_back(argv[0]);
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg.rfind("--sets=", 0) != 0) {
-      rest->push_back(argv[i]);
-      continue;
-    }
-    const std::string value = arg.substr(7);
-    const size_t x = value.find('x');
-    if (x == std::string::npos || !absl::SimpleAtoi(value.substr(0, x), sets) ||
-        !absl::SimpleAtoi(value.substr(x + 1), points) || *sets == 0 || *points == 0) {
-      return absl::InvalidArgumentError(absl::StrCat("--sets: '", value, "' is not SETSxPOINTS (e.g. 10000x1000)"));
-    }
-  }
-  return absl::OkStatus();
-}
-
 /// --sets: one distribution's packed build against its references (see the file comment). Returns
 /// false on an engine error or a sampled set unlike its own build.
 bool RunPackedSets(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options) {
   constexpr size_t kSampledSets = 200;
   const gen::NamedGenerator* generator = gen::FindDistribution(name);
   std::vector<Point2> points;
-  std::vector<uint32_t> set_begin{0};
-  for (size_t s = 0; s < num_sets; ++s) {
-    const std::vector<Point2> set = generator->generate(points_per_set, options.seed + s);
-    points.insert(points.end(), set.begin(), set.end());
-    set_begin.push_back(static_cast<uint32_t>(points.size()));
-  }
+  std::vector<uint32_t> set_begin;
+  GenerateBenchSets(*generator, num_sets, points_per_set, options.seed, &points, &set_begin);
   TriangulateOptions triangulate_options;
   triangulate_options.backend = options.backend;
   double packed_ms = std::numeric_limits<double>::infinity(), whole_ms = packed_ms;

@@ -62,6 +62,33 @@ struct BuildHooks {
   bool resident = false;
 };
 
+/// What a packed build of many sets' families hands back (gpu/alpha/packed_family.cuh): one family
+/// of all the sets' simplices, named by indices of the whole input (each set's triangles one run,
+/// set after set; each set's edges one run; each set's ranks one run, set after set, numbered on
+/// from the sets' before it), and where each set's runs lie.
+struct PackedFamilyOutput {
+  /// The packed family: `ranks.area_units` in each set's own scale (`set_area_scale`), the
+  /// comparison counts those of all the sets together.
+  FamilyOutput all;
+  std::vector<uint32_t> set_triangle_begin;  // num_sets + 1 (all zero when no set has a mesh)
+  std::vector<uint32_t> set_edge_begin;      // per set, its edges' run [begin, end)
+  std::vector<uint32_t> set_edge_end;
+  std::vector<uint32_t> set_rank_begin;  // num_sets + 1: set s's ranks are R + 1..R + K, R = [s]
+  std::vector<AreaCurveScale> set_area_scale;
+  /// Per set: 1 where its mesh held a flat triangle (DelaunaySetsOutput::build_alone): its part of
+  /// `all` is not its family, and the caller builds it alone.
+  std::vector<uint8_t> build_alone;
+};
+
+/// Builds the families of the `num_sets` sets of the `n` finite points (set s: [set_begin[s],
+/// set_begin[s + 1]); n > 0) in one packed build on the OpenMP backend, or on the CUDA backend on
+/// `stream`. Unweighted; `hooks.persistence` and `hooks.resident` are not taken. Throws as
+/// BuildFamilyOnCpu.
+void BuildFamiliesOnCpu(const Point2* points, const uint32_t* set_begin, uint32_t num_sets, uint32_t n,
+                        const BuildHooks& hooks, PackedFamilyOutput* out);
+void BuildFamiliesOnCuda(const Point2* points, const uint32_t* set_begin, uint32_t num_sets, uint32_t n, void* stream,
+                         const BuildHooks& hooks, PackedFamilyOutput* out);
+
 /// Builds the family of `n` finite points (with `weights`, one per point, or nullptr for the
 /// unweighted family) on the OpenMP backend. Throws EngineError (or a Thrust/std exception) on
 /// failure.

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <string_view>
+#include <vector>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
@@ -35,6 +36,34 @@ struct BuildOptions {
   /// keep it with the family (AlphaFamily::persistence()).
   bool persistence = false;
 };
+
+/// Many families built together (BuildAlphaFamilies).
+struct AlphaFamilies {
+  /// One family a set, in the sets' order, each equal on every table to BuildAlphaFamily's of the
+  /// set alone on the same backend (its indices the set's own, from 0). Their reports name the
+  /// backend only: the stage times, exact comparisons and peak memory are the build's, below (a
+  /// set built alone, and every set of a call without points, keeps its own build's report).
+  std::vector<AlphaFamily> families;
+  /// The packed build's: its stage times, the exact comparisons of all the sets, its peak memory.
+  BuildReport report;
+  /// Sets built alone after the packed build (a mesh with a flat triangle; none measured).
+  uint32_t built_alone = 0;
+};
+
+/// Builds the families of many point sets in one packed build: set s is points[set_begin[s],
+/// set_begin[s + 1]) (TriangulateSets' offsets; empty sets allowed). The sets are triangulated
+/// together (TriangulateSets) and the alpha pipeline runs once over all their simplices, not once
+/// a set: thousands of small sets take about what one build of all their points takes.
+/// docs/design.md, "Many sets in one build".
+///
+/// Options: `max_exact_comparisons` bounds all the sets' together; `cancelled` and `progress` as
+/// BuildAlphaFamily's (phases "triangulation", "alpha", "split"); `persistence` is not computed in
+/// a packed build (InvalidArgument: build the sets one by one).
+///
+/// Errors: TriangulateSets' (a set's error prefixed by the set), ResourceExhausted for the limit
+/// of exact comparisons (IsExactComparisonLimit) or for host memory, and Cancelled. Unweighted.
+absl::StatusOr<AlphaFamilies> BuildAlphaFamilies(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
+                                                 const BuildOptions& options = {});
 
 /// Whether `status` is a build stopped by BuildOptions::max_exact_comparisons.
 bool IsExactComparisonLimit(const absl::Status& status);

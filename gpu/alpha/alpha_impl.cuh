@@ -550,9 +550,10 @@ SpectrumRanks<System> RankSpectrum(System& sys, const PipelineMesh& mesh, ExactS
   thrust::fill_n(policy, tri_rank.data(), mesh.num_tri, kNeverRank);  // collinear triangles: never born
   thrust::fill_n(policy, edge_rho_rank.data(), mesh.num_edges, uint32_t{0});
   Buffer<uint32_t, System> spectrum_simplex(sys, num_ranks);
+  thrust::fill_n(policy, spectrum_simplex.data(), num_ranks, ~0u);
   thrust::for_each_n(policy, zero, total_entries,
-                     ScatterRanks{spectrum->ids.data(), rank.data(), spectrum->new_value.data(), mesh.num_tri,
-                                  tri_rank.data(), edge_rho_rank.data(), spectrum_simplex.data()});
+                     ScatterRanks{spectrum->ids.data(), rank.data(), mesh.num_tri, tri_rank.data(),
+                                  edge_rho_rank.data(), spectrum_simplex.data()});
   rank.Reset();
   spectrum->ids.Reset();
   spectrum->new_value.Reset();
@@ -779,14 +780,23 @@ MasterListCsr<System> BuildMasterList(System& sys, const PipelineMesh& mesh, con
   return {std::move(master_begin), std::move(master_entries), num_master};
 }
 
+/// A packed build's sets, for its area curves (PackedAreaCurves): every input index's set, and
+/// where each set's scale and error go.
+struct PackedAreaSets {
+  const uint32_t* input_set;
+  uint32_t num_sets;
+  std::vector<AreaCurveScale>* set_scales;
+};
+
 /// Component and hole curves over all levels (Borůvka spanning forests, component_curve.cuh) and
-/// the area curve (area_curve.cuh). Given the canonical edge positions, the general forest is also
-/// the persistence diagram's primal forest, marked by position in `primal_forest_mark`.
+/// the area curve (area_curve.cuh; a packed build's in each set's scale, `packed`). Given the
+/// canonical edge positions, the general forest is also the persistence diagram's primal forest,
+/// marked by position in `primal_forest_mark`.
 template <class System>
 ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                                         const Buffer<EdgeTris, System>& edge_tris, const SpectrumRanks<System>& ranks,
                                         const IntervalRanks<System>& iv, const uint32_t* edge_position = nullptr,
-                                        uint8_t* primal_forest_mark = nullptr) {
+                                        uint8_t* primal_forest_mark = nullptr, const PackedAreaSets* packed = nullptr) {
   const size_t levels = static_cast<size_t>(ranks.num_ranks) + 1;
   ComponentCounts<System> counts{Buffer<uint32_t, System>(sys, levels),
                                  Buffer<uint32_t, System>(sys, levels),
@@ -802,9 +812,12 @@ ComponentCounts<System> CountComponents(System& sys, const PipelineMesh& mesh,
                        iv.edge_mu_low.data(), iv.edge_mu_high.data(), iv.vertex_tri_low.data(), edge_position},
       TopologyCurvesOut{counts.components.data(), counts.solid_components.data(), counts.holes.data(),
                         counts.regularized_components.data(), counts.regularized_holes.data(), primal_forest_mark});
-  counts.area_scale =
-      AreaCurve(sys, AreaCurveIn{mesh.points, mesh.tri, ranks.tri_rank.data(), mesh.n, mesh.num_tri, ranks.num_ranks},
-                counts.area_units.data());
+  const AreaCurveIn area_in{mesh.points, mesh.tri, ranks.tri_rank.data(), mesh.n, mesh.num_tri, ranks.num_ranks};
+  if (packed != nullptr) {
+    PackedAreaCurves(sys, area_in, packed->input_set, packed->num_sets, counts.area_units.data(), packed->set_scales);
+  } else {
+    counts.area_scale = AreaCurve(sys, area_in, counts.area_units.data());
+  }
   return counts;
 }
 

@@ -8,4 +8,9 @@ void BuildFamilyOnCuda(const Point2*, const double*, uint32_t, void*, const Buil
   throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
 }
 
+void BuildFamiliesOnCuda(const Point2*, const uint32_t*, uint32_t, uint32_t, void*, const BuildHooks&,
+                         PackedFamilyOutput*) {
+  throw EngineError(EngineError::Kind::kUnavailable, "this build of galpha has no CUDA backend");
+}
+
 }  // namespace galpha::detail

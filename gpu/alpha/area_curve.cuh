@@ -16,16 +16,21 @@
 #include <thrust/for_each.h>
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
+#include <thrust/reduce.h>
 #include <thrust/scan.h>
+#include <thrust/transform.h>
 #include <thrust/transform_reduce.h>
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 #include "core/exact/expansion.hpp"
 #include "core/family/alpha_ranks.hpp"
 #include "gpu/alpha/alpha_functors.cuh"
 #include "gpu/system/atomic_increment.cuh"
+#include "gpu/system/engine_system.cuh"
 #include "gpu/triangulation/point_order.cuh"
 
 namespace galpha::detail {
@@ -43,11 +48,16 @@ struct TriangleAreaUnits {
   const Point2* points;
   const TriIdx* tri;
   int scale_log2;  ///< the differences are multiplied by 2^scale_log2
+  /// A packed build of many sets: each set's own scale (set_scale_log2[input_set[vertex]]) instead
+  /// of `scale_log2`; null for one set.
+  const uint32_t* input_set = nullptr;
+  const int* set_scale_log2 = nullptr;
 
   GALPHA_HD void Evaluate(uint32_t t, unsigned long long* units, unsigned long long* error) const {
     // The rotation that starts at the smallest index: the same rounding whichever rotation of
     // the triangle a backend stores.
     const TriIdx& v = tri[t];
+    const int scale_log2 = set_scale_log2 == nullptr ? this->scale_log2 : set_scale_log2[input_set[v.v[0]]];
     const int first = v.v[0] < v.v[1] ? (v.v[0] < v.v[2] ? 0 : 2) : (v.v[1] < v.v[2] ? 1 : 2);
     const Point2 a = points[v.v[first]], b = points[v.v[(first + 1) % 3]], c = points[v.v[(first + 2) % 3]];
     using exact::Mul;
@@ -91,19 +101,30 @@ struct TriangleAreaError {
   }
 };
 
-/// The area curve's scale: 2^scale_log2 brings the bounding box's larger side to [0.5, 1). Zero
+/// The area curve's scale of a bounding box: 2^scale_log2 brings its larger side to [0.5, 1). Zero
 /// for a box without extent (then there are no triangles).
-template <class System>
-int AreaScaleLog2(System& sys, const Point2* points, uint32_t n) {
-  if (n == 0) return 0;
-  auto policy = sys.policy();
-  const BoundingBox box =
-      thrust::transform_reduce(policy, points, points + n, PointToBox(), PointToBox()(sys.Read(points)), MergeBoxes());
+GALPHA_HD inline int AreaScaleLog2Of(const BoundingBox& box) {
   const double width = exact::Sub(box.max_x, box.min_x), height = exact::Sub(box.max_y, box.min_y);
   const double side = width > height ? width : height;
   if (side == 0.0) return 0;
   return -(exact::ExponentOf(side) + 1);
 }
+
+template <class System>
+int AreaScaleLog2(System& sys, const Point2* points, uint32_t n) {
+  if (n == 0) return 0;
+  auto policy = sys.policy();
+  return AreaScaleLog2Of(
+      thrust::transform_reduce(policy, points, points + n, PointToBox(), PointToBox()(sys.Read(points)), MergeBoxes()));
+}
+
+/// A set's box as its area scale.
+struct BoxAreaScale {
+  GALPHA_HD int operator()(const BoundingBox& box) const { return AreaScaleLog2Of(box); }
+};
+
+/// The unit of a curve whose differences were scaled by 2^scale_log2: units of twice the area, halved.
+inline int32_t AreaUnitLog2(int scale_log2) { return -(kAreaFractionBits + 2 * scale_log2) - 1; }
 
 struct AreaCurveIn {
   const Point2* points;
@@ -121,7 +142,7 @@ AreaCurveScale AreaCurve(System& sys, const AreaCurveIn& in, unsigned long long*
   const uint32_t levels = in.num_ranks + 1;
   AreaCurveScale scale;
   const int scale_log2 = AreaScaleLog2(sys, in.points, in.n);
-  scale.unit_log2 = -(kAreaFractionBits + 2 * scale_log2) - 1;  // units of twice the area: halve
+  scale.unit_log2 = AreaUnitLog2(scale_log2);
   thrust::fill_n(policy, units_out, levels, 0ull);
   if (in.num_tri == 0) return scale;
   const TriangleAreaUnits area{in.points, in.tri, scale_log2};
@@ -130,6 +151,67 @@ AreaCurveScale AreaCurve(System& sys, const AreaCurveIn& in, unsigned long long*
   scale.error_units = thrust::transform_reduce(policy, zero, zero + in.num_tri, TriangleAreaError{area, in.tri_rank},
                                                0ull, thrust::plus<unsigned long long>());
   return scale;
+}
+
+/// The set of a triangle of a packed build (of its first vertex, an input index).
+struct TriangleSetOf {
+  const TriIdx* tri;
+  const uint32_t* input_set;
+  GALPHA_HD uint32_t operator()(uint32_t t) const { return input_set[tri[t].v[0]]; }
+};
+
+/// The area curves of a packed build of `num_sets` sets (input indices grouped by set, `input_set`
+/// naming each one's; triangles grouped by set; ranks numbered set after set): every triangle is
+/// measured in its set's own scale (the box of the set's input, as the set's build alone measures
+/// it), the units are added into the packed levels and scanned once, and each set's error bound is
+/// the sum over its own triangles. Set s's curve is then units_out[R_s + l] - units_out[R_s] at
+/// its level l (R_s: the ranks of the sets before it), in its scale: the levels of the other sets
+/// add constants below and above it. The scan may wrap past 2^64 over thousands of sets; the
+/// differences are exact all the same (unsigned arithmetic is modular, and each set's own sum stays
+/// below 2^59). `set_scales` receives each set's scale and error.
+template <class System>
+void PackedAreaCurves(System& sys, const AreaCurveIn& in, const uint32_t* input_set, uint32_t num_sets,
+                      unsigned long long* units_out, std::vector<AreaCurveScale>* set_scales) {
+  auto policy = sys.policy();
+  thrust::counting_iterator<uint32_t> zero(0);
+  const uint32_t levels = in.num_ranks + 1;
+  thrust::fill_n(policy, units_out, levels, 0ull);
+  std::vector<int> scale_log2(num_sets, 0);
+  std::vector<unsigned long long> error(num_sets, 0);
+  if (in.n > 0) {
+    // Every nonempty set's box (its input indices are one run), as its scale.
+    Buffer<uint32_t, System> keys(sys, num_sets);
+    Buffer<BoundingBox, System> boxes(sys, num_sets);
+    const auto end = thrust::reduce_by_key(policy, input_set, input_set + in.n,
+                                           thrust::make_transform_iterator(in.points, PointToBox()), keys.data(),
+                                           boxes.data(), thrust::equal_to<uint32_t>(), MergeBoxes());
+    const auto num_nonempty = static_cast<uint32_t>(end.first - keys.data());
+    Buffer<int, System> scales(sys, num_nonempty);
+    thrust::transform(policy, boxes.data(), boxes.data() + num_nonempty, scales.data(), BoxAreaScale{});
+    const std::vector<uint32_t> host_keys = keys.ToHostVector(num_nonempty);
+    const std::vector<int> host_scales = scales.ToHostVector(num_nonempty);
+    for (uint32_t j = 0; j < num_nonempty; ++j) scale_log2[host_keys[j]] = host_scales[j];
+  }
+  if (in.num_tri > 0) {
+    Buffer<int, System> set_scale(sys, num_sets);
+    sys.FromHost(set_scale.data(), scale_log2.data(), num_sets);
+    TriangleAreaUnits area{in.points, in.tri, 0, input_set, set_scale.data()};
+    thrust::for_each_n(policy, zero, in.num_tri, AddTriangleArea{area, in.tri_rank, units_out});
+    thrust::inclusive_scan(policy, units_out, units_out + levels, units_out);
+    Buffer<uint32_t, System> tri_set(sys, in.num_tri);
+    thrust::transform(policy, zero, zero + in.num_tri, tri_set.data(), TriangleSetOf{in.tri, input_set});
+    Buffer<uint32_t, System> keys(sys, num_sets);
+    Buffer<unsigned long long, System> sums(sys, num_sets);
+    const auto errors = thrust::make_transform_iterator(zero, TriangleAreaError{area, in.tri_rank});
+    const auto end =
+        thrust::reduce_by_key(policy, tri_set.data(), tri_set.data() + in.num_tri, errors, keys.data(), sums.data());
+    const auto num_meshes = static_cast<uint32_t>(end.first - keys.data());
+    const std::vector<uint32_t> host_keys = keys.ToHostVector(num_meshes);
+    const std::vector<unsigned long long> host_sums = sums.ToHostVector(num_meshes);
+    for (uint32_t j = 0; j < num_meshes; ++j) error[host_keys[j]] = host_sums[j];
+  }
+  set_scales->resize(num_sets);
+  for (uint32_t s = 0; s < num_sets; ++s) (*set_scales)[s] = AreaCurveScale{AreaUnitLog2(scale_log2[s]), error[s]};
 }
 
 }  // namespace galpha::detail

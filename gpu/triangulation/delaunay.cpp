@@ -133,8 +133,7 @@ bool SplitBySet(absl::Span<const Point2> points, absl::Span<const uint32_t> set_
 
 }  // namespace
 
-absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
-                                                 const TriangulateOptions& options) {
+absl::Status ValidatePointSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin) {
   // The packed build numbers all the points together: its limit is one build's.
   if (points.size() > kMaxPoints) {
     return absl::ResourceExhaustedError(absl::StrCat("too many points: ", points.size(),
@@ -143,20 +142,25 @@ absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points
   }
   GALPHA_RETURN_IF_ERROR(ValidateSetOffsets(set_begin, points.size()));
   const size_t num_sets = set_begin.size() - 1;
-  {
-    // Each set is validated as Triangulate validates it (its own input domain), the sets shared
-    // out over the host's cores (ValidatePoints' own parallel pass then runs on one thread), and
-    // the first set in order that fails names the error.
-    std::vector<absl::Status> valid(num_sets);
+  // Each set is validated as Triangulate validates it (its own input domain), the sets shared out
+  // over the host's cores (ValidatePoints' own parallel pass then runs on one thread), and the
+  // first set in order that fails names the error.
+  std::vector<absl::Status> valid(num_sets);
 #pragma omp parallel for schedule(dynamic, 16)
-    for (int64_t set = 0; set < static_cast<int64_t>(num_sets); ++set) {
-      const auto s = static_cast<size_t>(set);
-      valid[s] = ValidatePoints(points.subspan(set_begin[s], set_begin[s + 1] - set_begin[s]));
-    }
-    for (size_t s = 0; s < num_sets; ++s) {
-      if (!valid[s].ok()) return absl::Status(valid[s].code(), absl::StrCat("set ", s, ": ", valid[s].message()));
-    }
+  for (int64_t set = 0; set < static_cast<int64_t>(num_sets); ++set) {
+    const auto s = static_cast<size_t>(set);
+    valid[s] = ValidatePoints(points.subspan(set_begin[s], set_begin[s + 1] - set_begin[s]));
   }
+  for (size_t s = 0; s < num_sets; ++s) {
+    if (!valid[s].ok()) return absl::Status(valid[s].code(), absl::StrCat("set ", s, ": ", valid[s].message()));
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
+                                                 const TriangulateOptions& options) {
+  GALPHA_RETURN_IF_ERROR(ValidatePointSets(points, set_begin));
+  const size_t num_sets = set_begin.size() - 1;
   GALPHA_ASSIGN_OR_RETURN(const Backend backend, detail::ResolveBackend(options.backend));
   TriangulatedSets result;
   result.backend = backend;

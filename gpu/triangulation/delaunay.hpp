@@ -120,4 +120,8 @@ struct TriangulatedSets {
 absl::StatusOr<TriangulatedSets> TriangulateSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin,
                                                  const TriangulateOptions& options = {});
 
+/// TriangulateSets' checks of its input (its errors, above), for the other builds of many sets
+/// (BuildAlphaFamilies).
+absl::Status ValidatePointSets(absl::Span<const Point2> points, absl::Span<const uint32_t> set_begin);
+
 }  // namespace galpha

@@ -246,20 +246,38 @@ void GroupTrianglesBySet(System& sys, const uint32_t* input_set, uint32_t num_se
   result->nbr = std::move(nbr);
 }
 
-/// Triangulates the `num_sets` sets of `n` host points (set s: points [set_begin[s],
-/// set_begin[s + 1])) in one build on `sys` and downloads the result into `out`.
+/// The packed build's result in the system's memory: every set's mesh in `mesh` (each set's
+/// triangles one run, set after set; representatives for every input index; the input kept when
+/// asked for), the chains of the sets on one line apart, and every input index's set.
 template <class System>
-void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t* host_set_begin, uint32_t num_sets,
-                          uint32_t n, DelaunaySetsOutput* out) {
-  StageTimer<System> timer(sys, &out->meshes.stage_times);
+struct PackedTriangulation {
+  explicit PackedTriangulation(System& sys) : mesh(sys), chain(sys, 0), input_set(sys, 0) {}
+  SystemTriangulation<System> mesh;
+  Buffer<EdgePair, System> chain;
+  Buffer<uint32_t, System> input_set;
+  /// Where each set's run of triangles starts (num_sets + 1 entries; empty when no set has a mesh).
+  std::vector<uint32_t> set_triangle_begin;
+  /// Per set: 1 where its mesh held a flat triangle (DelaunaySetsOutput::build_alone).
+  std::vector<uint8_t> build_alone;
+};
+
+/// Triangulates the `num_sets` sets of `n` host points (set s: points [set_begin[s],
+/// set_begin[s + 1])) in one build on `sys`; the result stays there. With `keep_points` the
+/// uploaded input is kept in the result. One stage a call.
+template <class System>
+PackedTriangulation<System> TriangulateSetsOnSystem(System& sys, const Point2* host_points,
+                                                    const uint32_t* host_set_begin, uint32_t num_sets, uint32_t n,
+                                                    bool keep_points, StageTimer<System>& timer) {
   auto pol = sys.policy();
   const thrust::counting_iterator<uint32_t> first(0);
   const thrust::counting_iterator<int32_t> vfirst(0);
-  SystemTriangulation<System> result(sys);
+  PackedTriangulation<System> packed(sys);
+  SystemTriangulation<System>& result = packed.mesh;
   Buffer<Point2, System> input = UploadPoints(sys, host_points, n);
   Buffer<uint32_t, System> set_begin(sys, size_t{num_sets} + 1);
   sys.FromHost(set_begin.data(), host_set_begin, size_t{num_sets} + 1);
-  Buffer<uint32_t, System> input_set(sys, n);
+  packed.input_set = Buffer<uint32_t, System>(sys, n);
+  Buffer<uint32_t, System>& input_set = packed.input_set;
   // Set s holds indices below set_begin[s + 1]: the first bound above i names i's set.
   thrust::upper_bound(pol, set_begin.begin() + 1, set_begin.end(), first, first + n, input_set.begin());
   timer.EndStage("upload");
@@ -285,12 +303,9 @@ void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t
         thrust::copy_if(pol, first, first + m_all, chain_start.begin(),
                         StartsChainEdge{unique_set.data(), set_unique_begin.data(), off_line.data()}) -
         chain_start.begin());
-    Buffer<EdgePair, System> chain(sys, num_chain_edges);
+    packed.chain = Buffer<EdgePair, System>(sys, num_chain_edges);
     thrust::for_each(pol, first, first + num_chain_edges,
-                     WriteChainEdgeAt{distinct.unique.data(), chain_start.data(), chain.data()});
-    out->chain_edges.resize(num_chain_edges);
-    if (num_chain_edges > 0)
-      sys.ToHost(reinterpret_cast<EdgePair*>(out->chain_edges.data()), chain.data(), num_chain_edges);
+                     WriteChainEdgeAt{distinct.unique.data(), chain_start.data(), packed.chain.data()});
   }
   {
     Buffer<uint32_t, System> mesh_unique(sys, m_all);
@@ -305,7 +320,7 @@ void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t
   set_unique_begin.Reset();
   timer.EndStage("collinear_chain");
 
-  out->build_alone.assign(num_sets, 0);
+  packed.build_alone.assign(num_sets, 0);
   const uint32_t m = distinct.m;
   if (m > 0) {
     // Every set's box and power of two, as a build of it alone computes them (over its input).
@@ -398,7 +413,7 @@ void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t
       Buffer<uint8_t, System> flat(sys, num_sets);
       thrust::fill(pol, flat.begin(), flat.end(), uint8_t{0});
       builder->MarkSetsWithFlatTriangles(flat.data());
-      sys.ToHost(out->build_alone.data(), flat.data(), num_sets);
+      sys.ToHost(packed.build_alone.data(), flat.data(), num_sets);
     }
     timer.EndStage("hull_repair");
     builder->ReleaseWorkspace();
@@ -406,11 +421,30 @@ void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t
     builder.reset();
     vertex_points.Reset();
     distinct.unique.Reset();
-    GroupTrianglesBySet(sys, input_set.data(), num_sets, &result, &out->set_triangle_begin);
+    GroupTrianglesBySet(sys, input_set.data(), num_sets, &result, &packed.set_triangle_begin);
     if (result.tri.size() > 0) OutputEdges(sys, &result);
     timer.EndStage("output");
   }
-  DownloadTriangulation(sys, result, n, &out->meshes);
+  if (keep_points) result.points = std::move(input);
+  return packed;
+}
+
+/// Triangulates the `num_sets` sets of `n` host points in one build on `sys` and downloads the
+/// result into `out`.
+template <class System>
+void RunSetsTriangulation(System& sys, const Point2* host_points, const uint32_t* host_set_begin, uint32_t num_sets,
+                          uint32_t n, DelaunaySetsOutput* out) {
+  StageTimer<System> timer(sys, &out->meshes.stage_times);
+  PackedTriangulation<System> packed =
+      TriangulateSetsOnSystem(sys, host_points, host_set_begin, num_sets, n, /*keep_points=*/false, timer);
+  const size_t num_chain_edges = packed.chain.size();
+  out->chain_edges.resize(num_chain_edges);
+  if (num_chain_edges > 0) {
+    sys.ToHost(reinterpret_cast<EdgePair*>(out->chain_edges.data()), packed.chain.data(), num_chain_edges);
+  }
+  out->set_triangle_begin = std::move(packed.set_triangle_begin);
+  out->build_alone = std::move(packed.build_alone);
+  DownloadTriangulation(sys, packed.mesh, n, &out->meshes);
   timer.EndStage("download");
   timer.Finish();
   out->meshes.peak_memory_bytes = sys.peak_bytes();

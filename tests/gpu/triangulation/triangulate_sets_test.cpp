@@ -14,6 +14,7 @@
 #include "gpu/triangulation/delaunay.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/backend_fixture.hpp"
+#include "tests/support/packed_sets.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
 
@@ -21,19 +22,8 @@ namespace galpha {
 namespace {
 
 using testing::IsOk;
+using testing::SetsToPack;
 using testing::StatusIs;
-
-/// Sets to pack, with the names a failure prints.
-struct SetsToPack {
-  std::vector<std::string> names;
-  std::vector<Point2> points;
-  std::vector<uint32_t> set_begin{0};
-  void Add(std::string name, const std::vector<Point2>& set) {
-    names.push_back(std::move(name));
-    points.insert(points.end(), set.begin(), set.end());
-    set_begin.push_back(static_cast<uint32_t>(points.size()));
-  }
-};
 
 class TriangulateSetsTest : public testing::BackendTest {
  protected:
@@ -53,9 +43,7 @@ class TriangulateSetsTest : public testing::BackendTest {
     EXPECT_EQ(packed->built_alone, 0u);
     for (size_t s = 0; s < sets.names.size(); ++s) {
       SCOPED_TRACE("set " + std::to_string(s) + ": " + sets.names[s]);
-      const absl::Span<const Point2> points(sets.points.data() + sets.set_begin[s],
-                                            sets.set_begin[s + 1] - sets.set_begin[s]);
-      absl::StatusOr<Triangulation> alone = Triangulate(points, Options());
+      absl::StatusOr<Triangulation> alone = Triangulate(sets.Set(s), Options());
       ASSERT_THAT(alone.status(), IsOk());
       const Triangulation& got = packed->sets[s];
       EXPECT_EQ(got.points, alone->points);
