@@ -28,7 +28,7 @@ bins=()
 case "$set_name" in
   engine) names="predicates_test predicates_device_test power_test delaunay_test delaunay_cgal_test regular_test regular_cgal_test triangulation_checks_test triangulate_sets_test
                  radius_test weighted_radius_test alpha_family_cgal_test weighted_family_cgal_test alpha_family_test
-                 alpha_bruteforce_test alpha_backend_identity_test
+                 alpha_bruteforce_test alpha_backend_identity_test packed_families_test
                  persistence_gudhi_test persistence_engine_test resident_family_test shape_test delaunay_bench alpha_bench
                  topology_bench resident_bench" ;;
   service) names="alphactl service_bench galpha_server service_test alpha_bench" ;;

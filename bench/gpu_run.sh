@@ -18,9 +18,10 @@
 #           1M rows beside them, 10M with uniform weights; then compute-sanitizer memcheck of the
 #           weighted tests on CUDA (regular_test's small cases)
 #   identity the CUDA/CPU identity test alone
-#   sets    many sets in one triangulation (TriangulateSets, issue 20): delaunay_bench --sets at
-#           10,000 x 1,000 on every generator and 1,000 x 10,000 on three, against one 10M build,
-#           one call a set and CGAL a set; then triangulate_sets_test on the CUDA backend
+#   sets    many sets in one build (issue 20): delaunay_bench --sets (TriangulateSets) and
+#           alpha_bench --sets (BuildAlphaFamilies) at 10,000 x 1,000 on every generator and
+#           1,000 x 10,000 on three, against one 10M build, one call a set and CGAL a set; then
+#           triangulate_sets_test and packed_families_test on the CUDA backend
 #   topology topology_bench: Betti curves and persistence diagrams at 1M (GUDHI's exact persistence
 #           in the same run at 1M uniform and at 100K on the hard generators) and 10M uniform
 #   resident resident_bench: a resident family (rank tables kept on the device) against the family
@@ -78,7 +79,11 @@ for phase in "${phases[@]}"; do
       run_step sets 420 .carry/bin/delaunay_bench --backend=cuda --sets=10000x1000 --repeat=3
       run_step sets 200 .carry/bin/delaunay_bench --backend=cuda --sets=1000x10000 --repeat=3 \
         --dists=uniform,two_lines,circle
+      run_step sets 420 .carry/bin/alpha_bench --backend=cuda --sets=10000x1000 --repeat=3
+      run_step sets 200 .carry/bin/alpha_bench --backend=cuda --sets=1000x10000 --repeat=3 \
+        --dists=uniform,two_lines,circle
       run_step sets 300 .carry/bin/triangulate_sets_test --gtest_filter='*/cuda'
+      run_step sets 300 .carry/bin/packed_families_test --gtest_filter='*/cuda'
       grep -E '^\| [a-z_0-9]+ \| [0-9]+x|PASSED|FAILED' "$out/sets.log"
       ;;
     regular)

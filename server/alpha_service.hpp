@@ -39,6 +39,13 @@ inline size_t UploadedBuildBytes(size_t points, size_t weights) {
   return points * (kBuildBytesPerPoint + sizeof(Point2)) + weights * kBuildBytesPerWeight;
 }
 
+/// How BuildBatch builds its small unweighted sets (server/build_batch_reactor.hpp).
+enum class BatchPacking {
+  kAuto,  ///< packed on the CUDA backend (a set alone costs the GPU a fixed start), else one a core
+  kOn,    ///< packed together in one build of the service's backend (BuildAlphaFamilies)
+  kOff,   ///< one set a host core, each its own build
+};
+
 struct ServiceOptions {
   /// kAuto: the GPU when this build and machine have one, else the CPU.
   Backend backend = Backend::kAuto;
@@ -81,6 +88,8 @@ struct ServiceOptions {
   /// checked once a second; the first build after it maps its memory again. 0: kept for good.
   std::chrono::milliseconds device_idle_release{2000};
   TenantTokens tokens;
+  /// BuildBatch's small unweighted sets: packed into one build, or one set a host core.
+  BatchPacking batch_packing = BatchPacking::kAuto;
 };
 
 class AlphaService final : public galpha::v1::AlphaShapes::CallbackService {

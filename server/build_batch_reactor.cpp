@@ -123,12 +123,16 @@ void BuildBatchReactor::EndOfStream() {
     Respond(NameBatchSet(ended, sets_.size() - 1, sets_.back().name));
     return;
   }
-  // Cached sets answer now; the others are built one after the other by one job, whose working
-  // memory is the largest set's, plus the small sets' built on host cores at once, plus every
-  // set's points (already reserved as in flight, and held until their set is built).
-  size_t largest = 0;        // the largest set's working memory
+  // Cached sets answer now; the others are built by one job: the packed sets in one build, then
+  // the large ones one after the other on its slot, while the other small sets are built on host
+  // cores at once. Its working memory is the larger of the packed build's and the largest set's,
+  // plus the small sets' built on host cores at once, plus every set's points (already reserved
+  // as in flight, and held until their set is built) and the packed sets' points once more (the
+  // packed build's input, all of them together).
+  size_t largest = 0;        // the largest set's working memory, of those built one by one
   size_t largest_small = 0;  // the same of the sets built on host cores, several at once
   size_t small = 0;
+  size_t packed_points = 0;
   size_t held = 0;                         // every set's points and weights, held until the set is built
   std::map<std::string, size_t> first_of;  // handle -> the first set to build with it
   for (size_t i = 0; i < sets_.size(); ++i) {
@@ -147,6 +151,13 @@ void BuildBatchReactor::EndOfStream() {
       continue;
     }
     if (found.compact != nullptr && set.build->frame == nullptr) set.build->frame = found.compact->frame();
+    held += set.build->points.size() * sizeof(Point2) + set.build->weights.size() * sizeof(double);
+    first_of.emplace(set.build->handle, i);
+    to_build_.push_back(i);
+    if (Packed(i)) {
+      packed_points += set.build->points.size();
+      continue;
+    }
     const size_t working =
         set.build->points.size() * kBuildBytesPerPoint + set.build->weights.size() * kBuildBytesPerWeight;
     largest = std::max(largest, working);
@@ -154,12 +165,10 @@ void BuildBatchReactor::EndOfStream() {
       largest_small = std::max(largest_small, working);
       ++small;
     }
-    held += set.build->points.size() * sizeof(Point2) + set.build->weights.size() * sizeof(double);
-    first_of.emplace(set.build->handle, i);
-    to_build_.push_back(i);
   }
   const size_t host_threads = std::min<size_t>(std::max(std::thread::hardware_concurrency(), 1u), small);
-  const size_t need = largest + host_threads * largest_small + held;
+  const size_t need = std::max(largest, packed_points * kBuildBytesPerPoint) + host_threads * largest_small + held +
+                      packed_points * sizeof(Point2);
   if (to_build_.empty()) {
     AnswerRepeats();
     WriteNextPage();
@@ -209,13 +218,22 @@ void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
       BuildSet(indices[k], slot, limited, deadline, points, on_host);
     }
   };
-  // Small sets are built on the host's cores, one set a core (each build on one thread): a
-  // family is the same bit for bit on either backend (alpha_backend_identity_test), and a small
-  // set costs the GPU mostly its fixed start (about 6 ms a 1,000-point set on an H200, bench/README.md)
-  // while a host core builds it in a few. Larger sets are built on this slot, one after another,
-  // on the service's backend, at the same time.
-  std::vector<size_t> small, large;
-  for (size_t i : to_build_) (sets_[i].build->points.size() <= kHostBatchSetPoints ? small : large).push_back(i);
+  // Small unweighted sets are packed into one build on this slot (BuildAlphaFamilies: each
+  // family the same bit for bit as its own build's, packed_families_test) when the service packs:
+  // a set alone costs the GPU mostly its fixed start (about 6 ms a 1,000-point set on an H200,
+  // bench/README.md). The other small sets are built on the host's cores, one set a core (each
+  // build on one thread): a family is the same bit for bit on either backend
+  // (alpha_backend_identity_test), and a host core builds a small set in a few milliseconds.
+  // Larger sets are built on this slot after the packed build, one after another, on the
+  // service's backend, while the host cores work.
+  std::vector<size_t> packed, small, large;
+  for (size_t i : to_build_) {
+    if (Packed(i)) {
+      packed.push_back(i);
+    } else {
+      (sets_[i].build->points.size() <= kHostBatchSetPoints ? small : large).push_back(i);
+    }
+  }
   std::atomic<size_t> next_small{0}, next_large{0};
   std::vector<std::thread> workers;
   const size_t threads = std::min<size_t>(std::max(cores, 1u), small.size());
@@ -225,6 +243,12 @@ void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
       omp_set_num_threads(1);  // this thread's parallel regions: one thread (a set a core)
       build_all(small, &next_small, /*on_host=*/true);
     });
+  }
+  if (!packed.empty() && !CallerGone()) {
+    // A failed packed build's sets are built one by one on this slot, before the large ones.
+    const std::vector<size_t> alone = BuildPacked(packed, slot, limited, deadline, points);
+    std::atomic<size_t> next_alone{0};
+    build_all(alone, &next_alone, /*on_host=*/false);
   }
   build_all(large, &next_large, /*on_host=*/false);
   for (std::thread& worker : workers) worker.join();
@@ -242,16 +266,8 @@ void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limit
                                  uint64_t batch_points, bool on_host) {
   Set& set = sets_[index];
   const DecodedBuild& build = *set.build;
-  // An earlier set of this batch with the same points (or another call) may have built it since.
-  if (const FamilyCache::Found found = service_->cache_->Lookup(tenant_, build.handle); found.resident != nullptr) {
-    if (build.frame != nullptr) found.resident->AttachFrameIfNone(build.frame);
-    Answer(index, *found.resident, /*was_cached=*/true);
-    set.decoder.reset();
-    return;
-  }
+  if (AnswerIfCachedSince(index)) return;
   const size_t points = build.points.size();
-  const bool cuda = service_->backend_name_ == "cuda";
-  const unsigned cores = std::thread::hardware_concurrency();
   BuildOptions options;
   options.backend = on_host ? Backend::kCpu : service_->backend_;
   options.cuda_stream = on_host ? nullptr : slot.cuda_stream;
@@ -264,13 +280,7 @@ void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limit
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (!family.ok()) {
     if (absl::IsCancelled(family.status()) && !cancelled_ && limited && Clock::now() > deadline) {
-      AnswerError(index,
-                  TagRefusal(absl::DeadlineExceededError(absl::StrCat(
-                                 "the batch ran past its time limit during this set's build (a batch may take "
-                                 "the limit of one build of all its ",
-                                 batch_points, " points plus ", kBatchBuildTimePerSet.count(), " ms a set: ",
-                                 BuildTimeLimitMessage(batch_points, cuda, cores, service_->options_.build_time), ")")),
-                             BuildRefusal::kBuildTime));
+      AnswerError(index, LateDuringBuild(batch_points));
     } else if (IsExactComparisonLimit(family.status())) {
       AnswerError(index, TagRefusal(absl::ResourceExhaustedError(
                                         ExactComparisonLimitMessage(points, service_->options_.exact_comparisons)),
@@ -282,7 +292,94 @@ void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limit
     return;
   }
   service_->metrics_->RecordBuild((*family)->reader().report(), seconds);
-  auto inserted = service_->cache_->Insert(tenant_, build.handle, *std::move(family));
+  CacheAndAnswer(index, *std::move(family));
+}
+
+bool BuildBatchReactor::AnswerIfCachedSince(size_t index) {
+  Set& set = sets_[index];
+  const DecodedBuild& build = *set.build;
+  const FamilyCache::Found found = service_->cache_->Lookup(tenant_, build.handle);
+  if (found.resident == nullptr) return false;
+  if (build.frame != nullptr) found.resident->AttachFrameIfNone(build.frame);
+  Answer(index, *found.resident, /*was_cached=*/true);
+  set.decoder.reset();
+  return true;
+}
+
+bool BuildBatchReactor::Packed(size_t index) const {
+  const BatchPacking packing = service_->options_.batch_packing;
+  const bool packs =
+      packing == BatchPacking::kOn || (packing == BatchPacking::kAuto && service_->backend_name_ == "cuda");
+  const DecodedBuild& build = *sets_[index].build;
+  return packs && !build.header.weighted() && build.points.size() <= kHostBatchSetPoints;
+}
+
+std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& all, const BuildSlot& slot, bool limited,
+                                                   Clock::time_point deadline, uint64_t batch_points) {
+  std::vector<size_t> indices;
+  for (size_t i : all) {
+    if (!AnswerIfCachedSince(i)) indices.push_back(i);
+  }
+  if (indices.empty()) return {};
+  std::vector<Point2> points;
+  std::vector<uint32_t> set_begin{0};
+  BuildOptions options;
+  options.backend = service_->backend_;
+  options.cuda_stream = slot.cuda_stream;
+  options.cancelled = [this, limited, deadline] { return cancelled_.load() || (limited && Clock::now() > deadline); };
+  // The sets' limits of exact comparisons, together (none when one of them has none).
+  bool unlimited = false;
+  try {
+    set_begin.reserve(indices.size() + 1);
+    for (size_t i : indices) {
+      const HostVector<Point2>& set = sets_[i].build->points;
+      points.insert(points.end(), set.begin(), set.end());
+      set_begin.push_back(static_cast<uint32_t>(points.size()));
+      const uint64_t limit = ExactComparisonLimit(set.size(), service_->options_.exact_comparisons);
+      unlimited |= limit == 0;
+      options.max_exact_comparisons += limit;
+    }
+  } catch (const std::bad_alloc&) {
+    return indices;  // no memory for the packed input: one by one, each with its own
+  }
+  if (unlimited) options.max_exact_comparisons = 0;
+  const auto start = Clock::now();
+  absl::StatusOr<AlphaFamilies> built = BuildAlphaFamilies(points, set_begin, options);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  points = {};
+  if (!built.ok()) {
+    if (!absl::IsCancelled(built.status())) return indices;  // each set then answers its own limits and errors
+    if (!cancelled_ && limited && Clock::now() > deadline) {
+      for (size_t i : indices) {
+        AnswerError(i, LateDuringBuild(batch_points));
+        sets_[i].decoder.reset();
+      }
+    }
+    return {};  // the caller went away: Run answers for the batch
+  }
+  // One build: its stage times and comparisons counted once.
+  service_->metrics_->RecordBuild(built->report, seconds);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    CacheAndAnswer(indices[k], ShareCachedFamily(std::move(built->families[k]), sets_[indices[k]].build->frame));
+  }
+  return {};
+}
+
+absl::Status BuildBatchReactor::LateDuringBuild(uint64_t batch_points) const {
+  const bool cuda = service_->backend_name_ == "cuda";
+  const unsigned cores = std::thread::hardware_concurrency();
+  return TagRefusal(
+      absl::DeadlineExceededError(absl::StrCat(
+          "the batch ran past its time limit during this set's build (a batch may take the limit of one build of "
+          "all its ",
+          batch_points, " points plus ", kBatchBuildTimePerSet.count(),
+          " ms a set: ", BuildTimeLimitMessage(batch_points, cuda, cores, service_->options_.build_time), ")")),
+      BuildRefusal::kBuildTime);
+}
+
+void BuildBatchReactor::CacheAndAnswer(size_t index, std::shared_ptr<const CachedFamily> family) {
+  Set& set = sets_[index];
+  auto inserted = service_->cache_->Insert(tenant_, set.build->handle, std::move(family));
   if (!inserted.ok()) {
     AnswerError(index, absl::IsResourceExhausted(inserted.status())
                            ? TagRefusal(inserted.status(), BuildRefusal::kCacheBytes)
@@ -290,7 +387,7 @@ void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limit
   } else {
     Answer(index, **inserted, /*was_cached=*/false);
   }
-  set.decoder.reset();
+  set.decoder.reset();  // its points and their reservation
 }
 
 void BuildBatchReactor::Answer(size_t index, const CachedFamily& family, bool was_cached) {

@@ -1,9 +1,12 @@
 // The BuildBatch RPC (issue "Speak GIS and molecules", item 3: one hull per feature): many point
 // sets in one client stream, each as a Build stream would carry it (a header, then its chunks),
 // read through one decoder a set; then one job on the build scheduler builds the sets that are
-// not cached, one after the other on its slot, and the answer goes back in pages of
-// kBatchSetsPerPage. A bad stream fails the whole call, naming the set; a set whose build alone
-// fails answers its own status and the others go on.
+// not cached: the small unweighted ones packed into one build (BuildAlphaFamilies; or one a host
+// core, ServiceOptions::batch_packing), the others one after the other on its slot; the answer
+// goes back in pages of kBatchSetsPerPage. A bad stream fails the whole call, naming the set; a
+// set whose build fails answers its own status and the others go on (a packed build that fails
+// for any reason but the batch's time limit or the caller's cancellation builds its sets again one
+// by one, so that each answers its own limits and errors).
 #pragma once
 
 #include <atomic>
@@ -33,8 +36,9 @@ class AlphaService;
 inline constexpr size_t kMaxBatchSets = 100'000;
 /// Sets a BuildBatchResponse page answers.
 inline constexpr size_t kBatchSetsPerPage = 1000;
-/// Sets of at most this many points are built on the host's cores, one set a core at a time,
-/// whatever the service's backend; larger ones on the build's slot.
+/// Sets of at most this many points are small: unweighted ones are packed into one build when the
+/// service packs (ServiceOptions::batch_packing), the others are built on the host's cores, one
+/// set a core at a time, whatever the service's backend; larger ones on the build's slot.
 inline constexpr size_t kHostBatchSetPoints = 20000;
 /// Build time a batch is given a set, beyond the limit of one build of all its points: each set
 /// costs the engine a fixed start whatever its size.
@@ -82,6 +86,20 @@ class BuildBatchReactor final
   // `on_host`: on the CPU backend, in host memory, whatever the service's backend.
   void BuildSet(size_t index, const BuildSlot& slot, bool limited, Clock::time_point deadline, uint64_t batch_points,
                 bool on_host);
+  // Answers set `index` from the cache when an earlier set of this batch with the same points, or
+  // another call, built it since the stream ended.
+  bool AnswerIfCachedSince(size_t index);
+  // Whether set `index` goes into the batch's packed build (small, unweighted, and the service packs).
+  bool Packed(size_t index) const;
+  // Builds the sets `indices` together on `slot` (BuildAlphaFamilies) and caches their families;
+  // returns the sets to build one by one instead (all of them when the packed build failed for a
+  // reason of its own), having answered the others.
+  std::vector<size_t> BuildPacked(const std::vector<size_t>& indices, const BuildSlot& slot, bool limited,
+                                  Clock::time_point deadline, uint64_t batch_points);
+  // The batch's time limit as the error of a set whose build it stopped.
+  absl::Status LateDuringBuild(uint64_t batch_points) const;
+  // Caches set `index`'s new family and answers it (or the cache's refusal).
+  void CacheAndAnswer(size_t index, std::shared_ptr<const CachedFamily> family);
   // `family` as set `index`'s answer.
   void Answer(size_t index, const CachedFamily& family, bool was_cached);
   // Set `index`'s answer as a failure (counted as a refusal when it is one and `count_refusal`).

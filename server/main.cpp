@@ -55,6 +55,10 @@ ABSL_FLAG(uint64_t, compact_cache_bytes, uint64_t{4} << 30,
 ABSL_FLAG(uint64_t, device_cache_bytes, 0,
           "GPU memory for families whose rank tables stay on the GPU after their build (no download; queries "
           "answered there), taken from the builds' default budget; 0: CUDA families are copied to host memory");
+ABSL_FLAG(std::string, batch_packing, "auto",
+          "how BuildBatch builds its small unweighted sets (at most 20,000 points): on (packed into one build on the "
+          "service's backend), off (one set a host core, each its own build) or auto (on with the CUDA backend, off "
+          "on the CPU)");
 ABSL_FLAG(int, max_message_bytes, 4 << 20, "largest request message accepted");
 ABSL_FLAG(std::string, tls_cert, "", "PEM certificate chain; with --tls_key turns TLS on");
 ABSL_FLAG(std::string, tls_key, "", "PEM private key");
@@ -142,6 +146,16 @@ int main(int argc, char** argv) {
   options.service.cache_bytes = absl::GetFlag(FLAGS_cache_bytes);
   options.service.compact_cache_bytes = absl::GetFlag(FLAGS_compact_cache_bytes);
   options.service.device_cache_bytes = absl::GetFlag(FLAGS_device_cache_bytes);
+  const std::string packing = absl::GetFlag(FLAGS_batch_packing);
+  if (packing == "auto") {
+    options.service.batch_packing = galpha::server::BatchPacking::kAuto;
+  } else if (packing == "on") {
+    options.service.batch_packing = galpha::server::BatchPacking::kOn;
+  } else if (packing == "off") {
+    options.service.batch_packing = galpha::server::BatchPacking::kOff;
+  } else {
+    return Fail(absl::StrCat("unknown --batch_packing '", packing, "' (expected auto, on or off)"));
+  }
   if (const std::string path = absl::GetFlag(FLAGS_token_file); !path.empty()) {
     auto tokens = galpha::server::TenantTokens::ReadFile(path);
     if (!tokens.ok()) return Fail(std::string(tokens.status().message()));

@@ -108,8 +108,13 @@ v1::BuildRequest PointsOf(const std::vector<Point2>& points) {
   return chunk;
 }
 
-TEST(ServiceBatchTest, ABatchGivesTheFamiliesItsSetsGiveAlone) {
-  auto server = StartServer(TestServerOptions());
+class ServiceBatchPackingTest : public ::testing::TestWithParam<BatchPacking> {};
+
+TEST_P(ServiceBatchPackingTest, ABatchGivesTheFamiliesItsSetsGiveAlone) {
+  // The small unweighted sets packed into one build (on), or built one a host core (off).
+  auto options = TestServerOptions();
+  options.service.batch_packing = GetParam();
+  auto server = StartServer(options);
   auto alone = StartServer(TestServerOptions());
   ASSERT_NE(server, nullptr);
   ASSERT_NE(alone, nullptr);
@@ -158,6 +163,38 @@ TEST(ServiceBatchTest, ABatchGivesTheFamiliesItsSetsGiveAlone) {
     }
   }
   EXPECT_EQ(ScrapeMetric(*server, "galpha_rpcs_total{code=\"OK\",method=\"BuildBatch\"}"), 2.0);
+  // Builds: packed, the seven small unweighted sets (the repeat is answered by its first) are one,
+  // then the large set and the weighted one; one a core, nine.
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_build_seconds_count"), GetParam() == BatchPacking::kOn ? 3.0 : 9.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Packing, ServiceBatchPackingTest, ::testing::Values(BatchPacking::kOn, BatchPacking::kOff),
+                         [](const ::testing::TestParamInfo<BatchPacking>& info) {
+                           return info.param == BatchPacking::kOn ? std::string("packed") : std::string("one_a_core");
+                         });
+
+TEST(ServiceBatchTest, APackedSetPastItsOwnComparisonLimitFailsAloneAndTheOthersAreBuilt) {
+  // A limit of 2,000 exact comparisons a set: a 4,000-point grid's exact ties need about 19,500,
+  // uniform points none. The packed build passes the sets' summed limit and stops; its sets are
+  // built again one by one, and only the grid answers the limit.
+  auto options = TestServerOptions();
+  options.service.batch_packing = BatchPacking::kOn;
+  options.service.exact_comparisons.per_point = 0.5;
+  options.service.exact_comparisons.floor = 2000;
+  auto server = StartServer(options);
+  ASSERT_NE(server, nullptr);
+  auto client = ClientOf(*server);
+  const auto grid = gen::Grid(4000, 31);
+  auto answers = client->BuildBatch(std::vector<client::BatchSet>{
+      {"uniform", gen::Uniform(3000, 30), {}}, {"grid", grid, {}}, {"uniform-too", gen::Uniform(2000, 32), {}}});
+  ASSERT_THAT(answers, IsOk());
+  ASSERT_EQ(answers->size(), 3u);
+  EXPECT_THAT((*answers)[0], IsOk());
+  EXPECT_THAT((*answers)[1].status(),
+              StatusIs(absl::StatusCode::kResourceExhausted, HasSubstr("exact radius comparisons")));
+  EXPECT_THAT((*answers)[2], IsOk());
+  EXPECT_THAT(client->Describe(PointSetHandle(grid)).status(), StatusIs(absl::StatusCode::kNotFound));
+  EXPECT_EQ(ScrapeMetric(*server, "galpha_builds_rejected_total{reason=\"exact_comparisons\"}"), 1.0);
 }
 
 TEST(ServiceBatchTest, AMalformedSetFailsTheWholeBatchNamingIt) {
