@@ -1,7 +1,7 @@
 // alphactl shape --group-by: one shape per group of points (issue "Speak GIS": a hull per feature
 // class, cluster or region). Each group is framed (its own local projection for a geographic
-// CRS), built and shaped on its own, here or, with --server, by the server from one BuildBatch
-// call.
+// CRS) and shaped on its own; the families are built here in one packed build
+// (BuildAlphaFamilies), or, with --server, by the server from one BuildBatch call.
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -15,6 +15,7 @@
 #include "core/geometry/shape.hpp"
 #include "core/geometry/shape_holes.hpp"
 #include "core/io/json_text.hpp"
+#include "gpu/alpha/alpha_engine.hpp"
 
 namespace galpha::alphactl {
 
@@ -49,8 +50,8 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
       return Failure(absl::Status(frame.status().code(), absl::StrCat(names.back(), ": ", frame.status().message())));
     frames.push_back(*std::move(frame));
   }
-  // Each group's level, squared alpha and shape: built here one by one, or by the server in one
-  // BuildBatch call.
+  // Each group's level, squared alpha and shape: built here, or by the server in one BuildBatch
+  // call.
   std::vector<RemoteSetShape> shapes;
   if (!common.server.empty()) {
     std::vector<absl::Span<const Point2>> sets;
@@ -62,9 +63,22 @@ int RunGroupedShape(const CommonArgs& common, const ThresholdArg& threshold, con
     }
     shapes = *std::move(remote);
   } else {
+    // Every group's family in one packed build (BuildAlphaFamilies: each the family of its group
+    // alone); when it fails, the groups are built one by one, so that the error names its group.
+    std::vector<Point2> all;
+    std::vector<uint32_t> set_begin{0};
+    for (const FramedPoints& frame : frames) {
+      all.insert(all.end(), frame.Computed().begin(), frame.Computed().end());
+      set_begin.push_back(static_cast<uint32_t>(all.size()));
+    }
+    BuildOptions options;
+    options.backend = common.backend;
+    absl::StatusOr<AlphaFamilies> packed = BuildAlphaFamilies(all, set_begin, options);
+    all = {};
     for (size_t g = 0; g < groups.size(); ++g) {
       const std::string& name = names[g];
-      auto family = BuildFamily(common, frames[g].Computed(), /*weights=*/{});
+      absl::StatusOr<AlphaFamily> family = packed.ok() ? absl::StatusOr<AlphaFamily>(std::move(packed->families[g]))
+                                                       : BuildFamily(common, frames[g].Computed(), /*weights=*/{});
       if (!family.ok())
         return Failure(absl::Status(family.status().code(), absl::StrCat(name, ": ", family.status().message())));
       auto level = ResolveThreshold(*family, threshold);
