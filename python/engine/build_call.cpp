@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string_view>
 #include <utility>
@@ -90,6 +91,16 @@ struct PythonCallbacks {
   std::optional<py::error_already_set> error;
 };
 
+/// Python runs signal handlers only when the interpreter runs: the engine asks between phases,
+/// so that Ctrl-C stops a long build (KeyboardInterrupt from the default SIGINT handler).
+std::function<bool()> CancelledBySignal(PythonCallbacks* callbacks) {
+  return [callbacks] {
+    py::gil_scoped_acquire gil;
+    if (!callbacks->error && PyErr_CheckSignals() != 0) callbacks->error.emplace();
+    return callbacks->error.has_value();
+  };
+}
+
 /// `call()` (returning an absl::StatusOr<T>) with the GIL released; its error raised as
 /// EngineError once the GIL is held again.
 template <class T, class Call>
@@ -144,13 +155,7 @@ std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const p
       }
     };
   }
-  // Python runs signal handlers only when the interpreter runs: the engine asks between phases,
-  // so that Ctrl-C stops a long build (KeyboardInterrupt from the default SIGINT handler).
-  options.cancelled = [&callbacks] {
-    py::gil_scoped_acquire gil;
-    if (!callbacks.error && PyErr_CheckSignals() != 0) callbacks.error.emplace();
-    return callbacks.error.has_value();
-  };
+  options.cancelled = CancelledBySignal(&callbacks);
 
   std::optional<absl::StatusOr<AlphaFamily>> built;
   {
@@ -160,6 +165,46 @@ std::shared_ptr<const FamilyState> BuildFamily(const py::object& points, const p
   }
   if (callbacks.error) throw std::move(*callbacks.error);
   return std::make_shared<const FamilyState>(ValueOrThrow(*std::move(built)), name);
+}
+
+std::vector<std::shared_ptr<const FamilyState>> BuildFamilies(const py::object& points, const py::object& set_begin,
+                                                              const std::string& backend,
+                                                              const std::vector<std::string>& names) {
+  const PointArray array = AsPointArray(points);
+  const absl::Span<const Point2> span = PointsOf(array);
+  using OffsetArray = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+  const OffsetArray offsets = OffsetArray::ensure(set_begin);
+  if (!offsets || offsets.ndim() != 1 || static_cast<size_t>(offsets.shape(0)) != names.size() + 1) {
+    PyErr_Clear();
+    throw StatusError(absl::InvalidArgumentError(
+        absl::StrCat("set_begin must be a 1-D array of ", names.size() + 1, " offsets (one more than the names)")));
+  }
+  std::vector<uint32_t> begin(names.size() + 1);
+  for (size_t s = 0; s < begin.size(); ++s) {
+    const int64_t offset = offsets.at(static_cast<py::ssize_t>(s));
+    if (offset < 0 || static_cast<uint64_t>(offset) > span.size()) {
+      throw StatusError(absl::InvalidArgumentError(
+          absl::StrCat("set offset ", s, " is ", offset, ", outside 0..", span.size(), " (the points given)")));
+    }
+    begin[s] = static_cast<uint32_t>(offset);
+  }
+  PythonCallbacks callbacks{py::none(), std::nullopt};
+  BuildOptions options;
+  options.backend = ParseBackend(backend);
+  options.cancelled = CancelledBySignal(&callbacks);
+  std::optional<absl::StatusOr<AlphaFamilies>> built;
+  {
+    py::gil_scoped_release release;
+    built.emplace(BuildAlphaFamilies(span, begin, options));
+  }
+  if (callbacks.error) throw std::move(*callbacks.error);
+  AlphaFamilies families = ValueOrThrow(*std::move(built));
+  std::vector<std::shared_ptr<const FamilyState>> out;
+  out.reserve(families.families.size());
+  for (size_t s = 0; s < families.families.size(); ++s) {
+    out.push_back(std::make_shared<const FamilyState>(std::move(families.families[s]), names[s]));
+  }
+  return out;
 }
 
 std::string HandleOf(const py::object& points) {

@@ -5,6 +5,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <pybind11/pybind11.h>
 
@@ -21,6 +22,15 @@ namespace galpha::python {
 std::shared_ptr<const FamilyState> BuildFamily(const pybind11::object& points, const pybind11::object& weights,
                                                const std::string& backend, const pybind11::object& progress,
                                                const std::string& name);
+
+/// Builds the families of many point sets in one packed build (BuildAlphaFamilies): set s is
+/// points[set_begin[s]:set_begin[s + 1]] (`set_begin`: a 1-D array of S + 1 offsets from 0 to N),
+/// labelled names[s]; each family equals BuildFamily's of the set alone. Unweighted. Ctrl-C stops
+/// the build between phases, as BuildFamily's; engine errors raise EngineError.
+std::vector<std::shared_ptr<const FamilyState>> BuildFamilies(const pybind11::object& points,
+                                                              const pybind11::object& set_begin,
+                                                              const std::string& backend,
+                                                              const std::vector<std::string>& names);
 
 /// The content handle of `points` (core/io/point_set_handle.hpp), hashed with the GIL released.
 std::string HandleOf(const pybind11::object& points);

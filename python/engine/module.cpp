@@ -1,8 +1,11 @@
 // galpha._engine: the embedded engine for the galpha Python package (python/src/galpha/_local.py
 // adapts it to the package's types). Every error is galpha._engine.EngineError with the absl code.
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include "gpu/system/backend.hpp"
 #include "python/engine/build_call.hpp"
@@ -29,6 +32,20 @@ PYBIND11_MODULE(_engine, module) {
       "backend 'auto', 'cpu' or 'cuda', with the GIL released; with weights (N numbers, squared radii) the "
       "weighted family. progress(phase, fraction) is called after each phase; Ctrl-C or an exception in "
       "progress stops the build between phases and is raised.");
+  module.def(
+      "build_many",
+      [](const py::object& points, const py::object& set_begin, const std::vector<std::string>& names,
+         const std::string& backend) {
+        std::vector<galpha::python::FamilyObject> families;
+        for (auto& state : galpha::python::BuildFamilies(points, set_begin, backend, names)) {
+          families.emplace_back(std::move(state));
+        }
+        return families;
+      },
+      py::arg("points"), py::arg("set_begin"), py::arg("names"), py::arg("backend") = "auto",
+      "Builds the exact alpha families of many point sets in one packed build: set s is "
+      "points[set_begin[s]:set_begin[s + 1]] of an (N, 2) float64 array, labelled names[s]; each family equals "
+      "build()'s of the set alone. Unweighted; the GIL is released; Ctrl-C stops the build between phases.");
   module.def("handle", &galpha::python::HandleOf, py::arg("points"),
              "The content handle of an (N, 2) float64 array, as the server and the C++ client compute it.");
   module.def("frame", &galpha::python::FrameOf, py::arg("crs"), py::arg("points"),

@@ -464,3 +464,39 @@ def test_ctrl_c_during_a_long_build_stops_it() -> None:
             pass
         pytest.skip(f"the build finished in {end - start:.2f} s, before the signal")
     assert build(OBTUSE).summary()["spectrum_size"] == 3  # the interpreter and the engine go on
+
+
+def test_local_build_batch_gives_each_set_the_family_it_gives_alone() -> None:
+    # One packed engine build of sets of every kind (a grid's exact ties, a line, an empty set,
+    # one point, a repeat); the oracle is each set built alone.
+    rng = np.random.default_rng(41)
+    sets = {
+        "uniform": rng.random((700, 2)),
+        "grid": np.array([[i, j] for i in range(20) for j in range(15)], dtype=np.float64),
+        "line": np.column_stack([np.arange(40.0), np.zeros(40)]),
+        "empty": np.empty((0, 2)),
+        "one": np.array([[0.5, 0.25]]),
+    }
+    sets["again"] = sets["uniform"].copy()
+    with galpha.local("cpu") as c:
+        families = c.build_batch(sets)
+        assert [f.summary.name for f in families] == list(sets)
+        for (name, points), family in zip(sets.items(), families):
+            alone = c.build(points)
+            assert family.handle == alone.handle, name
+            assert family.spectrum_size == alone.spectrum_size, name
+            np.testing.assert_array_equal(family.spectrum(), alone.spectrum())
+            assert family.summary.triangles == alone.summary.triangles, name
+            for k in {0, family.spectrum_size // 2, family.spectrum_size}:
+                got, want = family.classify(rank=k), alone.classify(rank=k)
+                np.testing.assert_array_equal(got.triangles, want.triangles)
+                np.testing.assert_array_equal(got.triangle_classes, want.triangle_classes)
+                np.testing.assert_array_equal(got.edge_classes, want.edge_classes)
+                assert (got.components, got.solid_components, got.interior_area) == (
+                    want.components,
+                    want.solid_components,
+                    want.interior_area,
+                ), name
+        assert c.build_batch({}) == []
+        with pytest.raises(galpha.InvalidInput, match="a mapping of name to points"):
+            c.build_batch([sets["uniform"]])

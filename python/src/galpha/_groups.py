@@ -48,9 +48,10 @@ def shapes_by_group(
     first appear.
 
     ``data`` is anything ``client.build`` takes; ``by`` a column of a GeoDataFrame or one label per
-    point (None or NaN labels form one group, labelled None). Each group is built on its own with
-    ``client`` (under a geographic CRS in its own local projection: ``alpha`` in metres, ``area``
-    in square metres) and released after. The threshold keywords are :meth:`Family.shape`'s, and
+    point (None or NaN labels form one group, labelled None). The groups are built together with
+    ``client.build_batch`` (the local engine packs them into one build; a server reads them from
+    one BuildBatch stream), each as it would be built on its own (under a geographic CRS in its own
+    local projection: ``alpha`` in metres, ``area`` in square metres), and released after. The threshold keywords are :meth:`Family.shape`'s, and
     ``crs`` is :meth:`NetworkClient.build`'s. ``alphactl shape --group-by`` gives the same shapes
     for files."""
     import geopandas
@@ -63,9 +64,12 @@ def shapes_by_group(
         groups.setdefault(None if _missing(label) else label, []).append(i)
     rows: Dict[str, List[Any]] = {"group": [], "points": [], "level": [], "area": []}
     geometries: List[Any] = []
-    for label, indices in groups.items():
-        subset = points[np.asarray(indices)]
-        with client.build(subset, crs=data_crs if crs is None else crs) as family:
+    subsets = [points[np.asarray(indices)] for indices in groups.values()]
+    families = client.build_batch(
+        [(str(label), subset) for label, subset in zip(groups, subsets)], crs=data_crs if crs is None else crs
+    )
+    for (label, indices), subset, built in zip(groups.items(), subsets, families):
+        with built as family:
             level = family.classify(alpha=alpha, alpha_sq=alpha_sq, rank=rank, ratio=ratio, summary_only=True).level
             rows["group"].append(label)
             rows["points"].append(len(indices))

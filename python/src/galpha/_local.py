@@ -38,7 +38,7 @@ from ._types import (
     VertexRule,
 )
 
-__all__ = ["LocalFamilyBackend", "build_local"]
+__all__ = ["LocalFamilyBackend", "build_local", "build_many_local"]
 
 _T = TypeVar("_T")
 
@@ -202,3 +202,11 @@ def build_local(
     build between phases (KeyboardInterrupt), as does an exception raised by ``progress``
     (re-raised here)."""
     return LocalFamilyBackend(_engine.build(points, backend, progress, name, weights))
+
+
+@_translated
+def build_many_local(points: np.ndarray, set_begin: np.ndarray, backend: str, names: List[str]) -> List[LocalFamilyBackend]:
+    """Builds the families of many point sets in one packed build: set s is
+    ``points[set_begin[s]:set_begin[s + 1]]``, labelled ``names[s]``; each family equals
+    :func:`build_local`'s of the set alone. Unweighted."""
+    return [LocalFamilyBackend(f) for f in _engine.build_many(points, set_begin, names, backend)]
