@@ -155,13 +155,29 @@ struct VertexAsExtremes {
   GALPHA_HD Extremes operator()(int32_t v) const { return {{v, v, v, v}}; }
 };
 
+/// Merges two runs' extremes. CUB's reduce-by-key also applies the operator to the unloaded
+/// values past the input's end (their results are dropped), so an operand outside the `m`
+/// vertices is never read: the other one is taken (the unchecked version read far outside the
+/// points on the device, compute-sanitizer's memcheck found it).
 struct MergeExtremes {
   const Point2* pts;
+  int32_t m;
   GALPHA_HD Extremes operator()(const Extremes& a, const Extremes& b) const {
     const VertexLexLess xy{pts};
     const VertexLexLessYX yx{pts};
-    return {{xy(b.v[0], a.v[0]) ? b.v[0] : a.v[0], xy(a.v[1], b.v[1]) ? b.v[1] : a.v[1],
-             yx(b.v[2], a.v[2]) ? b.v[2] : a.v[2], yx(a.v[3], b.v[3]) ? b.v[3] : a.v[3]}};
+    Extremes out;
+    for (int k = 0; k < 4; ++k) {
+      const int32_t x = a.v[k], y = b.v[k];
+      const bool x_valid = x >= 0 && x < m, y_valid = y >= 0 && y < m;
+      if (!x_valid || !y_valid) {
+        out.v[k] = x_valid ? x : y;
+        continue;
+      }
+      // 0: first in (x, y) order; 1: last; 2: first in (y, x) order; 3: last.
+      const bool take_y = k == 0 ? xy(y, x) : k == 1 ? xy(x, y) : k == 2 ? yx(y, x) : yx(x, y);
+      out.v[k] = take_y ? y : x;
+    }
+    return out;
   }
 };
 
@@ -395,7 +411,8 @@ PackedTriangulation<System> TriangulateSetsOnSystem(System& sys, const Point2* h
         Buffer<Extremes, System> extremes(sys, num_meshes);
         thrust::reduce_by_key(pol, vertex_set.begin(), vertex_set.end(),
                               thrust::make_transform_iterator(vfirst, VertexAsExtremes()), keys.begin(),
-                              extremes.begin(), thrust::equal_to<uint32_t>(), MergeExtremes{vertex_points.data()});
+                              extremes.begin(), thrust::equal_to<uint32_t>(),
+                              MergeExtremes{vertex_points.data(), static_cast<int32_t>(m)});
         thrust::for_each(pol, first, first + num_meshes,
                          ScatterBySet<Extremes>{keys.data(), extremes.data(), set_extremes.data()});
       }
