@@ -314,13 +314,13 @@ bool BuildBatchReactor::Packed(size_t index) const {
   return packs && !build.header.weighted() && build.points.size() <= kHostBatchSetPoints;
 }
 
-std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& all, const BuildSlot& slot, bool limited,
-                                                   Clock::time_point deadline, uint64_t batch_points) {
-  std::vector<size_t> indices;
-  for (size_t i : all) {
-    if (!AnswerIfCachedSince(i)) indices.push_back(i);
+std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& indices, const BuildSlot& slot,
+                                                   bool limited, Clock::time_point deadline, uint64_t batch_points) {
+  std::vector<size_t> to_pack;
+  for (size_t i : indices) {
+    if (!AnswerIfCachedSince(i)) to_pack.push_back(i);
   }
-  if (indices.empty()) return {};
+  if (to_pack.empty()) return {};
   std::vector<Point2> points;
   std::vector<uint32_t> set_begin{0};
   BuildOptions options;
@@ -330,8 +330,8 @@ std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& al
   // The sets' limits of exact comparisons, together (none when one of them has none).
   bool unlimited = false;
   try {
-    set_begin.reserve(indices.size() + 1);
-    for (size_t i : indices) {
+    set_begin.reserve(to_pack.size() + 1);
+    for (size_t i : to_pack) {
       const HostVector<Point2>& set = sets_[i].build->points;
       points.insert(points.end(), set.begin(), set.end());
       set_begin.push_back(static_cast<uint32_t>(points.size()));
@@ -340,7 +340,7 @@ std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& al
       options.max_exact_comparisons += limit;
     }
   } catch (const std::bad_alloc&) {
-    return indices;  // no memory for the packed input: one by one, each with its own
+    return to_pack;  // no memory for the packed input: one by one, each with its own
   }
   if (unlimited) options.max_exact_comparisons = 0;
   const auto start = Clock::now();
@@ -348,9 +348,9 @@ std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& al
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   points = {};
   if (!built.ok()) {
-    if (!absl::IsCancelled(built.status())) return indices;  // each set then answers its own limits and errors
+    if (!absl::IsCancelled(built.status())) return to_pack;  // each set then answers its own limits and errors
     if (!cancelled_ && limited && Clock::now() > deadline) {
-      for (size_t i : indices) {
+      for (size_t i : to_pack) {
         AnswerError(i, LateDuringBuild(batch_points));
         sets_[i].decoder.reset();
       }
@@ -359,8 +359,8 @@ std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& al
   }
   // One build: its stage times and comparisons counted once.
   service_->metrics_->RecordBuild(built->report, seconds);
-  for (size_t k = 0; k < indices.size(); ++k) {
-    CacheAndAnswer(indices[k], ShareCachedFamily(std::move(built->families[k]), sets_[indices[k]].build->frame));
+  for (size_t k = 0; k < to_pack.size(); ++k) {
+    CacheAndAnswer(to_pack[k], ShareCachedFamily(std::move(built->families[k]), sets_[to_pack[k]].build->frame));
   }
   return {};
 }
