@@ -913,19 +913,35 @@ void KeepResidentTables(System& sys, const PipelineMesh& mesh, SystemTriangulati
 
 // ---- The pipeline -------------------------------------------------------------------------------------------
 
+/// What the pipeline of one set adds for many: nothing. A packed build of many sets passes its own
+/// (packed_family.cuh's SetPacking): the sets' edge runs, the exact order separated by set, the
+/// sets' rank runs and their area scales.
+struct NoPacking {
+  template <class System>
+  void AfterMesh(System&, const PipelineMesh&) {}
+  template <class System>
+  void AfterExactOrder(System&, const PipelineMesh&, ExactSpectrum<System>*, StageTimer<System>&) {}
+  template <class System>
+  void AfterRanks(System&, const PipelineMesh&, const SpectrumRanks<System>&) {}
+  const PackedAreaSets* area_sets() const { return nullptr; }
+};
+
 /// Runs the alpha pipeline on the triangulation `t` (in `sys`'s memory, with its points kept) and
 /// downloads the family into `out`: triangles, edges, duplicate map and rank tables (or, with
 /// `resident`, downloads the mesh and keeps the rank tables there). `host_points` is the same input
 /// in host memory (the host's exact repairs read it). One stage a call; the buffers a stage no
-/// longer needs are freed by the stage that reads them last.
-template <class System>
+/// longer needs are freed by the stage that reads them last. `packing`: a packed build's additions
+/// (then without persistence or resident tables).
+template <class System, class Packing = NoPacking>
 void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2* host_points,
                       const double* host_weights, StageTimer<System>& timer, uint64_t max_exact_comparisons,
-                      bool persistence, ResidentTablesOn<System>* resident, FamilyOutput* family) {
+                      bool persistence, ResidentTablesOn<System>* resident, FamilyOutput* family,
+                      Packing packing = {}) {
   AlphaRanks* out = &family->ranks;
   PipelineMesh mesh = PipelineMeshOf(t);
   if (mesh.weights != nullptr) HiddenVertices(sys, t, mesh);
   HostMesh<System> host_mesh = StartMeshDownload(sys, t, mesh, host_points, host_weights, family);
+  packing.AfterMesh(sys, mesh);
   Buffer<EdgeTris, System> edge_tris = EdgeTriangles(sys, mesh, &t);
   timer.EndStage("edge_topology");
   SimplexKeys<System> keys = KeySimplices(sys, mesh, edge_tris, host_mesh);
@@ -934,7 +950,9 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   timer.EndStage("spectrum_sort");
   ExactSpectrum<System> exact =
       RepairSpectrum(sys, mesh, host_mesh, &sorted, timer, max_exact_comparisons, &out->comparisons);
+  packing.AfterExactOrder(sys, mesh, &exact, timer);
   SpectrumRanks<System> ranks = RankSpectrum(sys, mesh, &exact);
+  packing.AfterRanks(sys, mesh, ranks);
   timer.EndStage("ranks");
   SpectrumValues<System> values = RoundSpectrumValues(sys, mesh, ranks);
   timer.EndStage("spectrum_values");
@@ -967,7 +985,7 @@ void RunAlphaPipeline(System& sys, SystemTriangulation<System>& t, const Point2*
   // the master list is not yet held beside it.
   ComponentCounts<System> components =
       CountComponents(sys, mesh, edge_tris, ranks, intervals, persistence ? orders->edge_position.data() : nullptr,
-                      persistence ? primal_forest.data() : nullptr);
+                      persistence ? primal_forest.data() : nullptr, packing.area_sets());
   timer.EndStage("components");
   MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
   timer.EndStage("master_list");

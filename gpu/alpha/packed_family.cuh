@@ -40,7 +40,6 @@
 #include <thrust/transform.h>
 
 #include <cstdint>
-#include <optional>
 #include <utility>
 #include <vector>
 
@@ -159,14 +158,33 @@ std::vector<uint32_t> SetRankBegin(System& sys, const PipelineMesh& mesh, const 
   return begin.ToHostVector(size_t{num_sets} + 1);
 }
 
+/// The packed build's additions to the pipeline (alpha_impl.cuh's RunAlphaPipeline): where each
+/// set's edges lie, the exact order separated by set, where each set's ranks lie, each set's
+/// area scale.
+template <class System>
+struct SetPacking {
+  const uint32_t* input_set;
+  uint32_t num_sets;
+  PackedFamilyOutput* out;
+  PackedAreaSets area;
+
+  void AfterMesh(System& sys, const PipelineMesh& mesh) { FindSetEdgeRuns(sys, mesh, input_set, num_sets, out); }
+  void AfterExactOrder(System& sys, const PipelineMesh& mesh, ExactSpectrum<System>* exact, StageTimer<System>& timer) {
+    SeparateSetsInSpectrum(sys, mesh, input_set, exact);
+    timer.EndStage("spectrum_sets");
+  }
+  void AfterRanks(System& sys, const PipelineMesh& mesh, const SpectrumRanks<System>& ranks) {
+    out->set_rank_begin = SetRankBegin(sys, mesh, input_set, ranks, num_sets);
+  }
+  const PackedAreaSets* area_sets() const { return &area; }
+};
+
 /// The packed build of the families of `num_sets` sets of `n` host points (set s: [set_begin[s],
 /// set_begin[s + 1])) on `sys`, downloaded into `out` (see PackedFamilyOutput). One stage a call.
 template <class System>
 void RunPackedFamilyBuild(System& sys, const Point2* host_points, const uint32_t* host_set_begin, uint32_t num_sets,
                           uint32_t n, const BuildHooks& hooks, PackedFamilyOutput* out) {
-  FamilyOutput* family = &out->all;
-  AlphaRanks* ranks_out = &family->ranks;
-  StageTimer<System> timer(sys, &family->stage_times);
+  StageTimer<System> timer(sys, &out->all.stage_times);
   PackedTriangulation<System> packed =
       TriangulateSetsOnSystem(sys, host_points, host_set_begin, num_sets, n, /*keep_points=*/true, timer);
   if (hooks.after_triangulation) hooks.after_triangulation();
@@ -175,40 +193,12 @@ void RunPackedFamilyBuild(System& sys, const Point2* host_points, const uint32_t
   if (out->set_triangle_begin.empty()) out->set_triangle_begin.assign(size_t{num_sets} + 1, 0);
   out->build_alone = std::move(packed.build_alone);
   const uint32_t* input_set = packed.input_set.data();
-
-  PipelineMesh mesh = PipelineMeshOf(packed.mesh);
-  HostMesh<System> host_mesh = StartMeshDownload(sys, packed.mesh, mesh, host_points, nullptr, family);
-  FindSetEdgeRuns(sys, mesh, input_set, num_sets, out);
-  Buffer<EdgeTris, System> edge_tris = EdgeTriangles(sys, mesh, &packed.mesh);
-  timer.EndStage("edge_topology");
-  SimplexKeys<System> keys = KeySimplices(sys, mesh, edge_tris, host_mesh);
-  timer.EndStage("radii_attachment");
-  SortedSpectrum<System> sorted = SortSpectrum(sys, mesh, &keys);
-  timer.EndStage("spectrum_sort");
-  ExactSpectrum<System> exact =
-      RepairSpectrum(sys, mesh, host_mesh, &sorted, timer, hooks.max_exact_comparisons, &ranks_out->comparisons);
-  SeparateSetsInSpectrum(sys, mesh, input_set, &exact);
-  timer.EndStage("spectrum_sets");
-  SpectrumRanks<System> ranks = RankSpectrum(sys, mesh, &exact);
-  out->set_rank_begin = SetRankBegin(sys, mesh, input_set, ranks, num_sets);
-  timer.EndStage("ranks");
-  SpectrumValues<System> values = RoundSpectrumValues(sys, mesh, ranks);
-  timer.EndStage("spectrum_values");
-  IntervalRanks<System> intervals = ComputeIntervals(sys, mesh, edge_tris, &ranks, &keys);
-  timer.EndStage("intervals");
-  // Declared after the buffers it reads: on an early exit it waits for its copies before they go.
-  std::optional<PendingDownloadOf<System>> tables_download;
-  tables_download.emplace(StartTablesDownload(sys, mesh, edge_tris, ranks, values, intervals, ranks_out));
-  const PackedAreaSets area_sets{input_set, num_sets, &out->set_area_scale};
-  ComponentCounts<System> components =
-      CountComponents(sys, mesh, edge_tris, ranks, intervals, nullptr, nullptr, &area_sets);
-  timer.EndStage("components");
-  MasterListCsr<System> master = BuildMasterList(sys, mesh, ranks, intervals);
-  timer.EndStage("master_list");
-  FinishDownload(sys, ranks, values, master, components, &*tables_download, &host_mesh, ranks_out);
-  timer.EndStage("download");
+  const SetPacking<System> packing{input_set, num_sets, out, PackedAreaSets{input_set, num_sets, &out->set_area_scale}};
+  RunAlphaPipeline<System, SetPacking<System>>(sys, packed.mesh, host_points, /*host_weights=*/nullptr, timer,
+                                               hooks.max_exact_comparisons,
+                                               /*persistence=*/false, /*resident=*/nullptr, &out->all, packing);
   timer.Finish();
-  family->peak_memory_bytes = sys.peak_bytes();
+  out->all.peak_memory_bytes = sys.peak_bytes();
 }
 
 }  // namespace galpha::detail
