@@ -96,40 +96,17 @@ class PackedFamiliesTest : public testing::BackendTest {
 };
 
 TEST_P(PackedFamiliesTest, EveryGeneratorAtEverySizeEqualsItsSetAlone) {
-  SetsToPack sets;
-  uint64_t seed = 1;
-  for (const gen::NamedGenerator& g : gen::AllDistributions()) {
-    for (const size_t n : {0, 1, 2, 3, 4, 7, 50, 333, 1000}) {
-      sets.Add(g.name + " n=" + std::to_string(n), g.generate(n, seed++));
-    }
-  }
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::SetsOfEveryGenerator({0, 1, 2, 3, 4, 7, 50, 333, 1000}));
 }
 
 TEST_P(PackedFamiliesTest, DegenerateSetsAndChainsEqualTheirSetAlone) {
-  SetsToPack sets;
-  for (const gen::NamedPoints& p : gen::SmallDegenerateSets()) sets.Add(p.name, p.points);
-  std::vector<Point2> line, diagonal;
-  for (int i = 0; i < 40; ++i) line.push_back({0.25 * i, 3.0});
-  for (int i = 0; i < 25; ++i) diagonal.push_back({i * 1.0, i * 2.0 + 1.0});
-  sets.Add("horizontal line", line);
-  sets.Add("uniform", gen::Uniform(500, 9));
-  sets.Add("diagonal line", diagonal);
-  sets.Add("one point four times", std::vector<Point2>(4, Point2{2.0, -1.0}));
-  sets.Add("empty", {});
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::DegenerateSetsAndChains());
 }
 
-TEST_P(PackedFamiliesTest, SetsWithoutAMeshEqualTheirSetAlone) {
-  SetsToPack sets;
-  std::vector<Point2> vertical, repeated_pair;
-  for (int i = 0; i < 30; ++i) vertical.push_back({-2.0, 0.125 * (i % 17) + i});
-  for (int i = 0; i < 9; ++i) repeated_pair.push_back(i % 2 == 0 ? Point2{1.0, 1.0} : Point2{3.0, -5.0});
-  sets.Add("vertical line", vertical);
-  sets.Add("empty", {});
-  sets.Add("two points, repeated", repeated_pair);
-  sets.Add("one point", {Point2{0.5, 0.5}});
-  ExpectEqualToEachAlone(sets);
+TEST_P(PackedFamiliesTest, SetsWithoutAMeshEqualTheirSetAlone) { ExpectEqualToEachAlone(testing::SetsWithoutAMesh()); }
+
+TEST_P(PackedFamiliesTest, SetsOfThreePointsEqualTheirSetAlone) {
+  ExpectEqualToEachAlone(testing::SetsOfThreePoints());
 }
 
 TEST_P(PackedFamiliesTest, RadiiTiedExactlyAcrossSetsEqualTheirSetAlone) {
@@ -148,24 +125,12 @@ TEST_P(PackedFamiliesTest, RadiiTiedExactlyAcrossSetsEqualTheirSetAlone) {
 }
 
 TEST_P(PackedFamiliesTest, SetsOfVeryDifferentMagnitudesEachMeasureAsAlone) {
-  // Each set's area scale (its own box) and filters' scaling: tiny, offset by 1e15, ordinary.
-  SetsToPack sets;
-  sets.Add("tiny", gen::Tiny(800, 3));
-  sets.Add("huge offset 1e15", gen::HugeOffset(800, 4, 1e15));
-  sets.Add("uniform", gen::Uniform(800, 5));
-  sets.Add("tiny again", gen::Tiny(300, 6));
-  ExpectEqualToEachAlone(sets);
+  // Each set's area scale (its own box) and filters' scaling.
+  ExpectEqualToEachAlone(testing::SetsOfVeryDifferentMagnitudes());
 }
 
 TEST_P(PackedFamiliesTest, HundredsOfSmallSetsEqualTheirSetsAlone) {
-  SetsToPack sets;
-  const std::vector<gen::NamedGenerator> generators = gen::AllDistributions();
-  for (uint32_t s = 0; s < 400; ++s) {
-    const gen::NamedGenerator& g = generators[s % generators.size()];
-    const size_t n = 20 + (s * 37) % 280;
-    sets.Add(g.name + " n=" + std::to_string(n), g.generate(n, 1000 + s));
-  }
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::SmallSetsOfEveryKind(400));
 }
 
 TEST_P(PackedFamiliesTest, OneSetCountsTheComparisonsOfItsBuildAlone) {

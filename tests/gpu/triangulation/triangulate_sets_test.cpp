@@ -60,80 +60,29 @@ class TriangulateSetsTest : public testing::BackendTest {
 };
 
 TEST_P(TriangulateSetsTest, EveryGeneratorAtEverySizeEqualsItsSetAlone) {
-  SetsToPack sets;
-  uint64_t seed = 1;
-  for (const gen::NamedGenerator& g : gen::AllDistributions()) {
-    for (const size_t n : {0, 1, 2, 3, 4, 7, 50, 333, 2000}) {
-      sets.Add(g.name + " n=" + std::to_string(n), g.generate(n, seed++));
-    }
-  }
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::SetsOfEveryGenerator({0, 1, 2, 3, 4, 7, 50, 333, 2000}));
 }
 
 TEST_P(TriangulateSetsTest, DegenerateSetsEqualTheirSetAlone) {
-  SetsToPack sets;
-  for (const gen::NamedPoints& p : gen::SmallDegenerateSets()) sets.Add(p.name, p.points);
-  // Sets on one line (a chain, no mesh) between sets with meshes, and a set of one point repeated.
-  std::vector<Point2> line, diagonal;
-  for (int i = 0; i < 40; ++i) line.push_back({0.25 * i, 3.0});
-  for (int i = 0; i < 25; ++i) diagonal.push_back({i * 1.0, i * 2.0 + 1.0});
-  sets.Add("horizontal line", line);
-  sets.Add("uniform", gen::Uniform(500, 9));
-  sets.Add("diagonal line", diagonal);
-  sets.Add("one point four times", std::vector<Point2>(4, Point2{2.0, -1.0}));
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::DegenerateSetsAndChains());
 }
 
 TEST_P(TriangulateSetsTest, SetsWithoutAMeshEqualTheirSetAlone) {
-  // No set has a mesh (every one on a line, or of at most two distinct points): the packed build
-  // writes chains only.
-  SetsToPack sets;
-  std::vector<Point2> vertical, repeated_pair;
-  for (int i = 0; i < 30; ++i) vertical.push_back({-2.0, 0.125 * (i % 17) + i});
-  for (int i = 0; i < 9; ++i) repeated_pair.push_back(i % 2 == 0 ? Point2{1.0, 1.0} : Point2{3.0, -5.0});
-  sets.Add("vertical line", vertical);
-  sets.Add("empty", {});
-  sets.Add("two points, repeated", repeated_pair);
-  sets.Add("one point", {Point2{0.5, 0.5}});
-  ExpectEqualToEachAlone(sets);
+  // No set has a mesh: the packed build writes chains only.
+  ExpectEqualToEachAlone(testing::SetsWithoutAMesh());
 }
 
 TEST_P(TriangulateSetsTest, SetsOfThreePointsEqualTheirSetAlone) {
-  // Every set is its first triangle: nothing is left to insert in any set.
-  SetsToPack sets;
-  for (int s = 0; s < 50; ++s) {
-    const double d = 1.0 + s;
-    sets.Add("triangle " + std::to_string(s), {Point2{0.0, 0.0}, Point2{d, s % 2 == 0 ? 0.0 : 1.0}, Point2{0.0, d}});
-  }
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::SetsOfThreePoints());
 }
 
 TEST_P(TriangulateSetsTest, SetsOfVeryDifferentMagnitudesEachScaleAsAlone) {
-  // Each set's power of two (the floating filters' scaling) is its own: a set of tiny coordinates
-  // beside one offset by 1e15 and one of ordinary ones.
-  SetsToPack sets;
-  sets.Add("tiny", gen::Tiny(800, 3));
-  sets.Add("huge offset 1e15", gen::HugeOffset(800, 4, 1e15));
-  sets.Add("uniform", gen::Uniform(800, 5));
-  sets.Add("tiny again", gen::Tiny(300, 6));
-  sets.Add("the same uniform points shifted", [] {
-    std::vector<Point2> p = gen::Uniform(800, 5);
-    for (Point2& q : p) q = {q.x + 1024.0, q.y - 4096.0};
-    return p;
-  }());
-  ExpectEqualToEachAlone(sets);
+  // Each set's power of two (the floating filters' scaling) is its own.
+  ExpectEqualToEachAlone(testing::SetsOfVeryDifferentMagnitudes());
 }
 
 TEST_P(TriangulateSetsTest, ThousandsOfSmallSetsEqualTheirSetsAlone) {
-  // A batch as issue 20's users send it: many features of a few hundred points, every kind.
-  SetsToPack sets;
-  const std::vector<gen::NamedGenerator> generators = gen::AllDistributions();
-  for (uint32_t s = 0; s < 1500; ++s) {
-    const gen::NamedGenerator& g = generators[s % generators.size()];
-    const size_t n = 20 + (s * 37) % 280;
-    sets.Add(g.name + " n=" + std::to_string(n), g.generate(n, 1000 + s));
-  }
-  ExpectEqualToEachAlone(sets);
+  ExpectEqualToEachAlone(testing::SmallSetsOfEveryKind(1500));
 }
 
 TEST_P(TriangulateSetsTest, NoPointsAtAllGiveEmptySets) {
