@@ -419,22 +419,8 @@ bool RunPackedFamilies(const std::string& name, size_t num_sets, size_t points_p
     cgal_ms += MillisecondsSince(start);
   }
   const double scale = static_cast<double>(num_sets) / static_cast<double>(sampled);
-  alone_ms *= scale;
-  cgal_ms *= scale;
-  std::printf(
-      "| %s | %zux%zu | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.1f | %.1f | %s |\n", name.c_str(), num_sets,
-      points_per_set, packed->report.backend.c_str(), packed_ms, whole_ms, packed_ms / whole_ms, alone_ms,
-      alone_ms / packed_ms, cgal_ms, cgal_ms / packed_ms,
-      equal ? (packed->built_alone == 0 ? "yes" : absl::StrCat("yes (", packed->built_alone, " built alone)").c_str())
-            : "NO: MISMATCH");
-  std::string stages;
-  for (const StageTime& stage : packed->report.stage_times) {
-    char ms[64];
-    std::snprintf(ms, sizeof ms, "%s%s %.2f", stages.empty() ? "" : ", ", stage.stage.c_str(), stage.seconds * 1e3);
-    stages += ms;
-  }
-  std::printf("|  | stages (ms) | %s |||||||||\n", stages.c_str());
-  std::fflush(stdout);
+  PrintPackedSetsRow({name, num_sets, points_per_set, packed->report.backend, packed_ms, whole_ms, alone_ms * scale,
+                      cgal_ms * scale, equal, packed->built_alone, packed->report.stage_times});
   return equal;
 }
 

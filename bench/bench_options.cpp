@@ -1,6 +1,7 @@
 #include "bench/bench_options.hpp"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -129,6 +130,28 @@ void GenerateBenchSets(const gen::NamedGenerator& generator, size_t num_sets, si
     points->insert(points->end(), set.begin(), set.end());
     set_begin->push_back(static_cast<uint32_t>(points->size()));
   }
+}
+
+std::string StageSummary(const std::vector<StageTime>& stages) {
+  std::string out;
+  for (const StageTime& stage : stages) {
+    absl::StrAppend(&out, out.empty() ? "" : ", ", stage.stage, " ");
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%.2f", stage.seconds * 1e3);
+    absl::StrAppend(&out, ms);
+  }
+  return out;
+}
+
+void PrintPackedSetsRow(const PackedSetsRow& row) {
+  std::string equal = row.sampled_equal ? "yes" : "NO: MISMATCH";
+  if (row.sampled_equal && row.built_alone > 0) equal = absl::StrCat("yes (", row.built_alone, " built alone)");
+  std::printf("| %s | %zux%zu | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.1f | %.1f | %s |\n", row.name.c_str(),
+              row.num_sets, row.points_per_set, row.backend.c_str(), row.packed_ms, row.whole_ms,
+              row.packed_ms / row.whole_ms, row.alone_ms, row.alone_ms / row.packed_ms, row.competitor_ms,
+              row.competitor_ms / row.packed_ms, equal.c_str());
+  std::printf("|  | stages (ms) | %s |||||||||\n", StageSummary(row.stages).c_str());
+  std::fflush(stdout);
 }
 
 }  // namespace galpha

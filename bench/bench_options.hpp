@@ -10,6 +10,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "core/base/point.hpp"
+#include "core/base/stage_time.hpp"
 #include "gpu/triangulation/delaunay.hpp"
 #include "tests/support/point_generators.hpp"
 
@@ -47,6 +48,26 @@ absl::Status TakeSetsOption(int argc, char** argv, size_t* sets, size_t* points,
 /// after the other in *points, with their offsets (num_sets + 1) in *set_begin.
 void GenerateBenchSets(const gen::NamedGenerator& generator, size_t num_sets, size_t points_per_set, uint64_t seed,
                        std::vector<Point2>* points, std::vector<uint32_t>* set_begin);
+
+/// Stage times as "name ms, name ms, ...", in milliseconds with two decimals.
+std::string StageSummary(const std::vector<StageTime>& stages);
+
+/// What the --sets benchmarks measure of one distribution (times in ms; the two last over a sample
+/// of the sets, scaled to all of them).
+struct PackedSetsRow {
+  std::string name;
+  size_t num_sets = 0, points_per_set = 0;
+  std::string backend;
+  double packed_ms = 0, whole_ms = 0, alone_ms = 0, competitor_ms = 0;
+  bool sampled_equal = false;
+  uint32_t built_alone = 0;
+  std::vector<StageTime> stages;  // the packed build's
+};
+
+/// Prints the row (the columns: distribution, sets x points, backend, packed, all in one, packed /
+/// all in one, one call a set, calls / packed, competitor, competitor / packed, sampled sets equal)
+/// and the packed build's stages under it.
+void PrintPackedSetsRow(const PackedSetsRow& row);
 
 /// Calls `run` with every input the options name: each distribution at each size (generated with
 /// the seed), then each data file (named by its file name). An error reading a file stops there.

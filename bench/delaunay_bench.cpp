@@ -144,8 +144,6 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
   return result;
 }
 
-std::string StageSummary(const std::vector<StageTime>& stages);
-
 /// --sets: one distribution's packed build against its references (see the file comment). Returns
 /// false on an engine error or a sampled set unlike its own build.
 bool RunPackedSets(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options) {
@@ -204,28 +202,9 @@ bool RunPackedSets(const std::string& name, size_t num_sets, size_t points_per_s
     cgal_ms += best;
   }
   const double scale = static_cast<double>(num_sets) / static_cast<double>(sampled);
-  alone_ms *= scale;
-  cgal_ms *= scale;
-  std::printf(
-      "| %s | %zux%zu | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.1f | %.1f | %s |\n", name.c_str(), num_sets,
-      points_per_set, BackendName(packed->backend), packed_ms, whole_ms, packed_ms / whole_ms, alone_ms,
-      alone_ms / packed_ms, cgal_ms, cgal_ms / packed_ms,
-      equal ? (packed->built_alone == 0 ? "yes" : absl::StrCat("yes (", packed->built_alone, " built alone)").c_str())
-            : "NO: MISMATCH");
-  std::printf("|  | stages (ms) | %s |||||||||\n", StageSummary(packed->stage_times).c_str());
-  std::fflush(stdout);
+  PrintPackedSetsRow({name, num_sets, points_per_set, BackendName(packed->backend), packed_ms, whole_ms,
+                      alone_ms * scale, cgal_ms * scale, equal, packed->built_alone, packed->stage_times});
   return equal;
-}
-
-std::string StageSummary(const std::vector<StageTime>& stages) {
-  std::string out;
-  for (const StageTime& stage : stages) {
-    absl::StrAppend(&out, out.empty() ? "" : ", ", stage.stage, " ");
-    char ms[32];
-    std::snprintf(ms, sizeof ms, "%.2f", stage.seconds * 1e3);
-    absl::StrAppend(&out, ms);
-  }
-  return out;
 }
 
 void PrintHeader() {
