@@ -500,3 +500,12 @@ def test_local_build_batch_gives_each_set_the_family_it_gives_alone() -> None:
         assert c.build_batch({}) == []
         with pytest.raises(galpha.InvalidInput, match="a mapping of name to points"):
             c.build_batch([sets["uniform"]])
+        # A set the engine refuses: the packed build fails, the sets are built one by one, and the
+        # error names its set (or takes its place).
+        bad = sets["uniform"].copy()
+        bad[3, 0] = np.nan
+        with pytest.raises(galpha.InvalidInput, match="set 'bad': point 3 is not finite"):
+            c.build_batch([("fine", sets["grid"]), ("bad", bad)])
+        results = c.build_batch([("fine", sets["grid"]), ("bad", bad)], return_exceptions=True)
+        assert isinstance(results[0], galpha.Family) and results[0].spectrum_size == families[1].spectrum_size
+        assert isinstance(results[1], galpha.InvalidInput)
