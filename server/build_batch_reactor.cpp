@@ -197,13 +197,7 @@ void BuildBatchReactor::Run(const BuildSlot& slot, bool draining) {
   const bool limited = one_build.count() > 0;
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(one_build) +
                         kBatchBuildTimePerSet * static_cast<int64_t>(to_build_.size());
-  const absl::Status late = TagRefusal(
-      absl::DeadlineExceededError(absl::StrCat(
-          "the batch ran past its time limit before this set was built (a batch may take the limit of one build "
-          "of all its ",
-          points, " points plus ", kBatchBuildTimePerSet.count(),
-          " ms a set: ", BuildTimeLimitMessage(points, cuda, cores, service_->options_.build_time), ")")),
-      BuildRefusal::kBuildTime);
+  const absl::Status late = PastTimeLimit("before this set was built", points);
   std::atomic<bool> any_late{false};
   // Builds `indices` in order, from `next` on (shared by the threads that take them), until the
   // deadline: past it, the sets left are answered `late` without being started.
@@ -280,7 +274,7 @@ void BuildBatchReactor::BuildSet(size_t index, const BuildSlot& slot, bool limit
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (!family.ok()) {
     if (absl::IsCancelled(family.status()) && !cancelled_ && limited && Clock::now() > deadline) {
-      AnswerError(index, LateDuringBuild(batch_points));
+      AnswerError(index, PastTimeLimit("during this set's build", batch_points));
     } else if (IsExactComparisonLimit(family.status())) {
       AnswerError(index, TagRefusal(absl::ResourceExhaustedError(
                                         ExactComparisonLimitMessage(points, service_->options_.exact_comparisons)),
@@ -351,7 +345,7 @@ std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& in
     if (!absl::IsCancelled(built.status())) return to_pack;  // each set then answers its own limits and errors
     if (!cancelled_ && limited && Clock::now() > deadline) {
       for (size_t i : to_pack) {
-        AnswerError(i, LateDuringBuild(batch_points));
+        AnswerError(i, PastTimeLimit("during this set's build", batch_points));
         sets_[i].decoder.reset();
       }
     }
@@ -365,13 +359,12 @@ std::vector<size_t> BuildBatchReactor::BuildPacked(const std::vector<size_t>& in
   return {};
 }
 
-absl::Status BuildBatchReactor::LateDuringBuild(uint64_t batch_points) const {
+absl::Status BuildBatchReactor::PastTimeLimit(absl::string_view when, uint64_t batch_points) const {
   const bool cuda = service_->backend_name_ == "cuda";
   const unsigned cores = std::thread::hardware_concurrency();
   return TagRefusal(
       absl::DeadlineExceededError(absl::StrCat(
-          "the batch ran past its time limit during this set's build (a batch may take the limit of one build of "
-          "all its ",
+          "the batch ran past its time limit ", when, " (a batch may take the limit of one build of all its ",
           batch_points, " points plus ", kBatchBuildTimePerSet.count(),
           " ms a set: ", BuildTimeLimitMessage(batch_points, cuda, cores, service_->options_.build_time), ")")),
       BuildRefusal::kBuildTime);

@@ -21,6 +21,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "galpha/v1/alpha_shapes.grpc.pb.h"
 #include "server/build_scheduler.hpp"
 #include "server/build_stream.hpp"
@@ -96,8 +97,9 @@ class BuildBatchReactor final
   // reason of its own), having answered the others.
   std::vector<size_t> BuildPacked(const std::vector<size_t>& indices, const BuildSlot& slot, bool limited,
                                   Clock::time_point deadline, uint64_t batch_points);
-  // The batch's time limit as the error of a set whose build it stopped.
-  absl::Status LateDuringBuild(uint64_t batch_points) const;
+  // The batch's time limit as a set's error, `when` it stopped the set ("before this set was
+  // built", "during this set's build"); `batch_points`: the points the batch builds.
+  absl::Status PastTimeLimit(absl::string_view when, uint64_t batch_points) const;
   // Caches set `index`'s new family and answers it (or the cache's refusal).
   void CacheAndAnswer(size_t index, std::shared_ptr<const CachedFamily> family);
   // `family` as set `index`'s answer.
