@@ -16,6 +16,7 @@
 #include "gpu/alpha/alpha_engine.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/backend_fixture.hpp"
+#include "tests/support/family_tables.hpp"
 #include "tests/support/packed_sets.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
@@ -27,46 +28,9 @@ using testing::IsOk;
 using testing::SetsToPack;
 using testing::StatusIs;
 
-template <class V>
-auto AsVector(const V& v) {
-  return std::vector<typename V::value_type>(v.begin(), v.end());
-}
-
-std::vector<uint64_t> PackedEntries(const HostVector<MasterEntry>& master) {
-  std::vector<uint64_t> out;
-  out.reserve(master.size());
-  for (const MasterEntry& m : master) out.push_back(m.packed());
-  return out;
-}
-
-/// Every table of two families of one set, field by field.
+/// Every table of two families of one set, and the backend their reports name.
 void ExpectSameFamily(const AlphaFamily& got, const AlphaFamily& want) {
-  EXPECT_EQ(AsVector(got.points()), AsVector(want.points()));
-  EXPECT_EQ(AsVector(got.representative()), AsVector(want.representative()));
-  EXPECT_EQ(AsVector(got.triangles()), AsVector(want.triangles()));
-  EXPECT_EQ(AsVector(got.edges()), AsVector(want.edges()));
-  const AlphaRanks& g = got.ranks();
-  const AlphaRanks& w = want.ranks();
-  EXPECT_EQ(AsVector(g.spectrum), AsVector(w.spectrum));
-  EXPECT_EQ(AsVector(g.spectrum_simplex), AsVector(w.spectrum_simplex));
-  EXPECT_EQ(AsVector(g.tri_rank), AsVector(w.tri_rank));
-  EXPECT_EQ(AsVector(g.edge_rho_rank), AsVector(w.edge_rho_rank));
-  EXPECT_EQ(AsVector(g.edge_mu_low), AsVector(w.edge_mu_low));
-  EXPECT_EQ(AsVector(g.edge_mu_high), AsVector(w.edge_mu_high));
-  EXPECT_EQ(AsVector(g.edge_triangles), AsVector(w.edge_triangles));
-  EXPECT_EQ(AsVector(g.vertex_mu_low), AsVector(w.vertex_mu_low));
-  EXPECT_EQ(AsVector(g.vertex_mu_high), AsVector(w.vertex_mu_high));
-  EXPECT_EQ(AsVector(g.vertex_tri_low), AsVector(w.vertex_tri_low));
-  EXPECT_EQ(AsVector(g.master_begin), AsVector(w.master_begin));
-  EXPECT_EQ(PackedEntries(g.master), PackedEntries(w.master));
-  EXPECT_EQ(AsVector(g.components), AsVector(w.components));
-  EXPECT_EQ(AsVector(g.solid_components), AsVector(w.solid_components));
-  EXPECT_EQ(AsVector(g.holes), AsVector(w.holes));
-  EXPECT_EQ(AsVector(g.regularized_components), AsVector(w.regularized_components));
-  EXPECT_EQ(AsVector(g.regularized_holes), AsVector(w.regularized_holes));
-  EXPECT_EQ(AsVector(g.area_units), AsVector(w.area_units));
-  EXPECT_EQ(g.area_scale.unit_log2, w.area_scale.unit_log2);
-  EXPECT_EQ(g.area_scale.error_units, w.area_scale.error_units);
+  testing::ExpectSameFamilyTables(got, want);
   EXPECT_EQ(got.report().backend, want.report().backend);
 }
 

@@ -20,24 +20,16 @@
 #include "gpu/alpha/resident_family.hpp"
 #include "gtest/gtest.h"
 #include "tests/support/backend_fixture.hpp"
+#include "tests/support/family_tables.hpp"
 #include "tests/support/point_generators.hpp"
 #include "tests/support/status_matchers.hpp"
 
 namespace galpha {
 namespace {
 
+using testing::AsVector;
 using testing::IsOk;
-
-template <typename T>
-std::vector<T> AsVector(const HostVector<T>& v) {
-  return std::vector<T>(v.begin(), v.end());
-}
-
-std::vector<uint64_t> Packed(const HostVector<MasterEntry>& entries) {
-  std::vector<uint64_t> out;
-  for (const MasterEntry& e : entries) out.push_back(e.packed());
-  return out;
-}
+using testing::PackedEntries;
 
 std::vector<uint64_t> Packed(const std::vector<MasterEntry>& entries) {
   std::vector<uint64_t> out;
@@ -51,39 +43,6 @@ class ResidentFamilyTest : public testing::BackendTest {
     BuildOptions options;
     options.backend = GetParam();
     return options;
-  }
-
-  static void ExpectSameTables(const AlphaFamily& a, const AlphaFamily& b) {
-    EXPECT_EQ(AsVector(a.points()), AsVector(b.points()));
-    EXPECT_EQ(AsVector(a.representative()), AsVector(b.representative()));
-    EXPECT_EQ(a.num_unique(), b.num_unique());
-    EXPECT_EQ(AsVector(a.triangles()), AsVector(b.triangles()));
-    EXPECT_EQ(AsVector(a.edges()), AsVector(b.edges()));
-    EXPECT_EQ(AsVector(a.weights()), AsVector(b.weights()));
-    EXPECT_EQ(AsVector(a.hidden_flags()), AsVector(b.hidden_flags()));
-    const AlphaRanks& r = a.ranks();
-    const AlphaRanks& s = b.ranks();
-    EXPECT_EQ(AsVector(r.spectrum), AsVector(s.spectrum));
-    EXPECT_EQ(AsVector(r.spectrum_simplex), AsVector(s.spectrum_simplex));
-    EXPECT_EQ(AsVector(r.tri_rank), AsVector(s.tri_rank));
-    EXPECT_EQ(AsVector(r.edge_rho_rank), AsVector(s.edge_rho_rank));
-    EXPECT_EQ(AsVector(r.edge_mu_low), AsVector(s.edge_mu_low));
-    EXPECT_EQ(AsVector(r.edge_mu_high), AsVector(s.edge_mu_high));
-    EXPECT_EQ(AsVector(r.edge_triangles), AsVector(s.edge_triangles));
-    EXPECT_EQ(AsVector(r.vertex_mu_low), AsVector(s.vertex_mu_low));
-    EXPECT_EQ(AsVector(r.vertex_mu_high), AsVector(s.vertex_mu_high));
-    EXPECT_EQ(AsVector(r.vertex_tri_low), AsVector(s.vertex_tri_low));
-    EXPECT_EQ(AsVector(r.master_begin), AsVector(s.master_begin));
-    EXPECT_EQ(Packed(r.master), Packed(s.master));
-    EXPECT_EQ(AsVector(r.components), AsVector(s.components));
-    EXPECT_EQ(AsVector(r.solid_components), AsVector(s.solid_components));
-    EXPECT_EQ(AsVector(r.holes), AsVector(s.holes));
-    EXPECT_EQ(AsVector(r.regularized_components), AsVector(s.regularized_components));
-    EXPECT_EQ(AsVector(r.regularized_holes), AsVector(s.regularized_holes));
-    EXPECT_EQ(AsVector(r.area_units), AsVector(s.area_units));
-    EXPECT_EQ(r.area_scale.unit_log2, s.area_scale.unit_log2);
-    EXPECT_EQ(r.area_scale.error_units, s.area_scale.error_units);
-    EXPECT_EQ(a.SolidLevel(), b.SolidLevel());
   }
 
   /// Thresholds that probe the exact resolution: spectrum values, their neighbouring doubles, the
@@ -265,7 +224,7 @@ class ResidentFamilyTest : public testing::BackendTest {
     EXPECT_FALSE(resident.MasterBegins(0, k + 3).ok());
     const absl::StatusOr<std::vector<MasterEntry>> all = resident.MasterEntries(0, host.ranks().master.size());
     ASSERT_THAT(all, IsOk());
-    EXPECT_EQ(Packed(*all), Packed(host.ranks().master));
+    EXPECT_EQ(Packed(*all), PackedEntries(host.ranks().master));
     EXPECT_EQ(resident.MasterEntries(0, host.ranks().master.size() + 1).status().code(), absl::StatusCode::kOutOfRange);
 
     // Optimal levels.
@@ -310,7 +269,7 @@ class ResidentFamilyTest : public testing::BackendTest {
     // The same family, array for array, once downloaded.
     const absl::StatusOr<AlphaFamily> downloaded = resident.ToHostFamily();
     ASSERT_THAT(downloaded, IsOk());
-    ExpectSameTables(*downloaded, host);
+    testing::ExpectSameFamilyTables(*downloaded, host);
   }
 
   void ExpectSameAsHost(const std::vector<Point2>& points, const std::string& where) {
