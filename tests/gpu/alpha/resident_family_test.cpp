@@ -33,6 +33,7 @@ using testing::PackedEntries;
 
 std::vector<uint64_t> Packed(const std::vector<MasterEntry>& entries) {
   std::vector<uint64_t> out;
+  out.reserve(entries.size());
   for (const MasterEntry& e : entries) out.push_back(e.packed());
   return out;
 }
@@ -78,7 +79,7 @@ class ResidentFamilyTest : public testing::BackendTest {
     EXPECT_EQ(resident.comparisons().bounded_exact, host.report().comparisons.bounded_exact);
     EXPECT_EQ(resident.comparisons().cpu_fallback, host.report().comparisons.cpu_fallback);
     const int64_t k = host.max_level();
-    if (host.points().size() > 0) {
+    if (!host.points().empty()) {
       EXPECT_GT(resident.ResidentBytes(), 0u);
     }
 
