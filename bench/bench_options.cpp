@@ -1,7 +1,9 @@
 #include "bench/bench_options.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <limits>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -152,6 +154,71 @@ void PrintPackedSetsRow(const PackedSetsRow& row) {
               row.competitor_ms / row.packed_ms, equal.c_str());
   std::printf("|  | stages (ms) | %s |||||||||\n", StageSummary(row.stages).c_str());
   std::fflush(stdout);
+}
+
+bool RunPackedSetsBench(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options,
+                        const PackedSetsCalls& calls) {
+  constexpr size_t kSampledSets = 200;
+  const gen::NamedGenerator* generator = gen::FindDistribution(name);
+  std::vector<Point2> points;
+  std::vector<uint32_t> set_begin;
+  GenerateBenchSets(*generator, num_sets, points_per_set, options.seed, &points, &set_begin);
+  const auto since = [](std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
+  PackedSetsRow row;
+  row.name = name;
+  row.num_sets = num_sets;
+  row.points_per_set = points_per_set;
+  row.packed_ms = row.whole_ms = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < options.repeat; ++r) {
+    calls.release();  // the last run's result is freed outside the timing
+    std::string error;
+    const auto start = std::chrono::steady_clock::now();
+    if (!calls.packed(points, set_begin, &error)) {
+      std::printf("| %s | %zux%zu | error: %s | | | | | | | |\n", name.c_str(), num_sets, points_per_set,
+                  error.c_str());
+      return false;
+    }
+    row.packed_ms = std::min(row.packed_ms, since(start));
+  }
+  {
+    const std::vector<Point2> whole = generator->generate(num_sets * points_per_set, options.seed);
+    for (int r = 0; r < options.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      if (!calls.whole(whole)) return false;
+      row.whole_ms = std::min(row.whole_ms, since(start));
+    }
+  }
+  // The sampled sets one call each, and by the competitor; their packed results checked against their own.
+  const size_t sampled = std::min(num_sets, kSampledSets);
+  row.sampled_equal = true;
+  for (size_t s = 0; s < sampled; ++s) {
+    const absl::Span<const Point2> set(points.data() + set_begin[s], set_begin[s + 1] - set_begin[s]);
+    double best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < options.repeat; ++r) {
+      bool equal = false;
+      const auto start = std::chrono::steady_clock::now();
+      if (!calls.alone(set, s, &equal)) return false;
+      best = std::min(best, since(start));
+      row.sampled_equal &= equal;
+    }
+    row.alone_ms += best;
+    best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < calls.competitor_repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      calls.competitor(set);
+      best = std::min(best, since(start));
+    }
+    row.competitor_ms += best;
+  }
+  const double scale = static_cast<double>(num_sets) / static_cast<double>(sampled);
+  row.alone_ms *= scale;
+  row.competitor_ms *= scale;
+  calls.describe(&row);
+  PrintPackedSetsRow(row);
+  calls.release();
+  return row.sampled_equal;
 }
 
 }  // namespace galpha

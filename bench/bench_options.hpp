@@ -9,6 +9,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/types/span.h"
 #include "core/base/point.hpp"
 #include "core/base/stage_time.hpp"
 #include "gpu/triangulation/delaunay.hpp"
@@ -68,6 +69,32 @@ struct PackedSetsRow {
 /// all in one, one call a set, calls / packed, competitor, competitor / packed, sampled sets equal)
 /// and the packed build's stages under it.
 void PrintPackedSetsRow(const PackedSetsRow& row);
+
+/// What a --sets benchmark times for one distribution (RunPackedSetsBench).
+struct PackedSetsCalls {
+  /// Builds all the sets in one packed call and keeps the result (for `alone`); false on failure,
+  /// its message in *error.
+  std::function<bool(const std::vector<Point2>& points, const std::vector<uint32_t>& set_begin, std::string* error)>
+      packed;
+  /// Frees the kept result (outside the timing).
+  std::function<void()> release;
+  /// Builds all the points as one set; false on failure.
+  std::function<bool(const std::vector<Point2>& points)> whole;
+  /// Builds set `s` alone; false on failure. *equal: whether it equals the kept result's set `s`.
+  std::function<bool(absl::Span<const Point2> set, size_t s, bool* equal)> alone;
+  /// The competitor's build of a set, timed best of `competitor_repeat`.
+  std::function<void(absl::Span<const Point2> set)> competitor;
+  int competitor_repeat = 1;
+  /// The kept result's backend, sets built alone and stage times into the row.
+  std::function<void(PackedSetsRow* row)> describe;
+};
+
+/// --sets for one distribution: SETS sets of POINTS points of it (GenerateBenchSets) in one packed
+/// call (best of --repeat), against one call of SETS * POINTS points of it, one call a set and the
+/// competitor a set (both over the first 200 sets, scaled to all); prints the row
+/// (PrintPackedSetsRow). False on a failed call or a sampled set unlike its own build.
+bool RunPackedSetsBench(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options,
+                        const PackedSetsCalls& calls);
 
 /// Calls `run` with every input the options name: each distribution at each size (generated with
 /// the seed), then each data file (named by its file name). An error reading a file stops there.

@@ -28,6 +28,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -147,64 +148,36 @@ BenchResult RunOne(const BenchInput& input, const BenchOptions& options) {
 /// --sets: one distribution's packed build against its references (see the file comment). Returns
 /// false on an engine error or a sampled set unlike its own build.
 bool RunPackedSets(const std::string& name, size_t num_sets, size_t points_per_set, const BenchOptions& options) {
-  constexpr size_t kSampledSets = 200;
-  const gen::NamedGenerator* generator = gen::FindDistribution(name);
-  std::vector<Point2> points;
-  std::vector<uint32_t> set_begin;
-  GenerateBenchSets(*generator, num_sets, points_per_set, options.seed, &points, &set_begin);
   TriangulateOptions triangulate_options;
   triangulate_options.backend = options.backend;
-  double packed_ms = std::numeric_limits<double>::infinity(), whole_ms = packed_ms;
-  absl::StatusOr<TriangulatedSets> packed = absl::UnknownError("not run");
-  for (int r = 0; r < options.repeat; ++r) {
-    packed = absl::UnknownError("not run");  // the last run's sets are freed outside the timing
-    const auto start = std::chrono::steady_clock::now();
-    packed = TriangulateSets(points, set_begin, triangulate_options);
-    if (!packed.ok()) break;
-    packed_ms = std::min(packed_ms, MillisecondsSince(start));
-  }
-  if (!packed.ok()) {
-    std::printf("| %s | %zux%zu | error: %s | | | | | | | |\n", name.c_str(), num_sets, points_per_set,
-                packed.status().ToString().c_str());
-    return false;
-  }
-  {
-    const std::vector<Point2> whole = generator->generate(num_sets * points_per_set, options.seed);
-    for (int r = 0; r < options.repeat; ++r) {
-      const auto start = std::chrono::steady_clock::now();
-      if (!Triangulate(whole, triangulate_options).ok()) return false;
-      whole_ms = std::min(whole_ms, MillisecondsSince(start));
-    }
-  }
-  // The sampled sets one call each, and by CGAL; their packed triangulations checked against their own.
-  const size_t sampled = std::min(num_sets, kSampledSets);
-  bool equal = true;
-  double alone_ms = 0, cgal_ms = 0;
-  for (size_t s = 0; s < sampled; ++s) {
-    const absl::Span<const Point2> set(points.data() + set_begin[s], set_begin[s + 1] - set_begin[s]);
-    double best = std::numeric_limits<double>::infinity();
-    for (int r = 0; r < options.repeat; ++r) {
-      const auto start = std::chrono::steady_clock::now();
-      absl::StatusOr<Triangulation> alone = Triangulate(set, triangulate_options);
-      best = std::min(best, MillisecondsSince(start));
-      if (!alone.ok()) return false;
-      equal &= alone->triangles == packed->sets[s].triangles && alone->edges == packed->sets[s].edges;
-    }
-    alone_ms += best;
+  std::optional<TriangulatedSets> packed;
+  PackedSetsCalls calls;
+  calls.packed = [&](const std::vector<Point2>& points, const std::vector<uint32_t>& set_begin, std::string* error) {
+    absl::StatusOr<TriangulatedSets> built = TriangulateSets(points, set_begin, triangulate_options);
+    if (!built.ok()) *error = built.status().ToString();
+    if (built.ok()) packed = *std::move(built);
+    return packed.has_value();
+  };
+  calls.release = [&] { packed.reset(); };
+  calls.whole = [&](const std::vector<Point2>& points) { return Triangulate(points, triangulate_options).ok(); };
+  calls.alone = [&](absl::Span<const Point2> set, size_t s, bool* equal) {
+    absl::StatusOr<Triangulation> alone = Triangulate(set, triangulate_options);
+    if (!alone.ok()) return false;
+    *equal = alone->triangles == packed->sets[s].triangles && alone->edges == packed->sets[s].edges;
+    return true;
+  };
+  calls.competitor = [](absl::Span<const Point2> set) {
     std::vector<Kernel::Point_2> cgal_points;
     for (const Point2& p : set) cgal_points.emplace_back(p.x, p.y);
-    best = std::numeric_limits<double>::infinity();
-    for (int r = 0; r < options.repeat; ++r) {
-      const auto start = std::chrono::steady_clock::now();
-      const CgalDelaunay dt(cgal_points.begin(), cgal_points.end());
-      best = std::min(best, MillisecondsSince(start));
-    }
-    cgal_ms += best;
-  }
-  const double scale = static_cast<double>(num_sets) / static_cast<double>(sampled);
-  PrintPackedSetsRow({name, num_sets, points_per_set, BackendName(packed->backend), packed_ms, whole_ms,
-                      alone_ms * scale, cgal_ms * scale, equal, packed->built_alone, packed->stage_times});
-  return equal;
+    const CgalDelaunay dt(cgal_points.begin(), cgal_points.end());
+  };
+  calls.competitor_repeat = options.repeat;
+  calls.describe = [&](PackedSetsRow* row) {
+    row->backend = BackendName(packed->backend);
+    row->built_alone = packed->built_alone;
+    row->stages = packed->stage_times;
+  };
+  return RunPackedSetsBench(name, num_sets, points_per_set, options, calls);
 }
 
 void PrintHeader() {
