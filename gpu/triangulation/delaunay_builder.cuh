@@ -123,9 +123,11 @@ GALPHA_HD inline void WriteFirstTriangles(int32_t a, int32_t b, int32_t c, int32
 struct StartSetMesh {
   MeshView mesh;
   const uint32_t* mesh_set;
+  uint32_t* set_triangles;  // SetRoundState::triangles
   GALPHA_HD void operator()(uint32_t j) const {
     const int32_t* center = mesh.set_center + 3 * static_cast<size_t>(mesh_set[j]);
     WriteFirstTriangles(center[0], center[1], center[2], mesh.inf, 4 * static_cast<int32_t>(j), mesh.tri, mesh.nbr);
+    set_triangles[mesh_set[j]] = 4;
   }
 };
 
@@ -178,7 +180,7 @@ class DelaunayBuilder {
         counts_(sys, kNumCounts),
         num_sets_(sets.num_sets),
         set_flags_(sys, num_sets_),
-        set_counts_(sys, 4 * static_cast<size_t>(num_sets_)) {
+        set_counts_(sys, 5 * static_cast<size_t>(num_sets_)) {
     mesh_ = MeshView{vertex_points, sos, tri_.data(), nbr_.data(), static_cast<int32_t>(m), a, b, c, sos_rank, weight};
     mesh_.vertex_set = sets.vertex_set;
     mesh_.set_center = sets.set_center;
@@ -226,7 +228,8 @@ class DelaunayBuilder {
   /// `mesh_set[j]`) as Start does, in slots 4j to 4j + 3.
   void StartSets(const uint32_t* mesh_set, uint32_t num_meshes) {
     thrust::for_each(sys_.policy(), thrust::counting_iterator<uint32_t>(0),
-                     thrust::counting_iterator<uint32_t>(num_meshes), StartSetMesh{mesh_, mesh_set});
+                     thrust::counting_iterator<uint32_t>(num_meshes),
+                     StartSetMesh{mesh_, mesh_set, set_rounds().triangles});
     num_tri_ = 4 * static_cast<int32_t>(num_meshes);
   }
 
@@ -286,17 +289,23 @@ class DelaunayBuilder {
       // points (uniform) never holds them.
       unsigned long long* edge_third_vote =
           second_winners && edge_third_vote_.size() > 0 ? edge_third_vote_.data() : nullptr;
+      // Points on slivers' edge lines are counted where they may wait (SliverEdgeWait): rounds
+      // with second winners, unweighted.
+      uint32_t* sliver_edge_points = second_winners && hidden_ == nullptr ? sliver_edge_counts() : nullptr;
       const thrust::counting_iterator<int32_t> tfirst(0);
-      thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                       ResetVotes{tri_vote_.data(), edge_vote, edge_third_vote, second_count, saw_edge_point});
+      thrust::for_each(
+          pol, tfirst, tfirst + num_tri_,
+          ResetVotes{tri_vote_.data(), edge_vote, edge_third_vote, second_count, saw_edge_point, sliver_edge_points});
       WithWeightedness([&](auto weighted) {
-        sys_.ForEachBelow(pending_count, VoteForInsertion<decltype(weighted)::value>{
-                                             mesh_, pending, location, tri_vote_.data(), edge_vote, saw_edge_point,
-                                             edge_third_vote, sector_pairs, mesh_.vertex_set, sets});
+        sys_.ForEachBelow(pending_count,
+                          VoteForInsertion<decltype(weighted)::value>{
+                              mesh_, pending, location, tri_vote_.data(), edge_vote, saw_edge_point, edge_third_vote,
+                              sector_pairs, mesh_.vertex_set, sets, sliver_edge_points});
       });
       if (second_winners) {
+        const SliverEdgeWait wait{sliver_edge_points, pending_count, num_tri_, mesh_.tri, mesh_.vertex_set, sets};
         thrust::for_each(pol, tfirst, tfirst + num_tri_,
-                         PickSecondWinners{tri_vote_.data(), edge_vote_.data(), edge_third_vote, second_count});
+                         PickSecondWinners{tri_vote_.data(), edge_vote_.data(), edge_third_vote, second_count, wait});
       }
       // Inclusive, so that its last entry is the number of splits.
       thrust::transform_inclusive_scan(pol, tri_vote_.data(), tri_vote_.data() + num_tri_, split_count_or_nb_.data(),
@@ -562,8 +571,19 @@ class DelaunayBuilder {
   SetRoundState set_rounds() {
     if (num_sets_ == 0) return {};
     uint32_t* counts = set_counts_.data();
-    return SetRoundState{set_flags_.data(), counts, counts + num_sets_, counts + 2 * size_t{num_sets_},
-                         counts + 3 * size_t{num_sets_}};
+    return SetRoundState{set_flags_.data(),
+                         counts,
+                         counts + num_sets_,
+                         counts + 2 * size_t{num_sets_},
+                         counts + 3 * size_t{num_sets_},
+                         counts + 4 * size_t{num_sets_}};
+  }
+
+  /// The round's count of points on slivers' edge lines per triangle (SliverEdgeWait), in the
+  /// split counts' buffer: the inclusive scan that fills it runs after PickSecondWinners reads them.
+  uint32_t* sliver_edge_counts() {
+    static_assert(sizeof(uint32_t) == sizeof(int32_t), "the counts share the split counts' buffer");
+    return reinterpret_cast<uint32_t*>(split_count_or_nb_.data());
   }
 
   int32_t* candidates() {
@@ -691,8 +711,8 @@ class DelaunayBuilder {
   // not end soon reaches the grid's launches and the flip loop's cap (kMaxFlipRuns).
   static constexpr uint32_t kFlipTailMaxIterations = 1u << 20;
   Buffer<uint32_t, System> counts_;
-  // Packed: the sets' round state (SetRoundState): flags, then saw_edge, splits, sector splits and
-  // voted.
+  // Packed: the sets' round state (SetRoundState): flags, then saw_edge, splits, sector splits,
+  // voted and triangles.
   uint32_t num_sets_;
   Buffer<uint8_t, System> set_flags_;
   Buffer<uint32_t, System> set_counts_;

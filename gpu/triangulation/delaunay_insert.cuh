@@ -35,9 +35,11 @@ struct SetRoundState {
   uint32_t* saw_edge = nullptr;
   uint32_t* splits = nullptr;
   uint32_t* sector_splits = nullptr;
-  // Per set: a point of the set voted this round (one build's rounds end where none is left, and
-  // it then decides nothing more).
+  // Per set: its points that voted this round, the pending points of a build of the set alone
+  // (its rounds end where none is left, and it then decides nothing more).
   uint32_t* voted = nullptr;
+  // Per set: the triangles of its mesh, a build of the set alone's count (SliverEdgeWait).
+  uint32_t* triangles = nullptr;
 };
 // The round picks second winners (one build's `second_winners`).
 constexpr uint8_t kSetSecondWinners = 1;
@@ -53,6 +55,65 @@ constexpr uint8_t kSetThirds = 4;
 GALPHA_HD inline int32_t ChildSlot(int32_t parent, int k, int32_t split_count, int32_t num_tri) {
   return k == 2 ? parent : num_tri + 2 * (split_count - 1) + k;
 }
+
+/// VoteForInsertion's count of a triangle's points that vote on a sliver's edge line (the low bits),
+/// with this bit set once a point votes on an edge line by thirds (SliverEdgeWait).
+constexpr uint32_t kVotedByThirds = 0x80000000u;
+
+/// Sets kVotedByThirds in a triangle's count, read first (as RaiseFlag) so that the points of one
+/// triangle, thousands of them in a grid's first rounds, do not each take an atomic on one word.
+GALPHA_HD inline void MarkVotedByThirds(uint32_t* count) {
+  cuda::atomic_ref<uint32_t, cuda::thread_scope_device> word(*count);
+  if ((word.load(cuda::memory_order_relaxed) & kVotedByThirds) == 0) {
+    word.fetch_or(kVotedByThirds, cuda::memory_order_relaxed);
+  }
+}
+
+/// Whether a triangle's points on its edges' lines wait for a later round: where its points vote
+/// on the edge line of a sliver (VoteForInsertion: one winner nearest the circumcentre, the
+/// middle of the edge's points) and number fewer than the pending points per triangle of the whole
+/// mesh. Why: on two crossing lines of points each round splits every edge of either line once, so
+/// that where one line is ahead of the other in the first rounds (pairs of points elected from both
+/// sides of one edge, an edge split in thirds), it stays ahead by the same factor in every round:
+/// the lagging line's vertices face fans of the other's points, 25 to 80 of them, and each of its
+/// late points takes such a fan over one flip an iteration, while the points still pending walk
+/// across it. A sliver whose points are few against the average is where its line is ahead; its
+/// points wait until the others' rounds bring the average down to them. Counted on the CPU backend
+/// at 1M (bench/README.md, twenty-seventh session), two_lines: one-block flip iterations 407 -> 121,
+/// relocation walk steps 46.2M -> 33.0M, rounds unchanged (23). Only slivers' points wait: with
+/// every edge line's points counted, grid took 17 rounds instead of 14 and tiny 23 instead of 20.
+///
+/// Every round still inserts a point: were every counted triangle waiting, with c_t of its points
+/// counted and P points pending in T triangles, c_t * T < P for each would sum (over at most T
+/// triangles) to P * T < P * T when every pending point is counted; a point that is not counted
+/// (inside a triangle, outside the hull, by thirds) votes where it is. A packed build counts each
+/// set's pending points and triangles, the counts of a build of the set alone.
+struct SliverEdgeWait {
+  const uint32_t* sliver_edge_points = nullptr;  // per triangle (VoteForInsertion); nullptr: none wait
+  // One build: its pending points (the device's count) and triangles.
+  const uint32_t* pending_count = nullptr;
+  int32_t num_tri = 0;
+  // A packed build: the triangles' vertices and each vertex's set, and the sets' round state.
+  const Tri* tri = nullptr;
+  const uint32_t* vertex_set = nullptr;
+  SetRoundState sets{};
+
+  GALPHA_HD bool Waits(int32_t t) const {
+    if (sliver_edge_points == nullptr) return false;
+    const uint32_t counted = sliver_edge_points[t];
+    if (counted == 0 || (counted & kVotedByThirds) != 0) return false;
+    uint64_t pending, triangles;
+    if (vertex_set != nullptr) {
+      const uint32_t set = vertex_set[tri[t].v[0]];  // finite: counted points lie on an edge's line
+      pending = sets.voted[set];
+      triangles = sets.triangles[set];
+    } else {
+      pending = *pending_count;
+      triangles = static_cast<uint64_t>(num_tri);
+    }
+    return uint64_t{counted} * triangles < pending;
+  }
+};
 
 /// Maps a float to an unsigned key with the same order (negative values included).
 GALPHA_HD inline uint32_t OrderedFloatKey(float f) {
@@ -114,6 +175,9 @@ struct VoteForInsertion {
   // `saw_edge_point`. nullptr: one set.
   const uint32_t* vertex_set = nullptr;
   SetRoundState sets{};
+  // Per triangle, zeroed: its points voting on a sliver's edge line, kVotedByThirds once one votes
+  // by thirds (SliverEdgeWait). nullptr: not counted (rounds without second winners, weighted).
+  uint32_t* sliver_edge_points = nullptr;
 
   /// The slope of a sector's support direction away from its hull edge's normal, toward one end:
   /// tan(turn / 6), approximated by tan(turn / 2) / 3, where `turn` is the hull's turning angle
@@ -160,7 +224,7 @@ struct VoteForInsertion {
       if ((flags & kSetSecondWinners) == 0 || (flags & kSetThirds) == 0) edge_third_vote = nullptr;
       sector_pairs = (flags & kSetSectorPairs) != 0;
       saw_edge_point = sets.saw_edge + set;
-      RaiseFlag(sets.voted + set);
+      AtomicIncrement(sets.voted + set);
     }
     const int32_t t = location[i];
     const Point2 p = mesh.pts[pending[i]];
@@ -243,6 +307,7 @@ struct VoteForInsertion {
           const double longest2 = fmax(fmax(b2, c2), (cx - bx) * (cx - bx) + (cy - by) * (cy - by));
           if (16.0 * edge2 >= longest2) {
             RaiseFlag(saw_edge_point);
+            if (sliver_edge_points != nullptr) MarkVotedByThirds(sliver_edge_points + t);
             VoteByThirds(i, t, ((px - ux) * ex + (py - uy) * ey) / edge2, edge_vote, edge_third_vote);
             return;
           }
@@ -282,24 +347,28 @@ struct VoteForInsertion {
     }
     const unsigned long long key = (static_cast<unsigned long long>(OrderedFloatKey(score)) << 32) | i;
     if (on_edge_line) RaiseFlag(saw_edge_point);
+    if (on_edge_line && edge_vote != nullptr && sliver_edge_points != nullptr) AtomicIncrement(sliver_edge_points + t);
     cuda::atomic_ref<unsigned long long, cuda::thread_scope_device> slot(
         on_edge_line && edge_vote != nullptr ? edge_vote[t] : tri_vote[t]);
     slot.fetch_min(key);
   }
 };
 
-/// Clears a round's votes (`edge_vote` and `edge_third_vote` too unless nullptr) and, in thread 0,
-/// its counts of second winners and of points on an edge's line: one launch for what were three.
+/// Clears a round's votes (`edge_vote`, `edge_third_vote` and `sliver_edge_points` too unless
+/// nullptr) and, in thread 0, its counts of second winners and of points on an edge's line: one
+/// launch for what were three.
 struct ResetVotes {
   unsigned long long* tri_vote;
   unsigned long long* edge_vote;
   unsigned long long* edge_third_vote;
   uint32_t* second_count;
   uint32_t* saw_edge_point;
+  uint32_t* sliver_edge_points = nullptr;
   GALPHA_HD void operator()(int32_t t) const {
     tri_vote[t] = kNoVote;
     if (edge_vote != nullptr) edge_vote[t] = kNoVote;
     if (edge_third_vote != nullptr) edge_third_vote[t] = kNoVote;
+    if (sliver_edge_points != nullptr) sliver_edge_points[t] = 0;
     if (t == 0) {
       *second_count = 0;
       *saw_edge_point = 0;
@@ -312,16 +381,19 @@ struct ResetVotes {
 /// counted into `*num_second`. With votes by thirds (`edge_third_vote` set), a triangle with
 /// points inside takes the better of its two edge votes as its edge class's; one without takes
 /// its first-half edge vote as the inside class's and its second-half one as the edge class's, so
-/// that an edge's points alone still give two winners.
+/// that an edge's points alone still give two winners. A triangle whose edge points wait
+/// (SliverEdgeWait) has no edge class this round.
 struct PickSecondWinners {
   unsigned long long* tri_vote;
   unsigned long long* edge_vote;
   const unsigned long long* edge_third_vote;
   uint32_t* num_second;
+  SliverEdgeWait wait{};
   GALPHA_HD void operator()(int32_t t) const {
-    unsigned long long inside = tri_vote[t], on_edge = edge_vote[t];
+    const bool edge_points_wait = wait.Waits(t);
+    unsigned long long inside = tri_vote[t], on_edge = edge_points_wait ? kNoVote : edge_vote[t];
     if (edge_third_vote != nullptr) {
-      const unsigned long long second_half = edge_third_vote[t];
+      const unsigned long long second_half = edge_points_wait ? kNoVote : edge_third_vote[t];
       if (inside == kNoVote) {
         inside = on_edge != kNoVote ? on_edge : second_half;
         on_edge = on_edge != kNoVote ? second_half : kNoVote;
@@ -451,6 +523,7 @@ struct SplitTriangles {
     if (mesh.vertex_set != nullptr) {
       const uint32_t set = mesh.vertex_set[w];
       AtomicIncrement(sets.splits + set);
+      cuda::atomic_ref<uint32_t, cuda::thread_scope_device>(sets.triangles[set]).fetch_add(2u);
       if (infinite) AtomicIncrement(sets.sector_splits + set);
     }
     const TriNbr nx = mesh.nbr[t];
