@@ -3,7 +3,7 @@
 // Reference: J. R. Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust
 // Geometric Predicates", Discrete & Computational Geometry 18(3):305-363, 1997. The algorithms
 // below are reimplementations of the paper's error-free transformations (Fast-Two-Sum, Two-Sum,
-// Split, Two-Product) and expansion operations (Grow-Expansion, Fast-Expansion-Sum,
+// Two-Product, here with a fused multiply-add instead of Dekker's split) and expansion operations (Grow-Expansion, Fast-Expansion-Sum,
 // Scale-Expansion, with zero elimination).
 //
 // An expansion is an array e[0..n) of doubles whose exact, unrounded sum is the value it stands
@@ -11,19 +11,24 @@
 // significant (last) nonzero component carries the sign of the whole value. Every function here
 // eliminates zero components; the value zero may therefore come back as length 0.
 //
-// Why no fma, and why the Add/Sub/Mul wrappers: the error-free transformations are only exact if
-// every operation is one correctly rounded IEEE-754 binary64 operation (round to nearest, ties to
-// even). A compiler that contracts x*y - z into fma(x, y, -z) breaks them (Dekker's product then
-// computes a wrong tail) and, even where a result stays exact, the host and the device would stop
-// agreeing bit for bit, which the GPU engine relies on (both sides must take the same decisions).
-// The build passes -ffp-contract=off (host) and --fmad=false (nvcc); on the device we also use the
+// Why the Add/Sub/Mul/Fma wrappers: the error-free transformations are only exact if every
+// operation is one correctly rounded IEEE-754 binary64 operation (round to nearest, ties to
+// even). A compiler that contracts x*y - z into fma(x, y, -z) on its own changes Two-Sum's and
+// the filters' roundings, and the host and the device would stop agreeing bit for bit, which the
+// GPU engine relies on (both sides must take the same decisions). The build passes
+// -ffp-contract=off (host) and --fmad=false (nvcc); on the device we also use the
 // __dadd_rn/__dsub_rn/__dmul_rn intrinsics, which the CUDA compiler never fuses, so the device code
 // stays exact even in a translation unit built without --fmad=false. On the host, the code relies
 // on -ffp-contract=off (GCC/Clang in ISO C++ mode do not contract by default either).
+// Two-Product is the one place that fuses, explicitly (Fma: __fma_rn on the device, std::fma on
+// the host, both correctly rounded): its tail a*b - fl(a*b) is exactly representable inside the
+// range below, so the fused operation returns it exactly, on both sides, with the same bits as
+// Dekker's 17-operation split product returned before 2026-11-29; it is 2 operations instead of
+// 17, and the double-double and expansion stages of the predicates are mostly Two-Products.
 //
 // Range: the transformations are error-free as long as nothing overflows and no product
 // underflows. Two-Product(a, b) is exact when exponent(a) + exponent(b) >= -970 (no underflow of
-// its tail) and |a|, |b| < 2^996 (Split multiplies by 2^27 + 1). Sums (Two-Sum, Two-Diff) are
+// its tail) and fl(a * b) is finite. Sums (Two-Sum, Two-Diff) are
 // exact for all finite operands whose sum does not overflow, subnormals included. The predicates
 // (core/exact/predicates.hpp) rescale their inputs by powers of two to stay inside these limits.
 //
@@ -31,14 +36,13 @@
 // callers provide fixed-size output arrays whose capacity bounds are stated per function.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include "core/base/hd.hpp"
 
 namespace galpha::exact {
 
-/// Dekker's splitter 2^27 + 1: splits a 53-bit significand into two halves of at most 26 bits.
-constexpr double kSplitter = 134217729.0;
 /// Half an ulp of 1: the relative rounding error bound of one binary64 operation (Shewchuk's
 /// "epsilon").
 constexpr double kEpsilon = 0x1p-53;
@@ -66,6 +70,15 @@ GALPHA_HD GALPHA_FORCEINLINE double Mul(double a, double b) {
   return __dmul_rn(a, b);
 #else
   return a * b;
+#endif
+}
+
+/// fl(a * b + c), one rounding (never split into a product and a sum).
+GALPHA_HD GALPHA_FORCEINLINE double Fma(double a, double b, double c) {
+#if defined(__CUDA_ARCH__)
+  return __fma_rn(a, b, c);
+#else
+  return std::fma(a, b, c);
 #endif
 }
 
@@ -142,31 +155,13 @@ GALPHA_HD GALPHA_FORCEINLINE void TwoDiff(double a, double b, double& x, double&
   y = Add(around, bround);
 }
 
-/// Dekker's split: hi + lo = a, each half fits in 26 bits (so their products are exact).
-GALPHA_HD GALPHA_FORCEINLINE void Split(double a, double& hi, double& lo) {
-  const double c = Mul(kSplitter, a);
-  const double abig = Sub(c, a);
-  hi = Sub(c, abig);
-  lo = Sub(a, hi);
-}
-
-/// Two-Product with b already split into (bhi, blo). x + y = a * b exactly, x = fl(a * b).
-/// Deliberately built from Split instead of fma: see the header comment.
-GALPHA_HD GALPHA_FORCEINLINE void TwoProductPresplit(double a, double b, double bhi, double blo, double& x, double& y) {
-  x = Mul(a, b);
-  double ahi, alo;
-  Split(a, ahi, alo);
-  const double err1 = Sub(x, Mul(ahi, bhi));
-  const double err2 = Sub(err1, Mul(alo, bhi));
-  const double err3 = Sub(err2, Mul(ahi, blo));
-  y = Sub(Mul(alo, blo), err3);
-}
-
-/// Dekker's Two-Product: x + y = a * b exactly, x = fl(a * b).
+/// Two-Product: x + y = a * b exactly, x = fl(a * b), when exponent(a) + exponent(b) >= -970 and
+/// x is finite. Why the fused tail is exact: a * b is an integer multiple of
+/// q = 2^(exponent(a) + exponent(b) - 104), and so is a * b - x, whose magnitude is at most half an
+/// ulp of x, below 2^53 q; with q >= 2^-1074 it is a double, and Fma returns it unrounded.
 GALPHA_HD GALPHA_FORCEINLINE void TwoProduct(double a, double b, double& x, double& y) {
-  double bhi, blo;
-  Split(b, bhi, blo);
-  TwoProductPresplit(a, b, bhi, blo, x, y);
+  x = Mul(a, b);
+  y = Fma(a, b, -x);
 }
 
 // ---- Expansion arithmetic (Shewchuk 1997, section 2.8) ------------------------------------------
@@ -253,15 +248,13 @@ GALPHA_HD inline int ExpansionDiffZeroElim(int elen, const double* e, int flen, 
 /// result, see ExpansionSumImpl.)
 GALPHA_HD inline int ScaleExpansionZeroElim(int elen, const double* e, double b, double* h) {
   if (elen == 0 || b == 0.0) return 0;
-  double bhi, blo;
-  Split(b, bhi, blo);
   double q, hh;
-  TwoProductPresplit(e[0], b, bhi, blo, q, hh);
+  TwoProduct(e[0], b, q, hh);
   int hindex = 0;
   if (hh != 0.0) h[hindex++] = hh;
   for (int i = 1; i < elen; ++i) {
     double p1, p0, sum;
-    TwoProductPresplit(e[i], b, bhi, blo, p1, p0);
+    TwoProduct(e[i], b, p1, p0);
     TwoSum(q, p0, sum, hh);
     if (hh != 0.0) h[hindex++] = hh;
     TwoSum(p1, sum, q, hh);

@@ -126,14 +126,24 @@ TEST(Expansion, ErrorFreeTransformations) {
       exact::FastTwoSum(a, b, x, y);
       EXPECT_EQ(Exact(x) + Exact(y), Exact(a) + Exact(b));
     }
-    // Two-Product is exact while exponent(a) + exponent(b) >= -970 and |a|, |b| < 2^996.
+    // Two-Product is exact while exponent(a) + exponent(b) >= -970 and fl(a * b) is finite.
     a = RandomDouble(rng, -480, 480);
     b = RandomDouble(rng, -480, 480);
     exact::TwoProduct(a, b, x, y);
+    EXPECT_EQ(x, a * b);
     EXPECT_EQ(Exact(x) + Exact(y), Exact(a) * Exact(b));
-    double hi, lo;
-    exact::Split(a, hi, lo);
-    EXPECT_EQ(Exact(hi) + Exact(lo), Exact(a));
+    // At the edges of that range: a tail as small as it gets (exponent sum -970), and factors
+    // beyond 2^996, where Dekker's split product (used before the fused one) overflowed.
+    const int low = -970 + static_cast<int>(rng() % 100);
+    a = RandomDouble(rng, -500, -400);
+    b = std::ldexp(1.0 + std::ldexp(static_cast<double>(rng() % (uint64_t{1} << 52)), -52),
+                   low - std::ilogb(a));
+    exact::TwoProduct(a, b, x, y);
+    EXPECT_EQ(Exact(x) + Exact(y), Exact(a) * Exact(b));
+    a = RandomDouble(rng, 996, 1010);
+    b = RandomDouble(rng, -100, 0);
+    exact::TwoProduct(a, b, x, y);
+    EXPECT_EQ(Exact(x) + Exact(y), Exact(a) * Exact(b));
   }
 }
 
