@@ -3,8 +3,8 @@
 // Reference: J. R. Shewchuk, "Adaptive Precision Floating-Point Arithmetic and Fast Robust
 // Geometric Predicates", Discrete & Computational Geometry 18(3):305-363, 1997. The algorithms
 // below are reimplementations of the paper's error-free transformations (Fast-Two-Sum, Two-Sum,
-// Two-Product, here with a fused multiply-add instead of Dekker's split) and expansion operations (Grow-Expansion, Fast-Expansion-Sum,
-// Scale-Expansion, with zero elimination).
+// Two-Product, here with a fused multiply-add instead of Dekker's split) and expansion operations
+// (Grow-Expansion, Fast-Expansion-Sum, Scale-Expansion, with zero elimination).
 //
 // An expansion is an array e[0..n) of doubles whose exact, unrounded sum is the value it stands
 // for. The components are nonoverlapping and sorted by increasing magnitude, so the most

@@ -136,8 +136,7 @@ TEST(Expansion, ErrorFreeTransformations) {
     // beyond 2^996, where Dekker's split product (used before the fused one) overflowed.
     const int low = -970 + static_cast<int>(rng() % 100);
     a = RandomDouble(rng, -500, -400);
-    b = std::ldexp(1.0 + std::ldexp(static_cast<double>(rng() % (uint64_t{1} << 52)), -52),
-                   low - std::ilogb(a));
+    b = std::ldexp(1.0 + std::ldexp(static_cast<double>(rng() % (uint64_t{1} << 52)), -52), low - std::ilogb(a));
     exact::TwoProduct(a, b, x, y);
     EXPECT_EQ(Exact(x) + Exact(y), Exact(a) * Exact(b));
     a = RandomDouble(rng, 996, 1010);
