@@ -6,7 +6,7 @@
 // Each operation's bound is in its comment, relative to the magnitudes of its operands (not of its
 // result: additions may cancel). The bounds assume that no operation underflows or overflows;
 // callers establish that (e.g. by scaling their inputs by a power of two onto a grid whose
-// products stay normal). Built on the never-fused operations and Dekker's products of
+// products stay normal). Built on the never-fused operations and the exact (fused) Two-Product of
 // expansion.hpp, so host and device compute the same bits.
 #pragma once
 

@@ -351,7 +351,7 @@ constexpr int kDifferencesLowestExponent = -80;
 ///
 /// The grid: every scaled part is then a multiple of 2^(-80-52) = 2^-132 and below 2^121, so every
 /// quantity of degree k that the difference stages form (sums, products, the tails of Two-Sum and
-/// Two-Product, Dekker's split halves) is an integer multiple of 2^(-132k) >= 2^-528 (a rounding
+/// Two-Product) is an integer multiple of 2^(-132k) >= 2^-528 (a rounding
 /// keeps a value on a grid coarser than its ulp, and tails are differences of values on the grid)
 /// and below 2^500: no operation underflows or overflows, which is all that expansion arithmetic
 /// needs to be exact and all that the bounds of double_double.hpp assume.

@@ -109,7 +109,7 @@ double RandomDouble(Rng& rng, int emin, int emax) {
 }
 
 TEST(Expansion, ErrorFreeTransformations) {
-  // (1 + 2^-30)^2 = 1 + 2^-29 + 2^-60: the tail 2^-60 must come back exactly (no fma shortcut).
+  // (1 + 2^-30)^2 = 1 + 2^-29 + 2^-60: the tail 2^-60 must come back exactly.
   double x, y;
   exact::TwoProduct(1.0 + 0x1p-30, 1.0 + 0x1p-30, x, y);
   EXPECT_EQ(x, 1.0 + 0x1p-29);
